@@ -16,21 +16,38 @@ from .errors import (
     SceneError,
 )
 from .limits import JointLimits
+from .motion import FixedPose, MotionLaw, PendulumMotion
 from .parameters import RobotParameters
 from .robot import Robot
+from .scene import Obstacle, Scene
+from .shapes import Box, Capsule, Cylinder, Shape, Sphere
+from .trajectory import BSplineTrajectory, KinematicBound, kinematic_lower_bound
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AdeptTrajError",
+    "BSplineTrajectory",
+    "Box",
+    "Capsule",
     "ConfigurationError",
+    "Cylinder",
+    "FixedPose",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
     "JointLimits",
+    "KinematicBound",
+    "MotionLaw",
+    "Obstacle",
+    "PendulumMotion",
     "Robot",
     "RobotModelError",
     "RobotParameters",
+    "Scene",
     "SceneError",
+    "Shape",
+    "Sphere",
     "__version__",
+    "kinematic_lower_bound",
 ]

@@ -18,7 +18,7 @@ import numpy as np
 from .errors import RobotModelError
 from .inertia import MassProperties, box_inertia, combine, cylinder_inertia, sphere_inertia
 from .parameters import JointParameters, LinkParameters, RobotParameters, SolidParameters
-from .transforms import rpy_matrix
+from .transforms import rotation_from_rpy
 
 __all__ = ["build_urdf", "link_mass_properties", "solid_inertia"]
 
@@ -51,7 +51,7 @@ def link_mass_properties(link: LinkParameters) -> MassProperties | None:
     if not link.solids:
         return None
     return combine(
-        (s.mass, np.array(s.xyz), rpy_matrix(s.rpy), solid_inertia(s)) for s in link.solids
+        (s.mass, np.array(s.xyz), rotation_from_rpy(s.rpy), solid_inertia(s)) for s in link.solids
     )
 
 

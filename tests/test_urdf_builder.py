@@ -11,7 +11,7 @@ import pytest
 from adept_traj.errors import InvalidInputError, RobotModelError
 from adept_traj.inertia import box_inertia, combine, cylinder_inertia, sphere_inertia
 from adept_traj.parameters import RobotParameters
-from adept_traj.transforms import rpy_matrix
+from adept_traj.transforms import rotation_from_rpy
 from adept_traj.urdf_builder import build_urdf, link_mass_properties
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,7 +52,7 @@ def test_cylinder_inertia_against_numerical_integration() -> None:
 
 
 def test_rotated_box_equals_box_with_permuted_sides() -> None:
-    rot = rpy_matrix((0.0, 0.0, np.pi / 2))
+    rot = rotation_from_rpy((0.0, 0.0, np.pi / 2))
     turned = combine([(1.0, np.zeros(3), rot, box_inertia(1.0, (0.1, 0.5, 0.2)))])
     np.testing.assert_allclose(turned.inertia, box_inertia(1.0, (0.5, 0.1, 0.2)), atol=1e-15)
 
