@@ -48,7 +48,7 @@ from pymoo.core.problem import Problem
 from ._validation import as_batch
 from .collision import CollisionChecker, paper_penalty
 from .errors import ConfigurationError, InputShapeError
-from .robot import Robot
+from .robot import Robot, coulomb_sign
 from .scene import Scene
 from .shapes import Box
 from .trajectory import BSplineTrajectory, kinematic_lower_bound
@@ -306,7 +306,7 @@ class TrajectoryProblem(Problem):
             for s, w in zip(self.s, self.weights):
                 q, qd, qdd = ref.evaluate(s)
                 u = pin.rnea(model, data, q, qd, qdd) + model.damping * qd
-                u = u + model.friction * np.sign(qd)
+                u = u + model.friction * coulomb_sign(qd)
                 z2 += T * w * float(u @ u)
                 u_max = np.maximum(u_max, np.abs(u))
                 jac = pin.computeFrameJacobian(model, data, q, tool_id, pin.LOCAL_WORLD_ALIGNED)

@@ -27,7 +27,11 @@ from .kinematics import BatchKinematics
 from .limits import JointLimits
 from .parameters import TASK_ROWS, RobotParameters
 
-__all__ = ["Robot"]
+__all__ = ["VELOCITY_AT_REST", "Robot", "coulomb_sign"]
+
+#: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
+#: friction (sign 0): a joint held still must not flip ±F_c on rounding noise (1e-17).
+VELOCITY_AT_REST = 1e-9
 
 #: Below this many configurations a plain loop over ``pinocchio.rnea`` is used.
 _PARALLEL_MIN_BATCH = 16
@@ -225,7 +229,9 @@ class Robot:
         (the paper's Euler–Lagrange model "with actuator inertia and friction"): rigid-body
         terms by Pinocchio's RNEA, rotor inertia :math:`J_a` = ``model.armature`` (added by
         RNEA), viscous :math:`F_v` = ``model.damping``, Coulomb :math:`F_c` =
-        ``model.friction``. At :math:`\dot q_i = 0` the Coulomb term is 0 (sign(0) = 0).
+        ``model.friction``. At rest (:math:`|\dot q_i| \le` ``VELOCITY_AT_REST`` = 1e-9) the
+        Coulomb term is 0: static friction is indeterminate, and rounding noise must not
+        switch ±F_c on and off.
 
         Parameters
         ----------
@@ -314,7 +320,7 @@ class Robot:
             tau = pin.rneaInParallel(
                 1, pool, np.asfortranarray(qf.T), np.asfortranarray(vf.T), np.asfortranarray(af.T)
             ).T
-        tau = tau + self.model.damping * vf + self.model.friction * np.sign(vf)
+        tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
         return tau.reshape(shape)
 
     def _tool_jacobian(self, q: np.ndarray) -> np.ndarray:
@@ -329,6 +335,11 @@ class Robot:
         if len(rows) == self.nq:
             return np.abs(np.linalg.det(jt))
         return np.sqrt(np.maximum(np.linalg.det(jt @ np.swapaxes(jt, -1, -2)), 0.0))
+
+
+def coulomb_sign(v: np.ndarray) -> np.ndarray:
+    """sign(v) with a dead band: 0 where ``|v| ≤ VELOCITY_AT_REST`` (a joint at rest)."""
+    return np.where(np.abs(v) > VELOCITY_AT_REST, np.sign(v), 0.0)
 
 
 def _joint_unit(model: pin.Model, i: int) -> str:

@@ -395,3 +395,11 @@ def test_bad_parameter_files(tmp_path: Path) -> None:
             Robot.from_urdf(urdf, path)
     with pytest.raises(RobotModelError, match="file not found"):
         Robot.from_urdf(urdf, tmp_path / "nothing.toml")
+
+
+def test_coulomb_friction_dead_band(robot: Robot) -> None:
+    q = np.tile([0.1, 0.4, 0.05, 0.0], (3, 1))
+    v = np.array([[0.0] * 4, [1e-12] * 4, [1e-6] * 4])
+    tau = robot.inverse_dynamics(q, v, np.zeros((3, 4)))
+    np.testing.assert_allclose(tau[1], tau[0], atol=1e-9)  # rounding noise: still at rest
+    np.testing.assert_allclose(tau[2] - tau[0], robot.model.friction, atol=1e-4)

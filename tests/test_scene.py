@@ -523,8 +523,11 @@ def test_paper_scene() -> None:
     np.testing.assert_array_equal(law.swing_axis, [1.0, 0.0, 0.0])
     assert scene.obstacle("pendulum.bob").shape == Sphere(0.08)
     assert scene.obstacle("pendulum.rod").shape == Cylinder(0.01, 1.0)
-    assert scene.start is None
-    assert scene.goal is None
+    # The reconstruction (docs/paper-scenario.md): theta1, theta2, theta4 as printed.
+    np.testing.assert_array_equal(scene.start[[0, 1, 3]], [0.1682, 1.3849, -0.7555])
+    np.testing.assert_array_equal(scene.goal[[0, 1, 3]], [-0.7610, 0.2450, 1.0095])
+    assert 0.0 <= scene.start[2] <= 0.203
+    assert 0.0 <= scene.goal[2] <= 0.203
 
 
 # ============================================================================ bad files

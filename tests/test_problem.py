@@ -1,0 +1,156 @@
+"""TrajectoryProblem: batched == per-sample reference, the paper scene's obstacles matter."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from adept_traj import Robot, Scene
+from adept_traj.collision import CollisionChecker
+from adept_traj.errors import ConfigurationError, InputShapeError, JointLimitError
+from adept_traj.problem import TrajectoryProblem
+
+
+@pytest.fixture(scope="module")
+def robot() -> Robot:
+    return Robot.adept_one_xl()
+
+
+@pytest.fixture(scope="module")
+def scene() -> Scene:
+    return Scene.paper()
+
+
+@pytest.fixture(scope="module")
+def problem(robot: Robot, scene: Scene) -> TrajectoryProblem:
+    return TrajectoryProblem(robot, scene, scene.start, scene.goal)
+
+
+def smoothstep(z: np.ndarray) -> np.ndarray:
+    return 10 * z**3 - 15 * z**4 + 6 * z**5
+
+
+def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
+    """A hand-made move: θ1, θ2, θ4 on a smooth ramp; d3 held at its start value (tool high
+    over cube 1) until ``late`` of the control polygon, then lowered to the goal."""
+    traj = problem.trajectory
+    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
+    start, goal = problem.start, problem.goal
+    free = start + (goal - start) * smoothstep(xi)[:, None]
+    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
+    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
+    return traj.encode(T, free)
+
+
+def dense_check(problem: TrajectoryProblem, x: np.ndarray, rate: float = 1000.0) -> dict:
+    """Independent verification at ``rate`` Hz: every pair by coal, torques by RNEA."""
+    T = float(x[0])
+    n = int(np.ceil(T * rate)) + 1
+    s = np.linspace(0.0, 1.0, n)
+    smp = problem.trajectory.sample(x, s)
+    checker = CollisionChecker(problem.robot, problem.scene)
+    pairs = checker.distances(smp.q[None], smp.t[None], exact=True)
+    tau = problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)
+    lim = problem.robot.limits
+    return {
+        "per_obstacle": pairs.per_obstacle[0],
+        "torque_ratio": np.abs(tau).max(0) / lim.effort,
+        "q_in_limits": bool(np.all((smp.q >= lim.lower - 1e-12) & (smp.q <= lim.upper + 1e-12))),
+        "qd_ratio": np.abs(smp.qd).max(0) / lim.velocity,
+        "qdd_ratio": np.abs(smp.qdd).max(0) / lim.acceleration,
+        "qddd_ratio": np.abs(smp.qddd).max(0) / lim.jerk,
+    }
+
+
+def test_problem_shape(problem: TrajectoryProblem) -> None:
+    assert (problem.n_var, problem.n_obj, problem.n_ieq_constr) == (65, 6, 21)
+    assert problem.xl[0] == pytest.approx(problem.lower_bound.T_min)
+    np.testing.assert_allclose(problem.xl[33:49], 0.0)  # d3 control points: inside the stroke
+    np.testing.assert_allclose(problem.xu[33:49], 0.203)
+    assert problem.constraint_names[0] == "q[joint1]"
+    assert problem.constraint_names[-1] == "distance"
+    assert len(problem.constraint_names) == 21
+
+
+def test_batched_equals_reference(problem: TrajectoryProblem) -> None:
+    rng = np.random.default_rng(12)
+    x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(3, problem.n_var))
+    x = np.vstack([x, problem.trajectory.straight_line(1.3), lift_then_lower(problem)])
+    batched = problem.evaluate_batch(x)
+    reference = problem.evaluate_reference(x)
+    np.testing.assert_allclose(batched.objectives, reference.objectives, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(batched.constraints, reference.constraints, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(batched.min_distance, reference.min_distance, rtol=0, atol=1e-9)
+    again = problem.evaluate_batch(x)
+    np.testing.assert_array_equal(again.objectives, batched.objectives)  # deterministic
+
+
+@pytest.mark.parametrize("variant", ["paper-sphere", "paper-ellipsoid"])
+def test_paper_penalty_variant_equals_reference(robot: Robot, scene: Scene, variant: str) -> None:
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, z3=variant)
+    x = np.vstack([problem.trajectory.straight_line(1.4), lift_then_lower(problem)])
+    batched = problem.evaluate_batch(x)
+    reference = problem.evaluate_reference(x)
+    np.testing.assert_allclose(batched.objectives, reference.objectives, rtol=1e-9, atol=1e-12)
+    assert batched.objectives[0, 2] > 0  # the straight move enters cube 1's sphere
+
+
+def test_straight_joint_space_move_collides(problem: TrajectoryProblem) -> None:
+    for T in (1.1, 1.5, 2.0):
+        x = problem.trajectory.straight_line(T)
+        ev = problem.evaluate_batch(x)
+        assert not ev.feasible
+        assert ev.constraints[-1] > 0
+        dense = dense_check(problem, x)
+        assert dense["per_obstacle"][0] < 0.0  # penetrates cube 1
+        assert ev.min_distance[0] == pytest.approx(dense["per_obstacle"][0], abs=2e-3)
+
+
+def test_a_collision_free_move_exists(problem: TrajectoryProblem) -> None:
+    x = lift_then_lower(problem)
+    ev = problem.evaluate_batch(x)
+    assert ev.feasible, dict(zip(problem.constraint_names, ev.constraints))
+    dense = dense_check(problem, x)
+    margin = problem.settings.margin
+    assert np.all(dense["per_obstacle"] >= margin), dense["per_obstacle"]
+    assert dense["q_in_limits"]
+    for key in ("torque_ratio", "qd_ratio", "qdd_ratio", "qddd_ratio"):
+        assert np.all(dense[key] <= 1.0), (key, dense[key])
+    # The pendulum matters: the same path 0.1 s slower hits the rod.
+    slower = problem.evaluate_batch(lift_then_lower(problem, T=2.0))
+    assert slower.min_distance[2] < margin
+
+
+def test_pymoo_interface_negates_z4(problem: TrajectoryProblem) -> None:
+    x = np.vstack([problem.trajectory.straight_line(1.3), lift_then_lower(problem)])
+    out = problem.evaluate(x, return_as_dictionary=True)
+    ev = problem.evaluate_batch(x)
+    np.testing.assert_allclose(out["F"][:, 3], -ev.objectives[:, 3])
+    np.testing.assert_allclose(out["F"][:, [0, 1, 2, 4, 5]], ev.objectives[:, [0, 1, 2, 4, 5]])
+    np.testing.assert_allclose(out["G"], ev.constraints)
+
+
+def test_single_vector_and_objective_values(problem: TrajectoryProblem) -> None:
+    x = lift_then_lower(problem)
+    ev = problem.evaluate_batch(x)
+    assert ev.objectives.shape == (6,)
+    assert ev.objectives[0] == pytest.approx(2.1)
+    integ = problem.trajectory.integrals(x)
+    assert ev.objectives[4] == pytest.approx(float(integ.z5))
+    assert ev.objectives[5] == pytest.approx(float(integ.z6))
+    assert 0 < ev.objectives[3] <= 0.425 * 0.375  # z4 ≤ a1·a2
+    assert ev.objectives[2] >= 0.0
+
+
+def test_bad_input(robot: Robot, scene: Scene) -> None:
+    with pytest.raises(JointLimitError, match=r"start: joint 'joint3' = 0\.3 m"):
+        TrajectoryProblem(robot, scene, [0.1, 1.0, 0.3, 0.0], scene.goal)
+    with pytest.raises(ConfigurationError, match="z3 must be"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, z3="spheres")
+    with pytest.raises(ConfigurationError, match="margin ≤ influence"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, margin=0.1, influence=0.05)
+    with pytest.raises(ConfigurationError, match="unknown problem setting"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, knots=12)
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
+    with pytest.raises(InputShapeError, match=r"x must have shape \(\.\.\., 65\)"):
+        problem.evaluate_batch(np.zeros(64))
