@@ -133,6 +133,47 @@ def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.
     return centres, np.full(k, 0.5 * np.linalg.norm(piece))
 
 
+#: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
+#: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
+_ROUNDING = 1e-9
+
+
+def _half_extent(kind: str, dims: np.ndarray, n_local: np.ndarray) -> np.ndarray:
+    """Half-length (...) of the projection of a centred shape on unit directions ``n_local``
+    (..., 3) given in the shape's frame. ``kind``/``dims``: box (hx, hy, hz), cylinder
+    (r, h), sphere (r,), capsule (r, h), with h the half length along local z."""
+    if kind == "box":
+        return np.abs(n_local) @ dims
+    if kind == "sphere":
+        return np.full(n_local.shape[:-1], dims[0])
+    axial = np.abs(n_local[..., 2])
+    if kind == "capsule":
+        return dims[1] * axial + dims[0]
+    return dims[1] * axial + dims[0] * np.sqrt(np.maximum(0.0, 1.0 - axial**2))
+
+
+def _coal_kind(geometry: coal.CollisionGeometry) -> tuple[str, np.ndarray] | None:
+    """(kind, dims) of a coal primitive for :func:`_half_extent`, or None (no bound)."""
+    if isinstance(geometry, coal.Box):
+        return "box", np.array(geometry.halfSide)
+    if isinstance(geometry, coal.Cylinder):
+        return "cylinder", np.array([geometry.radius, geometry.halfLength])
+    if isinstance(geometry, coal.Capsule):
+        return "capsule", np.array([geometry.radius, geometry.halfLength])
+    if isinstance(geometry, coal.Sphere):
+        return "sphere", np.array([geometry.radius])
+    return None
+
+
+def _enclosing_ball(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, float]:
+    """Centre (3,) in the geometry frame and radius of a ball containing the geometry (the
+    ball around its local bounding box)."""
+    geometry.computeLocalAABB()
+    lo = np.array(geometry.aabb_local.min_)
+    hi = np.array(geometry.aabb_local.max_)
+    return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
+
+
 class CollisionChecker:
     """Distances between a robot's collision solids and a scene's obstacles (see module doc).
 
@@ -154,17 +195,16 @@ class CollisionChecker:
         objects = robot.collision_model.geometryObjects
         self.solid_names = tuple(g.name for g in objects)
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
-        centres, radii, owner = [], [], []
-        for k, g in enumerate(objects):
-            c, r = _covering_spheres(g.geometry)
-            centres.append(c)
-            radii.append(r)
-            owner += [k] * len(r)
-        self._sphere_centres = np.vstack(centres)  # (n_spheres, 3) in the solids' frames
-        self._sphere_radii = np.concatenate(radii)
-        self._sphere_owner = np.array(owner)
+        covers = [_covering_spheres(g.geometry) for g in objects]
+        self._sphere_local = [c for c, _ in covers]  # per solid: (k, 3) in the solid's frame
+        self._sphere_radii = [r for _, r in covers]  # per solid: (k,)
+        balls = [_enclosing_ball(g.geometry) for g in objects]
+        self._ball_centre = np.array([c for c, _ in balls])  # (n_solids, 3)
+        self._ball_radius = np.array([r for _, r in balls])  # (n_solids,)
+        self._solid_kind = [_coal_kind(g.geometry) for g in objects]
         self._robot_geoms = [g.geometry for g in objects]
         self._obstacle_geoms = [ob.shape.to_coal() for ob in scene.obstacles]
+        self._obstacle_kind = [_coal_kind(geom) for geom in self._obstacle_geoms]
         self._functors = [
             [coal.ComputeDistance(g, o) for o in self._obstacle_geoms] for g in self._robot_geoms
         ]
@@ -206,46 +246,102 @@ class CollisionChecker:
             ) from None
         return qa, ta
 
-    def min_distances(self, q: Any, t: Any) -> MinDistances:
+    def min_distances(self, q: Any, t: Any, solid_poses: np.ndarray | None = None) -> MinDistances:
         """Per motion and obstacle, the smallest solid–obstacle distance over all samples.
 
         ``q`` (..., n_t, nq) [rad | m] and ``t`` (..., n_t) [s]: the leading axes ``...``
         are motions (e.g. the population). Branch and bound: candidates (sample, solid)
         are computed by coal in increasing order of their broad-phase lower bound until the
         best exact distance is below the next bound, so the result is the exact minimum
-        (when ≤ ``influence``) with few coal calls. A positive broad-phase bound is a true
-        lower bound; candidates with a bound ≤ 0 (possible penetration) are always computed,
-        so penetration depths are exact too.
+        (when ≤ ``influence``, penetration depths included) with few coal calls.
+        ``solid_poses`` (..., n_t, n_solids, 4, 4) may pass the robot's
+        :meth:`~adept_traj.robot.Robot.geometry_poses` if already computed.
         """
         qa, ta = self._check(q, t)
-        return self._min_distances(qa, ta)
+        if solid_poses is None:
+            solid_poses = self.robot.geometry_poses(qa)
+        return self._min_distances(qa, ta, solid_poses)
 
     # ------------------------------------------------------------------ private hooks
-    def _obstacle_poses(self, t: np.ndarray) -> np.ndarray:
-        """(n_obs, ..., 4, 4) obstacle poses in the robot base frame."""
-        if self.n_obstacles == 0:
-            return np.empty((0, *t.shape, 4, 4))
-        return self.scene.obstacle_poses(t, in_base_frame=True)
+    def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
+        """Obstacle poses in the robot base frame at the flattened times ``t``: per obstacle
+        one (4, 4) pose if it is fixed, else (N, 4, 4) with N = ``t.size``."""
+        to_base = self.scene.base_from_world
+        flat_t = t.reshape(-1)
+        return [
+            to_base @ ob.pose(0.0) if not ob.is_moving else to_base @ ob.pose(flat_t)
+            for ob in self.scene.obstacles
+        ]
 
-    def _lower_bounds(self, solid_poses: np.ndarray, obstacle_poses: np.ndarray) -> np.ndarray:
-        """(..., n_solids, n_obs) broad-phase lower bounds [m]."""
-        rot = solid_poses[..., self._sphere_owner, :3, :3]
-        centres = np.einsum("...ij,...j->...i", rot, self._sphere_centres)
-        centres += solid_poses[..., :3, 3][..., self._sphere_owner, :]  # (..., n_spheres, 3)
-        batch = solid_poses.shape[:-3]
-        lower = np.empty((*batch, self.n_solids, self.n_obstacles))
+    def _lower_bounds(self, solid_poses: np.ndarray, obstacle_poses: list[np.ndarray]):
+        """(N, n_solids, n_obs) broad-phase lower bounds [m], valid in every case, for the
+        flattened solid poses (N, n_solids, 4, 4).
+
+        Level 1: the ball enclosing each solid gives :math:`d(c, B) - R`, a lower bound of
+        the signed distance even under penetration. Level 2, only where level 1 is within
+        ``influence``: the covering spheres give a tighter bound, used when positive (a
+        positive bound proves separation by at least that much).
+        """
+        balls = (solid_poses[..., :3, :3] @ self._ball_centre[..., None])[..., 0]
+        balls += solid_poses[..., :3, 3]  # (N, n_solids, 3)
+        lower = np.empty((solid_poses.shape[0], self.n_solids, self.n_obstacles))
         for o, ob in enumerate(self.scene.obstacles):
-            pose = obstacle_poses[o][..., None, :, :]  # (..., 1, 4, 4)
-            local = np.einsum("...ji,...j->...i", pose[..., :3, :3], centres - pose[..., :3, 3])
-            bound = point_signed_distance(ob.shape, local) - self._sphere_radii
-            per_solid = np.full((*batch, self.n_solids), np.inf)
-            np.minimum.at(
-                per_solid.reshape(-1, self.n_solids),
-                (slice(None), self._sphere_owner),
-                bound.reshape(-1, bound.shape[-1]),
-            )
-            lower[..., o] = per_solid
+            pose = obstacle_poses[o]  # (4, 4) or (N, 4, 4)
+            # Row-vector form of R^T (c - t): (c - t) R; one product for a fixed obstacle.
+            local = (balls - pose[..., None, :3, 3]) @ pose[..., :3, :3]
+            lower[..., o] = point_signed_distance(ob.shape, local) - self._ball_radius
+        close = lower <= self.influence
+        for k, centres in enumerate(self._sphere_local):
+            if len(centres) == 1:
+                continue  # the covering sphere is the enclosing ball
+            for o, ob in enumerate(self.scene.obstacles):
+                idx = np.flatnonzero(close[:, k, o])
+                if idx.size == 0:
+                    continue
+                ps = solid_poses[idx, k]
+                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
+                world = np.swapaxes(ps[:, :3, :3] @ centres.T, -1, -2) + ps[:, None, :3, 3]
+                local = (world - po[..., None, :3, 3]) @ po[..., :3, :3]
+                cover = (point_signed_distance(ob.shape, local) - self._sphere_radii[k]).min(-1)
+                lower[idx, k, o] = np.where(cover > 0.0, np.maximum(cover, lower[idx, k, o]),
+                                            lower[idx, k, o])  # fmt: skip
+        self._separating_axis_bounds(lower, solid_poses, obstacle_poses)
         return lower
+
+    def _separating_axis_bounds(
+        self, lower: np.ndarray, solid_poses: np.ndarray, obstacle_poses: list[np.ndarray]
+    ) -> None:
+        """Level 3, in place, where ``lower`` is still within ``influence``: the gap between
+        the projections of solid and obstacle on the obstacle's axes and on the line joining
+        their centres. A positive gap along any unit axis is a lower bound of the distance;
+        for a SCARA solid hovering over a box it is the exact distance."""
+        close = lower <= self.influence
+        for k, kind_s in enumerate(self._solid_kind):
+            for o, kind_o in enumerate(self._obstacle_kind):
+                idx = np.flatnonzero(close[:, k, o])
+                if idx.size == 0 or kind_s is None or kind_o is None:
+                    continue
+                ps = solid_poses[idx, k]
+                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
+                rot_o = np.broadcast_to(po[..., :3, :3], (idx.size, 3, 3))
+                delta = ps[:, :3, 3] - po[..., :3, 3]
+                norm = np.linalg.norm(delta, axis=-1, keepdims=True)
+                towards = np.divide(delta, norm, out=np.zeros_like(delta), where=norm > 0)
+                axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
+                n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (…, 4, 3)
+                n_o = axes @ rot_o  # axes in the obstacle frame
+                gap = (
+                    np.abs(np.einsum("nai,ni->na", axes, delta))
+                    - _ROUNDING
+                    - _half_extent(*kind_s, n_s)
+                    - _half_extent(*kind_o, n_o)
+                ).max(axis=-1)
+                lower[idx, k, o] = np.where(gap > 0.0, np.maximum(gap, lower[idx, k, o]),
+                                            lower[idx, k, o])  # fmt: skip
+
+    @staticmethod
+    def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:
+        return poses if poses.ndim == 2 else poses[n]
 
     def _narrow(self, solid_pose: np.ndarray, obstacle_pose: np.ndarray, s: int, o: int) -> float:
         """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses."""
@@ -257,15 +353,13 @@ class CollisionChecker:
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
-    def _min_distances(self, q: np.ndarray, t: np.ndarray) -> MinDistances:
+    def _min_distances(self, q: np.ndarray, t: np.ndarray, solid_poses: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
-        solid_poses = self.robot.geometry_poses(q)  # (..., n_t, n_solids, 4, 4)
-        obstacle_poses = self._obstacle_poses(t)  # (n_obs, ..., n_t, 4, 4)
-        lower = self._lower_bounds(solid_poses, obstacle_poses)
         n_motions = int(np.prod(batch))
-        lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
         flat_s = solid_poses.reshape(n_motions * n_t, self.n_solids, 4, 4)
-        flat_o = obstacle_poses.reshape(self.n_obstacles, n_motions * n_t, 4, 4)
+        obstacle_poses = self._obstacle_poses(t)
+        lower = self._lower_bounds(flat_s, obstacle_poses)
+        lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
         where = np.full(best.shape, -1)
         calls = 0
@@ -274,16 +368,19 @@ class CollisionChecker:
             order = np.argsort(bounds, kind="stable")
             value = np.inf
             for c in order[bounds[order] <= self.influence]:
-                # A positive bound is a true lower bound (the solids are apart by at least
-                # that much); a bound ≤ 0 says nothing about the penetration depth.
-                if bounds[c] > 0.0 and bounds[c] >= value:
+                if bounds[c] >= value:  # every bound is a valid lower bound: prune the rest
                     break
                 k, s = divmod(int(c), self.n_solids)
-                d = self._narrow(flat_s[m * n_t + k, s], flat_o[o, m * n_t + k], s, o)
+                n = m * n_t + k
+                d = self._narrow(flat_s[n, s], self._pose_at(obstacle_poses[o], n), s, o)
                 calls += 1
                 if d < value:
                     value, where[m, o] = d, c
-            best[m, o] = value if np.isfinite(value) else best[m, o]
+            if value > self.influence:
+                # Not exact: candidates with a bound in (influence, value) were not computed;
+                # the smallest of value and those bounds is a lower bound above influence.
+                value = min(value, bounds.min(initial=np.inf, where=bounds > self.influence))
+            best[m, o] = value
         sample = np.where(where >= 0, where // self.n_solids, -1)
         solid = np.where(where >= 0, where % self.n_solids, -1)
         shape = (*batch, self.n_obstacles)
@@ -296,15 +393,15 @@ class CollisionChecker:
 
     def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
         solid_poses = self.robot.geometry_poses(q)  # (..., n_t, n_solids, 4, 4)
-        obstacle_poses = self._obstacle_poses(t)  # (n_obs, ..., n_t, 4, 4)
-        distance = self._lower_bounds(solid_poses, obstacle_poses)
-        todo = np.ones(distance.shape, bool) if exact else distance <= self.influence
-        flat_d = distance.reshape(-1, self.n_solids, self.n_obstacles)
+        obstacle_poses = self._obstacle_poses(t)
         flat_s = solid_poses.reshape(-1, self.n_solids, 4, 4)
-        flat_o = obstacle_poses.reshape(self.n_obstacles, -1, 4, 4)
-        samples, solids, obstacles = np.nonzero(todo.reshape(flat_d.shape))
+        flat_d = self._lower_bounds(flat_s, obstacle_poses)
+        todo = np.ones(flat_d.shape, bool) if exact else flat_d <= self.influence
+        samples, solids, obstacles = np.nonzero(todo)
         for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
-            flat_d[n, s, o] = self._narrow(flat_s[n, s], flat_o[o, n], s, o)
+            flat_d[n, s, o] = self._narrow(flat_s[n, s], self._pose_at(obstacle_poses[o], n), s, o)
+        shape = (*solid_poses.shape[:-2], self.n_obstacles)
+        distance, todo = flat_d.reshape(shape), todo.reshape(shape)
         return PairDistances(distance=distance, exact=todo, n_narrow=len(samples))
 
 
@@ -351,6 +448,13 @@ def paper_penalty(
             f"points (..., n_t, 3) and centres (n_obs, ..., n_t, 3) expected; got {p.shape}, "
             f"{c.shape} with {ax.shape[0]} obstacles"
         )
+    try:
+        np.broadcast_shapes(p.shape, c.shape[1:])
+    except ValueError:
+        raise InputShapeError(
+            f"centres (n_obs, ..., n_t, 3) must broadcast with points (..., n_t, 3); got "
+            f"{c.shape} and {p.shape}"
+        ) from None
     scaled = (p[None] - c) / ax.reshape(ax.shape[0], *([1] * (c.ndim - 2)), 3)
     r_e = np.min(np.sum(scaled**2, axis=-1), axis=-1)  # (n_obs, ...)
     inside = r_e <= 1.0

@@ -227,11 +227,12 @@ class TrajectoryProblem(Problem):
         smp = traj.sample(x, self.s, orders=(0, 1, 2))
         u = robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)  # (pop, n_s, nq)
         z2 = T * np.einsum("k,pki->p", self.weights, u**2)
-        z4 = robot.manipulability(smp.q).min(axis=-1)
+        fk = robot.forward_kinematics(smp.q)
+        z4 = fk.manipulability.min(axis=-1)
         integ = traj.integrals(x)
         bounds = traj.bounds(x)
-        mind = self.checker.min_distances(smp.q, smp.t)
-        z3 = self._z3(mind.distance, smp)
+        mind = self.checker.min_distances(smp.q, smp.t, solid_poses=fk.geometry_poses)
+        z3 = self._z3(mind.distance, smp, fk.tool_pose)
         f = np.stack([T, z2, z3, z4, integ.z5, integ.z6], axis=-1)
         g = self._constraints(
             bounds.q_min,
@@ -246,11 +247,11 @@ class TrajectoryProblem(Problem):
             n_narrow=mind.n_narrow,
         )
 
-    def _z3(self, min_dist: np.ndarray, smp: Any) -> np.ndarray:
+    def _z3(self, min_dist: np.ndarray, smp: Any, tool_pose: np.ndarray) -> np.ndarray:
         st = self.settings
         if st.z3 == "clearance":
             return np.sum(np.maximum(0.0, 1.0 - min_dist / st.influence) ** 2, axis=-1)
-        tool = self.robot.tool_pose(smp.q)[..., :3, 3]
+        tool = tool_pose[..., :3, 3]
         centres = self.scene.obstacle_poses(smp.t, in_base_frame=True)[..., :3, 3]
         return paper_penalty(tool, centres, self._semi_axes())
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from .kinematics import BatchKinematics
 from .limits import JointLimits
 from .parameters import TASK_ROWS, RobotParameters
 
-__all__ = ["VELOCITY_AT_REST", "Robot", "coulomb_sign"]
+__all__ = ["VELOCITY_AT_REST", "ForwardKinematics", "Robot", "coulomb_sign"]
 
 #: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
 #: friction (sign 0): a joint held still must not flip ±F_c on rounding noise (1e-17).
@@ -46,6 +47,25 @@ def _shipped(name: str) -> Path:
         if candidate.is_file():
             return candidate
     raise RobotModelError(f"shipped robot file '{name}' not found under {here} or {here.parent}")
+
+
+@dataclass(frozen=True)
+class ForwardKinematics:
+    """Everything the planner needs from one forward-kinematics pass over ``q`` (..., nq).
+
+    Attributes
+    ----------
+    joint_poses: (..., njoints, 4, 4) joint frames in the base frame (index 0 = universe).
+    geometry_poses: (..., n_geom, 4, 4) collision solids in the base frame.
+    tool_pose: (..., 4, 4) tool frame in the base frame.
+    manipulability: (...) as :meth:`Robot.manipulability` [m² for the SCARA], or ``None``
+        when the robot has no task rows.
+    """
+
+    joint_poses: np.ndarray
+    geometry_poses: np.ndarray
+    tool_pose: np.ndarray
+    manipulability: np.ndarray | None
 
 
 class Robot:
@@ -300,12 +320,30 @@ class Robot:
         :attr:`collision_model`) for ``q`` (..., nq)."""
         gm = self.collision_model if model is None else model
         qa = as_batch(q, "q", self.nq, "[rad | m]")
+        return self._geometry_poses(self.kinematics.joint_poses(qa), gm)
+
+    def forward_kinematics(self, q: object) -> ForwardKinematics:
+        """Joint, solid and tool poses and the manipulability of ``q`` (..., nq) from one
+        kinematics pass (what :meth:`geometry_poses`, :meth:`tool_pose` and
+        :meth:`manipulability` would each recompute)."""
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
         poses = self.kinematics.joint_poses(qa)
-        parents = [g.parentJoint for g in gm.geometryObjects]
-        local = np.array([g.placement.homogeneous for g in gm.geometryObjects])
-        return poses[..., parents, :, :] @ local
+        f = self.model.frames[self._tool_id]
+        tool = poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
+        w = None if self.task_rows is None else self._manipulability_from(poses, tool)
+        return ForwardKinematics(
+            joint_poses=poses,
+            geometry_poses=self._geometry_poses(poses, self.collision_model),
+            tool_pose=tool,
+            manipulability=w,
+        )
 
     # ------------------------------------------------------------------ private hooks
+    def _geometry_poses(self, joint_poses: np.ndarray, gm: pin.GeometryModel) -> np.ndarray:
+        parents = [g.parentJoint for g in gm.geometryObjects]
+        local = np.array([g.placement.homogeneous for g in gm.geometryObjects])
+        return joint_poses[..., parents, :, :] @ local
+
     def _inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         shape = q.shape
         qf, vf, af = (x.reshape(-1, self.nq) for x in (q, v, a))
@@ -330,8 +368,17 @@ class Robot:
         return self.kinematics.jacobian(poses, f.parentJoint, tool[..., :3, 3])
 
     def _manipulability(self, q: np.ndarray) -> np.ndarray:
+        poses = self.kinematics.joint_poses(q)
+        f = self.model.frames[self._tool_id]
+        return self._manipulability_from(
+            poses, poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
+        )
+
+    def _manipulability_from(self, joint_poses: np.ndarray, tool: np.ndarray) -> np.ndarray:
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
-        jt = self._tool_jacobian(q)[..., rows, :]
+        f = self.model.frames[self._tool_id]
+        jac = self.kinematics.jacobian(joint_poses, f.parentJoint, tool[..., :3, 3])
+        jt = jac[..., rows, :]
         if len(rows) == self.nq:
             return np.abs(np.linalg.det(jt))
         return np.sqrt(np.maximum(np.linalg.det(jt @ np.swapaxes(jt, -1, -2)), 0.0))
