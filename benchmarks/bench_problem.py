@@ -1,0 +1,93 @@
+"""Evaluations per second of the full trajectory problem (paper scene), batched vs reference.
+
+Run: ``python benchmarks/bench_problem.py [--pop 500] [--reference 10]``.
+
+Three populations of the 65-variable problem at the default sampling (6 Gauss–Legendre
+nodes on each of the 19 spline segments plus both ends: 116 samples per trajectory):
+
+- ``random``: uniform in the decision bounds (a typical initial population; wild motions,
+  many collisions);
+- ``near straight``: small perturbations of the straight joint-space move (it hits cube 1);
+- ``near feasible``: small perturbations of a collision-free move (a late-run population,
+  close to the obstacles: the hardest case for the distance computation).
+
+Prints evaluations per second of :meth:`TrajectoryProblem.evaluate_batch` and of the plain
+per-sample :meth:`TrajectoryProblem.evaluate_reference` (on a few individuals), their ratio
+measured in the same run, the coal calls per evaluation and the peak memory of one batched
+evaluation of the population (tracemalloc: numpy allocations).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+from adept_traj import Robot, Scene
+from adept_traj.problem import TrajectoryProblem
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from test_problem import lift_then_lower  # the tests' collision-free move
+
+
+def best_time(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--pop", type=int, default=500, help="population size")
+    parser.add_argument("--reference", type=int, default=10, help="individuals for reference")
+    parser.add_argument("--repeat", type=int, default=3, help="repetitions (best is kept)")
+    args = parser.parse_args()
+
+    robot, scene = Robot.adept_one_xl(), Scene.paper()
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
+    rng = np.random.default_rng(0)
+    span = problem.xu - problem.xl
+
+    def around(x0: np.ndarray, scale: float) -> np.ndarray:
+        pop = x0 + rng.normal(scale=scale, size=(args.pop, problem.n_var)) * span
+        return np.clip(pop, problem.xl, problem.xu)
+
+    populations = {
+        "random": problem.xl + span * rng.uniform(size=(args.pop, problem.n_var)),
+        "near straight": around(problem.trajectory.straight_line(1.6), 0.01),
+        "near feasible": around(lift_then_lower(problem), 0.01),
+    }
+    print(
+        f"{robot.name}, paper scene, {len(problem.s)} samples per trajectory, population {args.pop}"
+    )
+    print(
+        f"{'population':<15}{'batched ev/s':>13}{'reference ev/s':>16}{'ratio':>8}"
+        f"{'coal calls/ev':>15}{'feasible':>10}"
+    )
+    for name, pop in populations.items():
+        problem.evaluate_batch(pop[:5])  # warm-up
+        ev = problem.evaluate_batch(pop)
+        batched = args.pop / best_time(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
+        few = pop[: args.reference]
+        reference = len(few) / best_time(lambda few=few: problem.evaluate_reference(few), 1)
+        print(
+            f"{name:<15}{batched:>13.0f}{reference:>16.1f}{batched / reference:>7.0f}×"
+            f"{ev.n_narrow / args.pop:>15.1f}{int(ev.feasible.sum()):>10}"
+        )
+    pop = populations["near feasible"]
+    tracemalloc.start()
+    problem.evaluate_batch(pop)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    print(f"peak memory of one batched evaluation of {args.pop}: {peak / 2**20:.0f} MiB")
+
+
+if __name__ == "__main__":
+    main()
