@@ -6,6 +6,7 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
+from .collision import CollisionChecker, paper_penalty
 from .errors import (
     AdeptTrajError,
     ConfigurationError,
@@ -18,7 +19,8 @@ from .errors import (
 from .limits import JointLimits
 from .motion import FixedPose, MotionLaw, PendulumMotion
 from .parameters import RobotParameters
-from .robot import Robot
+from .problem import Evaluation, ProblemSettings, TrajectoryProblem
+from .robot import ForwardKinematics, Robot
 from .scene import Obstacle, Scene
 from .shapes import Box, Capsule, Cylinder, Shape, Sphere
 from .trajectory import BSplineTrajectory, KinematicBound, kinematic_lower_bound
@@ -30,9 +32,12 @@ __all__ = [
     "BSplineTrajectory",
     "Box",
     "Capsule",
+    "CollisionChecker",
     "ConfigurationError",
     "Cylinder",
+    "Evaluation",
     "FixedPose",
+    "ForwardKinematics",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
@@ -41,6 +46,7 @@ __all__ = [
     "MotionLaw",
     "Obstacle",
     "PendulumMotion",
+    "ProblemSettings",
     "Robot",
     "RobotModelError",
     "RobotParameters",
@@ -48,6 +54,8 @@ __all__ = [
     "SceneError",
     "Shape",
     "Sphere",
+    "TrajectoryProblem",
     "__version__",
     "kinematic_lower_bound",
+    "paper_penalty",
 ]
