@@ -443,11 +443,20 @@ def paper_penalty(
     ax = as_finite_array(semi_axes, "semi_axes")
     if ax.ndim != 2 or ax.shape[1] != 3 or (ax <= 0).any():
         raise InvalidInputError(f"semi_axes must be (n_obs, 3) positive [m]; got {ax.shape}")
-    if p.shape[-1] != 3 or c.shape[-1] != 3 or c.shape[0] != ax.shape[0]:
+    if p.ndim < 2 or p.shape[-1] != 3 or c.ndim < 2 or c.shape[-1] != 3:
         raise InputShapeError(
-            f"points (..., n_t, 3) and centres (n_obs, ..., n_t, 3) expected; got {p.shape}, "
-            f"{c.shape} with {ax.shape[0]} obstacles"
+            f"points must be (..., n_t, 3) and centres (n_obs, ..., n_t, 3) [m]; got "
+            f"{p.shape} and {c.shape}"
         )
+    if c.shape[0] != ax.shape[0]:
+        raise InputShapeError(f"centres has {c.shape[0]} obstacles but semi_axes has {ax.shape[0]}")
+    # Align the centres' (..., n_t) with the points' from the right, after the obstacle axis.
+    missing = p.ndim - (c.ndim - 1)
+    if missing < 0:
+        raise InputShapeError(
+            f"centres {c.shape} has more batch axes than points {p.shape} (n_obs first)"
+        )
+    c = c.reshape(c.shape[0], *([1] * missing), *c.shape[1:])
     try:
         np.broadcast_shapes(p.shape, c.shape[1:])
     except ValueError:
