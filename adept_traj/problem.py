@@ -46,11 +46,11 @@ import pinocchio as pin
 from pymoo.core.problem import Problem
 
 from ._validation import as_batch
-from .collision import CollisionChecker, paper_penalty
+from .collision import CollisionChecker, paper_penalty, point_signed_distance
 from .errors import ConfigurationError, InputShapeError
 from .robot import Robot, coulomb_sign
 from .scene import Scene
-from .shapes import Box
+from .shapes import Box, Sphere
 from .trajectory import BSplineTrajectory, kinematic_lower_bound
 
 __all__ = ["OBJECTIVE_NAMES", "Evaluation", "ProblemSettings", "TrajectoryProblem"]
@@ -292,6 +292,7 @@ class TrajectoryProblem(Problem):
         tool_id = model.getFrameId(robot.tool_frame)
         rows = [("vx", "vy", "vz", "wx", "wy", "wz").index(r) for r in robot.task_rows]
         obstacle_geoms = [ob.shape.to_coal() for ob in self.scene.obstacles]
+        solid_shapes = self.checker.solid_shapes
         req = coal.DistanceRequest()
         n_obs = len(obstacle_geoms)
         objectives, constraints, min_distances = [], [], []
@@ -320,12 +321,24 @@ class TrajectoryProblem(Problem):
                 tool_points.append(data.oMf[tool_id].translation.copy())
                 poses = self.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]
                 obs_centres.append(poses[:, :3, 3])
-                for o in range(n_obs):
+                for o, ob in enumerate(self.scene.obstacles):
                     tf_o = coal.Transform3s(poses[o, :3, :3], poses[o, :3, 3])
                     for k, g in enumerate(gm.geometryObjects):
-                        res = coal.DistanceResult()
-                        tf_g = coal.Transform3s(gdata.oMg[k].rotation, gdata.oMg[k].translation)
-                        d = coal.distance(g.geometry, tf_g, obstacle_geoms[o], tf_o, req, res)
+                        placement = gdata.oMg[k]
+                        if isinstance(ob.shape, Sphere) and solid_shapes[k] is not None:
+                            # Closed form, as documented (coal 3.0.3 misjudges a sphere's
+                            # penetration depth near a cylinder cap).
+                            centre = placement.rotation.T @ (
+                                poses[o, :3, 3] - placement.translation
+                            )
+                            d = (
+                                float(point_signed_distance(solid_shapes[k], centre))
+                                - ob.shape.radius
+                            )
+                        else:
+                            res = coal.DistanceResult()
+                            tf_g = coal.Transform3s(placement.rotation, placement.translation)
+                            d = coal.distance(g.geometry, tf_g, obstacle_geoms[o], tf_o, req, res)
                         d_obs[o] = min(d_obs[o], d)
             extrema = ref.extrema()
             z5, z6 = extrema["jerk_sq"], extrema["acc_sq"]

@@ -235,13 +235,12 @@ def test_distances_gripper_closed_forms(robot: Robot, exact: bool) -> None:
     out = checker.distances(Q_GRIPPER[None], 0.0, exact=exact)
     assert out.distance.shape == (1, checker.n_solids, 4)
     np.testing.assert_allclose(out.distance[0, g], expected, atol=1e-6)
-    # all four are within the influence distance, hence computed by coal
+    # all four are within the influence distance, hence exact (coal or closed form)
     assert out.exact[0, g].all()
+    by_coal = out.exact & ~checker.closed_form  # sphere obstacles need no coal call
     if exact:
         assert out.exact.all()
-        assert out.n_narrow == out.exact.size
-    else:
-        assert out.n_narrow == int(out.exact.sum())
+    assert out.n_narrow == int(by_coal.sum())
 
 
 def test_distances_gripper_closed_forms_batched_and_broadcast(robot: Robot) -> None:
@@ -281,12 +280,12 @@ def test_broad_phase_is_sound(robot: Robot, influence: float) -> None:
     fast = checker.distances(q, t)
     ref = checker.distances(q, t, exact=True)
     assert ref.exact.all()
-    assert ref.n_narrow == ref.exact.size
+    assert ref.n_narrow == int((ref.exact & ~checker.closed_form).sum())
     assert fast.distance.shape == ref.distance.shape == (6, 20, checker.n_solids, 4)
     skipped = ~fast.exact
     assert skipped.any()  # both phases exercised
     assert fast.exact.any()
-    assert fast.n_narrow == int(fast.exact.sum())
+    assert fast.n_narrow == int((fast.exact & ~checker.closed_form).sum())
     assert np.all(fast.distance[skipped] > influence)
     assert np.all(fast.distance[skipped] <= ref.distance[skipped])
     np.testing.assert_allclose(fast.distance[fast.exact], ref.distance[fast.exact], atol=1e-12)
@@ -732,3 +731,38 @@ def test_min_distances_empty_scene(robot: Robot) -> None:
     out = checker.min_distances(np.zeros((3, 2, 4)), 0.0)
     assert out.distance.shape == (3, 0)
     assert out.n_narrow == 0
+
+
+def test_sphere_obstacles_are_closed_form_and_match_coal_outside(robot: Robot) -> None:
+    """Sphere obstacles are computed as d(centre, solid) - r (no coal call); where the
+    sphere is outside the solid this equals coal's distance."""
+    checker = CollisionChecker(robot, Scene.paper())
+    bob = checker.obstacle_names.index("pendulum.bob")
+    assert checker.closed_form[:, bob].all()
+    assert not checker.closed_form[:, checker.obstacle_names.index("cube1")].any()
+    rng = np.random.default_rng(21)
+    q = random_q(robot, rng, (4, 30))
+    t = rng.uniform(0.0, 4.0, size=(4, 30))
+    ours = checker.distances(q, t, exact=True).distance[..., bob]
+    solid_poses = robot.geometry_poses(q)
+    bob_poses = Scene.paper().obstacle_poses(t, in_base_frame=True)[bob]
+    sphere = coal.Sphere(0.08)
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    separated = 0
+    for idx in np.ndindex(*q.shape[:2]):
+        for k, g in enumerate(robot.collision_model.geometryObjects):
+            if ours[idx][k] <= 0.0:
+                continue  # coal's penetration depth near a cylinder cap is not reliable
+            ps, pb = solid_poses[idx][k], bob_poses[idx]
+            result.clear()
+            d = coal.distance(
+                g.geometry,
+                coal.Transform3s(ps[:3, :3], ps[:3, 3]),
+                sphere,
+                coal.Transform3s(pb[:3, :3], pb[:3, 3]),
+                request,
+                result,
+            )
+            assert ours[idx][k] == pytest.approx(d, abs=1e-9)
+            separated += 1
+    assert separated > 500
