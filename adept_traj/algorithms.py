@@ -17,7 +17,7 @@ trials are merged and the next population is chosen by non-dominated sorting and
 distance (pymoo's ``RankAndCrowding``, feasibility first), the usual (μ + λ) selection of
 multi-objective DE (Babu & Jehan 2003; Robič & Filipič's DEMO uses the same survival).
 
-Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``agemoea``, ``moead``, ``rvea``
+Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``moead``, ``rvea``
 (reference directions: Das–Dennis with 3 partitions for 6 objectives when needed).
 
 Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless another
@@ -50,7 +50,7 @@ _PAPER: dict[str, dict[str, Any]] = {
     },
     "mode": {"pop_size": 500, "n_gen": 100, "CR": 0.9, "F": 0.5},
 }
-_OTHERS = ("nsga3", "unsga3", "smsemoa", "agemoea", "moead", "rvea")
+_OTHERS = ("nsga3", "unsga3", "smsemoa", "moead", "rvea")
 
 #: Names accepted by :func:`make_algorithm`.
 ALGORITHMS: tuple[str, ...] = (*_PAPER, *_OTHERS)
@@ -191,10 +191,6 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
         from pymoo.algorithms.moo.sms import SMSEMOA
 
         return SMSEMOA(pop_size=pop, sampling=sampling, repair=repair)
-    if key == "agemoea":
-        from pymoo.algorithms.moo.age import AGEMOEA
-
-        return AGEMOEA(pop_size=pop, sampling=sampling, repair=repair)
     if key == "moead":
         from pymoo.algorithms.moo.moead import MOEAD
 

@@ -1,0 +1,124 @@
+"""The optimisation loop: determinism, exact resume after an interruption, algorithms."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from adept_traj import Robot, Scene, TrajectoryProblem
+from adept_traj.algorithms import ALGORITHMS, make_algorithm
+from adept_traj.errors import ConfigurationError
+from adept_traj.repair import kinematic_time
+from adept_traj.run import PlanningInterrupted, optimise
+from adept_traj.sampling import RampSampling
+
+
+@pytest.fixture(scope="module")
+def problem() -> TrajectoryProblem:
+    scene = Scene.paper()
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+
+
+@pytest.mark.parametrize("name", ["nsga2", "mode"])
+def test_same_seed_same_population(problem: TrajectoryProblem, name: str) -> None:
+    runs = [optimise(problem, make_algorithm(name, 16, 3)[0], 3, seed=7) for _ in range(2)]
+    np.testing.assert_array_equal(runs[0].X, runs[1].X)
+    np.testing.assert_array_equal(runs[0].F, runs[1].F)
+    other = optimise(problem, make_algorithm(name, 16, 3)[0], 3, seed=8)
+    assert not np.array_equal(other.X, runs[0].X)
+    assert runs[0].n_evaluations == 16 * 3
+    assert runs[0].n_generations == 3
+    assert 0 < runs[0].evaluation_s <= runs[0].total_s
+
+
+@pytest.mark.parametrize("name", ["nsga2", "mode"])
+def test_interrupted_run_resumes_exactly(
+    problem: TrajectoryProblem, name: str, tmp_path: Path
+) -> None:
+    fingerprint = {"algorithm": name, "seed": 3}
+    full = optimise(problem, make_algorithm(name, 12, 5)[0], 5, seed=3)
+
+    def interrupt(info) -> None:
+        if info.generation == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(PlanningInterrupted, match="after generation 2"):
+        optimise(
+            problem,
+            make_algorithm(name, 12, 5)[0],
+            5,
+            seed=3,
+            checkpoint=tmp_path,
+            fingerprint=fingerprint,
+            progress=interrupt,
+        )
+    resumed = optimise(
+        problem,
+        make_algorithm(name, 12, 5)[0],
+        5,
+        seed=3,
+        checkpoint=tmp_path,
+        resume=True,
+        fingerprint=fingerprint,
+    )
+    np.testing.assert_array_equal(resumed.X, full.X)
+    np.testing.assert_array_equal(resumed.F, full.F)
+    assert resumed.n_evaluations == full.n_evaluations
+    assert [h["generation"] for h in resumed.history] == [1, 2, 3, 4, 5]
+    with pytest.raises(ConfigurationError, match="another run"):
+        optimise(
+            problem,
+            make_algorithm(name, 12, 5)[0],
+            5,
+            seed=4,
+            checkpoint=tmp_path,
+            resume=True,
+            fingerprint={"algorithm": name, "seed": 4},
+        )
+
+
+def test_resume_without_checkpoint(problem: TrajectoryProblem, tmp_path: Path) -> None:
+    with pytest.raises(ConfigurationError, match="no checkpoint"):
+        optimise(problem, make_algorithm("nsga2", 8, 2)[0], 2, 1, checkpoint=tmp_path, resume=True)
+
+
+def test_kinematic_time_repair_meets_the_limits(problem: TrajectoryProblem) -> None:
+    x = RampSampling().do(problem, 30, random_state=np.random.default_rng(1)).get("X")
+    t_kin = kinematic_time(problem, x)
+    x[:, 0] = t_kin * (1 + 1e-9)
+    b = problem.trajectory.bounds(x)
+    lim = problem.robot.limits
+    ratios = np.stack(
+        [b.qd_abs_max / lim.velocity, b.qdd_abs_max / lim.acceleration, b.qddd_abs_max / lim.jerk]
+    )
+    assert np.all(ratios <= 1.0)
+    assert np.allclose(ratios.max(axis=(0, 2)), 1.0, atol=1e-6)  # tight: one limit is active
+    assert np.all(t_kin >= problem.lower_bound.T_min * (1 - 1e-9))  # never beats the bound
+
+
+def test_paper_settings_and_names() -> None:
+    alg, settings = make_algorithm("NSGA-II")
+    assert (settings.name, settings.pop_size, settings.n_gen) == ("nsga2", 100, 100)
+    assert settings.params["crossover_prob"] == 0.7
+    assert settings.params["mutation_prob_var"] == 0.01
+    assert alg.mating.mutation.prob_var.value == 0.01
+    assert alg.mating.crossover.eta.value == 10.0
+    _, mode = make_algorithm("mode")
+    assert (mode.pop_size, mode.params["CR"], mode.params["F"]) == (500, 0.9, 0.5)
+    for name in ALGORITHMS:
+        make_algorithm(name, pop_size=12, n_gen=1)
+    with pytest.raises(ConfigurationError, match="unknown algorithm 'cmaes'"):
+        make_algorithm("cmaes")
+    with pytest.raises(ConfigurationError, match="pop_size must be an integer ≥ 2"):
+        make_algorithm("nsga2", pop_size=1)
+    with pytest.raises(ConfigurationError, match="unknown parameter"):
+        make_algorithm("mode", eta=3)
+
+
+@pytest.mark.parametrize("name", ["nsga3", "smsemoa"])
+def test_other_pymoo_algorithms_run(problem: TrajectoryProblem, name: str) -> None:
+    state = optimise(problem, make_algorithm(name, 12, 2)[0], 2, seed=1)
+    assert state.n_generations == 2
+    assert state.X.shape[1] == problem.n_var
