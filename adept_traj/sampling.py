@@ -10,8 +10,10 @@ draws **rest-to-rest ramps with random timing and a random detour per joint**:
     P_{c,j} = q_{s,j} + \Delta_j\,\sigma\!\left(\frac{\xi_c - a_j}{b_j - a_j}\right)
               + \beta_j \sin(\pi \xi_c)\,(\bar q_j - \underline q_j),
 
-with :math:`\xi_c` the control points' positions in [0, 1], σ the smoothstep
-:math:`10u^3 - 15u^4 + 6u^5` clipped to [0, 1], a random window
+with :math:`\xi_c` the control points' Greville abscissae in [0, 1], σ a normalised
+S-curve — the position profile of a trapezoidal acceleration (jerk phases of a random
+fraction r ∈ [0.05, 0.25] of the move, r = 0.25 being a triangular acceleration), the shape
+of time-optimal jerk-limited moves — a random window
 :math:`0 \le a_j < b_j \le 1` (when joint j moves) and a random detour amplitude
 :math:`\beta_j \sim \mathcal N(0, \text{detour}^2)`; T is uniform in its bounds. The straight
 joint-space move is always included. Control points are clipped to the decision bounds.
@@ -30,9 +32,26 @@ from .errors import ConfigurationError
 __all__ = ["RampSampling"]
 
 
-def _smoothstep(u: np.ndarray) -> np.ndarray:
-    u = np.clip(u, 0.0, 1.0)
-    return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
+_GRID = np.linspace(0.0, 1.0, 2001)
+
+
+def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Normalised S-curves σ(u) (σ(0) = 0, σ(1) = 1, rest to rest) with jerk-phase fraction
+    ``r``: acceleration ramps up over r, holds, ramps down over r (first half), mirrored
+    negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast."""
+    r = np.asarray(r, dtype=float)[..., None]
+    g = _GRID
+    half = np.minimum(g, 1.0 - g)  # symmetric shape, sign from the half
+    acc = np.minimum(np.clip(half / r, 0.0, 1.0), np.clip((0.5 - half) / r, 0.0, 1.0))
+    acc = np.where(g < 0.5, acc, -acc)
+    vel = np.cumsum(acc, axis=-1)
+    pos = np.cumsum(vel, axis=-1)
+    pos = (pos - pos[..., :1]) / (pos[..., -1:] - pos[..., :1])
+    uu = np.clip(u, 0.0, 1.0)
+    idx = np.minimum((uu * (len(g) - 1)).astype(int), len(g) - 2)
+    w = uu * (len(g) - 1) - idx
+    take = np.take_along_axis
+    return take(pos, idx, axis=-1) * (1 - w) + take(pos, idx + 1, axis=-1) * w
 
 
 class RampSampling(Sampling):
@@ -59,13 +78,16 @@ class RampSampling(Sampling):
         rng = random_state if random_state is not None else np.random.default_rng()
         traj = problem.trajectory
         nq = traj.nq
-        xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]  # (n_free,)
+        # Greville abscissae of a uniform cubic B-spline's free control points.
+        xi = np.clip((np.arange(traj.n_control) - 1.0) / traj.n_segments, 0.0, 1.0)[3:-3]
         span = problem.robot.limits.upper - problem.robot.limits.lower
         T = rng.uniform(problem.xl[0], problem.xu[0], size=n_samples)
         a = rng.uniform(0.0, 1.0 - self.min_window, size=(n_samples, nq))
         b = a + rng.uniform(self.min_window, 1.0, size=(n_samples, nq)) * (1.0 - a)
         b = np.maximum(b, a + self.min_window)
-        ramp = _smoothstep((xi[None, :, None] - a[:, None, :]) / (b - a)[:, None, :])
+        r = rng.uniform(0.05, 0.25, size=(n_samples, nq))
+        u = (xi[None, None, :] - a[:, :, None]) / (b - a)[:, :, None]  # (n, nq, n_free)
+        ramp = np.swapaxes(_s_curve(u, r), 1, 2)  # (n, n_free, nq)
         detour = rng.normal(0.0, self.detour, size=(n_samples, 1, nq)) * span
         free = (
             traj.start
