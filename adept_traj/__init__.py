@@ -6,7 +6,9 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
+from .algorithms import ALGORITHMS, make_algorithm
 from .collision import CollisionChecker, paper_penalty
+from .decision import PAPER_WEIGHTS, average_fitness, best_tradeoff, combined_objective
 from .errors import (
     AdeptTrajError,
     ConfigurationError,
@@ -19,19 +21,26 @@ from .errors import (
 from .limits import JointLimits
 from .motion import FixedPose, MotionLaw, PendulumMotion
 from .parameters import RobotParameters
+from .planner import plan
 from .problem import Evaluation, ProblemSettings, TrajectoryProblem
+from .results import PlanningResult, ResultFormatError
 from .robot import ForwardKinematics, Robot
+from .run import PlanningInterrupted
 from .scene import Obstacle, Scene
 from .shapes import Box, Capsule, Cylinder, Shape, Sphere
 from .trajectory import BSplineTrajectory, KinematicBound, kinematic_lower_bound
+from .verification import Certificate, certify
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "ALGORITHMS",
+    "PAPER_WEIGHTS",
     "AdeptTrajError",
     "BSplineTrajectory",
     "Box",
     "Capsule",
+    "Certificate",
     "CollisionChecker",
     "ConfigurationError",
     "Cylinder",
@@ -46,7 +55,10 @@ __all__ = [
     "MotionLaw",
     "Obstacle",
     "PendulumMotion",
+    "PlanningInterrupted",
+    "PlanningResult",
     "ProblemSettings",
+    "ResultFormatError",
     "Robot",
     "RobotModelError",
     "RobotParameters",
@@ -56,6 +68,12 @@ __all__ = [
     "Sphere",
     "TrajectoryProblem",
     "__version__",
+    "average_fitness",
+    "best_tradeoff",
+    "certify",
+    "combined_objective",
     "kinematic_lower_bound",
+    "make_algorithm",
     "paper_penalty",
+    "plan",
 ]

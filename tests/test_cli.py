@@ -7,9 +7,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from adept_traj.cli import main
+from adept_traj.results import PlanningResult
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -48,6 +50,79 @@ def test_bad_input_is_one_line_without_traceback(
     assert len(err.strip().splitlines()) == 1
     assert "Traceback" not in err
     assert re.search(message, err), err
+
+
+def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run"
+    assert main(["plan", "--pop", "12", "--gens", "3", "--out", str(out), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "verified at 1000 Hz" in text
+    assert (out / "result.json").is_file()
+    assert not (out / "checkpoint").exists()  # cleaned up after success
+    status = main(["verify", str(out)])
+    assert status in (0, 1)  # 1: the (tiny) run's best is not feasible
+    assert "re-verified at 1000 Hz" in capsys.readouterr().out
+    # An interrupted run (simulated: a checkpoint and run.json left behind) resumes.
+    interrupted = tmp_path / "interrupted"
+    import adept_traj.cli as cli
+
+    calls = {"n": 0}
+    real = cli._progress_bar
+
+    def stop_after_two(label, quiet):
+        def progress(info):
+            calls["n"] += 1
+            if info.generation == 2:
+                raise KeyboardInterrupt
+
+        return progress
+
+    cli._progress_bar = stop_after_two
+    try:
+        argv = ["plan", "--pop", "12", "--gens", "4", "--out", str(interrupted)]
+        assert main(argv) == 130
+    finally:
+        cli._progress_bar = real
+    assert "--resume" in capsys.readouterr().err
+    assert main(["plan", "--resume", str(interrupted), "--quiet"]) == 0
+    resumed = PlanningResult.load(interrupted)
+    assert (
+        main(["plan", "--pop", "12", "--gens", "4", "--out", str(tmp_path / "u"), "--quiet"]) == 0
+    )
+    uninterrupted = PlanningResult.load(tmp_path / "u")
+    np.testing.assert_array_equal(resumed.front.x, uninterrupted.front.x)
+
+
+def test_compare_writes_tables(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["compare", "--gens", "2", "--pop-nsga2", "8", "--pop-mode", "8"]
+    assert main([*argv, "--out", str(tmp_path), "--quiet"]) == 0
+    table = (tmp_path / "comparison.md").read_text()
+    for heading in ("Table 3", "Table 4", "Table 5", "0.683650", "0.852519", "0.497040"):
+        assert heading in table
+    assert (tmp_path / "nsga2" / "result.json").is_file()
+    assert (tmp_path / "mode" / "result.json").is_file()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["plan", "--algorithm", "foo", "--out", "x"], "unknown algorithm 'foo'"),
+        (["plan", "--pop", "1", "--out", "x"], "pop_size must be an integer ≥ 2"),
+        (["plan", "--weights", "1,1,1,1,1,-1", "--out", "x"], "--weights must be 6"),
+        (["plan", "--weights", "1,1,1", "--out", "x"], "--weights must be 6"),
+        (["plan", "--start", "0,0,0.3,0", "--out", "x"], "outside its limits"),
+        (["plan", "--scene", "missing.toml", "--out", "x"], "scene file not found"),
+        (["plan"], "give --out DIR"),
+        (["plan", "--resume", "nothing-here"], "no interrupted run"),
+        (["verify", "nothing-here"], "nothing-here"),
+    ],
+)
+def test_plan_bad_input(argv, message, capsys: pytest.CaptureFixture[str], tmp_path) -> None:
+    argv = [str(tmp_path / a) if a in ("x", "nothing-here", "missing.toml") else a for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert message in err
 
 
 def test_console_script_runs_in_a_subprocess() -> None:
