@@ -71,6 +71,9 @@ def _parser() -> argparse.ArgumentParser:
         )
         p.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
         p.add_argument("--quiet", action="store_true", help="no progress bar")
+        p.add_argument(
+            "--workers", type=int, default=1, help="processes evaluating in parallel (default 1)"
+        )
 
     p_plan = sub.add_parser("plan", help="plan a trajectory and save a verified result")
     problem_args(p_plan)
@@ -145,7 +148,7 @@ def _problem(args: argparse.Namespace) -> TrajectoryProblem:
         raise InvalidInputError("--weights must not all be 0")
     if not (np.isfinite(args.rate) and args.rate >= 100):
         raise InvalidInputError(f"--rate must be ≥ 100 Hz; got {args.rate}")
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal)
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal, workers=args.workers)
 
 
 def _summary(result: PlanningResult, folder: Path) -> str:
@@ -188,6 +191,7 @@ def _plan(args: argparse.Namespace) -> int:
     folder.mkdir(parents=True, exist_ok=True)
     if not resume:
         keys = ("scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens")
+        keys = (*keys, "workers")
         saved = {k: getattr(args, k) for k in keys}
         saved["scene"] = str(saved["scene"])
         (folder / _RUN_FILE).write_text(json.dumps(saved, indent=1))
@@ -207,6 +211,8 @@ def _plan(args: argparse.Namespace) -> int:
     except PlanningInterrupted as exc:
         sys.stderr.write(f"\n{exc}: adept-traj plan --resume {folder}\n")
         return 130
+    finally:
+        problem.close()
     result.save(folder)
     shutil.rmtree(folder / "checkpoint", ignore_errors=True)
     (folder / _RUN_FILE).unlink(missing_ok=True)
@@ -341,6 +347,7 @@ def _compare(args: argparse.Namespace) -> int:
         )
         results[name].save(args.out / name)
         print(_summary(results[name], args.out / name))
+    problem.close()
     text = _comparison_markdown(results, args.weights)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "comparison.md").write_text(text)

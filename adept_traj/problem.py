@@ -36,7 +36,10 @@ and the baseline for benchmarks.
 
 from __future__ import annotations
 
+import multiprocessing
+import signal
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -81,6 +84,10 @@ class ProblemSettings:
     z3:
         ``"clearance"`` (default, exact distances), ``"paper-sphere"`` or
         ``"paper-ellipsoid"`` (eqs. 13–16 on the tool point).
+    workers:
+        Processes evaluating a population in parallel (default 1: in this process).
+        With ``workers > 1`` the population is split into contiguous chunks evaluated by
+        forked worker processes (Linux); results are identical to the serial evaluation.
     """
 
     n_knots: int = 20
@@ -89,6 +96,7 @@ class ProblemSettings:
     influence: float = 0.05
     t_bounds: tuple[float, float] | None = None
     z3: str = "clearance"
+    workers: int = 1
 
     def __post_init__(self) -> None:
         if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
@@ -100,6 +108,10 @@ class ProblemSettings:
                 f"need 0 ≤ margin ≤ influence and influence > 0 [m]; got margin={self.margin}, "
                 f"influence={self.influence}"
             )
+        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
+            raise ConfigurationError(f"workers must be an integer ≥ 1; got {self.workers!r}")
+        if self.workers > 1 and "fork" not in multiprocessing.get_all_start_methods():
+            raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
         if int(self.nodes_per_segment) < 1:
             raise ConfigurationError(f"nodes_per_segment must be ≥ 1; got {self.nodes_per_segment}")
 
@@ -129,6 +141,21 @@ class Evaluation:
     def feasible(self) -> np.ndarray:
         """(pop,) bool: every constraint satisfied (at the evaluation's resolution)."""
         return np.all(self.constraints <= 0.0, axis=-1)
+
+
+#: Problems shared with forked evaluation workers (looked up by id in the child).
+_REGISTRY: dict[int, TrajectoryProblem] = {}
+#: Smallest chunk worth sending to a worker.
+_MIN_CHUNK = 8
+
+
+def _worker_init() -> None:
+    """Workers leave Ctrl-C to the parent, which checkpoints and stops the run."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _worker_evaluate(key: int, x: np.ndarray) -> Evaluation:
+    return _REGISTRY[key]._evaluate_serial(x)
 
 
 class TrajectoryProblem(Problem):
@@ -220,8 +247,46 @@ class TrajectoryProblem(Problem):
         out["F"] = f
         out["G"] = ev.constraints
 
+    def close(self) -> None:
+        """Stop the evaluation worker processes (if any); they restart when needed."""
+        pool = self.__dict__.pop("_pool", None)
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+        _REGISTRY.pop(id(self), None)
+
     # ------------------------------------------------------------------ batched
     def _evaluate_batch(self, x: np.ndarray) -> Evaluation:
+        workers = self.settings.workers
+        if workers > 1 and len(x) >= 2 * _MIN_CHUNK:
+            return self._evaluate_parallel(x, workers)
+        return self._evaluate_serial(x)
+
+    def _evaluate_parallel(self, x: np.ndarray, workers: int) -> Evaluation:
+        pool = self.__dict__.get("_pool")
+        if pool is None:
+            _REGISTRY[id(self)] = self
+            pool = ProcessPoolExecutor(
+                max_workers=workers,
+                mp_context=multiprocessing.get_context("fork"),
+                initializer=_worker_init,
+            )
+            self.__dict__["_pool"] = pool
+        chunks = np.array_split(x, workers)
+        futures = [pool.submit(_worker_evaluate, id(self), c) for c in chunks if len(c)]
+        try:
+            parts = [f.result() for f in futures]
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
+        return Evaluation(
+            objectives=np.concatenate([e.objectives for e in parts]),
+            constraints=np.concatenate([e.constraints for e in parts]),
+            min_distance=np.concatenate([e.min_distance for e in parts]),
+            n_narrow=sum(e.n_narrow for e in parts),
+        )
+
+    def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
         traj, robot, st = self.trajectory, self.robot, self.settings
         T = x[:, 0]
         smp = traj.sample(x, self.s, orders=(0, 1, 2))

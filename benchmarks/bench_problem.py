@@ -48,6 +48,7 @@ def main() -> None:
     parser.add_argument("--pop", type=int, default=500, help="population size")
     parser.add_argument("--reference", type=int, default=10, help="individuals for reference")
     parser.add_argument("--repeat", type=int, default=3, help="repetitions (best is kept)")
+    parser.add_argument("--workers", type=int, default=2, help="processes for the parallel row")
     args = parser.parse_args()
 
     robot, scene = Robot.adept_one_xl(), Scene.paper()
@@ -81,6 +82,16 @@ def main() -> None:
             f"{name:<15}{batched:>13.0f}{reference:>16.1f}{batched / reference:>7.0f}×"
             f"{ev.n_narrow / args.pop:>15.1f}{int(ev.feasible.sum()):>10}"
         )
+    parallel = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=args.workers)
+    parallel.evaluate_batch(populations["random"][:40])  # start the workers
+    for name, pop in populations.items():
+        serial = args.pop / best_time(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
+        both = args.pop / best_time(lambda pop=pop: parallel.evaluate_batch(pop), args.repeat)
+        print(
+            f"{name:<15} {args.workers} workers: {both:.0f} ev/s, serial {serial:.0f} ev/s "
+            f"({both / serial:.2f}×)"
+        )
+    parallel.close()
     pop = populations["near feasible"]
     tracemalloc.start()
     problem.evaluate_batch(pop)

@@ -154,3 +154,20 @@ def test_bad_input(robot: Robot, scene: Scene) -> None:
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
     with pytest.raises(InputShapeError, match=r"x must have shape \(\.\.\., 65\)"):
         problem.evaluate_batch(np.zeros(64))
+
+
+def test_parallel_workers_equal_serial(robot: Robot, scene: Scene, problem) -> None:
+    parallel = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2)
+    try:
+        rng = np.random.default_rng(30)
+        x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(40, problem.n_var))
+        serial = problem.evaluate_batch(x)
+        both = parallel.evaluate_batch(x)
+        np.testing.assert_array_equal(both.objectives, serial.objectives)
+        np.testing.assert_array_equal(both.constraints, serial.constraints)
+        np.testing.assert_array_equal(both.min_distance, serial.min_distance)
+        assert both.n_narrow == serial.n_narrow
+    finally:
+        parallel.close()
+    with pytest.raises(ConfigurationError, match="workers must be an integer ≥ 1"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=0)
