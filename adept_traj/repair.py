@@ -12,7 +12,9 @@ jerk limit is
 :class:`KinematicTimeRepair` (a pymoo ``Repair``) raises T to
 :math:`\min(\max(T, T_{kin}(P)), T_{max})`; the decision vector keeps its meaning
 (``[T, control points]``), constraints (8)–(10) hold by construction whenever
-:math:`T_{kin}(P) \le T_{max}`, and the search concentrates on shapes and timing. It is
+:math:`T_{kin}(P) \le T_{max}`, and the search concentrates on shapes and timing. A
+fraction ``snap`` of the candidates is set exactly to :math:`T_{kin}(P)` (also lowered),
+pushing the search towards the fastest move of each shape. It is
 applied to the initial population and to every offspring (pymoo calls it after mating).
 """
 
@@ -22,6 +24,8 @@ from typing import Any
 
 import numpy as np
 from pymoo.core.repair import Repair
+
+from .errors import ConfigurationError
 
 __all__ = ["KinematicTimeRepair", "kinematic_time"]
 
@@ -48,12 +52,30 @@ def kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
 
 
 class KinematicTimeRepair(Repair):
-    """Raise each candidate's T to its kinematic minimum (see module doc)."""
+    """Raise each candidate's T to its kinematic minimum (see module doc).
+
+    Parameters
+    ----------
+    snap:
+        Probability that a candidate's T is instead set exactly to its kinematic minimum
+        (also lowered), which pushes the search towards the fastest moves of each shape
+        (default 0.2; drawn from the algorithm's seeded generator; 0 disables it).
+    """
+
+    def __init__(self, snap: float = 0.2) -> None:
+        super().__init__()
+        if not 0.0 <= snap <= 1.0:
+            raise ConfigurationError(f"snap must be a probability in [0, 1]; got {snap}")
+        self.snap = float(snap)
 
     def _do(self, problem: Any, X: np.ndarray, **kwargs: Any) -> np.ndarray:
         X = np.array(X, dtype=float)
         if X.size == 0:
             return X
         t_kin = kinematic_time(problem, X) * (1.0 + _SLACK)
-        X[:, 0] = np.clip(np.maximum(X[:, 0], t_kin), problem.xl[0], problem.xu[0])
+        T = np.maximum(X[:, 0], t_kin)
+        rng = kwargs.get("random_state")
+        if self.snap > 0.0 and rng is not None:
+            T = np.where(rng.uniform(size=len(T)) < self.snap, t_kin, T)
+        X[:, 0] = np.clip(T, problem.xl[0], problem.xu[0])
         return X
