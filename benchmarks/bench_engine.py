@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import argparse
 
-from adept_traj import Robot, Scene, TrajectoryProblem, plan
+import numpy as np
+
+from adept_traj import Robot, Scene, TrajectoryProblem, certify, plan
 from adept_traj.metrics import normalised_hypervolume, objective_bounds
 
 
@@ -39,16 +41,21 @@ def main() -> None:
     print(f"kinematic lower bound on T: {bound:.3f} s")
     print(
         f"{'algorithm':<10}{'evals':>8}{'wall s':>9}{'eval s':>9}{'OO':>7}{'HV':>9}"
-        f"{'front':>7}{'feasible':>10}{'best T s':>10}{'T/bound':>9}{'verified':>10}"
+        f"{'front':>7}{'feasible':>10}{'trade-off T':>12}{'fastest T':>11}{'T/bound':>9}"
+        f"{'verified':>10}"
     )
     for name, r in results.items():
         front = r.feasible_front.objectives
         hv = normalised_hypervolume(front, lo, hi) if len(front) else float("nan")
+        # The fastest member of the front, verified on its own 1 kHz grid.
+        fastest = int(np.argmin(r.front.objectives[:, 0]))
+        cert = certify(problem, r.front.x[fastest])
+        t_fast = r.front.objectives[fastest, 0]
         print(
             f"{name:<10}{r.timing.n_evaluations:>8}{r.timing.total_s:>9.1f}"
             f"{r.timing.evaluation_s:>9.1f}{r.metrics.oo:>7.3f}{hv:>9.4f}{len(r.front):>7}"
-            f"{len(front):>10}{r.best_objectives[0]:>10.3f}{r.gap:>9.2f}"
-            f"{'yes' if r.feasible else 'NO':>10}"
+            f"{len(front):>10}{r.best_objectives[0]:>12.3f}{t_fast:>11.3f}"
+            f"{t_fast / bound:>9.2f}{'yes' if cert.feasible else 'NO':>10}"
         )
 
 
