@@ -78,6 +78,40 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
     )
 
 
+#: Most generations whose hypervolume is recorded in the history (evenly spread + last).
+_HV_GENERATIONS = 25
+
+
+def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecord]:
+    """Generation records with the hypervolume of each generation's feasible front, on the
+    bounds of the final front (reference point 1.1), for up to ``_HV_GENERATIONS``
+    generations of this session (a resumed run has none for the generations before)."""
+    n = len(state.history)
+    offset = n - len(state.fronts)  # generations restored from a checkpoint
+    chosen = set()
+    if final_front is not None and len(state.fronts):
+        k = len(state.fronts)
+        chosen = {int(i) for i in np.linspace(0, k - 1, min(k, _HV_GENERATIONS)).round()}
+        lo, hi = objective_bounds(final_front)
+    records = []
+    for i, h in enumerate(state.history):
+        hv = None
+        j = i - offset
+        if j in chosen and len(state.fronts[j]):
+            F = state.fronts[j].copy()
+            F[:, 3] = -F[:, 3]  # back to z4 positive
+            hv = normalised_hypervolume(F, lo, hi)
+        records.append(
+            GenerationRecord(
+                generation=h["generation"],
+                n_evaluations=h["n_evaluations"],
+                n_feasible=h["n_feasible"],
+                hypervolume=hv,
+            )
+        )
+    return records
+
+
 def plan(
     problem: TrajectoryProblem,
     algorithm: str = "nsga2",
@@ -177,13 +211,6 @@ def plan(
             n_generations=state.n_generations,
         ),
         metrics=metrics,
-        history=[
-            GenerationRecord(
-                generation=h["generation"],
-                n_evaluations=h["n_evaluations"],
-                n_feasible=h["n_feasible"],
-            )
-            for h in state.history
-        ],
+        history=_history(state, front.objectives if feasible.any() else None),
         warning=warning,
     )

@@ -24,6 +24,7 @@ import numpy as np
 from pymoo.core.population import Population
 
 from .errors import AdeptTrajError, ConfigurationError
+from .metrics import non_dominated
 
 __all__ = ["GenerationInfo", "PlanningInterrupted", "RunState", "optimise"]
 
@@ -67,6 +68,9 @@ class RunState:
     total_s: float
     evaluation_s: float
     history: list[dict[str, Any]] = field(default_factory=list)
+    #: Per generation of this session (not restored on resume): the objectives (pymoo's
+    #: sense) of the population's feasible non-dominated members, for hypervolume history.
+    fronts: list[np.ndarray] = field(default_factory=list)
 
 
 def _population_arrays(pop: Population) -> dict[str, np.ndarray]:
@@ -187,6 +191,7 @@ def optimise(
         history = meta["history"]
     start = time.perf_counter() - spent_total
     evaluation_s = spent_eval
+    fronts: list[np.ndarray] = []
     try:
         while algorithm.has_next():
             infills = algorithm.ask()
@@ -199,6 +204,11 @@ def optimise(
             cv = pop.get("CV")[:, 0]
             feasible = cv <= 0.0
             best_t = float(pop.get("X")[feasible, 0].min()) if feasible.any() else None
+            if feasible.any():
+                F = pop.get("F")[feasible]
+                fronts.append(F[non_dominated(F, maximised=False)])
+            else:
+                fronts.append(np.empty((0, pop.get("F").shape[1])))
             info = GenerationInfo(
                 generation=len(history) + 1,
                 n_gen=n_gen,
@@ -241,4 +251,5 @@ def optimise(
         total_s=time.perf_counter() - start,
         evaluation_s=evaluation_s,
         history=history,
+        fronts=fronts,
     )

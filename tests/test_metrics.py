@@ -396,3 +396,16 @@ def test_algorithm_effort_hand_values() -> None:
 def test_algorithm_effort_bad_inputs(total: float, n: object, error: type[Exception]) -> None:
     with pytest.raises(error):
         algorithm_effort(total, n)  # type: ignore[arg-type]
+
+
+def test_hypervolume_methods_agree_and_auto_is_fast_path() -> None:
+    rng = np.random.default_rng(44)
+    P = rng.uniform(size=(60, 5))
+    ref = np.full(5, 1.1)
+    wfg = hypervolume(P, ref, maximised=False, method="wfg")
+    fast = hypervolume(P, ref, maximised=False, method="moocore")
+    auto = hypervolume(P, ref, maximised=False)
+    assert wfg == pytest.approx(fast, rel=1e-12)
+    assert auto == pytest.approx(fast, rel=1e-12)
+    with pytest.raises(InvalidInputError, match="method"):
+        hypervolume(P, ref, maximised=False, method="grid")
