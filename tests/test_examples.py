@@ -1,0 +1,40 @@
+"""Every script in examples/ runs (small budgets) and prints what it promises."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.mark.parametrize(
+    ("script", "args", "expect"),
+    [
+        ("robot_dynamics.py", [], "kinematic lower bound on T: 1.073 s"),
+        ("plan_paper.py", ["--gens", "2", "--small"], "mode: 32 evaluations"),
+        ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
+        ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
+    ],
+)
+def test_example_runs(script: str, args: list[str], expect: str, tmp_path: Path) -> None:
+    if script == "plan_paper.py":
+        args = [*args, "--out", str(tmp_path / "out")]
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / script), *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    assert expect in result.stdout, result.stdout
+
+
+def test_every_example_is_tested() -> None:
+    scripts = {p.name for p in EXAMPLES.glob("*.py")}
+    assert scripts == {"robot_dynamics.py", "plan_paper.py", "custom_scene.py", "other_robot.py"}
