@@ -21,7 +21,7 @@ rpy = [0.0, 0.0, 0.0]
 
 [task]                       # theta1 [rad], theta2 [rad], d3 [m], theta4 [rad]
 start = [0.9, 1.2, 0.10, 0.0]
-goal = [-0.9, -1.2, 0.10, 1.0]
+goal = [-0.9, 1.2, 0.10, 1.0]
 
 [[obstacle]]                 # a post in front of the robot, below the outer arm
 name = "post"
@@ -34,11 +34,11 @@ xyz = [0.72, 0.0, 0.3]
 name = "ball"
 shape = "sphere"
 radius = 0.06
-xyz = [0.3, 0.45, 0.25]
+xyz = [0.35, -0.45, 0.25]
 
 [[pendulum]]
 name = "pendulum"
-pivot = [0.6, -0.4, 1.5]
+pivot = [-0.7, 0.5, 1.6]
 length = 1.0
 v0 = 2.0
 omega = 3.14

@@ -27,10 +27,11 @@ def main() -> None:
     q = np.array([[0.3, 0.9], [1.0, -0.4]])
     print("tool positions [m]:", robot.tool_pose(q)[:, :3, 3].round(3).tolist())
     print("manipulability [m²]:", robot.manipulability(q).round(4).tolist())
-    # A sphere between the start and goal poses of the hand, in the arm's plane (y = 0).
+    # A sphere on the hand's straight path, in the arm's plane (y = 0): folding the elbow
+    # while passing avoids it.
     scene = at.Scene(
         obstacles=(
-            at.Obstacle("ball", at.Sphere(0.08), at.FixedPose.from_xyz_rpy((0.55, 0.0, 0.55))),
+            at.Obstacle("ball", at.Sphere(0.06), at.FixedPose.from_xyz_rpy((0.67, 0.0, 0.67))),
         )
     )
     start, goal = np.array([-0.2, 0.6]), np.array([1.4, 0.4])

@@ -38,7 +38,6 @@ from ..scene import Scene
 from ..shapes import Box, Capsule, Cylinder, Sphere
 
 if TYPE_CHECKING:
-    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 __all__ = [
@@ -64,6 +63,15 @@ OBJECTIVE_LABELS = (
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
 _MARKERS = ("o", "s", "^", "D", "v", "P")
 _DPI = 110
+_DISPLAY_NAMES = {
+    "nsga2": "NSGA-II",
+    "mode": "MODE",
+    "nsga3": "NSGA-III",
+    "unsga3": "U-NSGA-III",
+    "smsemoa": "SMS-EMOA",
+    "moead": "MOEA/D",
+    "rvea": "RVEA",
+}
 _KINDS = (
     # (DenseTrajectory field, row title, unit suffix for rad / m joints, JointLimits field)
     ("q", "position", ("rad", "m"), None),
@@ -102,11 +110,17 @@ def _as_results(results: Any) -> dict[str, PlanningResult]:
     return out
 
 
+def _display(algorithm: str) -> str:
+    """The usual spelling of an algorithm's name (``"nsga2"`` → ``"NSGA-II"``)."""
+    return _DISPLAY_NAMES.get(algorithm.lower(), algorithm)
+
+
 def _labels(results: Mapping[str, PlanningResult]) -> dict[str, str]:
-    """Legend label per key: the algorithm's name when unique, else the key."""
-    names = [r.algorithm for r in results.values()]
-    unique = len(set(names)) == len(names)
-    return {k: (r.algorithm if unique else f"{k} ({r.algorithm})") for k, r in results.items()}
+    """Legend label per key: the algorithm's name when unique, else key and name."""
+    names = [_display(r.algorithm) for r in results.values()]
+    if len(set(names)) == len(names):
+        return dict(zip(results, names))
+    return {k: f"{k} ({name})" for k, name in zip(results, names)}
 
 
 def _png_path(path: Any) -> Path:
@@ -191,10 +205,17 @@ def pareto_matrix(
     allobj = np.vstack([r.front.objectives for r in res.values()])
     limits = [_padded(float(allobj[:, j].min()), float(allobj[:, j].max())) for j in range(m)]
 
+    # histogram heights: share of each front per bin, on one scale for all results
+    peak = max(
+        np.histogram(r.front.objectives[:, j], bins=np.linspace(*limits[j], 13))[0].max()
+        / len(r.front)
+        for r in res.values()
+        for j in range(m)
+    )
     fig = _figure(15.0, 15.0)
     axes = fig.subplots(m, m)
     fig.subplots_adjust(left=0.08, right=0.98, bottom=0.07, top=0.9, wspace=0.08, hspace=0.08)
-    for k, (key, r) in enumerate(res.items()):
+    for k, r in enumerate(res.values()):
         colour, marker = _COLOURS[k], _MARKERS[k]
         obj, feas, best = r.front.objectives, r.front.feasible, r.best.index
         for i in range(m):
@@ -204,7 +225,7 @@ def pareto_matrix(
                     lo, hi = limits[j]
                     edges = np.linspace(lo, hi, 13)
                     counts, _ = np.histogram(obj[:, j], bins=edges)
-                    scale = 0.9 * (hi - lo) / max(1, counts.max())
+                    scale = 0.9 * (hi - lo) / (peak * len(obj))  # share of the front
                     ax.stairs(
                         lo + counts * scale,
                         edges,
@@ -216,9 +237,7 @@ def pareto_matrix(
                     ax.stairs(lo + counts * scale, edges, baseline=lo, color=colour, lw=1.2)
                     continue
                 x, y = obj[:, j], obj[:, i]
-                ax.scatter(
-                    x[feas], y[feas], s=16, marker=marker, color=colour, alpha=0.75, lw=0
-                )
+                ax.scatter(x[feas], y[feas], s=16, marker=marker, color=colour, alpha=0.75, lw=0)
                 ax.scatter(
                     x[~feas],
                     y[~feas],
@@ -275,17 +294,14 @@ def pareto_matrix(
     ]
     handles += [
         Line2D([], [], ls="", marker="o", color="grey", label="feasible (filled)"),
-        Line2D(
-            [], [], ls="", marker="o", mfc="none", mec="grey", label="infeasible (hollow)"
-        ),
-        Line2D(
-            [], [], ls="", marker="*", ms=13, mfc="grey", mec="black", label="best trade-off"
-        ),
+        Line2D([], [], ls="", marker="o", mfc="none", mec="grey", label="infeasible (hollow)"),
+        Line2D([], [], ls="", marker="*", ms=13, mfc="grey", mec="black", label="best trade-off"),
     ]
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), bbox_to_anchor=(0.5, 0.95))
     sizes = ", ".join(f"{labels[k]}: {len(r.front)} solutions" for k, r in res.items())
     fig.suptitle(
-        f"Final fronts, objectives z1…z6 ({sizes}); diagonal: histogram of each objective",
+        f"Final fronts, objectives z1…z6 ({sizes})\ndiagonal: histogram of each objective "
+        "(share of each front per bin, one scale for all)",
         fontsize=13,
         y=0.985,
     )
@@ -325,7 +341,7 @@ def best_tradeoffs(
 
     fig = _figure(12.0, 6.5)
     ax = fig.add_subplot()
-    fig.subplots_adjust(left=0.09, right=0.98, bottom=0.2, top=0.88)
+    fig.subplots_adjust(left=0.09, right=0.98, bottom=0.16, top=0.88)
     width = 0.8 / n
     x0 = np.arange(m)
     for k, key in enumerate(res):
@@ -337,7 +353,7 @@ def best_tradeoffs(
             width * 0.92,
             color=_COLOURS[k],
             alpha=0.85,
-            label=f"{labels[key]} (F_avg = {scores[k].mean():.3f}, {_status(r)})",
+            label=f"{labels[key]} (F_avg on these bounds {scores[k].mean():.3f}, {_status(r)})",
         )
         for xi, s, v in zip(xs, scores[k], bests[k]):
             ax.text(
@@ -362,7 +378,9 @@ def best_tradeoffs(
         "(Z_max − z)/(Z_max − Z_min); z4: (z − Z_min)/(Z_max − Z_min)",
         fontsize=9,
     )
-    ax.set_xlabel("objective [unit]\n[Z_min, Z_max] over all fronts and best trade-offs", fontsize=9)
+    ax.set_xlabel(
+        "objective [unit]\n[Z_min, Z_max] over all fronts and best trade-offs", fontsize=9
+    )
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, 1.1), ncol=min(n, 3), fontsize=9)
     ax.set_title("Best trade-offs (raw values on the bars)", fontsize=12, pad=30)
     return _save(fig, out)
@@ -462,7 +480,8 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     )
     ax0.set_xlim(float(t[0]), float(t[-1]))
     fig.suptitle(
-        f"{r.algorithm}: joint motion of the best trade-off, T = {r.best_objectives[0]:.3f} s "
+        f"{_display(r.algorithm)}: joint motion of the best trade-off, "
+        f"T = {r.best_objectives[0]:.3f} s "
         f"({_status(r)} at {r.certificate.rate_hz:g} Hz)",
         fontsize=13,
         x=0.06,
@@ -492,9 +511,7 @@ def _wireframe(kind: str, dims: Sequence[float], pose: np.ndarray) -> list[np.nd
             [[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float
         )
         world = c + (corners * h) @ rot.T
-        edges = [
-            (a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1
-        ]
+        edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
         return [world[[a, b]] for a, b in edges]
     if kind == "sphere":
         (rad,) = dims
@@ -540,22 +557,17 @@ def _coal_wireframe(geometry: Any, pose: np.ndarray) -> list[np.ndarray]:
     return []
 
 
-def _add_lines(ax: Axes, lines: list[np.ndarray], **style: Any) -> None:
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
-    if lines:
-        ax.add_collection3d(Line3DCollection(lines, **style))
-
-
 def tool_path_3d(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     """The tool path of the best trade-off in 3-D, world frame (Fig. 4).
 
-    Drawn: the tool path ``robot_base @ tool_pose(q(t))`` coloured by time, its start and
-    goal, the point of closest approach of the robot to an obstacle (from the certificate),
+    Left, in 3-D with equal scale on the three axes: the tool path
+    ``robot_base @ tool_pose(q(t))`` coloured by time, its start and goal, the tool's
+    position at the closest approach of the robot to an obstacle (from the certificate),
     the robot's collision solids at the start and the goal (grey wireframes), the fixed
-    obstacles (wireframes), every moving obstacle at t = 0 and t = T (wireframes) and the
-    centre path of every moving sphere (the pendulum bob) over the motion. Equal scale on
-    the three axes.
+    obstacles (boxes, spheres, cylinders and capsules as wireframes), every moving obstacle
+    at t = 0 and t = T and the centre path of every moving sphere (the pendulum bob) over
+    the motion. Right, the same zoomed on the tool path and projected on the world x–y
+    plane (top view) and y–z plane (side view, looking along −x), equal scale.
 
     Parameters
     ----------
@@ -571,8 +583,10 @@ def tool_path_3d(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     out = _png_path(path)
     import mpl_toolkits.mplot3d  # noqa: F401  (registers the 3-D projection)
     from matplotlib import colormaps
+    from matplotlib.collections import LineCollection
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
     robot = r.robot.load()
     scene = Scene.from_dict(r.scene, source="result scene")
@@ -581,101 +595,132 @@ def tool_path_3d(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     t, T = dense.t, float(dense.t[-1])
     tool = (base @ robot.tool_pose(dense.q))[:, :3, 3]
 
-    fig = _figure(11.0, 9.5)
-    ax = fig.add_subplot(projection="3d")
-    fig.subplots_adjust(left=0.0, right=0.95, bottom=0.02, top=0.92)
-    points = [tool, base[None, :3, 3]]
-
-    # robot solids at the start and the goal
-    gm = robot.collision_model
-    for q, alpha in ((dense.q[0], 0.5), (dense.q[-1], 0.25)):
-        poses = base @ robot.geometry_poses(q)
+    # everything but the tool path, as (polylines, style) layers in the world frame
+    layers: list[tuple[list[np.ndarray], dict[str, Any]]] = []
+    for q, alpha in ((dense.q[0], 0.55), (dense.q[-1], 0.25)):
         lines = []
-        for g, pose in zip(gm.geometryObjects, poses):
+        for g, pose in zip(robot.collision_model.geometryObjects, base @ robot.geometry_poses(q)):
             lines += _coal_wireframe(g.geometry, pose)
-        _add_lines(ax, lines, colors="dimgrey", linewidths=0.7, alpha=alpha)
-        if lines:
-            points.append(np.vstack(lines))
-
-    # obstacles
+        layers.append((lines, {"colors": "dimgrey", "linewidths": 0.7, "alpha": alpha}))
     for ob in scene.fixed:
-        lines = _shape_wireframe(ob.shape, ob.pose(0.0))
-        _add_lines(ax, lines, colors="saddlebrown", linewidths=1.2)
-        if lines:
-            points.append(np.vstack(lines))
-    snapshots = ((0.0, 0.35, "t = 0"), (T, 0.9, "t = T"))
+        layers.append(
+            (_shape_wireframe(ob.shape, ob.pose(0.0)), {"colors": "saddlebrown", "linewidths": 1.3})
+        )
     for ob in scene.moving:
-        for ts, alpha, _ in snapshots:
-            lines = _shape_wireframe(ob.shape, ob.pose(ts))
-            _add_lines(ax, lines, colors="tab:red", linewidths=1.0, alpha=alpha)
-            if lines:
-                points.append(np.vstack(lines))
+        for ts, alpha in ((0.0, 0.35), (T, 0.9)):
+            style = {"colors": "tab:red", "linewidths": 1.0, "alpha": alpha}
+            layers.append((_shape_wireframe(ob.shape, ob.pose(ts)), style))
         if isinstance(ob.shape, Sphere):
             centre = ob.pose(t)[:, :3, 3]
-            ax.plot(*centre.T, color="tab:red", ls="--", lw=1.4)
-            points.append(centre)
+            style = {"colors": "tab:red", "linewidths": 1.4, "linestyles": "--"}
+            layers.append(([centre], style))
 
-    # the tool path, coloured by time
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
+    fig = _figure(15.5, 9.5)
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.3, 1.0), left=0.0, right=0.92, bottom=0.06,
+                            top=0.9, wspace=0.0, hspace=0.22)  # fmt: skip
+    ax = fig.add_subplot(grid[:, 0], projection="3d")
+    views = (
+        (fig.add_subplot(grid[0, 1]), (0, 1), "top view (x–y), zoomed on the tool path"),
+        (fig.add_subplot(grid[1, 1]), (1, 2), "side view (y–z, looking along −x), zoomed"),
+    )
     norm = Normalize(0.0, T)
     cmap = colormaps["viridis"]
-    segments = np.stack([tool[:-1], tool[1:]], axis=1)
-    path_lines = Line3DCollection(segments, cmap=cmap, norm=norm, linewidths=2.6)
-    path_lines.set_array(0.5 * (t[:-1] + t[1:]))
-    ax.add_collection3d(path_lines)
-    ax.scatter(*tool[0], s=60, color=cmap(0.0), edgecolors="black", zorder=6, depthshade=False)
-    ax.scatter(*tool[-1], s=60, color=cmap(1.0), edgecolors="black", marker="s", zorder=6,
-               depthshade=False)  # fmt: skip
-    t_close = r.certificate.t_min_distance
-    if t_close is not None and math.isfinite(r.certificate.min_distance):
-        k = int(np.argmin(np.abs(t - t_close)))
-        ax.scatter(*tool[k], s=90, marker="X", color="black", zorder=7, depthshade=False)
-    ax.scatter(*base[:3, 3], s=50, marker="^", color="dimgrey", depthshade=False)
+    t_mid = 0.5 * (t[:-1] + t[1:])
+    k_close = None
+    if r.certificate.t_min_distance is not None and math.isfinite(r.certificate.min_distance):
+        k_close = int(np.argmin(np.abs(t - r.certificate.t_min_distance)))
 
-    # equal aspect on the data's bounding box
-    allp = np.vstack(points)
+    # ---- 3-D
+    for lines, style in layers:
+        if lines:
+            ax.add_collection3d(Line3DCollection(lines, **style))
+    segments = np.stack([tool[:-1], tool[1:]], axis=1)
+    path3 = Line3DCollection(segments, cmap=cmap, norm=norm, linewidths=2.6)
+    path3.set_array(t_mid)
+    ax.add_collection3d(path3)
+    marks = {"depthshade": False, "zorder": 6, "edgecolors": "black"}
+    ax.scatter(*tool[0], s=60, color=cmap(0.0), **marks)
+    ax.scatter(*tool[-1], s=60, color=cmap(1.0), marker="s", **marks)
+    if k_close is not None:
+        ax.scatter(*tool[k_close], s=90, marker="X", color="black", depthshade=False, zorder=7)
+    ax.scatter(*base[:3, 3], s=50, marker="^", color="dimgrey", depthshade=False)
+    allp = np.vstack([tool, base[None, :3, 3], *(np.vstack(ls) for ls, _ in layers if ls)])
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     pad = 0.03 * float((hi - lo).max())
     lo, hi = lo - pad, hi + pad
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(tuple(hi - lo))
+    ax.set_box_aspect(tuple(hi - lo), zoom=0.95)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
     ax.view_init(elev=24, azim=-60)
-    cb = fig.colorbar(path_lines, ax=ax, shrink=0.55, pad=0.02)
+
+    # ---- 2-D projections, zoomed on the tool path
+    centre = 0.5 * (tool.min(axis=0) + tool.max(axis=0))
+    half = 0.5 * float((tool.max(axis=0) - tool.min(axis=0)).max()) + 0.12
+    for axv, dims, title in views:
+        i, j = dims
+        for lines, style in layers:
+            if lines:
+                axv.add_collection(LineCollection([ln[:, dims] for ln in lines], **style))
+        path2 = LineCollection(segments[:, :, dims], cmap=cmap, norm=norm, linewidths=2.6)
+        path2.set_array(t_mid)
+        axv.add_collection(path2)
+        axv.scatter(*tool[0, dims], s=50, color=cmap(0.0), edgecolors="black", zorder=6)
+        axv.scatter(*tool[-1, dims], s=50, color=cmap(1.0), edgecolors="black", marker="s",
+                    zorder=6)  # fmt: skip
+        if k_close is not None:
+            axv.scatter(*tool[k_close, dims], s=80, marker="X", color="black", zorder=7)
+        axv.set_xlim(centre[i] - half, centre[i] + half)
+        axv.set_ylim(centre[j] - half, centre[j] + half)
+        axv.set_aspect("equal", adjustable="box")
+        axv.set_xlabel(f"{'xyz'[i]} [m]")
+        axv.set_ylabel(f"{'xyz'[j]} [m]")
+        axv.set_title(title, fontsize=10)
+        axv.grid(alpha=0.3)
+    cb = fig.colorbar(path3, ax=[v[0] for v in views], shrink=0.8, pad=0.03)
     cb.set_label("time along the tool path t [s]")
 
     closest = ""
-    if t_close is not None and r.certificate.closest_pair is not None:
-        pair = " – ".join(r.certificate.closest_pair)
-        closest = f"closest approach {r.certificate.min_distance:.3f} m at t = {t_close:.3f} s"
-        closest += f" ({pair})"
+    pair = r.certificate.closest_pair
+    if k_close is not None and pair is not None:
+        closest = (
+            f"tool at the closest approach: {r.certificate.min_distance:.3f} m "
+            f"at t = {r.certificate.t_min_distance:.3f} s ({' – '.join(pair)})"
+        )
     handles = [
         Line2D([], [], color=cmap(0.6), lw=2.6, label="tool path (colour: time)"),
         Line2D([], [], ls="", marker="o", color=cmap(0.0), mec="black", label="start"),
         Line2D([], [], ls="", marker="s", color=cmap(1.0), mec="black", label="goal"),
         Line2D([], [], color="saddlebrown", label="fixed obstacles"),
-        Line2D([], [], color="tab:red", alpha=0.5, label="moving obstacles at t = 0, T"),
-        Line2D([], [], color="tab:red", ls="--", label="pendulum bob centre over [0, T]"),
+        Line2D([], [], color="tab:red", alpha=0.5, label="moving obstacles at t = 0 (light), T"),
+        Line2D([], [], color="tab:red", ls="--", label="moving sphere (bob) centre over [0, T]"),
         Line2D([], [], color="dimgrey", label="robot solids at start (dark), goal (light)"),
         Line2D([], [], ls="", marker="^", color="dimgrey", label="robot base"),
     ]
     if closest:
         handles.append(Line2D([], [], ls="", marker="X", color="black", label=closest))
-    ax.legend(handles=handles, loc="upper left", fontsize=8, bbox_to_anchor=(0.0, 1.0))
+    ax.legend(handles=handles, loc="upper left", fontsize=8, bbox_to_anchor=(0.03, 1.02))
     fig.suptitle(
-        f"{r.algorithm}: tool path of the best trade-off in the world frame, "
+        f"{_display(r.algorithm)}: tool path of the best trade-off in the world frame, "
         f"T = {T:.3f} s ({_status(r)})",
-        fontsize=12,
+        fontsize=13,
     )
     return _save(fig, out)
 
 
 # ============================================================================ history
+def _evaluations_per_generation(history: Sequence[Any]) -> int:
+    """Median number of evaluations between consecutive records (the population size)."""
+    evals = np.array([rec.n_evaluations for rec in history], dtype=float)
+    gens = np.array([rec.generation for rec in history], dtype=float)
+    if len(evals) < 2:
+        return int(evals[0] / max(gens[0], 1.0))
+    return round(float(np.median(np.diff(evals) / np.maximum(np.diff(gens), 1.0))))
+
+
 def hypervolume_history(
     result_or_results: PlanningResult | Mapping[str, PlanningResult],
     path: str | os.PathLike[str],
@@ -721,8 +766,7 @@ def hypervolume_history(
             label = labels[key] if rows else f"{labels[key]} (no hypervolume recorded)"
         else:
             rows = [(rec.generation, rec.n_feasible) for rec in history]
-            pop = res[key].algorithm_settings.get("pop_size")
-            label = labels[key] + (f" (population {pop})" if pop is not None else "")
+            label = f"{labels[key]} ({_evaluations_per_generation(history)} evaluations/gen.)"
         g = np.array([row[0] for row in rows], dtype=float)
         v = np.array([row[1] for row in rows], dtype=float)
         ax.plot(g, v, color=_COLOURS[k], marker=_MARKERS[k], ms=3.5, lw=1.4, label=label)
@@ -734,9 +778,7 @@ def hypervolume_history(
         ax.set_title("Hypervolume per generation")
     else:
         ax.set_ylabel("feasible individuals in the population [-]")
-        ax.set_title(
-            "No hypervolume recorded in the history: feasible individuals per generation"
-        )
+        ax.set_title("No hypervolume recorded in the history: feasible individuals per generation")
         ax.set_ylim(bottom=0)
     from matplotlib.ticker import MaxNLocator
 
