@@ -8,6 +8,7 @@ Sub-commands:
 - ``adept-traj compare --out DIR`` — NSGA-II and MODE on the same problem, with the paper's
   Tables 3–5 beside ours (``DIR/comparison.md``).
 - ``adept-traj verify DIR`` — re-run the dense verification of a saved result.
+- ``adept-traj show DIR`` — play a saved result in the browser (meshcat, 127.0.0.1).
 - ``adept-traj robot`` — the robot-model demo (torques and manipulability along a move).
 - ``adept-traj build-urdf PARAMS --output URDF`` — regenerate a URDF from a parameter file.
 
@@ -91,6 +92,16 @@ def _parser() -> argparse.ArgumentParser:
     p_cmp.add_argument("--pop-nsga2", type=int, help="NSGA-II population (default 100)")
     p_cmp.add_argument("--pop-mode", type=int, help="MODE population (default 500)")
     p_cmp.add_argument("--out", type=Path, required=True, help="output folder")
+
+    p_plan.add_argument(
+        "--no-html", action="store_true", help="do not write playback.html (static meshcat)"
+    )
+
+    p_show = sub.add_parser("show", help="play a saved result in the browser (meshcat)")
+    p_show.add_argument("folder", type=Path, help="result folder (with result.json)")
+    p_show.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
+    p_show.add_argument("--closest", action="store_true", help="draw the closest-point segment")
+    p_show.add_argument("--open", action="store_true", help="open the page in a web browser")
 
     p_ver = sub.add_parser("verify", help="re-run the dense verification of a saved result")
     p_ver.add_argument("folder", type=Path, help="result folder (with result.json)")
@@ -191,7 +202,7 @@ def _plan(args: argparse.Namespace) -> int:
     folder.mkdir(parents=True, exist_ok=True)
     if not resume:
         keys = ("scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens")
-        keys = (*keys, "workers")
+        keys = (*keys, "workers", "no_html")
         saved = {k: getattr(args, k) for k in keys}
         saved["scene"] = str(saved["scene"])
         (folder / _RUN_FILE).write_text(json.dumps(saved, indent=1))
@@ -214,10 +225,31 @@ def _plan(args: argparse.Namespace) -> int:
     finally:
         problem.close()
     result.save(folder)
+    if not args.no_html:
+        from .viz import meshcat_view
+
+        meshcat_view.static_html(result, folder / "playback.html")
     shutil.rmtree(folder / "checkpoint", ignore_errors=True)
     (folder / _RUN_FILE).unlink(missing_ok=True)
     print(_summary(result, folder))
     return 0
+
+
+def _show(args: argparse.Namespace) -> int:
+    from .viz import meshcat_view
+
+    result = PlanningResult.load(args.folder)
+    vis = meshcat_view.show(
+        result, speed=args.speed, show_closest=args.closest, open_browser=args.open
+    )
+    print(f"playing {args.folder} at {vis.url()} (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        vis.close()
 
 
 #: The paper's Tables 3–5, as printed (strings keep their printed digits).
@@ -433,6 +465,7 @@ def _build_urdf(args: argparse.Namespace) -> int:
 
 _COMMANDS = {
     "plan": _plan,
+    "show": _show,
     "compare": _compare,
     "verify": _verify,
     "robot": _robot_demo,

@@ -134,3 +134,25 @@ def test_console_script_runs_in_a_subprocess() -> None:
     )
     assert result.returncode == 0, result.stderr
     assert "joint4" in result.stdout
+
+
+def test_show_serves_on_localhost_and_stops_on_ctrl_c(tmp_path: Path) -> None:
+    import signal
+
+    out = tmp_path / "run"
+    assert main(["plan", "--pop", "8", "--gens", "2", "--out", str(out), "--quiet"]) == 0
+    assert (out / "playback.html").is_file()  # plan writes the static playback page
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "adept_traj.cli", "show", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        line = proc.stdout.readline()
+        assert "http://127.0.0.1:" in line, line + proc.stderr.read()
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()

@@ -13,8 +13,9 @@ What is drawn, all in the **world** frame of the scene [m]: the robot's link sol
 colours of its visual model (poses ``scene.robot_base @`` the base-frame poses), the fixed
 obstacles (red), the moving obstacles (purple: the pendulum's rod and bob) at the physical
 time of each frame, the tool path of the best trajectory (a green line with a sphere at the
-start and the goal) and, optionally, the closest-point segment (red) between the robot and
-the nearest obstacle at every frame (exact coal distances).
+start and the goal), the floor z = 0 with a 0.1 m grid and the world axes and, optionally,
+the closest-point segment (yellow) between the robot's collision solids and the nearest
+obstacle at every frame (exact coal distances).
 
 Timing: frame ``k`` is shown at playback time ``k / fps`` [s] and shows the physical time
 ``t_k = k · speed / fps`` [s] (the last frame exactly at ``T``): ``speed = 1`` is real time,
@@ -32,6 +33,7 @@ import queue
 import subprocess
 import sys
 import threading
+import warnings
 import webbrowser
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -39,14 +41,17 @@ from pathlib import Path
 from typing import Any
 
 import coal
-import meshcat
-import meshcat.geometry as mg
 import numpy as np
-import umsgpack
 import zmq
-from meshcat.animation import Animation, AnimationFrameVisualizer
-from meshcat.path import Path as MeshcatPath
-from meshcat.visualizer import ViewerWindow
+
+with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
+    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
+    import meshcat
+    import meshcat.geometry as mg
+    import umsgpack
+    from meshcat.animation import Animation, AnimationFrameVisualizer
+    from meshcat.path import Path as MeshcatPath
+    from meshcat.visualizer import ViewerWindow
 
 from ..errors import AdeptTrajError, InvalidInputError
 from ..results import PlanningResult
@@ -76,7 +81,7 @@ MOVING_OBSTACLE_COLOR = 0x7D3C98
 TOOL_PATH_COLOR = 0x1E8449
 START_COLOR = 0x1E8449
 GOAL_COLOR = 0x0B5345
-CLOSEST_COLOR = 0xE74C3C
+CLOSEST_COLOR = 0xF1C40F
 #: Points of the drawn tool path at most (the dense trajectory is thinned evenly).
 MAX_PATH_POINTS = 4000
 #: Seconds to wait for the meshcat server to start.
@@ -85,10 +90,14 @@ SERVER_TIMEOUT_S = 30.0
 DEFAULT_ROOT = ("meshcat",)
 
 _MARKER_RADIUS = 0.012  # tool path start/goal spheres [m]
-_SEGMENT_RADIUS = 0.004  # closest-point segment [m]
-_POINT_RADIUS = 0.009  # closest-point end spheres [m]
+_SEGMENT_RADIUS = 0.005  # closest-point segment [m]
+_POINT_RADIUS = 0.01  # closest-point end spheres [m]
 _FOV_DEG = 75.0  # meshcat's default camera: vertical field of view
-_VIEW_DIRECTION = np.array([1.0, -1.3, 0.8])  # camera offset direction from the target
+_VIEW_DIRECTION = np.array([-0.7, -1.2, 0.9])
+_GRID_STEP = 0.1  # floor grid spacing [m]
+_FLOOR_MARGIN = 0.3  # floor beyond the drawn scene [m]
+FLOOR_COLOR = 0xE5E7E9
+GRID_COLOR = 0xB3B6B7  # camera offset direction from the target
 
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):
@@ -250,23 +259,21 @@ def build_animation(
             "lower fps or raise speed"
         )
     frames = np.arange(n_whole + 1, dtype=float)
-    if last - n_whole > 1e-9:
+    if last - n_whole > 1e-9 or n_whole == 0:  # the last frame exactly at t = T
         frames = np.append(frames, last)
-    if frames.size < 2:  # pragma: no cover - last > 0 always adds a frame
-        frames = np.array([0.0, last])
     times = np.minimum(frames * speed / fps, duration)
     times[-1] = duration
     q = problem.trajectory.sample(x, times / duration, orders=(0,)).q
     base = scene.robot_base
 
     objects: list[SceneObject] = []
-    # --- robot: the visual solids, in the visual model's colours
-    visual = robot.visual_model
+    # --- robot: the visual solids, in the visual model's colours (else the collision solids)
+    visual = robot.visual_model if robot.visual_model.ngeoms else robot.collision_model
     solid_poses = base @ robot.geometry_poses(q, visual)  # (n, n_geom, 4, 4)
     for k, g in enumerate(visual.geometryObjects):
         rgba = np.asarray(g.meshColor, dtype=float)
         material = mg.MeshLambertMaterial(color=_hex(rgba[:3]), opacity=float(rgba[3]))
-        parts = _coal_parts(g.geometry, material, g.name, getattr(g, "meshPath", ""), g)
+        parts = _solid_parts(g, material)
         objects.append(SceneObject(f"robot/{g.name}", parts, solid_poses[:, k]))
 
     # --- obstacles, at the physical time of each frame
@@ -306,7 +313,11 @@ def build_animation(
         )
         objects.extend(_closest_objects(closest_points))
 
-    target, position = _camera(objects, tool)
+    seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
+    seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
+    seen_points = np.vstack(seen)
+    objects.extend(_floor(seen_points))
+    target, position = _camera(seen_points)
     return Playback(
         objects=tuple(objects),
         times=_read_only(times),
@@ -339,7 +350,7 @@ def _read_only(arr: np.ndarray) -> np.ndarray:
 
 
 def _hex(rgb: np.ndarray) -> int:
-    r, g, b = (int(round(255 * min(max(float(c), 0.0), 1.0))) for c in rgb)
+    r, g, b = (round(255 * min(max(float(c), 0.0), 1.0)) for c in rgb)
     return (r << 16) | (g << 8) | b
 
 
@@ -378,10 +389,10 @@ def _shape_parts(shape: Shape, material: mg.Material) -> tuple[Part, ...]:
     raise InvalidInputError(f"cannot draw obstacle shape {type(shape).__name__}")
 
 
-def _coal_parts(
-    geometry: Any, material: mg.Material, name: str, mesh_path: str, gobj: Any
-) -> tuple[Part, ...]:
-    """Meshcat parts of a robot solid (a coal geometry in the solid's frame)."""
+def _solid_parts(gobj: Any, material: mg.Material) -> tuple[Part, ...]:
+    """Meshcat parts of a robot solid (a ``pinocchio.GeometryObject``: a coal geometry in the
+    solid's frame, or a mesh file)."""
+    geometry, name = gobj.geometry, gobj.name
     if isinstance(geometry, coal.Box):
         lengths = [2.0 * float(h) for h in geometry.halfSide]
         return (Part(mg.Mesh(mg.Box(lengths), material), np.eye(4)),)
@@ -397,6 +408,7 @@ def _coal_parts(
         return (Part(mg.Mesh(cone, material), _Y_TO_Z.copy()),)
     if isinstance(geometry, coal.Ellipsoid):
         return (Part(mg.Mesh(mg.Ellipsoid(list(geometry.radii)), material), np.eye(4)),)
+    mesh_path = str(getattr(gobj, "meshPath", "") or "")
     path = Path(mesh_path) if mesh_path else None
     if path is not None and path.is_file():
         loaders = {
@@ -478,29 +490,61 @@ def _closest_objects(points: np.ndarray) -> list[SceneObject]:
     return [SceneObject("closest/segment", (rod,), seg_poses, scales), *ends]
 
 
-def _camera(objects: Sequence[SceneObject], tool: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A camera target (the centre of everything drawn) and a position seeing all of it."""
-    pts = [tool]
-    for obj in objects:
-        pts.append(obj.poses[..., :3, 3].reshape(-1, 3))
-    allp = np.vstack(pts)
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
+def _floor(points: np.ndarray) -> list[SceneObject]:
+    """The floor z = 0 under ``points`` (n, 3): a light slab with a 0.1 m grid, and the world
+    axes (x red, y green, z blue, 0.2 m) at the origin."""
+    lo = np.floor((points[:, :2].min(axis=0) - _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
+    hi = np.ceil((points[:, :2].max(axis=0) + _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
+    size = hi - lo
+    slab = mg.Mesh(mg.Box([*size, 0.004]), mg.MeshLambertMaterial(color=FLOOR_COLOR))
+    centre = _translation([*(0.5 * (lo + hi)), -0.0021])
+    segments = []
+    for axis in (0, 1):
+        n = round(size[axis] / _GRID_STEP)
+        for v in lo[axis] + _GRID_STEP * np.arange(n + 1):
+            a, b = np.zeros(3), np.zeros(3)
+            a[axis] = b[axis] = v
+            a[1 - axis], b[1 - axis] = lo[1 - axis], hi[1 - axis]
+            segments += [a, b]
+    grid = mg.LineSegments(
+        mg.PointsGeometry(np.ascontiguousarray(np.array(segments).T, dtype=np.float32)),
+        mg.LineBasicMaterial(color=GRID_COLOR),
+    )
+    return [
+        SceneObject("floor/slab", (Part(slab, np.eye(4)),), centre),
+        SceneObject("floor/grid", (Part(grid, np.eye(4)),), np.eye(4)),
+        SceneObject("floor/axes", (Part(mg.triad(0.2), np.eye(4)),), np.eye(4)),
+    ]
+
+
+def _camera(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A camera target (the centre of the box around ``points`` (n, 3)) and a position from
+    which all of it is in view [m]."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
     target = 0.5 * (lo + hi)
-    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.5) + 0.2
-    distance = 1.15 * radius / math.tan(math.radians(0.5 * _FOV_DEG))
+    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.3) + 0.15
+    distance = 1.05 * radius / math.tan(math.radians(0.5 * _FOV_DEG))
     direction = _VIEW_DIRECTION / np.linalg.norm(_VIEW_DIRECTION)
     return target, target + distance * direction
 
 
 # ============================================================================ drawing
 def draw(vis: meshcat.Visualizer, playback: Playback, *, loop: bool = True) -> None:
-    """Send ``playback`` to ``vis``: background, camera, every node, then the animation
-    (playing; looping forever when ``loop``, else played once)."""
+    """Send ``playback`` to ``vis`` (a top-level visualizer): background, camera, every node,
+    then the animation (playing; looping forever when ``loop``, else played once).
+
+    Meshcat's orbit camera always turns about the viewer's origin, so the visualizer's root
+    node is shifted by ``-playback.camera_target``: every node below it keeps its world pose.
+    Meshcat's own grid and axes (20 m wide, at the viewer's origin) are hidden; the playback
+    draws its own floor and world axes.
+    """
+    vis.set_transform(_translation(-playback.camera_target))
+    vis["/Grid"].set_property("visible", False)
+    vis["/Axes"].set_property("visible", False)
     vis["/Background"].set_property("top_color", list(BACKGROUND_RGB))
     vis["/Background"].set_property("bottom_color", list(BACKGROUND_RGB))
-    vis["/Cameras/default"].set_transform(_translation(playback.camera_target))
     dx, dy, dz = playback.camera_position - playback.camera_target
-    # the camera sits in the y-up frame "rotated" (x, y, z)_world = (x, -z, y)_rotated
+    # the camera sits in the y-up frame "rotated": (x, y, z)_world = (x, -z, y)_rotated
     vis["/Cameras/default/rotated/<object>"].set_property(
         "position", [float(dx), float(dz), float(-dy)]
     )
@@ -683,10 +727,10 @@ def render_html(playback: Playback, *, loop: bool = True, title: str = "adept_tr
     draw(meshcat.Visualizer(window=window), playback, loop=loop)
     commands = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in window.commands)
     return (
-        "<!DOCTYPE html>\n<html>\n<head>\n<meta charset=\"utf-8\">\n"
+        '<!DOCTYPE html>\n<html>\n<head>\n<meta charset="utf-8">\n'
         f"<title>{html.escape(title)}</title>\n"
         "<style>body { margin: 0; } #meshcat-pane { width: 100vw; height: 100vh; "
-        "overflow: hidden; }</style>\n</head>\n<body>\n<div id=\"meshcat-pane\"></div>\n"
+        'overflow: hidden; }</style>\n</head>\n<body>\n<div id="meshcat-pane"></div>\n'
         f"<script>\n{_viewer_js()}\n</script>\n"
         "<script>\n"
         'var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));\n'

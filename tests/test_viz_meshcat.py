@@ -1,0 +1,312 @@
+"""Meshcat playback: the animation's frames and poses, the self-contained HTML page rendered
+for real in headless Chromium (two instants), and the live viewer bound to 127.0.0.1."""
+
+from __future__ import annotations
+
+import base64
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+import umsgpack
+
+from adept_traj import Robot, Scene
+from adept_traj.collision import CollisionChecker
+from adept_traj.errors import InvalidInputError
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import BestSolution, Front, PlanningResult, Timing
+from adept_traj.verification import certify
+from adept_traj.viz import meshcat_view as mv
+
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--disable-gpu",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--host-resolver-rules=MAP * ~NOTFOUND",  # no network: the page must not need it
+    "--window-size=800,600",
+]
+BUDGETS_MS = (300, 1500)  # two instants of the animation (T = 2.1 s, real time)
+
+
+def smoothstep(z: np.ndarray) -> np.ndarray:
+    return 10 * z**3 - 15 * z**4 + 6 * z**5
+
+
+def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
+    """The collision-free move of tests/test_problem.py (copied: this file stands alone)."""
+    traj = problem.trajectory
+    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
+    start, goal = problem.start, problem.goal
+    free = start + (goal - start) * smoothstep(xi)[:, None]
+    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
+    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
+    return traj.encode(T, free)
+
+
+@pytest.fixture(scope="module")
+def problem() -> TrajectoryProblem:
+    scene = Scene.paper()
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+
+
+@pytest.fixture(scope="module")
+def result(problem: TrajectoryProblem) -> PlanningResult:
+    x = lift_then_lower(problem)[None]
+    return PlanningResult.from_problem(
+        problem,
+        algorithm="NSGA-II",
+        algorithm_settings={},
+        seed=1,
+        front=Front.from_evaluation(x, problem.evaluate_batch(x)),
+        best=BestSolution(0),
+        certificate=certify(problem, x[0]),
+        timing=Timing(total_s=1.0, evaluation_s=1.0, n_evaluations=1, n_generations=1),
+    )
+
+
+@pytest.fixture(scope="module")
+def page(result: PlanningResult, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return mv.static_html(result, tmp_path_factory.mktemp("viz") / "run" / "playback.html")
+
+
+# ============================================================================ no server
+def test_viz_package_is_lazy() -> None:
+    code = (
+        "import sys, adept_traj, adept_traj.viz as v\n"
+        "assert 'meshcat' not in sys.modules and 'matplotlib' not in sys.modules\n"
+        "assert sorted(v.__all__) == ['meshcat_view', 'plots']\n"
+        "v.meshcat_view\n"
+        "assert 'meshcat' in sys.modules and 'matplotlib' not in sys.modules\n"
+        "try:\n    v.nothing\nexcept AttributeError:\n    pass\nelse:\n    raise SystemExit(1)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+
+
+def test_frames_and_poses(result: PlanningResult, problem: TrajectoryProblem) -> None:
+    pb = mv.build_animation(result, show_closest=True)
+    T = float(result.best_x[0])
+    assert pytest.approx(2.1) == T
+    assert pb.duration == pytest.approx(T)
+    assert pb.n_frames == math.ceil(30 * T) + 1
+    assert pb.times[0] == 0.0
+    assert pb.times[-1] == T
+    np.testing.assert_allclose(pb.frame_numbers, pb.times * 30, atol=1e-9)
+    np.testing.assert_allclose(pb.q[0], problem.start, atol=1e-12)
+    np.testing.assert_allclose(pb.q[-1], problem.goal, atol=1e-12)
+
+    objects = {o.path: o for o in pb.objects}
+    robot, scene = problem.robot, problem.scene
+    # every visual solid of the robot, in the WORLD frame, in the visual model's colours
+    names = [g.name for g in robot.visual_model.geometryObjects]
+    assert {f"robot/{n}" for n in names} <= set(objects)
+    k = names.index("link4/gripper")
+    world = scene.robot_base @ robot.geometry_poses(pb.q, robot.visual_model)[:, k]
+    np.testing.assert_allclose(objects["robot/link4/gripper"].poses, world, atol=1e-12)
+    mesh = objects["robot/link4/gripper"].parts[0].obj
+    assert mesh.material.color == 0xD9731A  # rgba 0.85 0.45 0.1 of the URDF
+    np.testing.assert_allclose(mesh.geometry.lengths, [0.12, 0.06, 0.05])
+    quill = objects["robot/link4/quill"].parts[0]  # meshcat cylinder: y axis turned onto z
+    np.testing.assert_allclose(quill.local[:3, :3] @ [0, 1, 0], [0, 0, 1], atol=1e-15)
+    # fixed obstacles static, the pendulum animated at the physical time of each frame
+    assert not objects["obstacles/cube1"].animated
+    np.testing.assert_allclose(objects["obstacles/cube1"].poses[:3, 3], [0.9, 0.7, 0.15])
+    bob = objects["obstacles/pendulum.bob"]
+    assert bob.animated
+    np.testing.assert_allclose(bob.poses, scene.obstacle("pendulum.bob").pose(pb.times))
+    # tool path from start to goal, world frame
+    tool = scene.robot_base @ robot.tool_pose(np.vstack([problem.start, problem.goal]))
+    np.testing.assert_allclose(pb.tool_path[[0, -1]], tool[:, :3, 3], atol=1e-12)
+    # closest points: exact distances, the segment joins the two witness points
+    checker = CollisionChecker(robot, scene)
+    exact = checker.distances(pb.q, pb.times, exact=True).min_distance
+    np.testing.assert_allclose(pb.closest_distance, exact, atol=1e-9)
+    gap = np.linalg.norm(pb.closest_points[:, 1] - pb.closest_points[:, 0], axis=-1)
+    np.testing.assert_allclose(gap, np.abs(pb.closest_distance), atol=1e-9)
+    seg = objects["closest/segment"]
+    ends = seg.poses[:, :3, :3] @ (seg.scales * [0, 0.5, 0])[..., None]
+    np.testing.assert_allclose(seg.poses[:, :3, 3] + ends[..., 0], pb.closest_points[:, 1])
+    # the animation: one clip per moving node, keyframes in frames at the playback fps
+    anim = pb.animation()
+    clip = anim.clips[mv.MeshcatPath(("meshcat", "robot", "link4", "gripper"))]
+    assert clip.fps == 30.0
+    assert clip.tracks["position"].frames[-1] == pytest.approx(30 * T)
+    assert mv.MeshcatPath(("meshcat", "obstacles", "cube1")) not in anim.clips
+
+
+def test_speed_and_fps(result: PlanningResult) -> None:
+    slow = mv.build_animation(result, speed=0.5, fps=10)
+    T = slow.duration
+    assert slow.n_frames == math.ceil(10 * T / 0.5) + 1
+    assert slow.playback_duration == pytest.approx(2 * T)
+    np.testing.assert_allclose(np.diff(slow.times)[:-1], 0.05)
+    assert slow.closest_points is None
+    assert not any(o.path.startswith("closest/") for o in slow.objects)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"speed": 0}, "speed"),
+        ({"speed": -1.0}, "speed"),
+        ({"speed": float("nan")}, "speed"),
+        ({"speed": float("inf")}, "speed"),
+        ({"speed": "1"}, "speed"),
+        ({"fps": 0}, "fps"),
+        ({"fps": True}, "fps"),
+        ({"fps": 1e7}, "MAX_FRAMES"),
+        ({"show_closest": "yes"}, "show_closest"),
+    ],
+)
+def test_bad_input(result: PlanningResult, kwargs: dict, match: str, tmp_path: Path) -> None:
+    with pytest.raises(InvalidInputError, match=match):
+        mv.build_animation(result, **kwargs)
+    with pytest.raises(InvalidInputError, match=match):
+        mv.static_html(result, tmp_path / "p.html", **kwargs)
+    with pytest.raises(InvalidInputError, match=match):  # before any server starts
+        mv.show(result, **kwargs)
+    assert not (tmp_path / "p.html").exists()
+
+
+def test_not_a_result(tmp_path: Path) -> None:
+    with pytest.raises(InvalidInputError, match="PlanningResult"):
+        mv.static_html("out", tmp_path / "p.html")
+
+
+# ============================================================================ static page
+def page_commands(text: str) -> list[dict]:
+    block = re.search(r"var adeptTrajCommands = \[(.*?)\];", text, re.S)
+    assert block is not None
+    return [umsgpack.unpackb(base64.b64decode(s)) for s in re.findall(r'"([^"]+)"', block[1])]
+
+
+def test_static_html_is_self_contained(page: Path, result: PlanningResult) -> None:
+    text = page.read_text(encoding="utf-8")
+    assert 0.5e6 < len(text) < 3e6
+    assert "MeshCat.Viewer" in text  # the viewer is inlined
+    # nothing to fetch: no external script, stylesheet, image, fetch() or import()
+    assert not re.search(r"<(?:script|link|img|iframe)\b[^>]*\b(?:src|href)\s*=", text, re.I)
+    assert not re.search(r"""(?:fetch|import)\s*\(\s*["'`](?:https?:)?//""", text)
+    urls = set(re.findall(r"https?://[^\s\"'<>)]+", text))
+    assert all(u.startswith("http://www.w3.org/") for u in urls), urls  # XML namespaces only
+    # the scene and the animation are in the page, playing and looping
+    commands = page_commands(text)
+    drawn = {c["path"] for c in commands if c["type"] == "set_object"}
+    assert "/meshcat/robot/link4/gripper/part0" in drawn
+    assert "/meshcat/obstacles/pendulum.bob/part0" in drawn
+    assert "/meshcat/tool_path/line/part0" in drawn
+    (anim,) = [c for c in commands if c["type"] == "set_animation"]
+    assert commands[-1] is anim
+    assert anim["options"] == {"play": True, "repetitions": math.inf}
+    clips = {a["path"]: a["clip"] for a in anim["animations"]}
+    assert "/meshcat/obstacles/pendulum.rod" in clips
+    assert "/meshcat/obstacles/cube1" not in clips
+    keys = clips["/meshcat/robot/link2/outer_arm"]["tracks"][0]["keys"]
+    assert len(keys) == math.ceil(30 * float(result.best_x[0])) + 1
+    assert keys[-1]["time"] == pytest.approx(30 * float(result.best_x[0]))
+
+
+def chromium() -> str:
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        pytest.skip("headless Chromium is not installed (Debian: apt-get install -y chromium)")
+    return exe
+
+
+def screenshot(exe: str, page: Path, png: Path, budget_ms: int, profile: Path) -> np.ndarray:
+    import matplotlib.image
+
+    args = [
+        exe,
+        *CHROMIUM_FLAGS,
+        f"--user-data-dir={profile}",
+        f"--virtual-time-budget={budget_ms}",
+        f"--screenshot={png}",
+        page.resolve().as_uri(),
+    ]
+    try:
+        run = subprocess.run(args, capture_output=True, text=True, timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"headless Chromium did not finish within 60 s: {' '.join(args)}")
+    assert png.is_file(), f"no screenshot (exit {run.returncode}): {run.stderr[-2000:]}"
+    return matplotlib.image.imread(png)[..., :3]
+
+
+def test_page_renders_in_headless_chromium(page: Path, tmp_path: Path) -> None:
+    exe = chromium()
+    shots = [
+        screenshot(exe, page, tmp_path / f"t{ms}.png", ms, tmp_path / f"profile{ms}")
+        for ms in BUDGETS_MS
+    ]
+    for img in shots:
+        assert img.shape == (600, 800, 3)
+        r, g, b = img[..., 0], img[..., 1], img[..., 2]
+        drawn = np.abs(img - np.array(mv.BACKGROUND_RGB)).max(axis=-1) > 0.03
+        assert drawn.mean() > 0.15  # floor, obstacles and robot cover much of the view
+        # the robot, in its own colours: blue elbow housing, orange gripper
+        assert ((b > r + 0.25) & (b > g + 0.1)).sum() > 300
+        assert ((r > 0.7) & (g > 0.3) & (g < 0.6) & (b < 0.25)).sum() > 30
+        assert ((r > g + 0.3) & (r > b + 0.3)).sum() > 3000  # the red cubes
+        assert ((r > g + 0.15) & (b > g + 0.15)).sum() > 300  # the purple pendulum
+    moved = np.abs(shots[0] - shots[1]).max(axis=-1) > 0.1
+    assert moved.sum() > 5000  # the robot and the pendulum moved between the two instants
+
+
+# ============================================================================ live viewer
+def listening_addresses(pid: int) -> list[tuple[str, str, int]]:
+    """(family, local address hex, port) of every listening TCP socket of process pid."""
+    inodes = set()
+    for fd in Path(f"/proc/{pid}/fd").iterdir():
+        try:
+            target = os.readlink(fd)
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target[8:-1])
+    found = []
+    for family in ("tcp", "tcp6"):
+        rows = Path(f"/proc/net/{family}").read_text().splitlines()[1:]
+        for row in rows:
+            cols = row.split()
+            if cols[3] == "0A" and cols[9] in inodes:  # state LISTEN
+                address, port = cols[1].split(":")
+                found.append((family, address, int(port, 16)))
+    return found
+
+
+def test_show_serves_on_localhost_only(
+    result: PlanningResult, capsys: pytest.CaptureFixture[str]
+) -> None:
+    vis = mv.show(result, speed=2.0, show_closest=True)
+    window = vis.window
+    try:
+        assert capsys.readouterr().out == ""  # prints nothing (meshcat itself would)
+        url = vis.url()
+        assert re.fullmatch(r"http://127\.0\.0\.1:\d+/static/", url)
+        assert re.fullmatch(r"tcp://127\.0\.0\.1:\d+", window.zmq_url)
+        with urllib.request.urlopen(url, timeout=10) as reply:
+            assert reply.status == 200
+            assert b"meshcat" in reply.read().lower()
+        if Path("/proc/net/tcp").is_file():
+            sockets = listening_addresses(window.server_proc.pid)
+            ports = {int(url.rsplit(":", 1)[1].split("/")[0]), int(window.zmq_url.rsplit(":")[-1])}
+            assert {p for _, _, p in sockets} == ports
+            assert all(f == "tcp" and a == "0100007F" for f, a, _ in sockets), sockets
+    finally:
+        vis.close()
+    assert window.closed
+    assert window.server_proc.poll() is not None
+    vis.close()  # idempotent
