@@ -114,8 +114,9 @@ def make_algorithm(
     if key not in ALGORITHMS:
         raise ConfigurationError(f"unknown algorithm {name!r}; choose one of {list(ALGORITHMS)}")
     defaults = dict(_PAPER.get(key, {"pop_size": 100, "n_gen": 100}))
-    pop = _positive_int(defaults.pop("pop_size") if pop_size is None else pop_size, "pop_size", 2)
-    gens = _positive_int(defaults.pop("n_gen") if n_gen is None else n_gen, "n_gen", 1)
+    default_pop, default_gens = defaults.pop("pop_size"), defaults.pop("n_gen")
+    pop = _positive_int(default_pop if pop_size is None else pop_size, "pop_size", 2)
+    gens = _positive_int(default_gens if n_gen is None else n_gen, "n_gen", 1)
     unknown = sorted(set(params) - set(defaults))
     if unknown:
         raise ConfigurationError(

@@ -92,10 +92,13 @@ def _parser() -> argparse.ArgumentParser:
     p_cmp.add_argument("--pop-nsga2", type=int, help="NSGA-II population (default 100)")
     p_cmp.add_argument("--pop-mode", type=int, help="MODE population (default 500)")
     p_cmp.add_argument("--out", type=Path, required=True, help="output folder")
+    p_cmp.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
 
     p_plan.add_argument(
         "--no-html", action="store_true", help="do not write playback.html (static meshcat)"
     )
+    p_plan.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
+    p_plan.add_argument("--ros", type=Path, help="also export the best trajectory as ROS JSON")
 
     p_show = sub.add_parser("show", help="play a saved result in the browser (meshcat)")
     p_show.add_argument("folder", type=Path, help="result folder (with result.json)")
@@ -193,7 +196,7 @@ def _plan(args: argparse.Namespace) -> int:
         saved = json.loads(run_file.read_text())
         folder, resume = args.resume, True
         for key, value in saved.items():
-            setattr(args, key, value)
+            setattr(args, key, Path(value) if key == "ros" and value is not None else value)
     else:
         if args.out is None:
             raise ConfigurationError("give --out DIR (or --resume DIR)")
@@ -202,9 +205,10 @@ def _plan(args: argparse.Namespace) -> int:
     folder.mkdir(parents=True, exist_ok=True)
     if not resume:
         keys = ("scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens")
-        keys = (*keys, "workers", "no_html")
+        keys = (*keys, "workers", "no_html", "no_plots", "ros")
         saved = {k: getattr(args, k) for k in keys}
         saved["scene"] = str(saved["scene"])
+        saved["ros"] = None if saved["ros"] is None else str(saved["ros"])
         (folder / _RUN_FILE).write_text(json.dumps(saved, indent=1))
     try:
         result = plan(
@@ -229,10 +233,29 @@ def _plan(args: argparse.Namespace) -> int:
         from .viz import meshcat_view
 
         meshcat_view.static_html(result, folder / "playback.html")
+    if not args.no_plots:
+        _figures({args.algorithm: result}, folder / "figures")
+    if args.ros is not None:
+        from .export import save_ros_joint_trajectory
+
+        save_ros_joint_trajectory(result, args.ros, allow_infeasible=not result.feasible)
+        print(f"ROS JointTrajectory written to {args.ros}")
     shutil.rmtree(folder / "checkpoint", ignore_errors=True)
     (folder / _RUN_FILE).unlink(missing_ok=True)
     print(_summary(result, folder))
     return 0
+
+
+def _figures(results: dict[str, PlanningResult], folder: Path) -> None:
+    """The paper's figures as PNGs (matplotlib, the ``plot`` extra)."""
+    try:
+        from .viz import plots
+
+        paths = plots.save_all(results, folder)
+    except ImportError as exc:
+        print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
+        return
+    print(f"{len(paths)} figures in {folder}")
 
 
 def _show(args: argparse.Namespace) -> int:
@@ -380,6 +403,8 @@ def _compare(args: argparse.Namespace) -> int:
         results[name].save(args.out / name)
         print(_summary(results[name], args.out / name))
     problem.close()
+    if not args.no_plots:
+        _figures(results, args.out / "figures")
     text = _comparison_markdown(results, args.weights)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "comparison.md").write_text(text)

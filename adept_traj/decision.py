@@ -14,7 +14,7 @@ module implements
   ``docs/decision-and-metrics.md``);
 * :func:`best_tradeoff` — a documented, deterministic rule combining both scores.
 
-Objective arrays ``F`` have shape ``(n, m)`` (paper: m = 6, ``[z1..z6]`` with z4 = |det J|
+Objective arrays ``F`` have shape ``(n, m)`` (paper: m = 6, ``[z1..z6]`` with z4 = :math:`|\det J|`
 positive and maximised); the sense is given by ``maximised`` (default :data:`MAXIMISED`).
 Inputs are never modified. Feasibility and non-dominance are the caller's business: pass
 the feasible Pareto front.

@@ -27,10 +27,10 @@ class JointLimits:
     names: joint names, in the order of q.
     units: ``"rad"`` (revolute) or ``"m"`` (prismatic) per joint.
     lower, upper: position limits [rad | m] (QC).
-    velocity: max |q̇| [rad/s | m/s] (VC).
-    acceleration: max |q̈| [rad/s² | m/s²] (WC); ``inf`` when unknown.
-    jerk: max |q⃛| [rad/s³ | m/s³] (JC); ``inf`` when unknown.
-    effort: max |u| [N·m | N] (UC).
+    velocity: max ``|q̇|`` [rad/s | m/s] (VC).
+    acceleration: max ``|q̈|`` [rad/s² | m/s²] (WC); ``inf`` when unknown.
+    jerk: max ``|q⃛|`` [rad/s³ | m/s³] (JC); ``inf`` when unknown.
+    effort: max ``|u|`` [N·m | N] (UC).
     """
 
     names: tuple[str, ...]

@@ -145,8 +145,8 @@ class PendulumMotion(MotionLaw):
 
     It is a prescribed (kinematic) law, not a simulation. With the paper's numbers
     (v0 = 2 m/s, g = 9.81 m/s², l = 1 m) ω = 3.14 rad/s is close to √(g/l) = 3.13 rad/s, so the
-    law is close to the small-amplitude pendulum: the bob's arc speed l·|φ̇| stays within
-    0.05 m/s (2.5 % of v0) of |v(t)|; φ_max = 0.650 rad (37.2°), h_max = 0.204 m.
+    law is close to the small-amplitude pendulum: the bob's arc speed ``l·|φ̇|`` stays within
+    0.05 m/s (2.5 % of v0) of ``|v(t)|``; φ_max = 0.650 rad (37.2°), h_max = 0.204 m.
 
     The moving frame (what :meth:`pose` returns) has its origin at the pivot, its z axis along
     the rod pointing from the bob to the pivot, its y axis ``e_n = e_z × e_swing`` (normal to
@@ -288,14 +288,14 @@ class PendulumMotion(MotionLaw):
     def swept_ball(
         self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0
     ) -> tuple[np.ndarray, float]:
-        """Smallest ball containing the arc swept by ``point`` (|φ| ≤ φ_max), grown by ``radius``.
+        """Smallest ball holding the arc swept by ``point`` (``|φ| ≤ φ_max``), grown by ``radius``.
 
         The point ``(a, b, c)`` of the pendulum frame turns about the normal axis through the
         pivot on a circle of radius ρ = √(a² + c²), over an arc of half-angle φ_max centred on
         its rest position ``p0`` (φ = 0). For φ_max ≤ π/2 the smallest ball containing the arc
         has its centre on the chord's midpoint, ``axis point + cos φ_max · (p0 − axis point)``,
         and radius ``ρ · sin φ_max``; beyond, the circle's centre and radius ρ are used.
-        Valid for all t since |φ(t)| ≤ φ_max always.
+        Valid for all t since ``|φ(t)| ≤ φ_max`` always.
         """
         p, r = _check_ball(point, radius)
         a, b, c = p

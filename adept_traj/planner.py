@@ -82,25 +82,32 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
 _HV_GENERATIONS = 25
 
 
+def _z4_positive(F: np.ndarray) -> np.ndarray:
+    """pymoo's objectives (z4 negated) as reported (z4 positive)."""
+    out = np.array(F, dtype=float)
+    out[:, 3] = -out[:, 3]
+    return out
+
+
 def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecord]:
     """Generation records with the hypervolume of each generation's feasible front, on the
-    bounds of the final front (reference point 1.1), for up to ``_HV_GENERATIONS``
-    generations of this session (a resumed run has none for the generations before)."""
+    bounds of the final front and of every generation's front (reference point 1.1), for
+    up to ``_HV_GENERATIONS`` generations of this session (a resumed run has none for the
+    generations before)."""
     n = len(state.history)
     offset = n - len(state.fronts)  # generations restored from a checkpoint
     chosen = set()
     if final_front is not None and len(state.fronts):
         k = len(state.fronts)
         chosen = {int(i) for i in np.linspace(0, k - 1, min(k, _HV_GENERATIONS)).round()}
-        lo, hi = objective_bounds(final_front)
+        positive = [_z4_positive(F) for F in state.fronts if len(F)]
+        lo, hi = objective_bounds(final_front, *positive)  # a one-point front would collapse
     records = []
     for i, h in enumerate(state.history):
         hv = None
         j = i - offset
         if j in chosen and len(state.fronts[j]):
-            F = state.fronts[j].copy()
-            F[:, 3] = -F[:, 3]  # back to z4 positive
-            hv = normalised_hypervolume(F, lo, hi)
+            hv = normalised_hypervolume(_z4_positive(state.fronts[j]), lo, hi)
         records.append(
             GenerationRecord(
                 generation=h["generation"],

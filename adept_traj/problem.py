@@ -4,16 +4,16 @@ r"""The paper's trajectory problem: six objectives and 21 constraints, batched (
 of :class:`~adept_traj.trajectory.BSplineTrajectory` (``[T, free control points]``).
 For a population ``x`` (pop, n_var) it returns (pymoo minimises):
 
-============  =====================================================================  ===========
-objective     definition                                                             paper
-============  =====================================================================  ===========
-z1            travel time :math:`T` [s]                                              (1)
+============  =======================================================================  ===========
+objective     definition                                                               paper
+============  =======================================================================  ===========
+z1            travel time :math:`T` [s]                                                (1)
 z2            :math:`\int_0^T \sum_i u_i^2\,dt` [N²·m²·s], Gauss–Legendre per segment  (2)
-z3            clearance penalty :math:`\sum_o \max(0, 1 - d_o/\delta)^2` [-]          (3), 13–16
-z4            :math:`\min_t |\det J(q(t))|` [m²] (entered negated: maximised)         (4)
-z5            :math:`\sum_i \int_0^T \dddot q_i^2\,dt` exact [rad²/s⁵ …]              (5)
-z6            :math:`\sum_i \int_0^T \ddot q_i^2\,dt` exact [rad²/s³ …]               (6)
-============  =====================================================================  ===========
+z3            clearance penalty :math:`\sum_o \max(0, 1 - d_o/\delta)^2` [-]           (3), 13–16
+z4            :math:`\min_t |\det J(q(t))|` [m²] (entered negated: maximised)          (4)
+z5            :math:`\sum_i \int_0^T \dddot q_i^2\,dt` exact [rad²/s⁵ …]               (5)
+z6            :math:`\sum_i \int_0^T \ddot q_i^2\,dt` exact [rad²/s³ …]                (6)
+============  =======================================================================  ===========
 
 where :math:`d_o` is the exact smallest signed distance between any robot solid and obstacle
 ``o`` over the motion (moving obstacles at their pose at each instant) and :math:`\delta` the

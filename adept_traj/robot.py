@@ -5,7 +5,7 @@
 batched over any leading axes (population, time, …):
 
 - :meth:`Robot.inverse_dynamics` — joint torques/forces with rotor inertia and friction;
-- :meth:`Robot.manipulability` — the paper's z4 = |det J| (eq. 4);
+- :meth:`Robot.manipulability` — the paper's z4 = ``|det J|`` (eq. 4);
 - :meth:`Robot.tool_pose`, :meth:`Robot.tool_jacobian`, :meth:`Robot.geometry_poses`.
 
 Joint values are in SI units: [rad] for revolute joints, [m] for prismatic ones. For the

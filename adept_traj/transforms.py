@@ -79,7 +79,7 @@ def xyz_rpy_from_transform(transform: Any) -> tuple[np.ndarray, np.ndarray]:
     """Translation and URDF roll-pitch-yaw angles of rigid transforms.
 
     Inverse of :func:`transform_from_xyz_rpy`, with pitch in [-π/2, π/2] and roll, yaw in
-    (-π, π]. At gimbal lock (|pitch| = π/2) roll is set to 0 and yaw carries the rotation.
+    (-π, π]. At gimbal lock (``|pitch| = π/2``) roll is set to 0 and yaw carries the rotation.
 
     Args:
         transform: (..., 4, 4) rigid transforms.

@@ -17,15 +17,15 @@ optimiser's coarse Gauss–Legendre samples:
 
 Each limit kind is summarised per joint by a :class:`LimitCheck`:
 
-==============  ================================================================  =========
-kind            value per joint                                                   feasible
-==============  ================================================================  =========
+==============  ========================================================================  =========
+kind            value per joint                                                           feasible
+==============  ========================================================================  =========
 position        :math:`\max_t \max(q - q^{\max},\ q^{\min} - q) / (q^{\max} - q^{\min})`  ≤ 0
-velocity        :math:`\max_t |\dot q| / VC`                                       ≤ 1
-acceleration    :math:`\max_t |\ddot q| / WC`                                      ≤ 1
-jerk            :math:`\max_t |\dddot q| / JC`                                     ≤ 1
-torque          :math:`\max_k |u(t_k)| / UC`                                       ≤ 1
-==============  ================================================================  =========
+velocity        :math:`\max_t |\dot q| / VC`                                              ≤ 1
+acceleration    :math:`\max_t |\ddot q| / WC`                                             ≤ 1
+jerk            :math:`\max_t |\dddot q| / JC`                                            ≤ 1
+torque          :math:`\max_k |u(t_k)| / UC`                                              ≤ 1
+==============  ========================================================================  =========
 
 (the position value is the problem's constraint :math:`g^q`: ≤ 0 inside the limits, the
 fraction of the joint range beyond the nearer limit otherwise; an infinite limit gives the

@@ -4,10 +4,11 @@ Build (exactly what ``tests/test_docs.py`` and CI run; warnings are errors)::
 
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
-The Markdown pages are read by myst-parser; the API reference (``api.md``) is generated from
-the numpy-style docstrings by autodoc + napoleon. The build needs no network: there is no
-intersphinx, and MathJax is only *linked* from its CDN (``mathjax_path`` is left at Sphinx's
-default), so a reader's browser loads it when a page with formulas is opened.
+The Markdown pages are read by myst-parser; the API reference (``api.md``) is generated
+from the docstrings (numpy and Google sections, RST ``.. math::``) by autodoc + napoleon.
+The build needs no network: there is no intersphinx, and MathJax is only *linked* from its
+CDN (``mathjax_path`` is left at Sphinx's default), so a reader's browser loads it when a
+page with formulas is opened.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import adept_traj
 
 project = "adept_traj"
 author = "adept_traj developers"
-copyright = "adept_traj developers, BSD-3-Clause"  # noqa: A001 (Sphinx's name)
+copyright = "adept_traj developers, BSD-3-Clause"
 version = release = adept_traj.__version__
 
 # -- General -----------------------------------------------------------------------------
@@ -65,8 +66,9 @@ napoleon_use_rtype = False
 autodoc_default_options = {
     "members": True,  # the names in each module's __all__
     "member-order": "bysource",
-    "show-inheritance": True,
 }
+# "show-inheritance" is set per module in api.md where the bases say something (errors,
+# pymoo subclasses); elsewhere it would print "Bases: object" under every dataclass.
 autodoc_typehints = "signature"
 autodoc_typehints_format = "short"
 autodoc_class_signature = "mixed"
@@ -122,11 +124,7 @@ def _is_header(lines: list[str], i: int) -> bool:
     if i + 1 >= len(lines) or not lines[i].strip():
         return False
     rule = lines[i + 1].strip()
-    return (
-        len(rule) >= 3
-        and set(rule) == {"-"}
-        and _indent(lines[i + 1]) == _indent(lines[i])
-    )
+    return len(rule) >= 3 and set(rule) == {"-"} and _indent(lines[i + 1]) == _indent(lines[i])
 
 
 def _project_numpy_sections(app, what, name, obj, options, lines: list[str]) -> None:
@@ -199,8 +197,46 @@ def _plain_property_type(app, what, name, obj, options, lines: list[str]) -> Non
                 lines[k] = ":Type: " + line[len(":type: ") :]
 
 
+# ``q_min, q_max: ...`` in an "Attributes" section becomes ``:ivar q_min, q_max:``, which
+# Sphinx reads as the variable ``q_max`` of type ``q_min,``. One field per name instead.
+_MULTI_IVAR = re.compile(r"^:(?P<kind>ivar|vartype) (?P<names>\w+(?:, \w+)+):(?P<rest>.*)$")
+
+
+def _split_multi_name_ivars(app, what, name, obj, options, lines: list[str]) -> None:
+    out: list[str] = []
+    k = 0
+    while k < len(lines):
+        m = _MULTI_IVAR.match(lines[k])
+        if not m:
+            out.append(lines[k])
+            k += 1
+            continue
+        end = k + 1
+        while end < len(lines) and lines[end].startswith(" ") and lines[end].strip():
+            end += 1
+        continuation = [c.strip() for c in lines[k + 1 : end]]
+        for one in m["names"].split(", "):
+            out.append(f":{m['kind']} {one}:{m['rest']}")
+            out += ["   " + c for c in continuation]
+        k = end
+    lines[:] = out
+
+
+def _public_bases(app, name, obj, options, bases: list) -> None:
+    """Show a private base class (``_ValueObject``) as its own bases."""
+    public: list = []
+    for base in bases:
+        if getattr(base, "__name__", "").startswith("_"):
+            public += [b for b in base.__bases__ if b is not object]
+        else:
+            public.append(base)
+    bases[:] = public
+
+
 def setup(app):
     # Priorities: lower runs first; napoleon's hook has the default 500.
     app.connect("autodoc-process-docstring", _project_numpy_sections, priority=400)
     app.connect("autodoc-process-docstring", _plain_property_type, priority=600)
+    app.connect("autodoc-process-docstring", _split_multi_name_ivars, priority=600)
+    app.connect("autodoc-process-bases", _public_bases)
     return {"parallel_read_safe": True}

@@ -4,14 +4,14 @@ Every function takes one :class:`~adept_traj.results.PlanningResult` or a mappin
 ``{name: PlanningResult}`` (e.g. ``{"nsga2": r1, "mode": r2}``), writes a PNG and returns
 its :class:`~pathlib.Path`:
 
-=========================  ==========================================================
-:func:`pareto_matrix`      scatter matrix of z1…z6 of the fronts (Figs. 5–6)
-:func:`best_tradeoffs`     the best trade-offs side by side, normalised bars (Fig. 7)
-:func:`joint_motion`       q, q̇, q̈, q⃛ and u of every joint against time (Figs. 8–9)
-:func:`tool_path_3d`       tool path, obstacles and pendulum in the world (Fig. 4)
-:func:`hypervolume_history` hypervolume (or feasible count) per generation
-:func:`save_all`           all of the above into a folder
-=========================  ==========================================================
+===========================  ==========================================================
+:func:`pareto_matrix`        scatter matrix of z1…z6 of the fronts (Figs. 5–6)
+:func:`best_tradeoffs`       the best trade-offs side by side, normalised bars (Fig. 7)
+:func:`joint_motion`         q, q̇, q̈, q⃛ and u of every joint against time (Figs. 8–9)
+:func:`tool_path_3d`         tool path, obstacles and pendulum in the world (Fig. 4)
+:func:`hypervolume_history`  hypervolume (or feasible count) per generation
+:func:`save_all`             all of the above into a folder
+===========================  ==========================================================
 
 matplotlib is imported lazily, inside the functions (``pip install 'adept-traj[plot]'``).
 Figures are drawn on the Agg canvas directly: no pyplot state, no window, nothing is
@@ -159,10 +159,13 @@ def _save(fig: Figure, path: Path) -> Path:
 
 
 def _padded(lo: float, hi: float, frac: float = 0.06) -> tuple[float, float]:
-    from matplotlib.transforms import nonsingular
-
-    pad = frac * (hi - lo)
-    return nonsingular(lo - pad, hi + pad, expander=0.05)
+    """Axis limits around [lo, hi], widened by ``frac`` of the span on each side; a
+    single value v gets ±5 % of |v| (±0.05 for 0)."""
+    span = hi - lo
+    if span <= 1e-12 * max(abs(lo), abs(hi)) or span == 0.0:
+        pad = 0.05 * abs(lo) if lo != 0.0 else 0.05
+        return lo - pad, hi + pad
+    return lo - frac * span, hi + frac * span
 
 
 def _front_rows(result: PlanningResult) -> np.ndarray:
@@ -173,6 +176,15 @@ def _front_rows(result: PlanningResult) -> np.ndarray:
 
 def _status(result: PlanningResult) -> str:
     return "verified feasible" if result.feasible else "NOT feasible"
+
+
+def _violations(result: PlanningResult, at_most: int = 2) -> str:
+    """A second title line listing the certificate's first violations (or nothing)."""
+    v = result.certificate.violations
+    if not v:
+        return ""
+    more = f"; {len(v) - at_most} more" if len(v) > at_most else ""
+    return "\n" + "; ".join(v[:at_most]) + more
 
 
 # ============================================================================ Figs. 5–6
@@ -203,7 +215,7 @@ def pareto_matrix(
     labels = _labels(res)
     m = len(OBJECTIVE_LABELS)
     allobj = np.vstack([r.front.objectives for r in res.values()])
-    limits = [_padded(float(allobj[:, j].min()), float(allobj[:, j].max())) for j in range(m)]
+    limits = [_padded(float(allobj[:, j].min()), float(allobj[:, j].max()), 0.09) for j in range(m)]
 
     # histogram heights: share of each front per bin, on one scale for all results
     peak = max(
@@ -250,11 +262,11 @@ def pareto_matrix(
                 ax.scatter(
                     [x[best]],
                     [y[best]],
-                    s=170,
+                    s=230 * 0.72**k,  # shrinking: coinciding best trade-offs stay visible
                     marker="*",
                     facecolors=colour if feas[best] else "white",
-                    edgecolors="black",
-                    lw=1.0,
+                    edgecolors="black" if feas[best] else colour,
+                    lw=1.0 if feas[best] else 2.0,
                     zorder=5,
                 )
     for i in range(m):
@@ -298,7 +310,10 @@ def pareto_matrix(
         Line2D([], [], ls="", marker="*", ms=13, mfc="grey", mec="black", label="best trade-off"),
     ]
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), bbox_to_anchor=(0.5, 0.95))
-    sizes = ", ".join(f"{labels[k]}: {len(r.front)} solutions" for k, r in res.items())
+    sizes = ", ".join(
+        f"{labels[k]}: {len(r.front)} solution{'s' if len(r.front) != 1 else ''}"
+        for k, r in res.items()
+    )
     fig.suptitle(
         f"Final fronts, objectives z1…z6 ({sizes})\ndiagonal: histogram of each objective "
         "(share of each front per bin, one scale for all)",
@@ -341,7 +356,7 @@ def best_tradeoffs(
 
     fig = _figure(12.0, 6.5)
     ax = fig.add_subplot()
-    fig.subplots_adjust(left=0.09, right=0.98, bottom=0.16, top=0.88)
+    fig.subplots_adjust(left=0.09, right=0.98, bottom=0.16, top=0.85)
     width = 0.8 / n
     x0 = np.arange(m)
     for k, key in enumerate(res):
@@ -353,6 +368,8 @@ def best_tradeoffs(
             width * 0.92,
             color=_COLOURS[k],
             alpha=0.85,
+            edgecolor=_COLOURS[k],
+            linewidth=1.5,  # a zero score still shows as a line
             label=f"{labels[key]} (F_avg on these bounds {scores[k].mean():.3f}, {_status(r)})",
         )
         for xi, s, v in zip(xs, scores[k], bests[k]):
@@ -381,8 +398,10 @@ def best_tradeoffs(
     ax.set_xlabel(
         "objective [unit]\n[Z_min, Z_max] over all fronts and best trade-offs", fontsize=9
     )
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 1.1), ncol=min(n, 3), fontsize=9)
-    ax.set_title("Best trade-offs (raw values on the bars)", fontsize=12, pad=30)
+    fig.legend(loc="upper center", bbox_to_anchor=(0.5, 0.93), ncol=min(n, 3), fontsize=9)
+    fig.suptitle("Best trade-offs: six objectives scored on common bounds", fontsize=13, y=0.98)
+    ax.text(0.995, 0.99, "raw values on the bars", transform=ax.transAxes, ha="right",
+            va="top", fontsize=8, color="dimgrey")  # fmt: skip
     return _save(fig, out)
 
 
@@ -482,7 +501,7 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     fig.suptitle(
         f"{_display(r.algorithm)}: joint motion of the best trade-off, "
         f"T = {r.best_objectives[0]:.3f} s "
-        f"({_status(r)} at {r.certificate.rate_hz:g} Hz)",
+        f"({_status(r)} at {r.certificate.rate_hz:g} Hz)" + _violations(r),
         fontsize=13,
         x=0.06,
         ha="left",
@@ -492,7 +511,9 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
 
 
 # ============================================================================ Fig. 4
-def _circle(centre: np.ndarray, u: np.ndarray, v: np.ndarray, radius: float, n: int = 40):
+def _circle(
+    centre: np.ndarray, u: np.ndarray, v: np.ndarray, radius: float, n: int = 40
+) -> np.ndarray:
     a = np.linspace(0.0, 2.0 * np.pi, n)
     return centre + radius * (np.cos(a)[:, None] * u + np.sin(a)[:, None] * v)
 
@@ -660,9 +681,15 @@ def tool_path_3d(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     # ---- 2-D projections, zoomed on the tool path
     centre = 0.5 * (tool.min(axis=0) + tool.max(axis=0))
     half = 0.5 * float((tool.max(axis=0) - tool.min(axis=0)).max()) + 0.12
+    close_layer: list[np.ndarray] = []  # the robot at the closest approach (2-D views)
+    if k_close is not None:
+        poses = base @ robot.geometry_poses(dense.q[k_close])
+        for g, pose in zip(robot.collision_model.geometryObjects, poses):
+            close_layer += _coal_wireframe(g.geometry, pose)
+    close_style = {"colors": "black", "linewidths": 0.9, "linestyles": ":"}
     for axv, dims, title in views:
         i, j = dims
-        for lines, style in layers:
+        for lines, style in (*layers, (close_layer, close_style)):
             if lines:
                 axv.add_collection(LineCollection([ln[:, dims] for ln in lines], **style))
         path2 = LineCollection(segments[:, :, dims], cmap=cmap, norm=norm, linewidths=2.6)
@@ -694,18 +721,28 @@ def tool_path_3d(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
         Line2D([], [], color=cmap(0.6), lw=2.6, label="tool path (colour: time)"),
         Line2D([], [], ls="", marker="o", color=cmap(0.0), mec="black", label="start"),
         Line2D([], [], ls="", marker="s", color=cmap(1.0), mec="black", label="goal"),
-        Line2D([], [], color="saddlebrown", label="fixed obstacles"),
-        Line2D([], [], color="tab:red", alpha=0.5, label="moving obstacles at t = 0 (light), T"),
-        Line2D([], [], color="tab:red", ls="--", label="moving sphere (bob) centre over [0, T]"),
+    ]
+    if scene.fixed:
+        handles.append(Line2D([], [], color="saddlebrown", label="fixed obstacles"))
+    if scene.moving:
+        label = "moving obstacles at t = 0 (light), T"
+        handles.append(Line2D([], [], color="tab:red", alpha=0.5, label=label))
+    if any(isinstance(ob.shape, Sphere) for ob in scene.moving):
+        label = "moving sphere (bob) centre over [0, T]"
+        handles.append(Line2D([], [], color="tab:red", ls="--", label=label))
+    handles += [
         Line2D([], [], color="dimgrey", label="robot solids at start (dark), goal (light)"),
         Line2D([], [], ls="", marker="^", color="dimgrey", label="robot base"),
     ]
     if closest:
         handles.append(Line2D([], [], ls="", marker="X", color="black", label=closest))
+        handles.append(
+            Line2D([], [], color="black", ls=":", label="robot solids then (right-hand views)")
+        )
     ax.legend(handles=handles, loc="upper left", fontsize=8, bbox_to_anchor=(0.03, 1.02))
     fig.suptitle(
         f"{_display(r.algorithm)}: tool path of the best trade-off in the world frame, "
-        f"T = {T:.3f} s ({_status(r)})",
+        f"T = {T:.3f} s ({_status(r)})" + _violations(r),
         fontsize=13,
     )
     return _save(fig, out)
@@ -719,6 +756,11 @@ def _evaluations_per_generation(history: Sequence[Any]) -> int:
     if len(evals) < 2:
         return int(evals[0] / max(gens[0], 1.0))
     return round(float(np.median(np.diff(evals) / np.maximum(np.diff(gens), 1.0))))
+
+
+def _records_hypervolume(histories: Any) -> bool:
+    """True when some history records a hypervolume (else feasible counts are drawn)."""
+    return any(rec.hypervolume is not None for h in histories for rec in h)
 
 
 def hypervolume_history(
@@ -751,7 +793,7 @@ def hypervolume_history(
     have = {k: r.history for k, r in res.items() if r.history}
     if not have:
         raise InvalidInputError("no result has a per-generation history to plot")
-    use_hv = any(rec.hypervolume is not None for h in have.values() for rec in h)
+    use_hv = _records_hypervolume(have.values())
 
     fig = _figure(9.0, 5.5)
     ax = fig.add_subplot()
@@ -774,8 +816,20 @@ def hypervolume_history(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=9)
     if use_hv:
+        ceilings = {
+            float(np.prod(r.metrics.hv_reference_point))
+            for r in res.values()
+            if r.metrics.hv_reference_point is not None
+        }
+        if len(ceilings) == 1:
+            (top,) = ceilings
+            ax.axhline(top, color="grey", ls=":", lw=1.0, label=f"maximum {top:.4g} (∏ ref. point)")
+            ax.legend(fontsize=9)
         ax.set_ylabel("hypervolume of the feasible front [-] (normalised objectives)")
-        ax.set_title("Hypervolume per generation")
+        title = "Hypervolume per generation"
+        if len(have) > 1:
+            title += "\neach run normalised on the bounds of its own final front: compare shapes"
+        ax.set_title(title)
     else:
         ax.set_ylabel("feasible individuals in the population [-]")
         ax.set_title("No hypervolume recorded in the history: feasible individuals per generation")

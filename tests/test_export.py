@@ -1,0 +1,266 @@
+"""adept_traj.export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
+dictionary and JSON file carry the dense trajectory exactly, with a correct
+time_from_start, or the spline resampled at a given rate; bad inputs are refused."""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from adept_traj import Robot, Scene
+from adept_traj.errors import InvalidInputError
+from adept_traj.export import (
+    MAX_ROS_POINTS,
+    _duration,
+    save_ros_joint_trajectory,
+    to_csv,
+    to_ros_joint_trajectory,
+)
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import BestSolution, Front, PlanningResult, Timing
+from adept_traj.verification import certify
+
+
+def smoothstep(z: np.ndarray) -> np.ndarray:
+    return 10 * z**3 - 15 * z**4 + 6 * z**5
+
+
+def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
+    """The collision-free move of tests/test_problem.py (copied: this file stands alone)."""
+    traj = problem.trajectory
+    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
+    start, goal = problem.start, problem.goal
+    free = start + (goal - start) * smoothstep(xi)[:, None]
+    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
+    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
+    return traj.encode(T, free)
+
+
+@pytest.fixture(scope="module")
+def problem() -> TrajectoryProblem:
+    scene = Scene.paper()
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+
+
+def make_result(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> PlanningResult:
+    x = np.atleast_2d(x)
+    return PlanningResult.from_problem(
+        problem,
+        algorithm="NSGA-II",
+        algorithm_settings={},
+        seed=1,
+        front=Front.from_evaluation(x, problem.evaluate_batch(x)),
+        best=BestSolution(0),
+        certificate=certify(problem, x[0], rate_hz=rate_hz),
+        timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),
+    )
+
+
+@pytest.fixture(scope="module")
+def result(problem: TrajectoryProblem) -> PlanningResult:
+    r = make_result(problem, lift_then_lower(problem), rate_hz=1000.0)
+    assert r.feasible
+    return r
+
+
+@pytest.fixture(scope="module")
+def infeasible(problem: TrajectoryProblem) -> PlanningResult:
+    r = make_result(problem, problem.trajectory.straight_line(1.5), rate_hz=200.0)
+    assert not r.feasible  # the straight move hits cube 1
+    return r
+
+
+def column(msg: dict[str, Any], key: str) -> np.ndarray:
+    return np.array([p[key] for p in msg["points"]], dtype=float)
+
+
+def times(msg: dict[str, Any]) -> np.ndarray:
+    return np.array(
+        [
+            p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"]
+            for p in msg["points"]
+        ]
+    )
+
+
+# ============================================================================ CSV
+def test_csv_equals_the_result_folder_file(result: PlanningResult, tmp_path: Path) -> None:
+    folder = result.save(tmp_path / "run")
+    out = to_csv(result, tmp_path / "new" / "trajectory.csv")
+    assert out == tmp_path / "new" / "trajectory.csv"
+    assert out.read_bytes() == (folder / "best_trajectory.csv").read_bytes()
+
+
+def test_csv_round_trip(result: PlanningResult, tmp_path: Path) -> None:
+    rows = list(csv.reader(to_csv(result, tmp_path / "t.csv").open(encoding="utf-8")))
+    names = result.robot.joint_names
+    header = ["t"]
+    for prefix in ("q", "qd", "qdd", "qddd", "tau"):
+        header += [f"{prefix}_{n}" for n in names]
+    assert rows[0] == [*header, "min_distance"]
+    table = np.array(rows[1:], dtype=float)
+    d = result.best_trajectory
+    expected = np.column_stack([d.t, d.q, d.qd, d.qdd, d.qddd, d.tau, d.min_distance])
+    assert table.shape == expected.shape
+    assert np.array_equal(table, expected)  # exact: shortest round-trip floats
+
+
+def test_csv_bad_input(tmp_path: Path) -> None:
+    with pytest.raises(InvalidInputError, match="PlanningResult"):
+        to_csv("result", tmp_path / "t.csv")  # type: ignore[arg-type]
+
+
+# ============================================================================ ROS
+def test_ros_dense_round_trip(result: PlanningResult) -> None:
+    msg = to_ros_joint_trajectory(result)
+    assert set(msg) == {"header", "joint_names", "points"}
+    assert msg["header"] == {"frame_id": ""}
+    assert msg["joint_names"] == ["joint1", "joint2", "joint3", "joint4"]
+    assert msg["joint_names"] == list(result.robot.joint_names)
+    d = result.best_trajectory
+    assert len(msg["points"]) == d.t.size == result.certificate.n_samples
+    assert set(msg["points"][0]) == {
+        "positions",
+        "velocities",
+        "accelerations",
+        "effort",
+        "time_from_start",
+    }
+    for key, expected in (
+        ("positions", d.q),
+        ("velocities", d.qd),
+        ("accelerations", d.qdd),
+        ("effort", d.tau),
+    ):
+        assert np.array_equal(column(msg, key), expected), key
+    np.testing.assert_allclose(times(msg), d.t, rtol=0, atol=0.6e-9)
+
+
+def test_time_from_start(result: PlanningResult) -> None:
+    points = to_ros_joint_trajectory(result)["points"]
+    stamps = [(p["time_from_start"]["sec"], p["time_from_start"]["nanosec"]) for p in points]
+    for sec, nanosec in stamps:
+        assert type(sec) is int
+        assert type(nanosec) is int
+        assert sec >= 0
+        assert 0 <= nanosec < 1_000_000_000
+    assert stamps[0] == (0, 0)
+    assert all(a < b for a, b in itertools.pairwise(stamps))  # strictly increasing
+    T = float(result.best_x[0])
+    assert stamps[-1] == divmod(round(T * 1e9), 1_000_000_000)
+    assert any(sec >= 1 for sec, _ in stamps)  # T = 2.1 s: the seconds carry
+
+
+@pytest.mark.parametrize(
+    ("t", "expected"),
+    [
+        (0.0, (0, 0)),
+        (1.5, (1, 500_000_000)),
+        (2.1, (2, 100_000_000)),
+        (0.000_000_001, (0, 1)),
+        (2.999_999_999_9, (3, 0)),  # rounds up to the next second, not nanosec = 10⁹
+        (12.345_678_901_2, (12, 345_678_901)),
+    ],
+)
+def test_duration_split(t: float, expected: tuple[int, int]) -> None:
+    assert _duration(t) == {"sec": expected[0], "nanosec": expected[1]}
+
+
+def test_resampled_at_the_certificate_rate_equals_the_dense_samples(
+    result: PlanningResult,
+) -> None:
+    msg = to_ros_joint_trajectory(result, rate_hz=result.certificate.rate_hz)
+    d = result.best_trajectory
+    for key, expected in (
+        ("positions", d.q),
+        ("velocities", d.qd),
+        ("accelerations", d.qdd),
+        ("effort", d.tau),
+    ):
+        np.testing.assert_allclose(column(msg, key), expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(times(msg), d.t, atol=1e-9)
+
+
+@pytest.mark.parametrize("rate", [50, 125.0, np.float64(333.3)])
+def test_resampled_from_the_spline(
+    result: PlanningResult, problem: TrajectoryProblem, rate: float
+) -> None:
+    msg = to_ros_joint_trajectory(result, rate_hz=rate)
+    x = result.best_x
+    T = float(x[0])
+    n = math.ceil(T * float(rate) - 1e-9) + 1
+    assert len(msg["points"]) == n
+    t = times(msg)
+    assert t[0] == 0.0
+    assert abs(t[-1] - T) <= 1e-9
+    assert np.diff(t).max() <= 1.0 / float(rate) + 1e-9
+    exact = problem.trajectory.sample(x, np.linspace(0.0, 1.0, n))
+    np.testing.assert_allclose(column(msg, "positions"), exact.q, atol=1e-15)
+    np.testing.assert_allclose(column(msg, "velocities"), exact.qd, atol=1e-12)
+    np.testing.assert_allclose(column(msg, "accelerations"), exact.qdd, atol=1e-12)
+    tau = problem.robot.inverse_dynamics(exact.q, exact.qd, exact.qdd)
+    np.testing.assert_allclose(column(msg, "effort"), tau, atol=1e-9)
+    np.testing.assert_allclose(msg["points"][0]["positions"], result.start, atol=1e-12)
+    np.testing.assert_allclose(msg["points"][-1]["positions"], result.goal, atol=1e-12)
+    np.testing.assert_allclose(msg["points"][0]["velocities"], 0.0, atol=1e-12)
+    np.testing.assert_allclose(msg["points"][-1]["velocities"], 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "rate",
+    [0, -10.0, math.nan, math.inf, True, "100", [100.0]],
+    ids=["zero", "negative", "nan", "inf", "bool", "str", "list"],
+)
+def test_bad_rate(result: PlanningResult, rate: object) -> None:
+    with pytest.raises(InvalidInputError, match="rate_hz"):
+        to_ros_joint_trajectory(result, rate_hz=rate)  # type: ignore[arg-type]
+
+
+def test_too_many_points(result: PlanningResult) -> None:
+    rate = 2.0 * MAX_ROS_POINTS / float(result.best_x[0])
+    with pytest.raises(InvalidInputError, match="at most"):
+        to_ros_joint_trajectory(result, rate_hz=rate)
+
+
+def test_infeasible_is_refused_unless_allowed(infeasible: PlanningResult, tmp_path: Path) -> None:
+    with pytest.raises(InvalidInputError, match="not verified feasible"):
+        to_ros_joint_trajectory(infeasible)
+    with pytest.raises(InvalidInputError, match="allow_infeasible"):
+        save_ros_joint_trajectory(infeasible, tmp_path / "t.json")
+    assert not (tmp_path / "t.json").exists()
+    msg = to_ros_joint_trajectory(infeasible, allow_infeasible=True)
+    assert len(msg["points"]) == infeasible.certificate.n_samples
+
+
+def test_bad_result() -> None:
+    with pytest.raises(InvalidInputError, match="PlanningResult"):
+        to_ros_joint_trajectory({"points": []})  # type: ignore[arg-type]
+
+
+def test_saved_json_is_valid_and_equal(result: PlanningResult, tmp_path: Path) -> None:
+    out = save_ros_joint_trajectory(result, tmp_path / "ros" / "trajectory.json")
+    assert out == tmp_path / "ros" / "trajectory.json"
+    text = out.read_text(encoding="utf-8")
+
+    def reject(constant: str) -> None:
+        raise AssertionError(f"JSON holds {constant}")
+
+    data = json.loads(text, parse_constant=reject)
+    assert "NaN" not in text
+    assert "Infinity" not in text
+    assert data == to_ros_joint_trajectory(result)  # exact floats after the round trip
+    assert len(text.splitlines()) == len(data["points"]) + 6  # one point per line
+
+
+def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:
+    out = save_ros_joint_trajectory(result, tmp_path / "t.json", rate_hz=100)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert len(data["points"]) == math.ceil(float(result.best_x[0]) * 100 - 1e-9) + 1
+    assert data == to_ros_joint_trajectory(result, rate_hz=100)
