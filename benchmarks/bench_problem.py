@@ -21,26 +21,17 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import tracemalloc
 from pathlib import Path
 
 import numpy as np
+from _timing import best_of  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
 from adept_traj.problem import TrajectoryProblem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_problem import lift_then_lower  # the tests' collision-free move
-
-
-def best_time(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+from paper_moves import lift_then_lower  # a hand-made collision-free move
 
 
 def main() -> None:
@@ -75,9 +66,9 @@ def main() -> None:
     for name, pop in populations.items():
         problem.evaluate_batch(pop[:5])  # warm-up
         ev = problem.evaluate_batch(pop)
-        batched = args.pop / best_time(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
+        batched = args.pop / best_of(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
         few = pop[: args.reference]
-        reference = len(few) / best_time(lambda few=few: problem.evaluate_reference(few), 1)
+        reference = len(few) / best_of(lambda few=few: problem.evaluate_reference(few), 1)
         print(
             f"{name:<15}{batched:>13.0f}{reference:>16.1f}{batched / reference:>7.0f}×"
             f"{ev.n_narrow / args.pop:>15.1f}{int(ev.feasible.sum()):>10}"
@@ -85,8 +76,8 @@ def main() -> None:
     parallel = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=args.workers)
     parallel.evaluate_batch(populations["random"][:40])  # start the workers
     for name, pop in populations.items():
-        serial = args.pop / best_time(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
-        both = args.pop / best_time(lambda pop=pop: parallel.evaluate_batch(pop), args.repeat)
+        serial = args.pop / best_of(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
+        both = args.pop / best_of(lambda pop=pop: parallel.evaluate_batch(pop), args.repeat)
         print(
             f"{name:<15} {args.workers} workers: {both:.0f} ev/s, serial {serial:.0f} ev/s "
             f"({both / serial:.2f}×)"

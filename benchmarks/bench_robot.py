@@ -8,23 +8,12 @@ ratios, not absolute times).
 from __future__ import annotations
 
 import argparse
-import time
-from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
+from _timing import best_of  # benchmarks/_timing.py
 
 from adept_traj import Robot
-
-
-def best_of(fn: Callable[[], object], repeat: int = 3) -> float:
-    """Best wall time [s] of ``repeat`` calls."""
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

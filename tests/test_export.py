@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from paper_moves import lift_then_lower, single_result
 
-from adept_traj import Robot, Scene
 from adept_traj.errors import InvalidInputError
 from adept_traj.export import (
     MAX_ROS_POINTS,
@@ -24,55 +24,19 @@ from adept_traj.export import (
     to_ros_joint_trajectory,
 )
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import BestSolution, Front, PlanningResult, Timing
-from adept_traj.verification import certify
-
-
-def smoothstep(z: np.ndarray) -> np.ndarray:
-    return 10 * z**3 - 15 * z**4 + 6 * z**5
-
-
-def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
-    """The collision-free move of tests/test_problem.py (copied: this file stands alone)."""
-    traj = problem.trajectory
-    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
-    start, goal = problem.start, problem.goal
-    free = start + (goal - start) * smoothstep(xi)[:, None]
-    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
-    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
-    return traj.encode(T, free)
-
-
-@pytest.fixture(scope="module")
-def problem() -> TrajectoryProblem:
-    scene = Scene.paper()
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
-
-
-def make_result(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> PlanningResult:
-    x = np.atleast_2d(x)
-    return PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=Front.from_evaluation(x, problem.evaluate_batch(x)),
-        best=BestSolution(0),
-        certificate=certify(problem, x[0], rate_hz=rate_hz),
-        timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),
-    )
+from adept_traj.results import PlanningResult
 
 
 @pytest.fixture(scope="module")
 def result(problem: TrajectoryProblem) -> PlanningResult:
-    r = make_result(problem, lift_then_lower(problem), rate_hz=1000.0)
+    r = single_result(problem, lift_then_lower(problem), rate_hz=1000.0)
     assert r.feasible
     return r
 
 
 @pytest.fixture(scope="module")
 def infeasible(problem: TrajectoryProblem) -> PlanningResult:
-    r = make_result(problem, problem.trajectory.straight_line(1.5), rate_hz=200.0)
+    r = single_result(problem, problem.trajectory.straight_line(1.5), rate_hz=200.0)
     assert not r.feasible  # the straight move hits cube 1
     return r
 

@@ -12,12 +12,6 @@ from adept_traj.results import NO_FEASIBLE_WARNING
 
 
 @pytest.fixture(scope="module")
-def problem() -> at.TrajectoryProblem:
-    scene = at.Scene.paper()
-    return at.TrajectoryProblem(at.Robot.adept_one_xl(), scene, scene.start, scene.goal)
-
-
-@pytest.fixture(scope="module")
 def small_run(problem: at.TrajectoryProblem) -> at.PlanningResult:
     return at.plan(problem, "nsga2", seed=2, pop_size=40, n_gen=25)
 

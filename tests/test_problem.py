@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from paper_moves import lift_then_lower
 
 from adept_traj import Robot, Scene
 from adept_traj.collision import CollisionChecker
@@ -19,27 +20,6 @@ def robot() -> Robot:
 @pytest.fixture(scope="module")
 def scene() -> Scene:
     return Scene.paper()
-
-
-@pytest.fixture(scope="module")
-def problem(robot: Robot, scene: Scene) -> TrajectoryProblem:
-    return TrajectoryProblem(robot, scene, scene.start, scene.goal)
-
-
-def smoothstep(z: np.ndarray) -> np.ndarray:
-    return 10 * z**3 - 15 * z**4 + 6 * z**5
-
-
-def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
-    """A hand-made move: θ1, θ2, θ4 on a smooth ramp; d3 held at its start value (tool high
-    over cube 1) until ``late`` of the control polygon, then lowered to the goal."""
-    traj = problem.trajectory
-    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
-    start, goal = problem.start, problem.goal
-    free = start + (goal - start) * smoothstep(xi)[:, None]
-    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
-    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
-    return traj.encode(T, free)
 
 
 def dense_check(problem: TrajectoryProblem, x: np.ndarray, rate: float = 1000.0) -> dict:

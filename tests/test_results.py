@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from paper_moves import lift_then_lower
 
 from adept_traj import Robot, Scene
 from adept_traj.errors import AdeptTrajError, InvalidInputError
@@ -30,27 +31,6 @@ from adept_traj.results import (
     Timing,
 )
 from adept_traj.verification import certify
-
-
-def smoothstep(z: np.ndarray) -> np.ndarray:
-    return 10 * z**3 - 15 * z**4 + 6 * z**5
-
-
-def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
-    """The collision-free move of tests/test_problem.py (copied: this file stands alone)."""
-    traj = problem.trajectory
-    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
-    start, goal = problem.start, problem.goal
-    free = start + (goal - start) * smoothstep(xi)[:, None]
-    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
-    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
-    return traj.encode(T, free)
-
-
-@pytest.fixture(scope="module")
-def problem() -> TrajectoryProblem:
-    scene = Scene.paper()
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
 
 
 def make_result(problem: TrajectoryProblem, x: np.ndarray, **overrides: Any) -> PlanningResult:

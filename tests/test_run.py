@@ -7,18 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from adept_traj import Robot, Scene, TrajectoryProblem
+from adept_traj import TrajectoryProblem
 from adept_traj.algorithms import ALGORITHMS, make_algorithm
 from adept_traj.errors import ConfigurationError
 from adept_traj.repair import kinematic_time
 from adept_traj.run import PlanningInterrupted, optimise
 from adept_traj.sampling import RampSampling
-
-
-@pytest.fixture(scope="module")
-def problem() -> TrajectoryProblem:
-    scene = Scene.paper()
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
 
 
 @pytest.mark.parametrize("name", ["nsga2", "mode"])

@@ -16,13 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import umsgpack
+from paper_moves import lift_then_lower, single_result
 
-from adept_traj import Robot, Scene
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import BestSolution, Front, PlanningResult, Timing
-from adept_traj.verification import certify
+from adept_traj.results import PlanningResult
 from adept_traj.viz import meshcat_view as mv
 
 CHROMIUM_FLAGS = [
@@ -41,40 +40,9 @@ CHROMIUM_FLAGS = [
 BUDGETS_MS = (300, 1500)  # two instants of the animation (T = 2.1 s, real time)
 
 
-def smoothstep(z: np.ndarray) -> np.ndarray:
-    return 10 * z**3 - 15 * z**4 + 6 * z**5
-
-
-def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.55) -> np.ndarray:
-    """The collision-free move of tests/test_problem.py (copied: this file stands alone)."""
-    traj = problem.trajectory
-    xi = np.linspace(0.0, 1.0, traj.n_control)[3:-3]
-    start, goal = problem.start, problem.goal
-    free = start + (goal - start) * smoothstep(xi)[:, None]
-    ramp = np.clip((xi - late) / (1 - late), 0.0, 1.0)
-    free[:, 2] = start[2] + (goal[2] - start[2]) * smoothstep(ramp)
-    return traj.encode(T, free)
-
-
-@pytest.fixture(scope="module")
-def problem() -> TrajectoryProblem:
-    scene = Scene.paper()
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
-
-
 @pytest.fixture(scope="module")
 def result(problem: TrajectoryProblem) -> PlanningResult:
-    x = lift_then_lower(problem)[None]
-    return PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=Front.from_evaluation(x, problem.evaluate_batch(x)),
-        best=BestSolution(0),
-        certificate=certify(problem, x[0]),
-        timing=Timing(total_s=1.0, evaluation_s=1.0, n_evaluations=1, n_generations=1),
-    )
+    return single_result(problem, lift_then_lower(problem))
 
 
 @pytest.fixture(scope="module")
