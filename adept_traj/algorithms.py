@@ -17,7 +17,8 @@ trials are merged and the next population is chosen by non-dominated sorting and
 distance (pymoo's ``RankAndCrowding``, feasibility first), the usual (μ + λ) selection of
 multi-objective DE (Babu & Jehan 2003; Robič & Filipič's DEMO uses the same survival).
 
-Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``moead``, ``rvea``
+Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``rvea`` (pymoo's MOEA/D handles no
+constraints, so it is not offered)
 (reference directions: Das–Dennis with 3 partitions for 6 objectives when needed).
 
 Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless another
@@ -50,7 +51,7 @@ _PAPER: dict[str, dict[str, Any]] = {
     },
     "mode": {"pop_size": 500, "n_gen": 100, "CR": 0.9, "F": 0.5},
 }
-_OTHERS = ("nsga3", "unsga3", "smsemoa", "moead", "rvea")
+_OTHERS = ("nsga3", "unsga3", "smsemoa", "rvea")
 
 #: Names accepted by :func:`make_algorithm`.
 ALGORITHMS: tuple[str, ...] = (*_PAPER, *_OTHERS)
@@ -93,7 +94,9 @@ def make_algorithm(
         are accepted).
     pop_size, n_gen:
         Population size (≥ 2) and generations (≥ 1); default: the paper's (NSGA-II 100 ×
-        100, MODE 500 × 100) or 100 × 100 for the others.
+        100, MODE 500 × 100) or 100 × 100 for the others. NSGA-III, U-NSGA-III and RVEA
+        use 56 reference directions (Das–Dennis, 3 partitions, 6 objectives); give them a
+        population of at least 56.
     sampling:
         Initial population (pymoo sampling, array or population); default
         :class:`~adept_traj.sampling.RampSampling`.
@@ -192,10 +195,6 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
         from pymoo.algorithms.moo.sms import SMSEMOA
 
         return SMSEMOA(pop_size=pop, sampling=sampling, repair=repair)
-    if key == "moead":
-        from pymoo.algorithms.moo.moead import MOEAD
-
-        return MOEAD(ref_dirs=ref_dirs(), sampling=sampling, repair=repair)
     from pymoo.algorithms.moo.rvea import RVEA
 
     return RVEA(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair)

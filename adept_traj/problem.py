@@ -40,7 +40,7 @@ import multiprocessing
 import signal
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import coal
@@ -50,8 +50,9 @@ from pymoo.core.problem import Problem
 
 from ._validation import as_batch
 from .collision import CollisionChecker, paper_penalty, point_signed_distance
-from .errors import ConfigurationError, InputShapeError
-from .robot import Robot, coulomb_sign
+from .errors import ConfigurationError, InputShapeError, RobotModelError
+from .parameters import TASK_ROWS
+from .robot import Robot, coulomb_sign, manipulability_measure
 from .scene import Scene
 from .shapes import Box, Sphere
 from .trajectory import BSplineTrajectory, kinematic_lower_bound
@@ -112,8 +113,19 @@ class ProblemSettings:
             raise ConfigurationError(f"workers must be an integer ≥ 1; got {self.workers!r}")
         if self.workers > 1 and "fork" not in multiprocessing.get_all_start_methods():
             raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
-        if int(self.nodes_per_segment) < 1:
-            raise ConfigurationError(f"nodes_per_segment must be ≥ 1; got {self.nodes_per_segment}")
+        n = self.nodes_per_segment
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ConfigurationError(f"nodes_per_segment must be an integer ≥ 1; got {n!r}")
+        if self.t_bounds is not None:
+            try:
+                lo, hi = (float(v) for v in self.t_bounds)
+            except (TypeError, ValueError):
+                raise ConfigurationError(
+                    f"t_bounds must be (T_min, T_max) in seconds; got {self.t_bounds!r}"
+                ) from None
+            if not (np.isfinite(hi) and 0.0 < lo < hi):
+                raise ConfigurationError(f"t_bounds must satisfy 0 < T_min < T_max; got {lo, hi}")
+            object.__setattr__(self, "t_bounds", (lo, hi))
 
 
 @dataclass(frozen=True)
@@ -135,7 +147,6 @@ class Evaluation:
     min_distance: np.ndarray
     n_narrow: int = 0
     seconds: float = 0.0
-    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def feasible(self) -> np.ndarray:
@@ -189,8 +200,15 @@ class TrajectoryProblem(Problem):
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
         self.robot, self.scene, self.settings = robot, scene, settings
         lim = robot.limits
+        if robot.task_rows is None:
+            raise RobotModelError(
+                f"robot '{robot.name}' has no task_rows for the manipulability objective z4: "
+                "give them in its parameter file or Robot.from_urdf(..., task_rows=[...])"
+            )
         self.start = lim.check_position(start, "start")
         self.goal = lim.check_position(goal, "goal")
+        if np.array_equal(self.start, self.goal):
+            raise ConfigurationError("start and goal are the same configuration: nothing to plan")
         if self.start.shape != (robot.nq,) or self.goal.shape != (robot.nq,):
             raise InputShapeError(f"start and goal must have shape ({robot.nq},)")
         self.trajectory = BSplineTrajectory(self.start, self.goal, n_knots=settings.n_knots)
@@ -355,7 +373,7 @@ class TrajectoryProblem(Problem):
         gm = robot.collision_model
         gdata = gm.createData()
         tool_id = model.getFrameId(robot.tool_frame)
-        rows = [("vx", "vy", "vz", "wx", "wy", "wz").index(r) for r in robot.task_rows]
+        rows = [TASK_ROWS.index(r) for r in robot.task_rows]
         obstacle_geoms = [ob.shape.to_coal() for ob in self.scene.obstacles]
         solid_shapes = self.checker.solid_shapes
         req = coal.DistanceRequest()
@@ -377,11 +395,7 @@ class TrajectoryProblem(Problem):
                 z2 += T * w * float(u @ u)
                 u_max = np.maximum(u_max, np.abs(u))
                 jac = pin.computeFrameJacobian(model, data, q, tool_id, pin.LOCAL_WORLD_ALIGNED)
-                jt = jac[rows]
-                if len(rows) == robot.nq:
-                    z4 = min(z4, abs(np.linalg.det(jt)))
-                else:
-                    z4 = min(z4, np.sqrt(max(np.linalg.det(jt @ jt.T), 0.0)))
+                z4 = min(z4, float(manipulability_measure(jac[rows])))
                 pin.updateGeometryPlacements(model, data, gm, gdata, q)
                 tool_points.append(data.oMf[tool_id].translation.copy())
                 poses = self.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]

@@ -28,7 +28,13 @@ from .kinematics import BatchKinematics
 from .limits import JointLimits
 from .parameters import TASK_ROWS, RobotParameters
 
-__all__ = ["VELOCITY_AT_REST", "ForwardKinematics", "Robot", "coulomb_sign"]
+__all__ = [
+    "VELOCITY_AT_REST",
+    "ForwardKinematics",
+    "Robot",
+    "coulomb_sign",
+    "manipulability_measure",
+]
 
 #: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
 #: friction (sign 0): a joint held still must not flip ±F_c on rounding noise (1e-17).
@@ -115,7 +121,7 @@ class Robot:
         if not model.existFrame(tool_frame):
             frames = [f.name for f in model.frames]
             raise RobotModelError(f"robot '{name}': no frame '{tool_frame}'; frames are {frames}")
-        self.tool_frame = tool_frame
+        self._tool_frame = tool_frame
         if task_rows is not None:
             task_rows = tuple(task_rows)
             if not task_rows or any(r not in TASK_ROWS for r in task_rows):
@@ -226,6 +232,11 @@ class Robot:
 
     # ------------------------------------------------------------------ basic facts
     @property
+    def tool_frame(self) -> str:
+        """Name of the tool frame (fixed at construction; build another Robot to change it)."""
+        return self._tool_frame
+
+    @property
     def nq(self) -> int:
         """Number of joint variables."""
         return self.model.nq
@@ -283,7 +294,10 @@ class Robot:
 
         .. math::
             w = |\det J_t| \ \text{(square } J_t\text{, the paper's eq. 4)}, \qquad
-            w = \sqrt{\det(J_t J_t^\top)} \ \text{(Yoshikawa, otherwise)}
+            w = \sqrt{\det(J_t J_t^\top)} \ \text{(Yoshikawa, fewer rows than joints)}
+
+        and :math:`\sqrt{\det(J_t^\top J_t)}` with more rows than joints
+        (:func:`manipulability_measure`).
 
         For the AdeptOne XL (rows v_x, v_y, v_z, ω_z) this is :math:`a_1 a_2 |\sin\theta_2|`
         [m²].
@@ -378,10 +392,26 @@ class Robot:
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
         f = self.model.frames[self._tool_id]
         jac = self.kinematics.jacobian(joint_poses, f.parentJoint, tool[..., :3, 3])
-        jt = jac[..., rows, :]
-        if len(rows) == self.nq:
-            return np.abs(np.linalg.det(jt))
-        return np.sqrt(np.maximum(np.linalg.det(jt @ np.swapaxes(jt, -1, -2)), 0.0))
+        return manipulability_measure(jac[..., rows, :])
+
+
+def manipulability_measure(jt: np.ndarray) -> np.ndarray:
+    r"""Manipulability (...) of task Jacobians ``jt`` (..., m, n).
+
+    .. math::
+        w = |\det J_t| \ (m = n), \qquad
+        w = \sqrt{\det(J_t J_t^\top)} \ (m < n, \text{Yoshikawa}), \qquad
+        w = \sqrt{\det(J_t^\top J_t)} \ (m > n)
+
+    (with more task rows than joints :math:`J_t J_t^\top` is singular; the volume of the
+    n-dimensional velocity ellipsoid is :math:`\sqrt{\det J_t^\top J_t}`).
+    """
+    m, n = jt.shape[-2:]
+    if m == n:
+        return np.abs(np.linalg.det(jt))
+    jt_t = np.swapaxes(jt, -1, -2)
+    gram = jt @ jt_t if m < n else jt_t @ jt
+    return np.sqrt(np.maximum(np.linalg.det(gram), 0.0))
 
 
 def coulomb_sign(v: np.ndarray) -> np.ndarray:

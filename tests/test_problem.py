@@ -8,7 +8,12 @@ from paper_moves import lift_then_lower
 
 from adept_traj import Robot, Scene
 from adept_traj.collision import CollisionChecker
-from adept_traj.errors import ConfigurationError, InputShapeError, JointLimitError
+from adept_traj.errors import (
+    ConfigurationError,
+    InputShapeError,
+    JointLimitError,
+    RobotModelError,
+)
 from adept_traj.problem import TrajectoryProblem
 
 
@@ -131,6 +136,15 @@ def test_bad_input(robot: Robot, scene: Scene) -> None:
         TrajectoryProblem(robot, scene, scene.start, scene.goal, margin=0.1, influence=0.05)
     with pytest.raises(ConfigurationError, match="unknown problem setting"):
         TrajectoryProblem(robot, scene, scene.start, scene.goal, knots=12)
+    with pytest.raises(ConfigurationError, match="t_bounds must"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, t_bounds=(1.0,))
+    with pytest.raises(ConfigurationError, match="nodes_per_segment must be an integer"):
+        TrajectoryProblem(robot, scene, scene.start, scene.goal, nodes_per_segment="x")
+    with pytest.raises(ConfigurationError, match="nothing to plan"):
+        TrajectoryProblem(robot, scene, scene.start, scene.start)
+    bare = Robot.from_urdf(robot.urdf_path)  # no parameter file: no task rows
+    with pytest.raises(RobotModelError, match="no task_rows"):
+        TrajectoryProblem(bare, scene, scene.start, scene.goal)
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
     with pytest.raises(InputShapeError, match=r"x must have shape \(\.\.\., 65\)"):
         problem.evaluate_batch(np.zeros(64))

@@ -327,10 +327,15 @@ def test_robot_without_parameters_has_infinite_acc_jerk_and_asks_for_task_rows()
     assert robot.tool_frame == "hand"  # the last frame of the model
     with pytest.raises(RobotModelError, match="task_rows"):
         robot.manipulability([0.1, 0.2])
-    yoshikawa = Robot.from_urdf(DATA / "planar_2link.urdf", task_rows=["vx", "vz", "wy"])
+    # Three rows for two joints: the volume of the 2-D velocity ellipsoid, sqrt(det(J^T J)).
+    tall = Robot.from_urdf(DATA / "planar_2link.urdf", task_rows=["vx", "vz", "wy"])
     q = np.array([0.3, 0.9])
-    jac = yoshikawa.tool_jacobian(q)[[0, 2, 4]]
-    assert yoshikawa.manipulability(q) == pytest.approx(np.sqrt(np.linalg.det(jac @ jac.T)))
+    jac = tall.tool_jacobian(q)[[0, 2, 4]]
+    assert tall.manipulability(q) == pytest.approx(np.sqrt(np.linalg.det(jac.T @ jac)))
+    # Yoshikawa's sqrt(det(J J^T)) with fewer rows than joints: one row here.
+    wide = Robot.from_urdf(DATA / "planar_2link.urdf", task_rows=["vx"])
+    row = wide.tool_jacobian(q)[[0]]
+    assert wide.manipulability(q) == pytest.approx(np.sqrt(float((row @ row.T)[0, 0])))
 
 
 # --------------------------------------------------------------------------- bad input
@@ -403,3 +408,17 @@ def test_coulomb_friction_dead_band(robot: Robot) -> None:
     tau = robot.inverse_dynamics(q, v, np.zeros((3, 4)))
     np.testing.assert_allclose(tau[1], tau[0], atol=1e-9)  # rounding noise: still at rest
     np.testing.assert_allclose(tau[2] - tau[0], robot.model.friction, atol=1e-4)
+
+
+def test_more_task_rows_than_joints_and_read_only_tool_frame() -> None:
+    robot = Robot.from_urdf(
+        Path(__file__).resolve().parents[1] / "urdf" / "adept_one_xl.urdf",
+        Path(__file__).resolve().parents[1] / "urdf" / "adept_one_xl.toml",
+        task_rows=["vx", "vy", "vz", "wx", "wy", "wz"],
+    )
+    q = np.array([0.1, 0.7, 0.1, 0.2])
+    jac = robot.tool_jacobian(q)
+    assert robot.manipulability(q) == pytest.approx(np.sqrt(np.linalg.det(jac.T @ jac)))
+    assert robot.manipulability(q) == pytest.approx(A1 * A2 * abs(np.sin(0.7)))
+    with pytest.raises(AttributeError):
+        robot.tool_frame = "link2"
