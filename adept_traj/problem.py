@@ -334,9 +334,17 @@ class TrajectoryProblem(Problem):
         st = self.settings
         if st.z3 == "clearance":
             return np.sum(np.maximum(0.0, 1.0 - min_dist / st.influence) ** 2, axis=-1)
-        tool = tool_pose[..., :3, 3]
-        centres = self.scene.obstacle_poses(smp.t, in_base_frame=True)[..., :3, 3]
-        return paper_penalty(tool, centres, self._semi_axes())
+        poses = self.scene.obstacle_poses(smp.t, in_base_frame=True)  # (n_obs, pop, n_s, 4, 4)
+        return self._paper_penalty(tool_pose[..., :3, 3], poses)
+
+    def _paper_penalty(self, tool: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Eq. 14 (``"paper-sphere"``) or eq. 16 with the obstacles' axes
+        (``"paper-ellipsoid"``) on the tool points (..., n_s, 3)."""
+        if self.settings.z3 == "paper-sphere":
+            return paper_penalty(tool, poses[..., :3, 3], self._semi_axes(), equation=14)
+        return paper_penalty(
+            tool, poses[..., :3, 3], self._semi_axes(), rotations=poses[..., :3, :3], equation=16
+        )
 
     def _semi_axes(self) -> np.ndarray:
         """Semi-axes (n_obs, 3) [m] of the circumscribing spheres/ellipsoids (eqs. 13, 15)."""
@@ -387,7 +395,7 @@ class TrajectoryProblem(Problem):
             z4 = np.inf
             u_max = np.zeros(robot.nq)
             d_obs = np.full(n_obs, np.inf)
-            tool_points, obs_centres = [], []
+            tool_points, obs_poses = [], []
             for s, w in zip(self.s, self.weights):
                 q, qd, qdd = ref.evaluate(s)
                 u = pin.rnea(model, data, q, qd, qdd) + model.damping * qd
@@ -399,7 +407,7 @@ class TrajectoryProblem(Problem):
                 pin.updateGeometryPlacements(model, data, gm, gdata, q)
                 tool_points.append(data.oMf[tool_id].translation.copy())
                 poses = self.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]
-                obs_centres.append(poses[:, :3, 3])
+                obs_poses.append(poses)
                 for o, ob in enumerate(self.scene.obstacles):
                     tf_o = coal.Transform3s(poses[o, :3, :3], poses[o, :3, 3])
                     for k, g in enumerate(gm.geometryObjects):
@@ -424,8 +432,8 @@ class TrajectoryProblem(Problem):
             if st.z3 == "clearance":
                 z3 = float(np.sum(np.maximum(0.0, 1.0 - d_obs / st.influence) ** 2))
             else:
-                centres = np.array(obs_centres).transpose(1, 0, 2)  # (n_obs, n_s, 3)
-                z3 = float(paper_penalty(np.array(tool_points), centres, self._semi_axes()))
+                poses = np.array(obs_poses).transpose(1, 0, 2, 3)  # (n_obs, n_s, 4, 4)
+                z3 = float(self._paper_penalty(np.array(tool_points), poses))
             objectives.append([T, z2, z3, z4, z5, z6])
             g = self._constraints(
                 extrema["q_min"][None],

@@ -766,3 +766,22 @@ def test_sphere_obstacles_are_closed_form_and_match_coal_outside(robot: Robot) -
             assert ours[idx][k] == pytest.approx(d, abs=1e-9)
             separated += 1
     assert separated > 500
+
+
+def test_paper_penalty_equation_14_and_rotated_ellipsoids() -> None:
+    # Eq. 14: a point at r_t = 0.5 inside a sphere of r0 = 1 gives 1 / 0.5**2 = 4.
+    pts = np.array([[0.5, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    centre = np.zeros((1, 1, 3))
+    assert float(paper_penalty(pts, centre, np.ones((1, 3)), equation=14)) == pytest.approx(4.0)
+    with pytest.raises(InvalidInputError, match="equal semi-axes"):
+        paper_penalty(pts, centre, np.array([[1.0, 2.0, 1.0]]), equation=14)
+    with pytest.raises(InvalidInputError, match="equation must be 14"):
+        paper_penalty(pts, centre, np.ones((1, 3)), equation=15)
+    # A long ellipsoid along its own x axis, turned 90° about z: a point on the world y axis
+    # is inside only when the rotation is taken into account.
+    axes = np.array([[1.0, 0.1, 0.1]])
+    point = np.array([[0.0, 0.5, 0.0]])
+    turn = np.array([[[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]]])  # Rz(90°)
+    assert float(paper_penalty(point, centre, axes)) == 0.0  # axis-aligned: outside
+    inside = float(paper_penalty(point, centre, axes, rotations=turn))
+    assert inside == pytest.approx(1.0 / 0.25**2)  # r_e = 0.5² / 1²
