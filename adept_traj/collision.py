@@ -548,7 +548,7 @@ def paper_penalty(
                 f"rotations must be (n_obs, ..., n_t, 3, 3) like centres; got {rot.shape}"
             )
         rot = rot.reshape(rot.shape[0], *([1] * missing), *rot.shape[1:])
-        d = (d[..., None, :] @ rot)[..., 0]  # R^T d as a row vector
+        d = (d[..., None, :] @ rot)[..., 0, :]  # R^T d as a row vector
     if equation == 14:
         r_t = np.min(np.linalg.norm(d, axis=-1), axis=-1)  # (n_obs, ...)
         inside = r_t <= ax[:, 0].reshape(-1, *([1] * (r_t.ndim - 1)))
