@@ -67,7 +67,10 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
             {
                 "start": problem.start.tolist(),
                 "goal": problem.goal.tolist(),
-                "problem_settings": problem.settings.__dict__,
+                # workers change nothing in the results: a run may resume with others.
+                "problem_settings": {
+                    k: v for k, v in problem.settings.__dict__.items() if k != "workers"
+                },
                 "scene": problem.scene.to_dict(),
                 "robot": problem.robot.name,
                 "algorithm": settings.to_dict(),
@@ -165,22 +168,23 @@ def plan(
         fingerprint=_fingerprint(problem, settings, int(seed)),
         progress=progress,
     )
-    evaluation = problem.evaluate_batch(state.X)
-    objectives = evaluation.objectives
-    feasible = evaluation.feasible
+    # The final population's values as the run computed them (z4 back to positive).
+    objectives = _z4_positive(state.F)
+    constraints = np.asarray(state.G, dtype=float)
+    feasible = np.all(constraints <= 0.0, axis=1)
     if feasible.any():
         rows = np.flatnonzero(feasible)
         rows = rows[non_dominated(objectives[rows])]
         warning = None
     else:
-        violation = np.maximum(evaluation.constraints, 0.0).sum(axis=1)
+        violation = np.maximum(constraints, 0.0).sum(axis=1)
         rows = np.argsort(violation, kind="stable")[:_LEAST_INFEASIBLE]
         warning = NO_FEASIBLE_WARNING
     rows = np.unique(rows)  # deterministic order
     front = Front(
         x=state.X[rows],
         objectives=objectives[rows],
-        constraints=evaluation.constraints[rows],
+        constraints=constraints[rows],
         feasible=feasible[rows],
     )
     choice = best_tradeoff(front.objectives, weights)

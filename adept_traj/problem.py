@@ -39,6 +39,7 @@ from __future__ import annotations
 import multiprocessing
 import signal
 import time
+import weakref
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -89,6 +90,9 @@ class ProblemSettings:
         Processes evaluating a population in parallel (default 1: in this process).
         With ``workers > 1`` the population is split into contiguous chunks evaluated by
         forked worker processes (Linux); results are identical to the serial evaluation.
+        The workers are forked when first needed and hold a snapshot of the problem (later
+        edits of ``robot.model`` are not seen by them); :meth:`TrajectoryProblem.close`
+        stops them.
     """
 
     n_knots: int = 20
@@ -154,8 +158,9 @@ class Evaluation:
         return np.all(self.constraints <= 0.0, axis=-1)
 
 
-#: Problems shared with forked evaluation workers (looked up by id in the child).
-_REGISTRY: dict[int, TrajectoryProblem] = {}
+#: Problems shared with forked evaluation workers (looked up by id in the child). Weak: a
+#: problem that is no longer used is collected, and its workers stop (``weakref.finalize``).
+_REGISTRY: weakref.WeakValueDictionary[int, TrajectoryProblem] = weakref.WeakValueDictionary()
 #: Smallest chunk worth sending to a worker.
 _MIN_CHUNK = 8
 
@@ -266,11 +271,20 @@ class TrajectoryProblem(Problem):
         out["G"] = ev.constraints
 
     def close(self) -> None:
-        """Stop the evaluation worker processes (if any); they restart when needed."""
+        """Stop the evaluation worker processes of ``workers > 1`` (if started); they start
+        again when needed. Also done when the problem is garbage-collected, or on leaving a
+        ``with TrajectoryProblem(...) as problem:`` block."""
         pool = self.__dict__.pop("_pool", None)
         if pool is not None:
+            self.__dict__.pop("_pool_finalizer").detach()
             pool.shutdown(wait=True, cancel_futures=True)
         _REGISTRY.pop(id(self), None)
+
+    def __enter__(self) -> TrajectoryProblem:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     # ------------------------------------------------------------------ batched
     def _evaluate_batch(self, x: np.ndarray) -> Evaluation:
@@ -289,6 +303,9 @@ class TrajectoryProblem(Problem):
                 initializer=_worker_init,
             )
             self.__dict__["_pool"] = pool
+            self.__dict__["_pool_finalizer"] = weakref.finalize(
+                self, pool.shutdown, wait=False, cancel_futures=True
+            )
         chunks = np.array_split(x, workers)
         futures = [pool.submit(_worker_evaluate, id(self), c) for c in chunks if len(c)]
         try:

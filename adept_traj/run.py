@@ -73,9 +73,11 @@ class RunState:
     fronts: list[np.ndarray] = field(default_factory=list)
 
 
-def _population_arrays(pop: Population) -> dict[str, np.ndarray]:
-    """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint)."""
+def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
+    """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint), with the
+    generation counter so that the two checkpoint files can be checked against each other."""
     out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
+    out["n_iter"] = np.array(n_iter)
     for key in pop[0].data if len(pop) else ():
         values = pop.get(key)
         if values.dtype != object and key not in out:
@@ -87,7 +89,7 @@ def _restore_population(arrays: dict[str, np.ndarray]) -> Population:
     pop = Population.new(X=arrays["X"])
     pop.set("F", arrays["F"], "G", arrays["G"], "CV", arrays["CV"])
     for key, values in arrays.items():
-        if key.startswith("data."):
+        if key.startswith("data."):  # (n_iter is checked by load_checkpoint, not stored)
             pop.set(key[5:], values)
     for ind in pop:
         ind.evaluated.update({"F", "G", "H"})
@@ -107,7 +109,7 @@ def _write_atomic(path: Path, writer: Callable[[Path], None]) -> None:
 
 def _save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
     folder.mkdir(parents=True, exist_ok=True)
-    arrays = _population_arrays(algorithm.pop)
+    arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
 
     def write_npz(path: Path) -> None:
         with path.open("wb") as fh:
@@ -136,8 +138,19 @@ def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError) as exc:
         raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
-    if meta.get("format") != "adept_traj.checkpoint" or meta.get("version") != 1:
-        raise ConfigurationError(f"{meta_path}: not an adept_traj checkpoint of version 1")
+    version = _CHECKPOINT_VERSION
+    if meta.get("format") != "adept_traj.checkpoint" or meta.get("version") != version:
+        raise ConfigurationError(f"{meta_path}: not an adept_traj checkpoint of version {version}")
+    needed = {"n_iter", "n_eval", "rng", "fingerprint", "total_s", "evaluation_s", "history"}
+    missing = sorted(needed - set(meta)) + sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays))
+    if missing:
+        raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {missing}")
+    if int(arrays["n_iter"]) != meta["n_iter"]:
+        # Interrupted between the two atomic renames: the files are from two generations.
+        raise ConfigurationError(
+            f"{folder}: checkpoint.npz (generation {int(arrays['n_iter']) - 1}) and "
+            f"checkpoint.json (generation {meta['n_iter'] - 1}) disagree; cannot resume exactly"
+        )
     return meta, arrays
 
 
