@@ -43,9 +43,6 @@ from .verification import certify
 
 __all__ = ["main"]
 
-#: The paper's start and goal (θ1, θ2, θ4 as printed) with d3 inside its stroke [rad, rad, m, rad].
-PAPER_START = (0.1682, 1.3849, 0.08, -0.7555)
-PAPER_GOAL = (-0.7610, 0.2450, 0.20, 1.0095)
 _RUN_FILE = "run.json"
 
 
@@ -113,8 +110,8 @@ def _parser() -> argparse.ArgumentParser:
     robot = sub.add_parser("robot", help="robot-model demo: torques and manipulability")
     robot.add_argument("--urdf", type=Path, help="URDF file (default: the AdeptOne XL)")
     robot.add_argument("--params", type=Path, help="parameter file for --urdf")
-    robot.add_argument("--start", type=_floats, default=PAPER_START, help="q1,...,qn [rad|m]")
-    robot.add_argument("--goal", type=_floats, default=PAPER_GOAL, help="q1,...,qn [rad|m]")
+    robot.add_argument("--start", type=_floats, help="q1,...,qn [rad|m] (default: paper's)")
+    robot.add_argument("--goal", type=_floats, help="q1,...,qn [rad|m] (default: paper's)")
     robot.add_argument("--duration", type=float, default=1.1, help="move time T [s]")
     robot.add_argument("--samples", type=int, default=1001, help="samples along the move")
 
@@ -447,8 +444,11 @@ def _quintic_move(
 
 def _robot_demo(args: argparse.Namespace) -> int:
     robot = Robot.adept_one_xl() if args.urdf is None else Robot.from_urdf(args.urdf, args.params)
-    start = robot.limits.check_position(args.start, "--start")
-    goal = robot.limits.check_position(args.goal, "--goal")
+    paper = Scene.paper()  # its [task]: the paper's start and goal (docs/paper-scenario.md)
+    start = robot.limits.check_position(
+        paper.start if args.start is None else args.start, "--start"
+    )
+    goal = robot.limits.check_position(paper.goal if args.goal is None else args.goal, "--goal")
     if not (np.isfinite(args.duration) and args.duration > 0):
         raise InvalidInputError(f"--duration must be a positive number [s]; got {args.duration}")
     if args.samples < 2:

@@ -320,7 +320,10 @@ class CollisionChecker:
         balls = (solid_poses[..., :3, :3] @ self._ball_centre[..., None])[..., 0]
         balls += solid_poses[..., :3, 3]  # (N, n_solids, 3)
         lower = np.empty((solid_poses.shape[0], self.n_solids, self.n_obstacles))
+        closed_all = self._closed_form.all(axis=0)
         for o, ob in enumerate(self.scene.obstacles):
+            if closed_all[o]:
+                continue  # exact values follow (_sphere_obstacle_distances)
             pose = obstacle_poses[o]  # (4, 4) or (N, 4, 4)
             # Row-vector form of R^T (c - t): (c - t) R; one product for a fixed obstacle.
             local = (balls - pose[..., None, :3, 3]) @ pose[..., :3, :3]
@@ -420,9 +423,9 @@ class CollisionChecker:
         calls = 0
         for m, o in zip(*np.nonzero((best <= self.influence) & ~closed)):
             bounds = lower[m, :, o]
-            order = np.argsort(bounds, kind="stable")
+            near = np.flatnonzero(bounds <= self.influence)
             value = np.inf
-            for c in order[bounds[order] <= self.influence]:
+            for c in near[np.argsort(bounds[near], kind="stable")]:
                 if bounds[c] >= value:  # every bound is a valid lower bound: prune the rest
                     break
                 k, s = divmod(int(c), self.n_solids)

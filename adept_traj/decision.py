@@ -216,7 +216,8 @@ class BestTradeoff:
 
     Attributes
     ----------
-    index: row of ``F`` chosen.
+    index: row of ``F`` chosen (``order[0]``).
+    order: (n,) every row, best first by the same rule (for fall-backs).
     objectives: (m,) objective values of the chosen row (raw units).
     f_c: (n,) combined objective of every row (lower is better).
     F_avg: (n,) average fitness factor of every row (higher is better).
@@ -228,6 +229,7 @@ class BestTradeoff:
     """
 
     index: int
+    order: np.ndarray
     objectives: np.ndarray
     f_c: np.ndarray
     F_avg: np.ndarray
@@ -241,7 +243,7 @@ class BestTradeoff:
     def __post_init__(self) -> None:
         for field in ("objectives", "f_c", "F_avg", "weights", "z_min", "z_max"):
             object.__setattr__(self, field, _readonly(getattr(self, field)))
-        for field in ("rank_f_c", "rank_F_avg", "rank_sum"):
+        for field in ("order", "rank_f_c", "rank_F_avg", "rank_sum"):
             arr = np.array(getattr(self, field), dtype=np.int64)
             arr.setflags(write=False)
             object.__setattr__(self, field, arr)
@@ -299,9 +301,11 @@ def best_tradeoff(
     rank_fc = _min_rank(f_c)
     rank_avg = _min_rank(-f_avg)
     rank_sum = rank_fc + rank_avg
-    index = int(np.lexsort((np.arange(arr.shape[0]), f_c, rank_sum))[0])
+    order = np.lexsort((np.arange(arr.shape[0]), f_c, rank_sum))
+    index = int(order[0])
     return BestTradeoff(
         index=index,
+        order=order,
         objectives=arr[index],
         f_c=f_c,
         F_avg=f_avg,

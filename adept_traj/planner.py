@@ -188,9 +188,8 @@ def plan(
         feasible=feasible[rows],
     )
     choice = best_tradeoff(front.objectives, weights)
-    order = np.lexsort((np.arange(len(rows)), choice.f_c, choice.rank_sum))
-    certificate, index = None, int(order[0])
-    for k in order[: max(1, max_certify)]:
+    certificate, index = None, choice.index
+    for k in choice.order[: max(1, max_certify)]:
         candidate = certify(problem, front.x[k], rate_hz=rate_hz)
         if certificate is None or (candidate.feasible and not certificate.feasible):
             certificate, index = candidate, int(k)

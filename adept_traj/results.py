@@ -342,7 +342,7 @@ class PlanningResult:
     problem_settings: the problem's :class:`ProblemSettings`.
     limits: the robot's :class:`JointLimits` (SI).
     lower_bound: the kinematic lower bound of the travel time (:class:`KinematicBound`).
-    algorithm: name of the optimiser (e.g. ``"NSGA-II"``).
+    algorithm: name of the optimiser as run (``"nsga2"``, ``"mode"``, …).
     algorithm_settings: its settings, stored as a JSON-compatible copy (numpy values become
         Python values, tuples lists, non-finite floats ``None``, other objects ``str``).
     seed: random seed, or ``None``.

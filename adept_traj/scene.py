@@ -280,7 +280,7 @@ class Scene(_ValueObject):
         """The paper's scene: two fixed cubes and the pendulum (``adept_traj/scenes/paper.toml``).
 
         The cubes and the pendulum law are the paper's; the robot base pose and the pivot are
-        a reconstruction (the paper does not give them), see ``docs/scene-files.md``.
+        a reconstruction (the paper does not give them), see ``docs/paper-scenario.md``.
         """
         resource = resources.files("adept_traj").joinpath("scenes").joinpath("paper.toml")
         try:
