@@ -262,8 +262,8 @@ def _show(args: argparse.Namespace) -> int:
     vis = meshcat_view.show(
         result, speed=args.speed, show_closest=args.closest, open_browser=args.open
     )
-    print(f"playing {args.folder} at {vis.url()} (Ctrl-C to stop)", flush=True)
-    try:
+    try:  # the URL is printed inside: a Ctrl-C right after it must still stop cleanly
+        print(f"playing {args.folder} at {vis.url()} (Ctrl-C to stop)", flush=True)
         while True:
             time.sleep(1.0)
     except KeyboardInterrupt:
