@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import InputShapeError, InvalidInputError
 
-__all__ = ["as_batch", "as_finite_array", "as_vector", "describe_bad_values"]
+__all__ = ["as_batch", "as_finite_array", "as_vector", "describe_bad_values", "readonly_copy"]
 
 
 def describe_bad_values(x: np.ndarray, bad: np.ndarray, limit: int = 3) -> str:
@@ -57,3 +57,11 @@ def as_vector(value: Any, name: str, size: int, unit: str = "") -> np.ndarray:
         units = f" {unit}" if unit else ""
         raise InputShapeError(f"{name} must have shape ({size},){units}; got shape {arr.shape}")
     return arr
+
+
+def readonly_copy(value: Any) -> np.ndarray:
+    """A new float64 array with the values of ``value``, marked read-only (for the fields of
+    frozen dataclasses: callers' arrays are never kept or mutated)."""
+    out = np.array(value, dtype=np.float64, copy=True)
+    out.setflags(write=False)
+    return out

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._validation import as_finite_array, as_vector
+from ._validation import as_finite_array, as_vector, readonly_copy
 from .errors import InputShapeError, InvalidInputError
 from .metrics import MAXIMISED, _as_objectives, _as_sense
 
@@ -45,12 +45,6 @@ __all__ = [
 
 PAPER_WEIGHTS: tuple[float, ...] = (0.25, 0.25, 0.1, 0.1, 0.15, 0.15)
 """The paper's sample weights w1..w6 for z1..z6 (Section 5; they sum to 1)."""
-
-
-def _readonly(x: np.ndarray) -> np.ndarray:
-    arr = np.array(x, dtype=float)
-    arr.setflags(write=False)
-    return arr
 
 
 def _bounds(
@@ -242,7 +236,7 @@ class BestTradeoff:
 
     def __post_init__(self) -> None:
         for field in ("objectives", "f_c", "F_avg", "weights", "z_min", "z_max"):
-            object.__setattr__(self, field, _readonly(getattr(self, field)))
+            object.__setattr__(self, field, readonly_copy(getattr(self, field)))
         for field in ("order", "rank_f_c", "rank_F_avg", "rank_sum"):
             arr = np.array(getattr(self, field), dtype=np.int64)
             arr.setflags(write=False)

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ._io import write_text_atomic
 from .errors import InvalidInputError
 from .results import PlanningResult, _trajectory_csv
 
@@ -54,15 +55,6 @@ def _as_path(path: Any, name: str = "path") -> Path:
         raise InvalidInputError(f"{name} must be a file path; got {type(path).__name__}") from None
 
 
-def _write_text(path: Path, text: str) -> Path:
-    """Write UTF-8 text through a temporary file in the same folder (created if needed)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8", newline="\n")
-    os.replace(tmp, path)
-    return path
-
-
 # ============================================================================ CSV
 def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     """Write the certified best trajectory as CSV, in the format of ``best_trajectory.csv``.
@@ -83,7 +75,7 @@ def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     The path written.
     """
     r = _as_result(result)
-    return _write_text(_as_path(path), _trajectory_csv(r))
+    return write_text_atomic(_as_path(path), _trajectory_csv(r))
 
 
 # ============================================================================ ROS
@@ -226,4 +218,4 @@ def save_ros_joint_trajectory(
         "  ]",
         "}",
     ]
-    return _write_text(out, "\n".join(lines) + "\n")
+    return write_text_atomic(out, "\n".join(lines) + "\n")

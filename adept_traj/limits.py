@@ -6,16 +6,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_batch
+from ._validation import as_batch, readonly_copy
 from .errors import JointLimitError
 
 __all__ = ["JointLimits"]
-
-
-def _readonly(x: np.ndarray) -> np.ndarray:
-    arr = np.array(x, dtype=float)
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True)
@@ -44,7 +38,7 @@ class JointLimits:
 
     def __post_init__(self) -> None:
         for field in ("lower", "upper", "velocity", "acceleration", "jerk", "effort"):
-            object.__setattr__(self, field, _readonly(getattr(self, field)))
+            object.__setattr__(self, field, readonly_copy(getattr(self, field)))
 
     @property
     def nq(self) -> int:

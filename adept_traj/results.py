@@ -33,7 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_finite_array
+from ._io import write_text_atomic
+from ._validation import as_finite_array, readonly_copy
 from .errors import AdeptTrajError, InputShapeError, InvalidInputError
 from .limits import JointLimits
 from .problem import OBJECTIVE_NAMES, Evaluation, ProblemSettings, TrajectoryProblem
@@ -248,7 +249,7 @@ class Metrics:
         for name in _JSON_METRICS:
             object.__setattr__(self, name, _metric(getattr(self, name), f"metrics.{name}"))
         if self.hv_reference_point is not None:
-            ref = _read_only(as_finite_array(self.hv_reference_point, "hv_reference_point"))
+            ref = readonly_copy(as_finite_array(self.hv_reference_point, "hv_reference_point"))
             if ref.ndim != 1:
                 raise InputShapeError(f"hv_reference_point must be 1-D; got {ref.shape}")
             object.__setattr__(self, "hv_reference_point", ref)
@@ -395,7 +396,7 @@ class PlanningResult:
                 f"{list(self.robot.joint_names)}"
             )
         for name in ("start", "goal"):
-            arr = _read_only(as_finite_array(getattr(self, name), name))
+            arr = readonly_copy(as_finite_array(getattr(self, name), name))
             if arr.shape != (nq,):
                 raise InputShapeError(f"{name} must have shape ({nq},); got {arr.shape}")
             object.__setattr__(self, name, arr)
@@ -546,9 +547,9 @@ class PlanningResult:
         (created if needed; existing files are replaced). Returns the folder's path."""
         path = Path(folder)
         path.mkdir(parents=True, exist_ok=True)
-        _write(path / RESULT_FILE, _dumps(_encode(self)) + "\n")
-        _write(path / FRONT_FILE, _front_csv(self))
-        _write(path / TRAJECTORY_FILE, _trajectory_csv(self))
+        write_text_atomic(path / RESULT_FILE, _dumps(_encode(self)) + "\n")
+        write_text_atomic(path / FRONT_FILE, _front_csv(self))
+        write_text_atomic(path / TRAJECTORY_FILE, _trajectory_csv(self))
         return path
 
     @classmethod
@@ -771,13 +772,6 @@ def _front_csv(r: PlanningResult) -> str:
 
 def _trajectory_csv(r: PlanningResult) -> str:
     return _csv_text(_trajectory_header(r.robot.joint_names), _trajectory_table(r))
-
-
-def _write(path: Path, text: str) -> None:
-    """Write UTF-8 text through a temporary file (no half-written file on failure)."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8", newline="\n")
-    os.replace(tmp, path)
 
 
 # ============================================================================ decoding
@@ -1200,14 +1194,10 @@ def _check_trajectory_csv(r: PlanningResult, path: Path) -> None:
 
 
 # ============================================================================ helpers
-def _read_only(arr: np.ndarray) -> np.ndarray:
-    out = np.array(arr, dtype=np.float64, copy=True)
-    out.flags.writeable = False
-    return out
 
 
 def _matrix(value: Any, name: str, shape: tuple[int, int | None] | None = None) -> np.ndarray:
-    arr = _read_only(as_finite_array(value, name))
+    arr = readonly_copy(as_finite_array(value, name))
     if arr.ndim != 2 or (
         shape is not None
         and (arr.shape[0] != shape[0] or (shape[1] is not None and arr.shape[1] != shape[1]))

@@ -13,7 +13,6 @@ generation on disk and raises :class:`PlanningInterrupted`.
 from __future__ import annotations
 
 import json
-import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -23,6 +22,7 @@ from typing import Any
 import numpy as np
 from pymoo.core.population import Population
 
+from ._io import write_atomic
 from .errors import AdeptTrajError, ConfigurationError
 from .metrics import non_dominated
 
@@ -101,12 +101,6 @@ def _json_state(rng: np.random.Generator) -> dict[str, Any]:
     return json.loads(json.dumps(state, default=int))
 
 
-def _write_atomic(path: Path, writer: Callable[[Path], None]) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    writer(tmp)
-    os.replace(tmp, path)
-
-
 def _save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
@@ -115,7 +109,7 @@ def _save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None
         with path.open("wb") as fh:
             np.savez(fh, **arrays)
 
-    _write_atomic(folder / "checkpoint.npz", write_npz)
+    write_atomic(folder / "checkpoint.npz", write_npz)
     state = {
         "format": "adept_traj.checkpoint",
         "version": _CHECKPOINT_VERSION,
@@ -124,7 +118,7 @@ def _save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None
         "rng": _json_state(algorithm.random_state),
         **meta,
     }
-    _write_atomic(folder / "checkpoint.json", lambda p: p.write_text(json.dumps(state, indent=1)))
+    write_atomic(folder / "checkpoint.json", lambda p: p.write_text(json.dumps(state, indent=1)))
 
 
 def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:

@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_batch, as_finite_array, as_vector, describe_bad_values
+from ._validation import as_batch, as_finite_array, as_vector, describe_bad_values, readonly_copy
 from .errors import ConfigurationError, InputShapeError, InvalidInputError, JointLimitError
 
 __all__ = [
@@ -204,13 +204,6 @@ class KinematicBound:
 # --------------------------------------------------------------------------------------------
 
 
-def _readonly(arr: np.ndarray) -> np.ndarray:
-    """Return a read-only copy of ``arr``."""
-    out = np.array(arr, dtype=np.float64, copy=True)
-    out.flags.writeable = False
-    return out
-
-
 def _monomial_derivative_rows(u: np.ndarray, order: int) -> np.ndarray:
     r"""Rows :math:`\frac{d^r}{du^r}[u^3, u^2, u, 1]`, shape ``(n, 4)``."""
     one = np.ones_like(u)
@@ -357,14 +350,14 @@ class BSplineTrajectory:
             raise ConfigurationError(f"n_knots must be an integer >= 4; got {n_knots!r}")
         if n_knots < 4:
             raise ConfigurationError(f"n_knots must be >= 4; got {n_knots}")
-        object.__setattr__(self, "start", _readonly(start))
-        object.__setattr__(self, "goal", _readonly(goal))
+        object.__setattr__(self, "start", readonly_copy(start))
+        object.__setattr__(self, "goal", readonly_copy(goal))
         object.__setattr__(self, "n_knots", int(n_knots))
         object.__setattr__(
-            self, "_fixed_head", _readonly(np.broadcast_to(start, (_N_FIXED_END, start.size)))
+            self, "_fixed_head", readonly_copy(np.broadcast_to(start, (_N_FIXED_END, start.size)))
         )
         object.__setattr__(
-            self, "_fixed_tail", _readonly(np.broadcast_to(goal, (_N_FIXED_END, goal.size)))
+            self, "_fixed_tail", readonly_copy(np.broadcast_to(goal, (_N_FIXED_END, goal.size)))
         )
 
     # ---- sizes -------------------------------------------------------------------------

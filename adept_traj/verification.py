@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_finite_array, as_vector
+from ._validation import as_finite_array, as_vector, readonly_copy
 from .errors import ConfigurationError, InvalidInputError
 from .problem import TrajectoryProblem
 
@@ -97,13 +97,13 @@ class DenseTrajectory:
     min_distance: np.ndarray
 
     def __post_init__(self) -> None:
-        t = _read_only(as_finite_array(self.t, "t"))
+        t = readonly_copy(as_finite_array(self.t, "t"))
         if t.ndim != 1 or t.size < 2:
             raise InvalidInputError(f"t must have shape (n,) with n ≥ 2; got {t.shape}")
         object.__setattr__(self, "t", t)
         nq = None
         for name in ("q", "qd", "qdd", "qddd", "tau"):
-            arr = _read_only(as_finite_array(getattr(self, name), name))
+            arr = readonly_copy(as_finite_array(getattr(self, name), name))
             if arr.ndim != 2 or arr.shape[0] != t.size or (nq is not None and arr.shape[1] != nq):
                 raise InvalidInputError(
                     f"{name} must have shape ({t.size}, nq) like the others; got {arr.shape}"
@@ -115,7 +115,7 @@ class DenseTrajectory:
             raise InvalidInputError(
                 f"min_distance must have shape {t.shape} with no NaN or -inf; got {d.shape}"
             )
-        object.__setattr__(self, "min_distance", _read_only(d))
+        object.__setattr__(self, "min_distance", readonly_copy(d))
 
     @property
     def n_samples(self) -> int:
@@ -162,14 +162,14 @@ class LimitCheck:
     def __post_init__(self) -> None:
         if self.kind not in LIMIT_KINDS:
             raise InvalidInputError(f"kind must be one of {LIMIT_KINDS}; got {self.kind!r}")
-        dense = _read_only(as_finite_array(self.dense, f"{self.kind}.dense"))
+        dense = readonly_copy(as_finite_array(self.dense, f"{self.kind}.dense"))
         if dense.ndim != 1:
             raise InvalidInputError(f"{self.kind}.dense must have shape (nq,); got {dense.shape}")
         object.__setattr__(self, "dense", dense)
         if self.exact is not None:
-            exact = _read_only(as_vector(self.exact, f"{self.kind}.exact", dense.size))
+            exact = readonly_copy(as_vector(self.exact, f"{self.kind}.exact", dense.size))
             object.__setattr__(self, "exact", exact)
-        t_worst = _read_only(as_vector(self.t_worst, f"{self.kind}.t_worst", dense.size))
+        t_worst = readonly_copy(as_vector(self.t_worst, f"{self.kind}.t_worst", dense.size))
         object.__setattr__(self, "t_worst", t_worst)
         tol = float(self.tolerance)
         if not (math.isfinite(tol) and tol >= 0.0):
@@ -249,7 +249,7 @@ class Certificate:
     dense: DenseTrajectory
 
     def __post_init__(self) -> None:
-        x = _read_only(as_finite_array(self.x, "x"))
+        x = readonly_copy(as_finite_array(self.x, "x"))
         if x.ndim != 1 or x.size < 1 or not x[0] > 0:
             raise InvalidInputError(f"x must have shape (n_var,) with T = x[0] > 0; got {x!r}")
         object.__setattr__(self, "x", x)
@@ -431,10 +431,6 @@ def certify(
 
 
 # ---------------------------------------------------------------------------- helpers
-def _read_only(arr: np.ndarray) -> np.ndarray:
-    out = np.array(arr, dtype=np.float64, copy=True)
-    out.flags.writeable = False
-    return out
 
 
 def _arrays_equal(a: np.ndarray | None, b: np.ndarray | None) -> bool:

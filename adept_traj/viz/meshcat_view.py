@@ -53,6 +53,7 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     from meshcat.path import Path as MeshcatPath
     from meshcat.visualizer import ViewerWindow
 
+from .._validation import readonly_copy
 from ..errors import AdeptTrajError, InvalidInputError
 from ..results import PlanningResult
 from ..scene import Obstacle
@@ -320,17 +321,17 @@ def build_animation(
     target, position = _camera(seen_points)
     return Playback(
         objects=tuple(objects),
-        times=_read_only(times),
-        frame_numbers=_read_only(frames),
-        q=_read_only(np.array(q)),
+        times=readonly_copy(times),
+        frame_numbers=readonly_copy(frames),
+        q=readonly_copy(np.array(q)),
         fps=fps,
         speed=speed,
         duration=duration,
-        tool_path=_read_only(tool),
-        closest_points=None if closest_points is None else _read_only(closest_points),
-        closest_distance=None if closest_distance is None else _read_only(closest_distance),
-        camera_target=_read_only(target),
-        camera_position=_read_only(position),
+        tool_path=readonly_copy(tool),
+        closest_points=None if closest_points is None else readonly_copy(closest_points),
+        closest_distance=None if closest_distance is None else readonly_copy(closest_distance),
+        camera_target=readonly_copy(target),
+        camera_position=readonly_copy(position),
     )
 
 
@@ -341,12 +342,6 @@ def _positive(value: Any, name: str, unit: str) -> float:
     if not (math.isfinite(v) and v > 0):
         raise InvalidInputError(f"{name} must be a positive finite number {unit}; got {v!r}")
     return v
-
-
-def _read_only(arr: np.ndarray) -> np.ndarray:
-    arr = np.array(arr, dtype=float)
-    arr.flags.writeable = False
-    return arr
 
 
 def _hex(rgb: np.ndarray) -> int:
