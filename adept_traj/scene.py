@@ -23,16 +23,12 @@ from typing import Any
 
 import numpy as np
 
+from ._toml import parse_toml, read_toml
 from ._validation import as_finite_array
 from .errors import AdeptTrajError, InputShapeError, InvalidInputError, SceneError
 from .motion import FixedPose, MotionLaw, PendulumMotion
 from .shapes import Box, Capsule, Cylinder, Shape, Sphere, _readonly, _ValueObject
 from .transforms import as_rigid_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
 
 __all__ = ["Obstacle", "Scene", "SceneFileNotFoundError", "pendulum_obstacles"]
 
@@ -299,13 +295,8 @@ class Scene(_ValueObject):
                 line and column), or does not describe a valid scene.
         """
         p = Path(path)
-        try:
-            raw = p.read_bytes()
-        except FileNotFoundError:
-            raise SceneFileNotFoundError(f"{p}: scene file not found") from None
-        except OSError as exc:
-            raise SceneError(f"{p}: cannot read scene file: {exc.strerror or exc}") from None
-        return _from_toml_bytes(raw, str(p), p.stem or "scene")
+        data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
+        return _parse_scene(data, str(p), p.stem or "scene")
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
@@ -745,12 +736,4 @@ def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
 
 
 def _from_toml_bytes(raw: bytes, source: str, default_name: str) -> Scene:
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"{source}: not UTF-8 text ({exc})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source}: invalid TOML: {exc}") from None
-    return _parse_scene(data, source, default_name)
+    return _parse_scene(parse_toml(raw, source, SceneError), source, default_name)

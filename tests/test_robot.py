@@ -390,7 +390,7 @@ def test_bad_parameter_files(tmp_path: Path) -> None:
         '[[joint]]\nname = "elbow"\njerk = -1.0\n': r"'elbow': field 'jerk' must be a positive",
         '[[joint]]\nname = "elbow"\nstiffness = 1.0\n': r"unknown field\(s\) \['stiffness'\]",
         'task_rows = ["vx", "spin"]\n': "task_rows",
-        "tool_frame = [": "not valid TOML",
+        "tool_frame = [": "invalid TOML",
         'tool_frame = "paw"\n': "no frame 'paw'",
     }
     for k, (text, pattern) in enumerate(cases.items()):
