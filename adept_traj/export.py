@@ -29,6 +29,7 @@ import numpy as np
 from ._io import write_text_atomic
 from .errors import InvalidInputError
 from .results import PlanningResult, _trajectory_csv
+from .verification import dense_samples
 
 __all__ = [
     "MAX_ROS_POINTS",
@@ -98,7 +99,7 @@ def _resample(r: PlanningResult, rate: float) -> tuple[np.ndarray, ...]:
     """(t, q, qd, qdd, tau) of the best trajectory on ``ceil(T·rate) + 1`` uniform samples."""
     x = r.best_x
     T = float(x[0])
-    n = max(2, math.ceil(T * rate - 1e-9) + 1)  # the grid of verification.certify
+    n = dense_samples(T, rate)  # the grid of verification.certify
     if n > MAX_ROS_POINTS:
         raise InvalidInputError(
             f"rate_hz = {rate:g} Hz gives {n} points over T = {T:.6g} s; at most "

@@ -54,6 +54,7 @@ __all__ = [
     "DenseTrajectory",
     "LimitCheck",
     "certify",
+    "dense_samples",
 ]
 
 #: Default sampling rate of the dense check [Hz].
@@ -326,6 +327,13 @@ class Certificate:
     __hash__ = None  # type: ignore[assignment]
 
 
+def dense_samples(T: float, rate_hz: float) -> int:
+    """Number of uniform samples over [0, T] [s] with spacing at most 1/``rate_hz`` [Hz],
+    both ends included: ``ceil(T·rate) + 1`` (at least 2). The 1e-9 keeps
+    T·rate = 2100.0000000000005 at 2100."""
+    return max(2, math.ceil(T * rate_hz - 1e-9) + 1)
+
+
 def certify(
     problem: TrajectoryProblem,
     x: Any,
@@ -371,8 +379,7 @@ def certify(
     robot, lim = problem.robot, problem.robot.limits
     span = _limits(lim)
 
-    # n - 1 intervals of at most 1/rate; the 1e-9 keeps T·rate = 2100.0000000000005 at 2100.
-    n = max(2, math.ceil(T * rate - 1e-9) + 1)
+    n = dense_samples(T, rate)
     s = np.linspace(0.0, 1.0, n)
     smp = problem.trajectory.sample(xa, s)
     t, q, qd, qdd, qddd = smp.t, smp.q, smp.qd, smp.qdd, smp.qddd
