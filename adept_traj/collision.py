@@ -4,17 +4,12 @@
 (..., n_t) [s], the signed distance [m] between **every** robot solid and **every** obstacle
 (moving obstacles at their pose at that time; negative = penetration depth), using coal.
 
-Broad phase (conservative, numpy, batched): every robot solid is covered by a few spheres
-(its local bounding box cut along its longest side); for each sphere centre ``c`` with radius
-``r`` and each obstacle ``B`` the exact signed distance ``d(c, B)`` of a point to a box,
-sphere, cylinder or capsule is computed in closed form, and
-
-.. math:: d(\\text{solid}, B) \\ge \\min_i \\big(d(c_i, B) - r_i\\big) =: \\text{LB}.
-
-Only pairs with LB ≤ ``influence`` go to coal (narrow phase, one call per close pair:
-the only Python loop, over close pairs, never over all samples). The other entries hold LB,
-a lower bound greater than ``influence``: every quantity built from distances below
-``influence`` (the constraint, the clearance penalty) is therefore exact.
+The broad phase (:mod:`adept_traj.broad_phase`, numpy, batched) gives a lower bound of
+every distance, exact for sphere obstacles (closed form) and static pairs. Only pairs whose
+bound is ≤ ``influence`` go to coal (narrow phase, one call per close pair: the only Python
+loop, over close pairs, never over all samples). The other entries hold a lower bound
+greater than ``influence``: every quantity built from distances below ``influence`` (the
+constraint, the clearance penalty) is therefore exact.
 
 Also here: :func:`paper_penalty`, the paper's eqs. (13)–(16) (circumscribing spheres or
 ellipsoids around obstacles, tool points), kept for comparison.
@@ -29,10 +24,10 @@ import coal
 import numpy as np
 
 from ._validation import as_finite_array
+from .broad_phase import BroadPhase, point_signed_distance
 from .errors import InputShapeError, InvalidInputError
 from .robot import Robot
 from .scene import Scene
-from .shapes import Box, Capsule, Cylinder, Sphere
 
 __all__ = [
     "CollisionChecker",
@@ -95,100 +90,6 @@ class MinDistances:
     n_narrow: int
 
 
-def point_signed_distance(shape: object, p: np.ndarray) -> np.ndarray:
-    """Exact signed distance [m] of points ``p`` (..., 3), in the shape's own frame, to a
-    :class:`Box`, :class:`Sphere`, :class:`Cylinder` (axis z) or :class:`Capsule` (axis z);
-    negative inside."""
-    if isinstance(shape, Sphere):
-        return np.linalg.norm(p, axis=-1) - shape.radius
-    if isinstance(shape, Box):
-        excess = np.abs(p) - 0.5 * np.asarray(shape.size)
-        outside = np.linalg.norm(np.maximum(excess, 0.0), axis=-1)
-        return outside + np.minimum(excess.max(axis=-1), 0.0)
-    if isinstance(shape, Cylinder):
-        radial = np.hypot(p[..., 0], p[..., 1]) - shape.radius
-        axial = np.abs(p[..., 2]) - 0.5 * shape.length
-        outside = np.hypot(np.maximum(radial, 0.0), np.maximum(axial, 0.0))
-        return outside + np.minimum(np.maximum(radial, axial), 0.0)
-    if isinstance(shape, Capsule):
-        half = 0.5 * shape.length
-        closest = np.clip(p[..., 2], -half, half)
-        return np.hypot(np.hypot(p[..., 0], p[..., 1]), p[..., 2] - closest) - shape.radius
-    raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
-
-
-def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.ndarray]:
-    """Centres (k, 3) in the geometry frame and radii (k,) of spheres covering its local
-    bounding box, cut into k near-cubic pieces along its longest side."""
-    geometry.computeLocalAABB()
-    lo = np.array(geometry.aabb_local.min_)
-    hi = np.array(geometry.aabb_local.max_)
-    extent = hi - lo
-    axis = int(np.argmax(extent))
-    others = np.delete(extent, axis)
-    k = max(1, int(np.ceil(extent[axis] / max(others.max(), 1e-9))))
-    piece = extent.copy()
-    piece[axis] /= k
-    centres = np.tile(0.5 * (lo + hi), (k, 1))
-    centres[:, axis] = lo[axis] + piece[axis] * (np.arange(k) + 0.5)
-    return centres, np.full(k, 0.5 * np.linalg.norm(piece))
-
-
-#: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
-#: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
-_ROUNDING = 1e-9
-
-
-def _half_extent(kind: str, dims: np.ndarray, n_local: np.ndarray) -> np.ndarray:
-    """Half-length (...) of the projection of a centred shape on unit directions ``n_local``
-    (..., 3) given in the shape's frame. ``kind``/``dims``: box (hx, hy, hz), cylinder
-    (r, h), sphere (r,), capsule (r, h), with h the half length along local z."""
-    if kind == "box":
-        return np.abs(n_local) @ dims
-    if kind == "sphere":
-        return np.full(n_local.shape[:-1], dims[0])
-    axial = np.abs(n_local[..., 2])
-    if kind == "capsule":
-        return dims[1] * axial + dims[0]
-    return dims[1] * axial + dims[0] * np.sqrt(np.maximum(0.0, 1.0 - axial**2))
-
-
-def _coal_kind(geometry: coal.CollisionGeometry) -> tuple[str, np.ndarray] | None:
-    """(kind, dims) of a coal primitive for :func:`_half_extent`, or None (no bound)."""
-    if isinstance(geometry, coal.Box):
-        return "box", np.array(geometry.halfSide)
-    if isinstance(geometry, coal.Cylinder):
-        return "cylinder", np.array([geometry.radius, geometry.halfLength])
-    if isinstance(geometry, coal.Capsule):
-        return "capsule", np.array([geometry.radius, geometry.halfLength])
-    if isinstance(geometry, coal.Sphere):
-        return "sphere", np.array([geometry.radius])
-    return None
-
-
-def _shape_of(kind: tuple[str, np.ndarray] | None) -> object | None:
-    """The :mod:`adept_traj.shapes` shape of a coal primitive (for point distances)."""
-    if kind is None:
-        return None
-    name, dims = kind
-    if name == "box":
-        return Box(2.0 * dims)
-    if name == "sphere":
-        return Sphere(float(dims[0]))
-    if name == "cylinder":
-        return Cylinder(float(dims[0]), 2.0 * float(dims[1]))
-    return Capsule(float(dims[0]), 2.0 * float(dims[1]))
-
-
-def _enclosing_ball(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, float]:
-    """Centre (3,) in the geometry frame and radius of a ball containing the geometry (the
-    ball around its local bounding box)."""
-    geometry.computeLocalAABB()
-    lo = np.array(geometry.aabb_local.min_)
-    hi = np.array(geometry.aabb_local.max_)
-    return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
-
-
 class CollisionChecker:
     """Distances between a robot's collision solids and a scene's obstacles (see module doc).
 
@@ -210,27 +111,11 @@ class CollisionChecker:
         objects = robot.collision_model.geometryObjects
         self.solid_names = tuple(g.name for g in objects)
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
-        covers = [_covering_spheres(g.geometry) for g in objects]
-        self._sphere_local = [c for c, _ in covers]  # per solid: (k, 3) in the solid's frame
-        self._sphere_radii = [r for _, r in covers]  # per solid: (k,)
-        balls = [_enclosing_ball(g.geometry) for g in objects]
-        self._ball_centre = np.array([c for c, _ in balls])  # (n_solids, 3)
-        self._ball_radius = np.array([r for _, r in balls])  # (n_solids,)
-        self._solid_kind = [_coal_kind(g.geometry) for g in objects]
-        self._solid_shape = [_shape_of(kind) for kind in self._solid_kind]
-        #: Sphere obstacles: exact distance to any primitive solid in closed form (numpy).
-        self._closed_form = np.array(
-            [
-                [isinstance(ob.shape, Sphere) and shape is not None for ob in scene.obstacles]
-                for shape in self._solid_shape
-            ],
-            dtype=bool,
-        ).reshape(len(objects), len(scene.obstacles))
+        self._broad = BroadPhase(robot, scene, self.influence)
         self._robot_geoms = [g.geometry for g in objects]
-        self._obstacle_geoms = [ob.shape.to_coal() for ob in scene.obstacles]
-        self._obstacle_kind = [_coal_kind(geom) for geom in self._obstacle_geoms]
         self._functors = [
-            [coal.ComputeDistance(g, o) for o in self._obstacle_geoms] for g in self._robot_geoms
+            [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
+            for g in self._robot_geoms
         ]
         self._request = coal.DistanceRequest()
         self._result = coal.DistanceResult()
@@ -239,13 +124,19 @@ class CollisionChecker:
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:
         """The robot solids as :mod:`adept_traj.shapes` objects (``None`` if not a primitive)."""
-        return tuple(self._solid_shape)
+        return tuple(self._broad.solid_shape)
 
     @property
     def closed_form(self) -> np.ndarray:
         """(n_solids, n_obstacles) bool: pairs whose distance is computed in closed form
         (a sphere obstacle and a primitive solid) instead of by coal."""
-        return self._closed_form.copy()
+        return self._broad.closed_form.copy()
+
+    @property
+    def static_pairs(self) -> np.ndarray:
+        """(n_solids, n_obstacles) bool: pairs of a solid fixed to the base and a fixed
+        obstacle, whose constant distance is computed once (at construction)."""
+        return self._broad.static.copy()
 
     @property
     def n_solids(self) -> int:
@@ -261,7 +152,8 @@ class CollisionChecker:
         """Solid–obstacle distances for configurations ``q`` (..., n_t, nq) [rad | m] at
         times ``t`` (..., n_t) [s] (broadcast against q's leading axes).
 
-        With ``exact=True`` every pair is computed by coal (for verification).
+        With ``exact=True`` every pair is computed exactly: by coal, in closed form for a
+        sphere obstacle, once for a static pair (for verification).
         """
         qa, ta = self._check(q, t)
         return self._distances(qa, ta, exact)
@@ -281,7 +173,7 @@ class CollisionChecker:
             ) from None
         return qa, ta
 
-    def min_distances(self, q: Any, t: Any, solid_poses: np.ndarray | None = None) -> MinDistances:
+    def min_distances(self, q: Any, t: Any, joint_poses: np.ndarray | None = None) -> MinDistances:
         """Per motion and obstacle, the smallest solid–obstacle distance over all samples.
 
         ``q`` (..., n_t, nq) [rad | m] and ``t`` (..., n_t) [s]: the leading axes ``...``
@@ -289,13 +181,13 @@ class CollisionChecker:
         are computed by coal in increasing order of their broad-phase lower bound until the
         best exact distance is below the next bound, so the result is the exact minimum
         (when ≤ ``influence``, penetration depths included) with few coal calls.
-        ``solid_poses`` (..., n_t, n_solids, 4, 4) may pass the robot's
-        :meth:`~adept_traj.robot.Robot.geometry_poses` if already computed.
+        ``joint_poses`` (..., n_t, njoints, 4, 4) may pass the robot's joint poses
+        (:attr:`~adept_traj.robot.ForwardKinematics.joint_poses`) if already computed.
         """
         qa, ta = self._check(q, t)
-        if solid_poses is None:
-            solid_poses = self.robot.geometry_poses(qa)
-        return self._min_distances(qa, ta, solid_poses)
+        if joint_poses is None:
+            joint_poses = self.robot.kinematics.joint_poses(qa)
+        return self._min_distances(qa, ta, joint_poses)
 
     # ------------------------------------------------------------------ private hooks
     def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
@@ -307,93 +199,6 @@ class CollisionChecker:
             to_base @ ob.pose(0.0) if not ob.is_moving else to_base @ ob.pose(flat_t)
             for ob in self.scene.obstacles
         ]
-
-    def _lower_bounds(self, solid_poses: np.ndarray, obstacle_poses: list[np.ndarray]):
-        """(N, n_solids, n_obs) broad-phase lower bounds [m], valid in every case, for the
-        flattened solid poses (N, n_solids, 4, 4).
-
-        Level 1: the ball enclosing each solid gives :math:`d(c, B) - R`, a lower bound of
-        the signed distance even under penetration. Level 2, only where level 1 is within
-        ``influence``: the covering spheres give a tighter bound, used when positive (a
-        positive bound proves separation by at least that much).
-        """
-        balls = (solid_poses[..., :3, :3] @ self._ball_centre[..., None])[..., 0]
-        balls += solid_poses[..., :3, 3]  # (N, n_solids, 3)
-        lower = np.empty((solid_poses.shape[0], self.n_solids, self.n_obstacles))
-        closed_all = self._closed_form.all(axis=0)
-        for o, ob in enumerate(self.scene.obstacles):
-            if closed_all[o]:
-                continue  # exact values follow (_sphere_obstacle_distances)
-            pose = obstacle_poses[o]  # (4, 4) or (N, 4, 4)
-            # Row-vector form of R^T (c - t): (c - t) R; one product for a fixed obstacle.
-            local = (balls - pose[..., None, :3, 3]) @ pose[..., :3, :3]
-            lower[..., o] = point_signed_distance(ob.shape, local) - self._ball_radius
-        self._sphere_obstacle_distances(lower, solid_poses, obstacle_poses)
-        close = (lower <= self.influence) & ~self._closed_form
-        for k, centres in enumerate(self._sphere_local):
-            if len(centres) == 1:
-                continue  # the covering sphere is the enclosing ball
-            for o, ob in enumerate(self.scene.obstacles):
-                idx = np.flatnonzero(close[:, k, o])
-                if idx.size == 0:
-                    continue
-                ps = solid_poses[idx, k]
-                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
-                world = np.swapaxes(ps[:, :3, :3] @ centres.T, -1, -2) + ps[:, None, :3, 3]
-                local = (world - po[..., None, :3, 3]) @ po[..., :3, :3]
-                cover = (point_signed_distance(ob.shape, local) - self._sphere_radii[k]).min(-1)
-                lower[idx, k, o] = np.where(cover > 0.0, np.maximum(cover, lower[idx, k, o]),
-                                            lower[idx, k, o])  # fmt: skip
-        self._separating_axis_bounds(lower, solid_poses, obstacle_poses)
-        return lower
-
-    def _sphere_obstacle_distances(
-        self, lower: np.ndarray, solid_poses: np.ndarray, obstacle_poses: list[np.ndarray]
-    ) -> None:
-        """In place: the exact signed distance between a primitive solid A and a sphere
-        obstacle (centre c, radius r), :math:`d(c, A) - r`, for every sample (closed form;
-        it also avoids coal 3.0.3's wrong sphere–cylinder penetration depth near a cap)."""
-        for o, ob in enumerate(self.scene.obstacles):
-            if not isinstance(ob.shape, Sphere):
-                continue
-            centre = obstacle_poses[o][..., :3, 3]  # (3,) or (N, 3)
-            for k, shape in enumerate(self._solid_shape):
-                if shape is None:
-                    continue
-                ps = solid_poses[:, k]
-                local = ((centre - ps[:, :3, 3])[:, None, :] @ ps[:, :3, :3])[:, 0]
-                lower[:, k, o] = point_signed_distance(shape, local) - ob.shape.radius
-
-    def _separating_axis_bounds(
-        self, lower: np.ndarray, solid_poses: np.ndarray, obstacle_poses: list[np.ndarray]
-    ) -> None:
-        """Level 3, in place, where ``lower`` is still within ``influence``: the gap between
-        the projections of solid and obstacle on the obstacle's axes and on the line joining
-        their centres. A positive gap along any unit axis is a lower bound of the distance;
-        for a SCARA solid hovering over a box it is the exact distance."""
-        close = (lower <= self.influence) & ~self._closed_form
-        for k, kind_s in enumerate(self._solid_kind):
-            for o, kind_o in enumerate(self._obstacle_kind):
-                idx = np.flatnonzero(close[:, k, o])
-                if idx.size == 0 or kind_s is None or kind_o is None:
-                    continue
-                ps = solid_poses[idx, k]
-                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
-                rot_o = np.broadcast_to(po[..., :3, :3], (idx.size, 3, 3))
-                delta = ps[:, :3, 3] - po[..., :3, 3]
-                norm = np.linalg.norm(delta, axis=-1, keepdims=True)
-                towards = np.divide(delta, norm, out=np.zeros_like(delta), where=norm > 0)
-                axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
-                n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (…, 4, 3)
-                n_o = axes @ rot_o  # axes in the obstacle frame
-                gap = (
-                    np.abs(np.einsum("nai,ni->na", axes, delta))
-                    - _ROUNDING
-                    - _half_extent(*kind_s, n_s)
-                    - _half_extent(*kind_o, n_o)
-                ).max(axis=-1)
-                lower[idx, k, o] = np.where(gap > 0.0, np.maximum(gap, lower[idx, k, o]),
-                                            lower[idx, k, o])  # fmt: skip
 
     @staticmethod
     def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:
@@ -409,38 +214,44 @@ class CollisionChecker:
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
-    def _min_distances(self, q: np.ndarray, t: np.ndarray, solid_poses: np.ndarray) -> MinDistances:
+    def _solid_pose(self, flat_joints: np.ndarray, n: int, s: int) -> np.ndarray:
+        broad = self._broad
+        return flat_joints[n, broad.parents[s]] @ broad.local[s]
+
+    def _min_distances(self, q: np.ndarray, t: np.ndarray, joint_poses: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
-        flat_s = solid_poses.reshape(n_motions * n_t, self.n_solids, 4, 4)
+        flat_j = joint_poses.reshape(n_motions * n_t, *joint_poses.shape[-3:])
         obstacle_poses = self._obstacle_poses(t)
-        lower = self._lower_bounds(flat_s, obstacle_poses)
-        lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
+        bounds = self._broad.bounds(flat_j, obstacle_poses)
+        lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
+        known = bounds.exact.reshape(lower.shape)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
         where = np.full(best.shape, -1)
-        closed = self._closed_form.all(axis=0)  # (n_obs,): every pair exact already
+        closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
         where[:, closed] = lower[:, :, closed].argmin(axis=1)
         calls = 0
         for m, o in zip(*np.nonzero((best <= self.influence) & ~closed)):
-            bounds = lower[m, :, o]
-            near = np.flatnonzero(bounds <= self.influence)
+            bounds_mo = lower[m, :, o]
+            near = np.flatnonzero(bounds_mo <= self.influence)
             value = np.inf
-            for c in near[np.argsort(bounds[near], kind="stable")]:
-                if bounds[c] >= value:  # every bound is a valid lower bound: prune the rest
+            for c in near[np.argsort(bounds_mo[near], kind="stable")]:
+                if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune the rest
                     break
-                k, s = divmod(int(c), self.n_solids)
-                n = m * n_t + k
-                if self._closed_form[s, o]:
-                    d = float(bounds[c])  # exact already
+                if known[m, c, o]:
+                    d = float(bounds_mo[c])  # exact already
                 else:
-                    d = self._narrow(flat_s[n, s], self._pose_at(obstacle_poses[o], n), s, o)
+                    k, s = divmod(int(c), self.n_solids)
+                    n = m * n_t + k
+                    pose = self._solid_pose(flat_j, n, s)
+                    d = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
                     calls += 1
                 if d < value:
                     value, where[m, o] = d, c
             if value > self.influence:
                 # Not exact: candidates with a bound in (influence, value) were not computed;
                 # the smallest of value and those bounds is a lower bound above influence.
-                value = min(value, bounds.min(initial=np.inf, where=bounds > self.influence))
+                value = min(value, bounds_mo.min(initial=np.inf, where=bounds_mo > self.influence))
             best[m, o] = value
         sample = np.where(where >= 0, where // self.n_solids, -1)
         solid = np.where(where >= 0, where % self.n_solids, -1)
@@ -453,19 +264,36 @@ class CollisionChecker:
         )
 
     def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
-        solid_poses = self.robot.geometry_poses(q)  # (..., n_t, n_solids, 4, 4)
+        joint_poses = self.robot.kinematics.joint_poses(q)  # (..., n_t, njoints, 4, 4)
         obstacle_poses = self._obstacle_poses(t)
-        flat_s = solid_poses.reshape(-1, self.n_solids, 4, 4)
-        flat_d = self._lower_bounds(flat_s, obstacle_poses)
-        todo = np.ones(flat_d.shape, bool) if exact else flat_d <= self.influence
-        todo &= ~self._closed_form  # sphere obstacles: exact in closed form already
+        flat_j = joint_poses.reshape(-1, *joint_poses.shape[-3:])
+        broad = self._broad
+        if exact:
+            n = flat_j.shape[0]
+            flat_d = np.empty((n, self.n_solids, self.n_obstacles))
+            known = np.ones(flat_d.shape, dtype=bool)
+            every = np.arange(n)
+            for k in range(self.n_solids):
+                poses = broad.solid_poses(flat_j, every, k)
+                for o in range(self.n_obstacles):
+                    if broad.static[k, o]:
+                        flat_d[:, k, o] = broad.static_distance[k, o]
+                    elif broad.closed_form[k, o]:
+                        flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
+            todo = ~(broad.static | broad.closed_form)[None] & known
+        else:
+            bounds = broad.bounds(flat_j, obstacle_poses)
+            flat_d, known = bounds.lower, bounds.exact.copy()
+            todo = (flat_d <= self.influence) & ~known
         samples, solids, obstacles = np.nonzero(todo)
         for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
-            flat_d[n, s, o] = self._narrow(flat_s[n, s], self._pose_at(obstacle_poses[o], n), s, o)
-        shape = (*solid_poses.shape[:-2], self.n_obstacles)
-        known = todo | self._closed_form
-        distance, known = flat_d.reshape(shape), known.reshape(shape)
-        return PairDistances(distance=distance, exact=known, n_narrow=len(samples))
+            pose = self._solid_pose(flat_j, n, s)
+            flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+        known |= todo
+        shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)
+        return PairDistances(
+            distance=flat_d.reshape(shape), exact=known.reshape(shape), n_narrow=len(samples)
+        )
 
 
 def paper_penalty(

@@ -163,6 +163,10 @@ class Evaluation:
 _REGISTRY: weakref.WeakValueDictionary[int, TrajectoryProblem] = weakref.WeakValueDictionary()
 #: Smallest chunk worth sending to a worker.
 _MIN_CHUNK = 8
+#: Samples (individuals × samples per trajectory) evaluated together: the working arrays of
+#: one block stay in the CPU cache (a whole population of 500 × 116 samples would stream
+#: every intermediate array through main memory: ≈ 1.3× slower, measured).
+_BLOCK_SAMPLES = 4096
 
 
 def _worker_init() -> None:
@@ -314,14 +318,15 @@ class TrajectoryProblem(Problem):
             for f in futures:
                 f.cancel()
             raise
-        return Evaluation(
-            objectives=np.concatenate([e.objectives for e in parts]),
-            constraints=np.concatenate([e.constraints for e in parts]),
-            min_distance=np.concatenate([e.min_distance for e in parts]),
-            n_narrow=sum(e.n_narrow for e in parts),
-        )
+        return _concatenate(parts)
 
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
+        step = max(1, _BLOCK_SAMPLES // len(self.s))
+        if len(x) <= step:
+            return self._evaluate_block(x)
+        return _concatenate([self._evaluate_block(x[i : i + step]) for i in range(0, len(x), step)])
+
+    def _evaluate_block(self, x: np.ndarray) -> Evaluation:
         traj, robot, st = self.trajectory, self.robot, self.settings
         T = x[:, 0]
         smp = traj.sample(x, self.s, orders=(0, 1, 2))
@@ -331,7 +336,7 @@ class TrajectoryProblem(Problem):
         z4 = fk.manipulability.min(axis=-1)
         integ = traj.integrals(x)
         bounds = traj.bounds(x)
-        mind = self.checker.min_distances(smp.q, smp.t, solid_poses=fk.geometry_poses)
+        mind = self.checker.min_distances(smp.q, smp.t, joint_poses=fk.joint_poses)
         z3 = self._z3(mind.distance, smp, fk.tool_pose)
         f = np.stack([T, z2, z3, z4, integ.z5, integ.z6], axis=-1)
         g = self._constraints(
@@ -465,6 +470,16 @@ class TrajectoryProblem(Problem):
             constraints=np.array(constraints),
             min_distance=np.array(min_distances).reshape(len(x), n_obs),
         )
+
+
+def _concatenate(parts: list[Evaluation]) -> Evaluation:
+    """One evaluation of the stacked populations of ``parts``."""
+    return Evaluation(
+        objectives=np.concatenate([e.objectives for e in parts]),
+        constraints=np.concatenate([e.constraints for e in parts]),
+        min_distance=np.concatenate([e.min_distance for e in parts]),
+        n_narrow=sum(e.n_narrow for e in parts),
+    )
 
 
 def _finish(ev: Evaluation, start: float, single: bool) -> Evaluation:

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -62,16 +63,24 @@ class ForwardKinematics:
     Attributes
     ----------
     joint_poses: (..., njoints, 4, 4) joint frames in the base frame (index 0 = universe).
-    geometry_poses: (..., n_geom, 4, 4) collision solids in the base frame.
     tool_pose: (..., 4, 4) tool frame in the base frame.
     manipulability: (...) as :meth:`Robot.manipulability` [m² for the SCARA], or ``None``
         when the robot has no task rows.
+    geometry_poses: (..., n_geom, 4, 4) collision solids in the base frame (computed on
+        first access: the collision checker works from the joint poses and forms solid
+        poses only near obstacles).
     """
 
     joint_poses: np.ndarray
-    geometry_poses: np.ndarray
     tool_pose: np.ndarray
     manipulability: np.ndarray | None
+    #: (parent joint per solid (n_geom,), solid placements in them (n_geom, 4, 4)).
+    solid_frames: tuple[np.ndarray, np.ndarray] = field(repr=False)
+
+    @cached_property
+    def geometry_poses(self) -> np.ndarray:
+        parents, local = self.solid_frames
+        return self.joint_poses[..., parents, :, :] @ local
 
 
 class Robot:
@@ -345,11 +354,13 @@ class Robot:
         f = self.model.frames[self._tool_id]
         tool = poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
         w = None if self.task_rows is None else self._manipulability_from(poses, tool)
+        gm = self.collision_model
+        frames = (
+            np.array([g.parentJoint for g in gm.geometryObjects], dtype=int),
+            np.array([g.placement.homogeneous for g in gm.geometryObjects]).reshape(-1, 4, 4),
+        )
         return ForwardKinematics(
-            joint_poses=poses,
-            geometry_poses=self._geometry_poses(poses, self.collision_model),
-            tool_pose=tool,
-            manipulability=w,
+            joint_poses=poses, tool_pose=tool, manipulability=w, solid_frames=frames
         )
 
     # ------------------------------------------------------------------ private hooks

@@ -237,7 +237,8 @@ def test_distances_gripper_closed_forms(robot: Robot, exact: bool) -> None:
     np.testing.assert_allclose(out.distance[0, g], expected, atol=1e-6)
     # all four are within the influence distance, hence exact (coal or closed form)
     assert out.exact[0, g].all()
-    by_coal = out.exact & ~checker.closed_form  # sphere obstacles need no coal call
+    # sphere obstacles (closed form) and static pairs (computed once) need no coal call
+    by_coal = out.exact & ~checker.closed_form & ~checker.static_pairs
     if exact:
         assert out.exact.all()
     assert out.n_narrow == int(by_coal.sum())
@@ -280,12 +281,13 @@ def test_broad_phase_is_sound(robot: Robot, influence: float) -> None:
     fast = checker.distances(q, t)
     ref = checker.distances(q, t, exact=True)
     assert ref.exact.all()
-    assert ref.n_narrow == int((ref.exact & ~checker.closed_form).sum())
+    no_call = checker.closed_form | checker.static_pairs
+    assert ref.n_narrow == int((ref.exact & ~no_call).sum())
     assert fast.distance.shape == ref.distance.shape == (6, 20, checker.n_solids, 4)
     skipped = ~fast.exact
     assert skipped.any()  # both phases exercised
     assert fast.exact.any()
-    assert fast.n_narrow == int((fast.exact & ~checker.closed_form).sum())
+    assert fast.n_narrow == int((fast.exact & ~no_call).sum())
     assert np.all(fast.distance[skipped] > influence)
     assert np.all(fast.distance[skipped] <= ref.distance[skipped])
     np.testing.assert_allclose(fast.distance[fast.exact], ref.distance[fast.exact], atol=1e-12)
@@ -361,6 +363,12 @@ def test_narrow_phase_matches_independent_coal(
                     result,
                 )
                 assert out.distance[n, s, o] == pytest.approx(d, abs=1e-9)
+    # the column (fixed to the base) and the two cubes are static pairs, computed once at
+    # construction: covered above against coal at five random configurations and times
+    static = paper_checker.static_pairs
+    column = solid_index(paper_checker, "base_link/column")
+    assert static.sum() == 2
+    assert static[column, [0, 1]].all()
 
 
 # ---------------------------------------------------------------------------------------
@@ -403,14 +411,14 @@ def test_min_distances_batched_equals_per_motion(
             np.testing.assert_array_equal(one.solid, m.solid[i, j])
 
 
-def test_min_distances_accepts_precomputed_solid_poses(
+def test_min_distances_accepts_precomputed_joint_poses(
     robot: Robot, paper_checker: CollisionChecker
 ) -> None:
     rng = np.random.default_rng(23)
     q = random_q(robot, rng, (2, 5))
     t = rng.uniform(0.0, 3.0, size=5)
     a = paper_checker.min_distances(q, t)
-    b = paper_checker.min_distances(q, t, solid_poses=robot.geometry_poses(q))
+    b = paper_checker.min_distances(q, t, joint_poses=robot.kinematics.joint_poses(q))
     np.testing.assert_array_equal(a.distance, b.distance)
     np.testing.assert_array_equal(a.sample, b.sample)
     np.testing.assert_array_equal(a.solid, b.solid)

@@ -1,0 +1,392 @@
+"""The broad phase: conservative lower bounds of solid–obstacle signed distances, batched.
+
+:class:`BroadPhase` turns joint poses (N, njoints, 4, 4) and obstacle poses into an
+(N, n_solids, n_obstacles) array of **lower bounds** of the signed distance [m] (negative =
+penetration depth), valid in every case, exact where it says so. The narrow phase
+(:class:`~adept_traj.collision.CollisionChecker`, coal) only needs the pairs whose bound is
+within ``influence``.
+
+Levels, each on the rows the previous one left within ``influence``:
+
+0. **Static pairs** — a solid fixed to the base (the SCARA's column) and a fixed obstacle:
+   the distance never changes; it is computed once (coal, or the closed form below) and
+   is exact everywhere.
+1. **Enclosing ball** of each solid (centre ``c``, radius ``R``), from the joint poses
+   directly (no solid pose is formed for far samples):
+
+   .. math:: d(\\text{solid}, B) \\ge d(c, B) - R
+
+   with :func:`point_signed_distance` the exact signed distance of a point to a box,
+   sphere, cylinder or capsule (a lower bound even under penetration).
+2. **Sphere obstacles** (the pendulum's bob) against a primitive solid: the exact signed
+   distance :math:`d(c_B, \\text{solid}) - r_B` in closed form (this also avoids coal 3.0.3's
+   wrong sphere–cylinder penetration depth near a cap).
+3. **Covering spheres**: the solid's bounding box cut into near-cubic pieces along its
+   longest side, :math:`\\min_i d(c_i, B) - r_i`, kept where positive (a positive value
+   proves separation by at least that much).
+4. **Separating axes**: the gap between the projections of solid and obstacle on the
+   obstacle's axes and on the line joining their centres, kept where positive; for a SCARA
+   solid hovering over a box it is the exact distance.
+
+Everything is numpy on whole arrays; the Python loops run over solids and obstacles
+(7 × 4 for the AdeptOne XL scene), never over samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+
+from .errors import InvalidInputError
+from .robot import Robot
+from .scene import Scene
+from .shapes import Box, Capsule, Cylinder, Sphere
+
+__all__ = ["Bounds", "BroadPhase", "point_signed_distance"]
+
+#: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
+#: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
+_ROUNDING = 1e-9
+
+
+def _norm3(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    return np.sqrt(x * x + y * y + z * z)
+
+
+def point_signed_distance(shape: object, p: np.ndarray) -> np.ndarray:
+    """Exact signed distance [m] of points ``p`` (..., 3), in the shape's own frame, to a
+    :class:`Box`, :class:`Sphere`, :class:`Cylinder` (axis z) or :class:`Capsule` (axis z);
+    negative inside.
+
+    .. math::
+        d_\\text{box}(p) = \\lVert \\max(e, 0) \\rVert + \\min(\\max_k e_k, 0),
+        \\qquad e = |p| - h
+
+    (h the half sides; the cylinder is the same in the (radial, axial) plane).
+    """
+    p = np.asarray(p, dtype=float)
+    return signed_distance_xyz(shape, p[..., 0], p[..., 1], p[..., 2])
+
+
+def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """:func:`point_signed_distance` with the coordinates [m] as separate arrays (...)
+    (the broad phase keeps points component-major: contiguous, fast elementwise)."""
+    if isinstance(shape, Sphere):
+        return _norm3(x, y, z) - shape.radius
+    if isinstance(shape, Box):
+        hx, hy, hz = (0.5 * float(v) for v in shape.size)
+        ex, ey, ez = np.abs(x) - hx, np.abs(y) - hy, np.abs(z) - hz
+        outside = _norm3(np.maximum(ex, 0.0), np.maximum(ey, 0.0), np.maximum(ez, 0.0))
+        return outside + np.minimum(np.maximum(np.maximum(ex, ey), ez), 0.0)
+    if isinstance(shape, Cylinder):
+        radial = np.sqrt(x * x + y * y) - shape.radius
+        axial = np.abs(z) - 0.5 * shape.length
+        outside = np.hypot(np.maximum(radial, 0.0), np.maximum(axial, 0.0))
+        return outside + np.minimum(np.maximum(radial, axial), 0.0)
+    if isinstance(shape, Capsule):
+        half = 0.5 * shape.length
+        dz = z - np.clip(z, -half, half)
+        return _norm3(x, y, dz) - shape.radius
+    raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
+
+
+def _points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points (3, R, m) [m] in the base frame, component-major, for joint frames ``frames``
+    (12, R) (rows: the 3 × 4 top of each pose, row-major) and points (m, 3) in the joint frame."""
+    f = frames.reshape(3, 4, -1)  # (row i, column j, R)
+    out = np.empty((3, f.shape[-1], len(points)))
+    for i in range(3):
+        out[i] = (
+            f[i, 0, :, None] * points[:, 0]
+            + f[i, 1, :, None] * points[:, 1]
+            + f[i, 2, :, None] * points[:, 2]
+            + f[i, 3, :, None]
+        )
+    return out
+
+
+def _in_obstacle_frame(points: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """Points (3, R, m) [m] expressed in the frame of an obstacle at ``pose`` (4, 4) or
+    (R, 4, 4): :math:`R_o^\\top (p - t_o)`, component-major."""
+    if pose.ndim == 2:  # fixed obstacle: one GEMM
+        shape = points.shape
+        flat = points.reshape(3, -1) - pose[:3, 3, None]
+        return (pose[:3, :3].T @ flat).reshape(shape)
+    delta = points - pose[:, :3, 3].T[..., None]  # (3, R, m)
+    rot = pose[:, :3, :3]
+    return np.stack([sum(rot[:, j, i, None] * delta[j] for j in range(3)) for i in range(3)])
+
+
+def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (k, 3) in the geometry frame and radii (k,) of spheres covering its local
+    bounding box, cut into k near-cubic pieces along its longest side."""
+    geometry.computeLocalAABB()
+    lo = np.array(geometry.aabb_local.min_)
+    hi = np.array(geometry.aabb_local.max_)
+    extent = hi - lo
+    axis = int(np.argmax(extent))
+    others = np.delete(extent, axis)
+    k = max(1, int(np.ceil(extent[axis] / max(others.max(), 1e-9))))
+    piece = extent.copy()
+    piece[axis] /= k
+    centres = np.tile(0.5 * (lo + hi), (k, 1))
+    centres[:, axis] = lo[axis] + piece[axis] * (np.arange(k) + 0.5)
+    return centres, np.full(k, 0.5 * np.linalg.norm(piece))
+
+
+def _enclosing_ball(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, float]:
+    """Centre (3,) in the geometry frame and radius of a ball containing the geometry (the
+    ball around its local bounding box)."""
+    geometry.computeLocalAABB()
+    lo = np.array(geometry.aabb_local.min_)
+    hi = np.array(geometry.aabb_local.max_)
+    return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
+
+
+def _half_extent(kind: str, dims: np.ndarray, n_local: np.ndarray) -> np.ndarray:
+    """Half-length (...) of the projection of a centred shape on unit directions ``n_local``
+    (..., 3) given in the shape's frame. ``kind``/``dims``: box (hx, hy, hz), cylinder
+    (r, h), sphere (r,), capsule (r, h), with h the half length along local z."""
+    if kind == "box":
+        return np.abs(n_local) @ dims
+    if kind == "sphere":
+        return np.full(n_local.shape[:-1], dims[0])
+    axial = np.abs(n_local[..., 2])
+    if kind == "capsule":
+        return dims[1] * axial + dims[0]
+    return dims[1] * axial + dims[0] * np.sqrt(np.maximum(0.0, 1.0 - axial**2))
+
+
+def coal_kind(geometry: coal.CollisionGeometry) -> tuple[str, np.ndarray] | None:
+    """(kind, dims) of a coal primitive for the separating-axis level, or None (no bound)."""
+    if isinstance(geometry, coal.Box):
+        return "box", np.array(geometry.halfSide)
+    if isinstance(geometry, coal.Cylinder):
+        return "cylinder", np.array([geometry.radius, geometry.halfLength])
+    if isinstance(geometry, coal.Capsule):
+        return "capsule", np.array([geometry.radius, geometry.halfLength])
+    if isinstance(geometry, coal.Sphere):
+        return "sphere", np.array([geometry.radius])
+    return None
+
+
+def shape_of(kind: tuple[str, np.ndarray] | None) -> object | None:
+    """The :mod:`adept_traj.shapes` shape of a coal primitive (for point distances)."""
+    if kind is None:
+        return None
+    name, dims = kind
+    if name == "box":
+        return Box(2.0 * dims)
+    if name == "sphere":
+        return Sphere(float(dims[0]))
+    if name == "cylinder":
+        return Cylinder(float(dims[0]), 2.0 * float(dims[1]))
+    return Capsule(float(dims[0]), 2.0 * float(dims[1]))
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Broad-phase result for N samples.
+
+    Attributes
+    ----------
+    lower:
+        (N, n_solids, n_obstacles) lower bound of the signed distance [m]; the exact
+        distance where ``exact``.
+    exact:
+        (N, n_solids, n_obstacles) bool: exact already (static pair, or a sphere obstacle in
+        closed form); these need no coal call.
+    """
+
+    lower: np.ndarray
+    exact: np.ndarray
+
+
+class BroadPhase:
+    """Lower bounds of every solid–obstacle distance (see the module docstring).
+
+    Parameters
+    ----------
+    robot, scene:
+        The robot's collision solids and the obstacles.
+    influence:
+        Distance [m] above which a bound needs no refinement (≥ 0).
+    """
+
+    def __init__(self, robot: Robot, scene: Scene, influence: float) -> None:
+        self.influence = float(influence)
+        objects = robot.collision_model.geometryObjects
+        self.n_solids, self.n_obstacles = len(objects), len(scene.obstacles)
+        self.parents = np.array([g.parentJoint for g in objects], dtype=int)
+        #: (n_solids, 4, 4) solid frames in their parent joint frames.
+        self.local = np.array([g.placement.homogeneous for g in objects]).reshape(-1, 4, 4)
+        covers = [_covering_spheres(g.geometry) for g in objects]
+        self._cover_centres = [c for c, _ in covers]  # per solid: (k, 3), solid frame
+        self._cover_radii = [r for _, r in covers]
+        balls = [_enclosing_ball(g.geometry) for g in objects]
+        local_ball = np.array([c for c, _ in balls]).reshape(-1, 3)
+        # Ball centres in the parent joint frame: one affine map per sample, no solid pose.
+        self._ball_in_joint = (
+            np.einsum("kij,kj->ki", self.local[:, :3, :3], local_ball) + self.local[:, :3, 3]
+        )
+        self._ball_radius = np.array([r for _, r in balls])
+        #: Covering-sphere centres of each solid in its parent joint frame (k, 3).
+        self._cover_in_joint = [
+            c @ self.local[k, :3, :3].T + self.local[k, :3, 3]
+            for k, c in enumerate(self._cover_centres)
+        ]
+        self._by_parent = [
+            (int(p), np.flatnonzero(self.parents == p)) for p in np.unique(self.parents)
+        ]
+        self.solid_kind = [coal_kind(g.geometry) for g in objects]
+        self.solid_shape = [shape_of(kind) for kind in self.solid_kind]
+        self.obstacle_shape = [ob.shape for ob in scene.obstacles]
+        self.obstacle_geometry = [ob.shape.to_coal() for ob in scene.obstacles]
+        self.obstacle_kind = [coal_kind(g) for g in self.obstacle_geometry]
+        self.moving = np.array([ob.is_moving for ob in scene.obstacles], dtype=bool)
+        #: (n_solids, n_obstacles): sphere obstacle and primitive solid (closed form).
+        self.closed_form = np.array(
+            [
+                [isinstance(shape, Sphere) and s is not None for shape in self.obstacle_shape]
+                for s in self.solid_shape
+            ],
+            dtype=bool,
+        ).reshape(self.n_solids, self.n_obstacles)
+        #: (n_solids, n_obstacles): solid fixed to the base and fixed obstacle.
+        self.static = (self.parents[:, None] == 0) & ~self.moving[None, :]
+        self.static_distance = np.full((self.n_solids, self.n_obstacles), np.nan)
+        to_base = scene.base_from_world
+        for k, o in zip(*np.nonzero(self.static)):
+            pose_o = to_base @ scene.obstacles[o].pose(0.0)
+            self.static_distance[k, o] = self.exact_distance(
+                self.local[k], pose_o, int(k), int(o), objects[int(k)].geometry
+            )
+
+    # ------------------------------------------------------------------ exact pieces
+    def closed_form_distance(
+        self, solid_poses: np.ndarray, obstacle_poses: np.ndarray, k: int, o: int
+    ) -> np.ndarray:
+        """Exact signed distance (R,) [m] of primitive solid ``k`` (poses (R, 4, 4)) and
+        sphere obstacle ``o`` (poses (4, 4) or (R, 4, 4)): :math:`d(c_B, A) - r_B`."""
+        centre = obstacle_poses[..., :3, 3]
+        delta = centre - solid_poses[:, :3, 3]  # (R, 3)
+        local = np.einsum("ni,nij->nj", delta, solid_poses[:, :3, :3])  # R^T delta
+        return point_signed_distance(self.solid_shape[k], local) - self.obstacle_shape[o].radius
+
+    def exact_distance(
+        self,
+        solid_pose: np.ndarray,
+        obstacle_pose: np.ndarray,
+        k: int,
+        o: int,
+        geometry: coal.CollisionGeometry,
+    ) -> float:
+        """Exact signed distance [m] of one solid–obstacle pair (closed form or coal)."""
+        if self.closed_form[k, o]:
+            return float(self.closed_form_distance(solid_pose[None], obstacle_pose, k, o)[0])
+        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        return float(
+            coal.distance(
+                geometry,
+                coal.Transform3s(solid_pose[:3, :3], solid_pose[:3, 3]),
+                self.obstacle_geometry[o],
+                coal.Transform3s(obstacle_pose[:3, :3], obstacle_pose[:3, 3]),
+                request,
+                result,
+            )
+        )
+
+    def solid_poses(self, joint_poses: np.ndarray, rows: np.ndarray, k: int) -> np.ndarray:
+        """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of ``joint_poses``
+        (N, njoints, 4, 4)."""
+        return joint_poses[rows, self.parents[k]] @ self.local[k]
+
+    # ------------------------------------------------------------------ bounds
+    def bounds(self, joint_poses: np.ndarray, obstacle_poses: list[np.ndarray]) -> Bounds:
+        """Lower bounds for joint poses (N, njoints, 4, 4) and obstacle poses in the base
+        frame (per obstacle (4, 4) if fixed, else (N, 4, 4))."""
+        n = joint_poses.shape[0]
+        lower = np.empty((n, self.n_solids, self.n_obstacles))
+        exact = np.zeros(lower.shape, dtype=bool)
+        if self.n_obstacles == 0:
+            return Bounds(lower, exact)
+        frames = {p: _frames(joint_poses, p) for p, _ in self._by_parent}
+        self._ball_bounds(lower, frames, obstacle_poses)
+        lower[:, self.static] = self.static_distance[self.static]
+        exact[:, self.static] = True
+        close = lower <= self.influence
+        close[:, self.static] = False
+        for k in range(self.n_solids):
+            for o in np.flatnonzero(close[:, k].any(axis=0)):
+                idx = np.flatnonzero(close[:, k, o])
+                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
+                if self.closed_form[k, o]:
+                    ps = self.solid_poses(joint_poses, idx, k)
+                    lower[idx, k, o] = self.closed_form_distance(ps, po, k, o)
+                    exact[idx, k, o] = True
+                    continue
+                lower[idx, k, o] = self._refine(
+                    lower[idx, k, o], frames[self.parents[k]][:, idx], joint_poses, idx, po, k, o
+                )
+        return Bounds(lower, exact)
+
+    def _ball_bounds(
+        self, lower: np.ndarray, frames: dict[int, np.ndarray], obstacle_poses: list[np.ndarray]
+    ) -> None:
+        """Level 1 in place: enclosing balls against every obstacle."""
+        n = lower.shape[0]
+        balls = np.empty((3, n, self.n_solids))
+        for p, ks in self._by_parent:
+            balls[:, :, ks] = _points_in_joint(frames[p], self._ball_in_joint[ks])
+        for o, shape in enumerate(self.obstacle_shape):
+            x, y, z = _in_obstacle_frame(balls, obstacle_poses[o])
+            lower[..., o] = signed_distance_xyz(shape, x, y, z) - self._ball_radius
+
+    def _refine(
+        self,
+        bound: np.ndarray,
+        frames: np.ndarray,
+        joint_poses: np.ndarray,
+        idx: np.ndarray,
+        po: np.ndarray,
+        k: int,
+        o: int,
+    ) -> np.ndarray:
+        """Levels 3 and 4 for solid ``k`` at the samples ``idx`` (parent joint ``frames``
+        (12, R)) and obstacle ``o`` (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
+        centres = self._cover_in_joint[k]
+        if len(centres) > 1:
+            x, y, z = _in_obstacle_frame(_points_in_joint(frames, centres), po)
+            cover = signed_distance_xyz(self.obstacle_shape[o], x, y, z) - self._cover_radii[k]
+            cover = cover.min(axis=-1)
+            bound = np.where(cover > 0.0, np.maximum(cover, bound), bound)
+        kind_s, kind_o = self.solid_kind[k], self.obstacle_kind[o]
+        still = np.flatnonzero(bound <= self.influence)
+        if still.size == 0 or kind_s is None or kind_o is None:
+            return bound
+        ps = self.solid_poses(joint_poses, idx[still], k)
+        po = po if po.ndim == 2 else po[still]
+        rot_o = np.broadcast_to(po[..., :3, :3], (still.size, 3, 3))
+        delta = ps[:, :3, 3] - po[..., :3, 3]
+        norm = np.sqrt(np.einsum("ni,ni->n", delta, delta))[:, None]
+        towards = np.divide(delta, norm, out=np.zeros_like(delta), where=norm > 0)
+        axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
+        n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (R, 4, 3)
+        n_o = axes @ rot_o  # axes in the obstacle frame
+        gap = (
+            np.abs(np.einsum("nai,ni->na", axes, delta))
+            - _ROUNDING
+            - _half_extent(*kind_s, n_s)
+            - _half_extent(*kind_o, n_o)
+        ).max(axis=-1)
+        bound = bound.copy()
+        bound[still] = np.where(gap > 0.0, np.maximum(gap, bound[still]), bound[still])
+        return bound
+
+
+def _frames(joint_poses: np.ndarray, p: int) -> np.ndarray:
+    """The 3 × 4 top of joint ``p``'s poses in (N, njoints, 4, 4), as (12, N) rows
+    (component-major, contiguous)."""
+    return np.ascontiguousarray(joint_poses[:, p, :3, :].reshape(-1, 12).T)
