@@ -93,30 +93,49 @@ def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarr
 
 
 def _points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Points (3, R, m) [m] in the base frame, component-major, for joint frames ``frames``
-    (12, R) (rows: the 3 × 4 top of each pose, row-major) and points (m, 3) in the joint frame."""
+    """Points (3, m, R) [m] in the base frame, component-major with the samples innermost,
+    for joint frames ``frames`` (12, R) (rows: the 3 × 4 top of each pose, row-major) and
+    points (m, 3) fixed in the joint frame."""
     f = frames.reshape(3, 4, -1)  # (row i, column j, R)
-    out = np.empty((3, f.shape[-1], len(points)))
+    out = np.empty((3, len(points), f.shape[-1]))
+    px, py, pz = (points[:, j, None] for j in range(3))
     for i in range(3):
-        out[i] = (
-            f[i, 0, :, None] * points[:, 0]
-            + f[i, 1, :, None] * points[:, 1]
-            + f[i, 2, :, None] * points[:, 2]
-            + f[i, 3, :, None]
-        )
+        out[i] = px * f[i, 0] + py * f[i, 1] + pz * f[i, 2] + f[i, 3]
     return out
 
 
 def _in_obstacle_frame(points: np.ndarray, pose: np.ndarray) -> np.ndarray:
-    """Points (3, R, m) [m] expressed in the frame of an obstacle at ``pose`` (4, 4) or
+    """Points (3, m, R) [m] expressed in the frame of an obstacle at ``pose`` (4, 4) or
     (R, 4, 4): :math:`R_o^\\top (p - t_o)`, component-major."""
     if pose.ndim == 2:  # fixed obstacle: one GEMM
-        shape = points.shape
         flat = points.reshape(3, -1) - pose[:3, 3, None]
-        return (pose[:3, :3].T @ flat).reshape(shape)
-    delta = points - pose[:, :3, 3].T[..., None]  # (3, R, m)
-    rot = pose[:, :3, :3]
-    return np.stack([sum(rot[:, j, i, None] * delta[j] for j in range(3)) for i in range(3)])
+        return (pose[:3, :3].T @ flat).reshape(points.shape)
+    delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
+    rt = np.ascontiguousarray(pose[:, :3, :3].transpose(2, 1, 0))  # rt[i, j] = R[:, j, i]
+    out = np.empty_like(delta)
+    for i in range(3):
+        out[i] = rt[i, 0] * delta[0] + rt[i, 1] * delta[1] + rt[i, 2] * delta[2]
+    return out
+
+
+def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """Exact signed distance (m, R) [m] of points (3, m, R) (base frame, component-major) to
+    an obstacle ``shape`` at ``pose`` (4, 4) or (R, 4, 4).
+
+    A moving sphere needs only its centre, a moving cylinder or capsule only its axis
+    :math:`a` (the third column of its rotation): with :math:`d = p - t_o`,
+    :math:`z = a \\cdot d` and :math:`\\rho = \\sqrt{\\lVert d \\rVert^2 - z^2}`.
+    """
+    if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
+        return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
+    delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
+    sq = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]
+    if isinstance(shape, Sphere):
+        return np.sqrt(sq) - shape.radius
+    axis = np.ascontiguousarray(pose[:, :3, 2].T)  # (3, R)
+    z = axis[0] * delta[0] + axis[1] * delta[1] + axis[2] * delta[2]
+    rho = np.sqrt(np.maximum(sq - z * z, 0.0))
+    return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
 
 
 def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.ndarray]:
@@ -308,41 +327,46 @@ class BroadPhase:
         """Lower bounds for joint poses (N, njoints, 4, 4) and obstacle poses in the base
         frame (per obstacle (4, 4) if fixed, else (N, 4, 4))."""
         n = joint_poses.shape[0]
-        lower = np.empty((n, self.n_solids, self.n_obstacles))
+        # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
+        lower = np.empty((self.n_obstacles, self.n_solids, n))
         exact = np.zeros(lower.shape, dtype=bool)
-        if self.n_obstacles == 0:
-            return Bounds(lower, exact)
-        frames = {p: _frames(joint_poses, p) for p, _ in self._by_parent}
-        self._ball_bounds(lower, frames, obstacle_poses)
-        lower[:, self.static] = self.static_distance[self.static]
-        exact[:, self.static] = True
-        close = lower <= self.influence
-        close[:, self.static] = False
-        for k in range(self.n_solids):
-            for o in np.flatnonzero(close[:, k].any(axis=0)):
-                idx = np.flatnonzero(close[:, k, o])
-                po = obstacle_poses[o] if obstacle_poses[o].ndim == 2 else obstacle_poses[o][idx]
+        if self.n_obstacles and n:
+            frames = {p: _frames(joint_poses, p) for p, _ in self._by_parent}
+            self._ball_bounds(lower, frames, obstacle_poses)
+            static = self.static.T  # (n_obstacles, n_solids)
+            lower[static] = self.static_distance.T[static][:, None]
+            exact[static] = True
+            close = lower <= self.influence
+            close[static] = False
+            for o, k in zip(*np.nonzero(close.any(axis=-1))):
+                idx = np.flatnonzero(close[o, k])
+                pose_o = obstacle_poses[o]
+                po = pose_o if pose_o.ndim == 2 else pose_o[idx]
                 if self.closed_form[k, o]:
                     ps = self.solid_poses(joint_poses, idx, k)
-                    lower[idx, k, o] = self.closed_form_distance(ps, po, k, o)
-                    exact[idx, k, o] = True
-                    continue
-                lower[idx, k, o] = self._refine(
-                    lower[idx, k, o], frames[self.parents[k]][:, idx], joint_poses, idx, po, k, o
-                )
-        return Bounds(lower, exact)
+                    lower[o, k, idx] = self.closed_form_distance(ps, po, k, o)
+                    exact[o, k, idx] = True
+                else:
+                    sub = frames[self.parents[k]][:, idx]
+                    lower[o, k, idx] = self._refine(
+                        lower[o, k, idx], sub, joint_poses, idx, po, k, o
+                    )
+        return Bounds(
+            np.ascontiguousarray(lower.transpose(2, 1, 0)),
+            np.ascontiguousarray(exact.transpose(2, 1, 0)),
+        )
 
     def _ball_bounds(
         self, lower: np.ndarray, frames: dict[int, np.ndarray], obstacle_poses: list[np.ndarray]
     ) -> None:
-        """Level 1 in place: enclosing balls against every obstacle."""
-        n = lower.shape[0]
-        balls = np.empty((3, n, self.n_solids))
+        """Level 1 in place (``lower`` (n_obstacles, n_solids, N)): enclosing balls against
+        every obstacle."""
+        balls = np.empty((3, self.n_solids, lower.shape[-1]))
         for p, ks in self._by_parent:
-            balls[:, :, ks] = _points_in_joint(frames[p], self._ball_in_joint[ks])
+            balls[:, ks] = _points_in_joint(frames[p], self._ball_in_joint[ks])
+        radius = self._ball_radius[:, None]
         for o, shape in enumerate(self.obstacle_shape):
-            x, y, z = _in_obstacle_frame(balls, obstacle_poses[o])
-            lower[..., o] = signed_distance_xyz(shape, x, y, z) - self._ball_radius
+            lower[o] = obstacle_signed_distance(shape, balls, obstacle_poses[o]) - radius
 
     def _refine(
         self,
@@ -358,9 +382,9 @@ class BroadPhase:
         (12, R)) and obstacle ``o`` (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
         centres = self._cover_in_joint[k]
         if len(centres) > 1:
-            x, y, z = _in_obstacle_frame(_points_in_joint(frames, centres), po)
-            cover = signed_distance_xyz(self.obstacle_shape[o], x, y, z) - self._cover_radii[k]
-            cover = cover.min(axis=-1)
+            points = _points_in_joint(frames, centres)
+            cover = obstacle_signed_distance(self.obstacle_shape[o], points, po).min(axis=0)
+            cover -= self._cover_radii[k][0]  # equal radii
             bound = np.where(cover > 0.0, np.maximum(cover, bound), bound)
         kind_s, kind_o = self.solid_kind[k], self.obstacle_kind[o]
         still = np.flatnonzero(bound <= self.influence)

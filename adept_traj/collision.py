@@ -195,10 +195,17 @@ class CollisionChecker:
         one (4, 4) pose if it is fixed, else (N, 4, 4) with N = ``t.size``."""
         to_base = self.scene.base_from_world
         flat_t = t.reshape(-1)
-        return [
-            to_base @ ob.pose(0.0) if not ob.is_moving else to_base @ ob.pose(flat_t)
-            for ob in self.scene.obstacles
-        ]
+        laws: dict[int, np.ndarray] = {}  # a pendulum's rod and bob share one motion law
+        poses = []
+        for ob in self.scene.obstacles:
+            if not ob.is_moving:
+                poses.append(to_base @ ob.pose(0.0))
+                continue
+            key = id(ob.motion)
+            if key not in laws:
+                laws[key] = (to_base @ ob.motion.pose(flat_t)).reshape(-1, 4, 4)
+            poses.append(laws[key] @ ob.offset)  # = to_base @ ob.pose(t)
+        return poses
 
     @staticmethod
     def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:

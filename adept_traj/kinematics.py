@@ -20,7 +20,6 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import RobotModelError
-from .transforms import axis_rotation
 
 __all__ = ["BatchKinematics"]
 
@@ -32,6 +31,17 @@ class _Joint:
     axis: np.ndarray  # (3,) unit, in the joint frame
     revolute: bool
     index: int  # index in q
+
+
+def _rotation_to_axis(axis: np.ndarray) -> np.ndarray:
+    """A rotation (3, 3) whose third column is the unit ``axis`` (identity for e_z)."""
+    z = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    if np.array_equal(z, [0.0, 0.0, 1.0]):
+        return np.eye(3)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
 
 
 class BatchKinematics:
@@ -74,6 +84,18 @@ class BatchKinematics:
                 )
             )
         self._joints = tuple(joints)
+        # Revolute: T = P U Rz(q) U^T with U e_z = axis (pre = P U, post = U^T or None).
+        self._pre, self._post = [], []
+        for j in joints:
+            u = _rotation_to_axis(j.axis) if j.revolute else np.eye(3)
+            pre = j.placement.copy()
+            pre[:3, :3] = j.placement[:3, :3] @ u
+            self._pre.append(pre)
+            post = None
+            if j.revolute and not np.allclose(u, np.eye(3), atol=0.0, rtol=0.0):
+                post = np.eye(4)
+                post[:3, :3] = u.T
+            self._post.append(post)
         self.nq = model.nq
         #: ``support[i, k]`` is true when q_k moves joint frame i (row 0 = universe).
         self.support = np.zeros((model.njoints, model.nq), dtype=bool)
@@ -84,19 +106,37 @@ class BatchKinematics:
 
     def joint_poses(self, q: np.ndarray) -> np.ndarray:
         """World poses (..., njoints, 4, 4) of every joint frame (index 0 = universe)
-        for configurations ``q`` (..., nq) [rad | m]."""
+        for configurations ``q`` (..., nq) [rad | m].
+
+        .. math::
+            {}^0T_i = {}^0T_{p(i)}\\, P_i\\, U_i\\, R_z(q_i)\\, U_i^\\top \\ \\text{(revolute)},
+            \\qquad {}^0T_{p(i)}\\, P_i\\, \\mathrm{Trans}(a_i q_i) \\ \\text{(prismatic)}
+
+        with :math:`P_i` the joint placement and :math:`U_i` a constant rotation taking
+        :math:`e_z` to the joint axis (the identity for z axes): the product by
+        :math:`R_z(q)` only mixes two columns, no per-sample matrix product.
+        """
         batch = q.shape[:-1]
-        out = np.empty((*batch, len(self._joints) + 1, 4, 4))
-        out[..., 0, :, :] = np.eye(4)
-        for i, j in enumerate(self._joints, start=1):
-            local = np.broadcast_to(j.placement, (*batch, 4, 4)).copy()
-            qi = q[..., j.index]
+        qf = q.reshape(-1, q.shape[-1])
+        n = qf.shape[0]
+        out = np.empty((n, len(self._joints) + 1, 4, 4))
+        out[:, 0] = np.eye(4)
+        for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
+            a = np.broadcast_to(pre, (n, 4, 4)) if j.parent == 0 else out[:, j.parent] @ pre
+            qi = qf[:, j.index, None]
+            dst = out[:, i]
             if j.revolute:
-                local[..., :3, :3] = j.placement[:3, :3] @ axis_rotation(j.axis, qi)
+                c, s = np.cos(qi), np.sin(qi)
+                a0, a1 = a[:, :, 0], a[:, :, 1]
+                dst[:, :, 0] = c * a0 + s * a1
+                dst[:, :, 1] = c * a1 - s * a0
+                dst[:, :, 2:] = a[:, :, 2:]
+                if post is not None:
+                    dst[:] = dst @ post
             else:
-                local[..., :3, 3] += (j.placement[:3, :3] @ j.axis) * qi[..., None]
-            out[..., i, :, :] = out[..., j.parent, :, :] @ local
-        return out
+                dst[:] = a
+                dst[:, :3, 3] += (a[:, :3, :3] @ j.axis) * qi
+        return out.reshape(*batch, len(self._joints) + 1, 4, 4)
 
     def jacobian(self, joint_poses: np.ndarray, point_joint: int, point: np.ndarray) -> np.ndarray:
         r"""Jacobians (..., 6, nq) of a point rigidly attached to joint frame ``point_joint``.
@@ -112,7 +152,12 @@ class BatchKinematics:
                 continue
             z = joint_poses[..., i, :3, :3] @ j.axis
             if j.revolute:
-                jac[..., :3, j.index] = np.cross(z, point - joint_poses[..., i, :3, 3])
+                r = point - joint_poses[..., i, :3, 3]
+                zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
+                rx, ry, rz = r[..., 0], r[..., 1], r[..., 2]
+                jac[..., 0, j.index] = zy * rz - zz * ry  # z × r
+                jac[..., 1, j.index] = zz * rx - zx * rz
+                jac[..., 2, j.index] = zx * ry - zy * rx
                 jac[..., 3:, j.index] = z
             else:
                 jac[..., :3, j.index] = z

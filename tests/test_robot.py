@@ -422,3 +422,56 @@ def test_more_task_rows_than_joints_and_read_only_tool_frame() -> None:
     assert robot.manipulability(q) == pytest.approx(A1 * A2 * abs(np.sin(0.7)))
     with pytest.raises(AttributeError):
         robot.tool_frame = "link2"
+
+
+def test_batch_kinematics_any_axis_matches_pinocchio() -> None:
+    """Joint poses and Jacobians of a chain with x, y, oblique revolute and prismatic axes
+    (the z-axis fast path and the general U Rz U^T path) against Pinocchio, per sample."""
+    from adept_traj.kinematics import BatchKinematics
+
+    model = pin.Model()
+    oblique = np.array([1.0, -2.0, 0.5]) / np.linalg.norm([1.0, -2.0, 0.5])
+    joints = [
+        pin.JointModelRZ(),
+        pin.JointModelRX(),
+        pin.JointModelRevoluteUnaligned(*oblique),
+        pin.JointModelPY(),
+        pin.JointModelPrismaticUnaligned(*oblique),
+        pin.JointModelRY(),
+    ]
+    rng = np.random.default_rng(3)
+    parent = 0
+    for k, jm in enumerate(joints):
+        placement = pin.SE3(pin.rpy.rpyToMatrix(*rng.uniform(-1, 1, 3)), rng.uniform(-0.5, 0.5, 3))
+        parent = model.addJoint(parent, jm, placement, f"j{k}")
+        model.appendBodyToJoint(parent, pin.Inertia.Random(), pin.SE3.Identity())
+    kin = BatchKinematics(model)
+    q = rng.uniform(-2.0, 2.0, size=(2, 3, model.nq))
+    poses = kin.joint_poses(q)
+    assert poses.shape == (2, 3, model.njoints, 4, 4)
+    data = model.createData()
+    point = np.array([0.1, -0.2, 0.3])
+    for idx in np.ndindex(2, 3):
+        pin.forwardKinematics(model, data, q[idx])
+        for i in range(model.njoints):
+            np.testing.assert_allclose(poses[idx][i], data.oMi[i].homogeneous, atol=1e-12)
+        last = model.njoints - 1
+        world = data.oMi[last].act(point)
+        pin.computeJointJacobians(model, data, q[idx])
+        ref = pin.getJointJacobian(model, data, last, pin.LOCAL_WORLD_ALIGNED).copy()
+        ref[:3] += np.cross(ref[3:].T, world - data.oMi[last].translation).T  # move to point
+        jac = kin.jacobian(poses[idx][None], last, world[None])[0]
+        np.testing.assert_allclose(jac, ref, atol=1e-12)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4, 5])
+def test_small_determinants_match_lapack(k: int) -> None:
+    from adept_traj.robot import _det
+
+    a = np.random.default_rng(k).normal(size=(7, 3, k, k))
+    np.testing.assert_allclose(_det(a), np.linalg.det(a), rtol=1e-12, atol=1e-12)
+    if k == 1:
+        return
+    singular = a.copy()
+    singular[..., -1, :] = singular[..., 0, :]  # two equal rows
+    np.testing.assert_allclose(_det(singular), 0.0, atol=1e-12)
