@@ -22,7 +22,10 @@ constraints, so it is not offered)
 (reference directions: Das–Dennis with 3 partitions for 6 objectives when needed).
 
 Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless another
-``sampling`` is given, and eliminates duplicates. Randomness comes only from pymoo's
+``sampling`` is given, repairs travel times with
+:class:`~adept_traj.repair.KinematicTimeRepair`, makes 30 % of its offspring by
+:class:`~adept_traj.local_search.FastEndSearch` (local search at the fast end of the front;
+same number of evaluations), and eliminates duplicates. Randomness comes only from pymoo's
 per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.planner`).
 """
 
@@ -34,6 +37,7 @@ from typing import Any
 from pymoo.core.algorithm import Algorithm
 
 from .errors import ConfigurationError
+from .local_search import FastEndSearch
 from .repair import KinematicTimeRepair
 from .sampling import RampSampling
 
@@ -83,6 +87,7 @@ def make_algorithm(
     n_gen: int | None = None,
     sampling: Any = None,
     repair: bool = True,
+    fast_end: float = 0.3,
     **params: Any,
 ) -> tuple[Algorithm, AlgorithmSettings]:
     """A configured pymoo algorithm and its settings.
@@ -103,6 +108,11 @@ def make_algorithm(
     repair:
         Apply :class:`~adept_traj.repair.KinematicTimeRepair` to every candidate (default;
         ``False`` runs the plain algorithm).
+    fast_end:
+        Share of each generation's offspring made by
+        :class:`~adept_traj.local_search.FastEndSearch` (local perturbations of the fastest
+        feasible members; default 0.3, ``0`` runs the algorithm's own mating only). The
+        number of evaluations is unchanged.
     params:
         Operator parameters overriding the paper's: NSGA-II ``crossover_prob``,
         ``crossover_eta``, ``mutation_prob_var``, ``mutation_eta``; MODE ``CR``, ``F``.
@@ -131,8 +141,17 @@ def make_algorithm(
             raise ConfigurationError(f"{key} parameter {k} must be a number ≥ 0; got {v!r}")
     sampling = RampSampling() if sampling is None else sampling
     fix = KinematicTimeRepair() if repair else None
+    if (
+        isinstance(fast_end, bool)
+        or not isinstance(fast_end, int | float)
+        or not 0.0 <= fast_end <= 1.0
+    ):
+        raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
+    if fast_end > 0 and hasattr(algorithm, "mating"):
+        algorithm.mating = FastEndSearch(algorithm.mating, fraction=float(fast_end))
     settings["kinematic_time_repair"] = bool(repair)
+    settings["fast_end"] = float(fast_end) if hasattr(algorithm, "mating") else 0.0
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 
