@@ -221,6 +221,16 @@ class CollisionChecker:
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
+    def _narrow_at(
+        self, flat_joints: np.ndarray, obstacle_poses: list[np.ndarray], base: int, c: int, o: int
+    ) -> float:
+        """Coal distance of candidate ``c`` (= sample · n_solids + solid) of the motion whose
+        first sample is ``base`` in the flattened arrays, to obstacle ``o``."""
+        k, s = divmod(c, self.n_solids)
+        n = base + k
+        pose = self._solid_pose(flat_joints, n, s)
+        return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+
     def _solid_pose(self, flat_joints: np.ndarray, n: int, s: int) -> np.ndarray:
         broad = self._broad
         return flat_joints[n, broad.parents[s]] @ broad.local[s]
@@ -236,25 +246,40 @@ class CollisionChecker:
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
         where = np.full(best.shape, -1)
         closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
-        where[:, closed] = lower[:, :, closed].argmin(axis=1)
+        # Every pair within influence of such an obstacle is exact already: the argmin is
+        # exact when at most influence; above, it may be a level-1 bound (then -1).
+        first = lower[:, :, closed].argmin(axis=1)  # (n_motions, n_closed)
+        is_exact = np.take_along_axis(known[:, :, closed], first[:, None, :], axis=1)[:, 0]
+        where[:, closed] = np.where(is_exact, first, -1)
         calls = 0
-        for m, o in zip(*np.nonzero((best <= self.influence) & ~closed)):
-            bounds_mo = lower[m, :, o]
-            near = np.flatnonzero(bounds_mo <= self.influence)
-            value = np.inf
-            for c in near[np.argsort(bounds_mo[near], kind="stable")]:
-                if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune the rest
-                    break
-                if known[m, c, o]:
-                    d = float(bounds_mo[c])  # exact already
-                else:
-                    k, s = divmod(int(c), self.n_solids)
-                    n = m * n_t + k
-                    pose = self._solid_pose(flat_j, n, s)
-                    d = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
-                    calls += 1
-                if d < value:
-                    value, where[m, o] = d, c
+        pm, po = np.nonzero((best <= self.influence) & ~closed)
+        # First candidate of every (motion, obstacle) at once: the smallest bound. Most
+        # searches end there (the second smallest bound is at least its exact distance).
+        rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
+        first = rows.argmin(axis=1)
+        second = (
+            np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
+        )
+        for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
+            bounds_mo = rows[i]
+            if known[m, c0, o]:
+                value = float(bounds_mo[c0])  # exact already
+            else:
+                value = self._narrow_at(flat_j, obstacle_poses, m * n_t, c0, o)
+                calls += 1
+            where[m, o] = c0
+            if second[i] < value and second[i] <= self.influence:
+                near = np.flatnonzero(bounds_mo <= self.influence)
+                for c in near[np.argsort(bounds_mo[near], kind="stable")][1:]:
+                    if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune
+                        break
+                    if known[m, c, o]:
+                        d = float(bounds_mo[c])
+                    else:
+                        d = self._narrow_at(flat_j, obstacle_poses, m * n_t, int(c), o)
+                        calls += 1
+                    if d < value:
+                        value, where[m, o] = d, c
             if value > self.influence:
                 # Not exact: candidates with a bound in (influence, value) were not computed;
                 # the smallest of value and those bounds is a lower bound above influence.

@@ -79,7 +79,7 @@ class FastEndSearch:
 
     def __getattr__(self, name: str) -> Any:
         # Everything else (repair, eliminate_duplicates, ...) is the wrapped mating's.
-        if name == "mating":
+        if name == "mating" or name.startswith("__"):  # not set yet (copying), or protocol
             raise AttributeError(name)
         return getattr(self.mating, name)
 
