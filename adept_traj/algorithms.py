@@ -31,6 +31,7 @@ per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.planner`).
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -143,7 +144,7 @@ def make_algorithm(
     fix = KinematicTimeRepair() if repair else None
     if (
         isinstance(fast_end, bool)
-        or not isinstance(fast_end, int | float)
+        or not isinstance(fast_end, numbers.Real)
         or not 0.0 <= fast_end <= 1.0
     ):
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")

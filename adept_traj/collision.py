@@ -79,7 +79,8 @@ class MinDistances:
         (..., n_obstacles) smallest signed distance [m] over the motion's samples and the
         robot solids; exact when ≤ ``influence``, else a lower bound greater than it.
     sample, solid:
-        (..., n_obstacles) int, where the smallest exact distance was found (-1 if none).
+        (..., n_obstacles) int, where the smallest exact distance was found (-1 if the
+        distance is only a lower bound above ``influence``).
     n_narrow:
         Number of coal distance calls made.
     """
@@ -284,6 +285,7 @@ class CollisionChecker:
                 # Not exact: candidates with a bound in (influence, value) were not computed;
                 # the smallest of value and those bounds is a lower bound above influence.
                 value = min(value, bounds_mo.min(initial=np.inf, where=bounds_mo > self.influence))
+                where[m, o] = -1  # only a bound is known
             best[m, o] = value
         sample = np.where(where >= 0, where // self.n_solids, -1)
         solid = np.where(where >= 0, where % self.n_solids, -1)

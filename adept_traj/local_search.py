@@ -87,23 +87,29 @@ class FastEndSearch:
         return self.do(problem, pop, n_offsprings, **kwargs)
 
     def do(self, problem: Any, pop: Population, n_offsprings: int, **kwargs: Any) -> Population:
-        """``n_offsprings`` children of ``pop``: the local-search share, then the mating's."""
+        """``n_offsprings`` children of ``pop``: the mating's, of which a random
+        ``fraction`` is replaced by local-search children (those are not evaluated: the
+        number of evaluations is the mating's)."""
         rng = kwargs.get("random_state")
         cv = pop.get("CV")
         feasible = np.flatnonzero(cv[:, 0] <= 0.0) if cv is not None and len(pop) else []
         n_local = 0
         if len(feasible) and rng is not None:
             n_local = min(round(self.fraction * n_offsprings), n_offsprings)
-        off = self.mating.do(problem, pop, n_offsprings - n_local, **kwargs)
-        if n_local == 0:
+        off = self.mating.do(problem, pop, n_offsprings, **kwargs)
+        if n_local == 0 or len(off) == 0:
             return off
+        # Replace a random subset of the mating's children (not its last ones: pymoo's DE
+        # uses the first members of the population as targets, in order).
+        n_local = min(n_local, len(off))
+        keep = np.sort(rng.permutation(len(off))[: len(off) - n_local])
         X = pop.get("X")
         fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
         parents = X[fastest[rng.integers(0, len(fastest), size=n_local)]]
         children = self._perturb(problem, parents, rng)
         t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
         children[:, 0] = np.clip(t_kin, problem.xl[0], problem.xu[0])
-        return Population.merge(off, Population.new(X=children))
+        return Population.merge(off[keep], Population.new(X=children))
 
     def _perturb(self, problem: Any, parents: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Smooth perturbations of the parents' free control points (:func:`_modes` over the

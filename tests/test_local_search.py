@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from paper_moves import lift_then_lower
+from pymoo.core.evaluator import Evaluator
 from pymoo.core.population import Population
 
 from adept_traj import TrajectoryProblem
@@ -45,8 +46,8 @@ def test_children_perturb_the_fastest_feasible_members(problem: TrajectoryProble
     mating = Recorder()
     search = FastEndSearch(mating, fraction=0.3, n_elite=1)
     off = search.do(problem, pop, 10, random_state=np.random.default_rng(1))
-    assert len(off) == 10  # same number of offspring: 7 from the mating, 3 local
-    assert mating.asked == [7]
+    assert len(off) == 10  # same number of offspring: 7 of the mating's 10 kept, 3 local
+    assert mating.asked == [10]
     assert search.repair == "the wrapped mating's repair"  # attributes pass through
     children = off.get("X")[7:]
     # the travel time is each child's own kinematic minimum
@@ -98,3 +99,27 @@ def test_settings_and_validation() -> None:
         FastEndSearch(None, n_elite=0)
     with pytest.raises(ConfigurationError, match="sigma"):
         FastEndSearch(None, sigma=(0.1, 0.01))
+
+
+@pytest.mark.parametrize("name", ["mode", "nsga2"])
+def test_all_offspring_local_with_the_real_matings(problem: TrajectoryProblem, name: str) -> None:
+    """fast_end = 1: every child is local, with MODE's DE variant and NSGA-II's SBX + PM
+    (MODE's DE once failed when asked for no child)."""
+    alg, _ = make_algorithm(name, pop_size=4, fast_end=1.0)
+    alg.setup(problem, seed=1)
+    pop = Population.new(X=np.repeat(lift_then_lower(problem)[None], 4, axis=0))
+    Evaluator().eval(problem, pop)
+    rng = np.random.default_rng(3)
+    pop = alg.survival.do(problem, pop, n_survive=4, algorithm=alg, random_state=rng)  # ranks
+    assert (pop.get("CV")[:, 0] <= 0).all()
+    off = alg.mating.do(problem, pop, 4, algorithm=alg, random_state=np.random.default_rng(3))
+    assert len(off) == 4
+    x = off.get("X")
+    np.testing.assert_allclose(x[:, 0], kinematic_time(problem, x), rtol=1e-8)
+
+
+def test_numpy_numbers_are_accepted() -> None:
+    _, settings = make_algorithm("nsga2", fast_end=np.float64(0.5))
+    assert settings.params["fast_end"] == 0.5
+    _, settings = make_algorithm("nsga2", fast_end=np.int64(0))
+    assert settings.params["fast_end"] == 0.0
