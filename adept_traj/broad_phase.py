@@ -40,7 +40,7 @@ import coal
 import numpy as np
 
 from .errors import InvalidInputError
-from .robot import Robot
+from .robot import Robot, solid_frames
 from .scene import Scene
 from .shapes import Box, Capsule, Cylinder, Sphere
 
@@ -138,12 +138,16 @@ def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray
     return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
 
 
+def _local_box(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.ndarray]:
+    """Corners (lo, hi) (3,) [m] of a geometry's bounding box in its own frame."""
+    geometry.computeLocalAABB()
+    return np.array(geometry.aabb_local.min_), np.array(geometry.aabb_local.max_)
+
+
 def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.ndarray]:
     """Centres (k, 3) in the geometry frame and radii (k,) of spheres covering its local
     bounding box, cut into k near-cubic pieces along its longest side."""
-    geometry.computeLocalAABB()
-    lo = np.array(geometry.aabb_local.min_)
-    hi = np.array(geometry.aabb_local.max_)
+    lo, hi = _local_box(geometry)
     extent = hi - lo
     axis = int(np.argmax(extent))
     others = np.delete(extent, axis)
@@ -158,9 +162,7 @@ def _covering_spheres(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, np.
 def _enclosing_ball(geometry: coal.CollisionGeometry) -> tuple[np.ndarray, float]:
     """Centre (3,) in the geometry frame and radius of a ball containing the geometry (the
     ball around its local bounding box)."""
-    geometry.computeLocalAABB()
-    lo = np.array(geometry.aabb_local.min_)
-    hi = np.array(geometry.aabb_local.max_)
+    lo, hi = _local_box(geometry)
     return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
 
 
@@ -238,9 +240,8 @@ class BroadPhase:
         self.influence = float(influence)
         objects = robot.collision_model.geometryObjects
         self.n_solids, self.n_obstacles = len(objects), len(scene.obstacles)
-        self.parents = np.array([g.parentJoint for g in objects], dtype=int)
-        #: (n_solids, 4, 4) solid frames in their parent joint frames.
-        self.local = np.array([g.placement.homogeneous for g in objects]).reshape(-1, 4, 4)
+        #: Parent joint of each solid (n_solids,) and its placement there (n_solids, 4, 4).
+        self.parents, self.local = solid_frames(robot.collision_model)
         covers = [_covering_spheres(g.geometry) for g in objects]
         self._cover_centres = [c for c, _ in covers]  # per solid: (k, 3), solid frame
         self._cover_radii = [r for _, r in covers]
@@ -317,9 +318,9 @@ class BroadPhase:
             )
         )
 
-    def solid_poses(self, joint_poses: np.ndarray, rows: np.ndarray, k: int) -> np.ndarray:
+    def solid_poses(self, joint_poses: np.ndarray, rows: np.ndarray | int, k: int) -> np.ndarray:
         """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of ``joint_poses``
-        (N, njoints, 4, 4)."""
+        (N, njoints, 4, 4); one pose (4, 4) for a single sample index."""
         return joint_poses[rows, self.parents[k]] @ self.local[k]
 
     # ------------------------------------------------------------------ bounds

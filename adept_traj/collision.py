@@ -229,12 +229,8 @@ class CollisionChecker:
         first sample is ``base`` in the flattened arrays, to obstacle ``o``."""
         k, s = divmod(c, self.n_solids)
         n = base + k
-        pose = self._solid_pose(flat_joints, n, s)
+        pose = self._broad.solid_poses(flat_joints, n, s)
         return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
-
-    def _solid_pose(self, flat_joints: np.ndarray, n: int, s: int) -> np.ndarray:
-        broad = self._broad
-        return flat_joints[n, broad.parents[s]] @ broad.local[s]
 
     def _min_distances(self, q: np.ndarray, t: np.ndarray, joint_poses: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
@@ -321,7 +317,7 @@ class CollisionChecker:
             todo = (flat_d <= self.influence) & ~known
         samples, solids, obstacles = np.nonzero(todo)
         for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
-            pose = self._solid_pose(flat_j, n, s)
+            pose = self._broad.solid_poses(flat_j, n, s)
             flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
         known |= todo
         shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)

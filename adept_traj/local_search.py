@@ -117,7 +117,7 @@ class FastEndSearch:
         traj = problem.trajectory
         _, P = traj.decode(parents)
         free = P[:, 3:-3, :]  # (n, n_free, nq)
-        xi = np.clip((np.arange(traj.n_control) - 1.0) / traj.n_segments, 0.0, 1.0)[3:-3]
+        xi = traj.free_abscissae
         n = len(parents)
         # Per child: one smooth bump per joint at a random place and width (all three
         # derivatives vanish at its ends, and it is cut off before the fixed end points).

@@ -79,8 +79,22 @@ class ForwardKinematics:
 
     @cached_property
     def geometry_poses(self) -> np.ndarray:
-        parents, local = self.solid_frames
-        return self.joint_poses[..., parents, :, :] @ local
+        return place_solids(self.joint_poses, self.solid_frames)
+
+
+def solid_frames(gm: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
+    """(parent joint of each object (n_geom,), its placement in that joint's frame
+    (n_geom, 4, 4)) of a geometry model."""
+    parents = np.array([g.parentJoint for g in gm.geometryObjects], dtype=int)
+    local = np.array([g.placement.homogeneous for g in gm.geometryObjects]).reshape(-1, 4, 4)
+    return parents, local
+
+
+def place_solids(joint_poses: np.ndarray, frames: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Poses (..., n_geom, 4, 4) of the objects of :func:`solid_frames` ``frames`` for joint
+    poses (..., njoints, 4, 4)."""
+    parents, local = frames
+    return joint_poses[..., parents, :, :] @ local
 
 
 class Robot:
@@ -354,20 +368,16 @@ class Robot:
         f = self.model.frames[self._tool_id]
         tool = poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
         w = None if self.task_rows is None else self._manipulability_from(poses, tool)
-        gm = self.collision_model
-        frames = (
-            np.array([g.parentJoint for g in gm.geometryObjects], dtype=int),
-            np.array([g.placement.homogeneous for g in gm.geometryObjects]).reshape(-1, 4, 4),
-        )
         return ForwardKinematics(
-            joint_poses=poses, tool_pose=tool, manipulability=w, solid_frames=frames
+            joint_poses=poses,
+            tool_pose=tool,
+            manipulability=w,
+            solid_frames=solid_frames(self.collision_model),
         )
 
     # ------------------------------------------------------------------ private hooks
     def _geometry_poses(self, joint_poses: np.ndarray, gm: pin.GeometryModel) -> np.ndarray:
-        parents = [g.parentJoint for g in gm.geometryObjects]
-        local = np.array([g.placement.homogeneous for g in gm.geometryObjects])
-        return joint_poses[..., parents, :, :] @ local
+        return place_solids(joint_poses, solid_frames(gm))
 
     def _inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         shape = q.shape

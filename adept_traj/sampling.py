@@ -101,8 +101,7 @@ class RampSampling(Sampling):
         rng = random_state if random_state is not None else np.random.default_rng()
         traj = problem.trajectory
         nq = traj.nq
-        # Greville abscissae of a uniform cubic B-spline's free control points.
-        xi = np.clip((np.arange(traj.n_control) - 1.0) / traj.n_segments, 0.0, 1.0)[3:-3]
+        xi = traj.free_abscissae
         span = problem.robot.limits.upper - problem.robot.limits.lower
         T = rng.uniform(problem.xl[0], problem.xu[0], size=n_samples)
         a = rng.uniform(0.0, 1.0 - self.min_window, size=(n_samples, nq))

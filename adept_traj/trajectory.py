@@ -383,6 +383,16 @@ class BSplineTrajectory:
         return self.n_control - 2 * _N_FIXED_END
 
     @property
+    def free_abscissae(self) -> np.ndarray:
+        """(n_free,) Greville abscissae in [0, 1] of the free control points (where each
+        control point acts along the normalised time; used to shape whole control polygons).
+
+        .. math:: \\xi_c = \\operatorname{clip}\\big((c - 1) / S,\\ 0,\\ 1\\big)
+        """
+        xi = np.clip((np.arange(self.n_control) - 1.0) / self.n_segments, 0.0, 1.0)
+        return xi[_N_FIXED_END:-_N_FIXED_END]
+
+    @property
     def n_var(self) -> int:
         """Length of the decision vector ``1 + nq·n_free`` (65 for the paper)."""
         return 1 + self.nq * self.n_free
