@@ -25,7 +25,8 @@ Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless an
 ``sampling`` is given, repairs travel times with
 :class:`~adept_traj.repair.KinematicTimeRepair`, makes 30 % of its offspring by
 :class:`~adept_traj.local_search.FastEndSearch` (local search at the fast end of the front;
-same number of evaluations), and eliminates duplicates. Randomness comes only from pymoo's
+same number of evaluations; a third of those are fresh ramps from the sampling, at their
+kinematic minimum time), and eliminates duplicates. Randomness comes only from pymoo's
 per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.planner`).
 """
 
@@ -112,8 +113,8 @@ def make_algorithm(
     fast_end:
         Share of each generation's offspring made by
         :class:`~adept_traj.local_search.FastEndSearch` (local perturbations of the fastest
-        feasible members; default 0.3, ``0`` runs the algorithm's own mating only). The
-        number of evaluations is unchanged.
+        feasible members and fresh ramps at their kinematic minimum time; default 0.3,
+        ``0`` runs the algorithm's own mating only). The number of evaluations is unchanged.
     params:
         Operator parameters overriding the paper's: NSGA-II ``crossover_prob``,
         ``crossover_eta``, ``mutation_prob_var``, ``mutation_eta``; MODE ``CR``, ``F``.
@@ -150,9 +151,13 @@ def make_algorithm(
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
     if fast_end > 0 and hasattr(algorithm, "mating"):
-        algorithm.mating = FastEndSearch(algorithm.mating, fraction=float(fast_end))
+        ramps = sampling if isinstance(sampling, RampSampling) else None
+        algorithm.mating = FastEndSearch(algorithm.mating, fraction=float(fast_end), sampling=ramps)
     settings["kinematic_time_repair"] = bool(repair)
-    settings["fast_end"] = float(fast_end) if hasattr(algorithm, "mating") else 0.0
+    mating = getattr(algorithm, "mating", None)
+    search = mating if isinstance(mating, FastEndSearch) else None
+    settings["fast_end"] = search.fraction if search else 0.0
+    settings["fast_end_immigrants"] = search.immigrants if search else 0.0
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 

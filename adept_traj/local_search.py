@@ -21,10 +21,19 @@ P the control points of one of the ``n_elite`` fastest feasible members (uniform
 chosen); the child is clipped to the bounds, and the travel time set to the child's own kinematic
 minimum :math:`T_{kin}(P')` (:func:`~adept_traj.repair.kinematic_time`), the fastest move
 of that shape. Survival then keeps a child only if it is better (e.g. feasible and faster).
+
+A share ``immigrants`` (default 1/3) of these local children are instead **fresh random
+ramps** from :class:`~adept_traj.sampling.RampSampling`, also at their own kinematic minimum
+time (random immigrants at the fast end). Perturbations refine the fastest shapes found so
+far; immigrants keep sampling new ones, so the search does not stay in the basin of the
+first feasible fast move (measured on the paper scenario with NSGA-II at the paper's
+settings, seeds 1–5: the fastest verified move went from 1.18–1.25 × the kinematic bound
+without immigrants to 1.07–1.11 × with them, see ``docs/engine.md``). Immigrants are made
+even before any member is feasible; perturbations only after.
 The number of offspring, hence of evaluations per generation, is unchanged; randomness
 comes from the algorithm's seeded generator (same seed, same front; exact resume).
 Nothing about a particular scene is assumed. Before any member is feasible the mating is
-the algorithm's own.
+the algorithm's own, apart from the immigrants.
 """
 
 from __future__ import annotations
@@ -36,6 +45,7 @@ from pymoo.core.population import Population
 
 from .errors import ConfigurationError
 from .repair import kinematic_time
+from .sampling import RampSampling
 
 __all__ = ["FastEndSearch"]
 
@@ -58,6 +68,12 @@ class FastEndSearch:
     sigma:
         (lo, hi) range of the perturbation scale as a fraction of each variable's range
         (default (0.0005, 0.01)); drawn log-uniformly per child.
+    immigrants:
+        Share of the local children that are fresh ramps instead of perturbations, in
+        [0, 1] (default 1/3; 0 disables them).
+    sampling:
+        Where immigrants come from (default: a :class:`~adept_traj.sampling.RampSampling`
+        with its default parameters).
     """
 
     def __init__(
@@ -66,9 +82,13 @@ class FastEndSearch:
         fraction: float = 0.3,
         n_elite: int = 5,
         sigma: tuple[float, float] = (0.0005, 0.01),
+        immigrants: float = 1.0 / 3.0,
+        sampling: RampSampling | None = None,
     ) -> None:
         if not 0.0 <= fraction <= 1.0:
             raise ConfigurationError(f"fast_end fraction must be in [0, 1]; got {fraction}")
+        if not 0.0 <= immigrants <= 1.0:
+            raise ConfigurationError(f"immigrants must be in [0, 1]; got {immigrants}")
         if isinstance(n_elite, bool) or not isinstance(n_elite, int) or n_elite < 1:
             raise ConfigurationError(f"n_elite must be an integer ≥ 1; got {n_elite!r}")
         lo, hi = (float(v) for v in sigma)
@@ -76,6 +96,8 @@ class FastEndSearch:
             raise ConfigurationError(f"sigma must be (lo, hi) with 0 < lo ≤ hi; got {sigma}")
         self.mating, self.fraction = mating, float(fraction)
         self.n_elite, self.sigma = n_elite, (lo, hi)
+        self.immigrants = float(immigrants)
+        self.sampling = RampSampling() if sampling is None else sampling
 
     def __getattr__(self, name: str) -> Any:
         # Everything else (repair, eliminate_duplicates, ...) is the wrapped mating's.
@@ -88,25 +110,29 @@ class FastEndSearch:
 
     def do(self, problem: Any, pop: Population, n_offsprings: int, **kwargs: Any) -> Population:
         """``n_offsprings`` children of ``pop``: the mating's, of which a random
-        ``fraction`` is replaced by local-search children (those are not evaluated: the
-        number of evaluations is the mating's)."""
+        ``fraction`` is replaced by local-search children — perturbations of the fastest
+        feasible members and fresh ramps (immigrants). The replaced children are not
+        evaluated: the number of evaluations is the mating's."""
         rng = kwargs.get("random_state")
         cv = pop.get("CV")
         feasible = np.flatnonzero(cv[:, 0] <= 0.0) if cv is not None and len(pop) else []
-        n_local = 0
-        if len(feasible) and rng is not None:
-            n_local = min(round(self.fraction * n_offsprings), n_offsprings)
         off = self.mating.do(problem, pop, n_offsprings, **kwargs)
-        if n_local == 0 or len(off) == 0:
+        if rng is None or len(off) == 0:
+            return off
+        n_local = min(round(self.fraction * n_offsprings), len(off))
+        n_new = round(self.immigrants * n_local)
+        n_bump = n_local - n_new if len(feasible) else 0
+        if n_new + n_bump == 0:
             return off
         # Replace a random subset of the mating's children (not its last ones: pymoo's DE
         # uses the first members of the population as targets, in order).
-        n_local = min(n_local, len(off))
-        keep = np.sort(rng.permutation(len(off))[: len(off) - n_local])
-        X = pop.get("X")
-        fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
-        parents = X[fastest[rng.integers(0, len(fastest), size=n_local)]]
-        children = self._perturb(problem, parents, rng)
+        keep = np.sort(rng.permutation(len(off))[: len(off) - n_new - n_bump])
+        children = self.sampling.ramps(problem, n_new, rng)
+        if n_bump:
+            X = pop.get("X")
+            fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
+            parents = X[fastest[rng.integers(0, len(fastest), size=n_bump)]]
+            children = np.concatenate([children, self._perturb(problem, parents, rng)])
         t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
         children[:, 0] = np.clip(t_kin, problem.xl[0], problem.xu[0])
         return Population.merge(off[keep], Population.new(X=children))

@@ -99,6 +99,14 @@ class RampSampling(Sampling):
 
     def _do(self, problem: Any, n_samples: int, random_state: Any = None, **kwargs: Any):
         rng = random_state if random_state is not None else np.random.default_rng()
+        x = self.ramps(problem, n_samples, rng)
+        if n_samples > 0:
+            x[0] = problem.trajectory.straight_line(0.5 * (problem.xl[0] + problem.xu[0]))
+        return np.clip(x, problem.xl, problem.xu)
+
+    def ramps(self, problem: Any, n_samples: int, rng: np.random.Generator) -> np.ndarray:
+        """(n_samples, n_var) random ramps (the module's distribution, without the straight
+        move), clipped to the decision bounds; randomness from ``rng`` only."""
         traj = problem.trajectory
         nq = traj.nq
         xi = traj.free_abscissae
@@ -122,6 +130,4 @@ class RampSampling(Sampling):
         x = traj.encode(T, free)
         fast = rng.uniform(size=n_samples) < 0.5
         x[fast, 0] = kinematic_time(problem, x[fast]) * rng.uniform(1.0, 1.3, size=fast.sum())
-        if n_samples > 0:
-            x[0] = traj.straight_line(0.5 * (problem.xl[0] + problem.xu[0]))
         return np.clip(x, problem.xl, problem.xu)

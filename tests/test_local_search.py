@@ -44,7 +44,7 @@ def test_children_perturb_the_fastest_feasible_members(problem: TrajectoryProble
     assert feasible[0]
     assert not feasible[1:].any()  # random moves collide or break limits
     mating = Recorder()
-    search = FastEndSearch(mating, fraction=0.3, n_elite=1)
+    search = FastEndSearch(mating, fraction=0.3, n_elite=1, immigrants=0.0)
     off = search.do(problem, pop, 10, random_state=np.random.default_rng(1))
     assert len(off) == 10  # same number of offspring: 7 of the mating's 10 kept, 3 local
     assert mating.asked == [10]
@@ -63,15 +63,47 @@ def test_children_perturb_the_fastest_feasible_members(problem: TrajectoryProble
     assert np.all(children[:, 0] < 1.5 * kinematic_time(problem, x0[None])[0])
 
 
-def test_no_feasible_member_means_the_plain_mating(problem: TrajectoryProblem) -> None:
+def test_no_feasible_member_means_no_perturbation(problem: TrajectoryProblem) -> None:
     rng = np.random.default_rng(2)
     x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(6, problem.n_var))
     pop = evaluated_population(problem, x)
     assert not (pop.get("CV")[:, 0] <= 0).any()
     mating = Recorder()
-    off = FastEndSearch(mating, fraction=0.5).do(problem, pop, 6, random_state=rng)
+    off = FastEndSearch(mating, fraction=0.5, immigrants=0.0).do(problem, pop, 6, random_state=rng)
     assert mating.asked == [6]
     np.testing.assert_array_equal(off.get("X"), x)
+    # with immigrants: a third of the 3 local children (1) is a fresh ramp, the rest the
+    # mating's own (nothing to perturb)
+    off = FastEndSearch(Recorder(), fraction=0.5).do(problem, pop, 6, random_state=rng)
+    X = off.get("X")
+    assert len(X) == 6
+    mating_children = [i for i in range(6) if any(np.array_equal(X[i], xi) for xi in x)]
+    assert len(mating_children) == 5
+
+
+def test_immigrants_are_fresh_ramps_at_their_kinematic_minimum(
+    problem: TrajectoryProblem,
+) -> None:
+    x0 = lift_then_lower(problem)
+    pop = evaluated_population(problem, x0[None])
+    assert pop.get("CV")[0, 0] <= 0
+    search = FastEndSearch(Recorder(), fraction=1.0, immigrants=1.0)
+    rng = np.random.default_rng(4)
+    off = search.do(problem, Population.merge(*[pop] * 8), 8, random_state=rng)
+    X = off.get("X")
+    assert len(X) == 8
+    expected = np.clip(kinematic_time(problem, X), problem.xl[0], problem.xu[0])
+    np.testing.assert_allclose(X[:, 0], expected, rtol=1e-8)  # T_max caps slow shapes
+    _, P = problem.trajectory.decode(X)
+    np.testing.assert_array_equal(P[:, :3], np.broadcast_to(problem.start, (8, 3, 4)))
+    np.testing.assert_array_equal(P[:, -3:], np.broadcast_to(problem.goal, (8, 3, 4)))
+    # not perturbations of the elite (at most a few σ_hi = 1 % of a range): fresh ramps
+    span = problem.xu[1:] - problem.xl[1:]
+    assert np.all((np.abs(X[:, 1:] - x0[1:]) / span).max(axis=1) > 0.05)
+    assert len(np.unique(X, axis=0)) == 8
+    # ramps are monotone between start and goal unless a detour was drawn: most are
+    d = np.diff(P, axis=1) * np.sign(problem.goal - problem.start)
+    assert np.mean(np.all(d >= -1e-12, axis=(1, 2))) > 0.2
 
 
 def test_same_generator_same_children(problem: TrajectoryProblem) -> None:
@@ -99,6 +131,11 @@ def test_settings_and_validation() -> None:
         FastEndSearch(None, n_elite=0)
     with pytest.raises(ConfigurationError, match="sigma"):
         FastEndSearch(None, sigma=(0.1, 0.01))
+    for bad in (-0.1, 1.5):
+        with pytest.raises(ConfigurationError, match="immigrants"):
+            FastEndSearch(None, immigrants=bad)
+    assert settings.params["fast_end_immigrants"] == 0.0
+    assert make_algorithm("mode")[1].params["fast_end_immigrants"] == pytest.approx(1 / 3)
 
 
 @pytest.mark.parametrize("name", ["mode", "nsga2"])
