@@ -1,6 +1,7 @@
 """The broad phase: conservative lower bounds of solid–obstacle signed distances, batched.
 
-:class:`BroadPhase` turns joint poses (N, njoints, 4, 4) and obstacle poses into an
+:class:`BroadPhase` turns joint frames (njoints, 3, 4, N) (component-major, from
+:meth:`~adept_traj.kinematics.BatchKinematics.joint_frames`) and obstacle poses into an
 (N, n_solids, n_obstacles) array of **lower bounds** of the signed distance [m] (negative =
 penetration depth), valid in every case, exact where it says so. The narrow phase
 (:class:`~adept_traj.collision.CollisionChecker`, coal) only needs the pairs whose bound is
@@ -40,6 +41,7 @@ import coal
 import numpy as np
 
 from .errors import InvalidInputError
+from .kinematics import compose
 from .robot import Robot, solid_frames
 from .scene import Scene
 from .shapes import Box, Capsule, Cylinder, Sphere
@@ -318,22 +320,30 @@ class BroadPhase:
             )
         )
 
-    def solid_poses(self, joint_poses: np.ndarray, rows: np.ndarray | int, k: int) -> np.ndarray:
-        """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of ``joint_poses``
-        (N, njoints, 4, 4); one pose (4, 4) for a single sample index."""
-        return joint_poses[rows, self.parents[k]] @ self.local[k]
+    def solid_poses(self, frames: np.ndarray, rows: np.ndarray | int, k: int) -> np.ndarray:
+        """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of the joint frames
+        ``frames`` (njoints, 3, 4, N); one pose (4, 4) for a single sample index."""
+        parent, local = frames[self.parents[k]], self.local[k]
+        if np.ndim(rows) == 0:
+            pose = np.empty((4, 4))
+            pose[:3] = parent[:, :, rows] @ local
+        else:
+            pose = np.empty((len(rows), 4, 4))
+            pose[:, :3] = compose(parent[..., rows], local).transpose(2, 0, 1)
+        pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+        return pose
 
     # ------------------------------------------------------------------ bounds
-    def bounds(self, joint_poses: np.ndarray, obstacle_poses: list[np.ndarray]) -> Bounds:
-        """Lower bounds for joint poses (N, njoints, 4, 4) and obstacle poses in the base
-        frame (per obstacle (4, 4) if fixed, else (N, 4, 4))."""
-        n = joint_poses.shape[0]
+    def bounds(self, frames: np.ndarray, obstacle_poses: list[np.ndarray]) -> Bounds:
+        """Lower bounds for joint frames (njoints, 3, 4, N) (component-major) and obstacle
+        poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4))."""
+        n = frames.shape[-1]
         # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
         lower = np.empty((self.n_obstacles, self.n_solids, n))
         exact = np.zeros(lower.shape, dtype=bool)
         if self.n_obstacles and n:
-            frames = {p: _frames(joint_poses, p) for p, _ in self._by_parent}
-            self._ball_bounds(lower, frames, obstacle_poses)
+            rows = {p: frames[p].reshape(12, n) for p, _ in self._by_parent}
+            self._ball_bounds(lower, rows, obstacle_poses)
             static = self.static.T  # (n_obstacles, n_solids)
             lower[static] = self.static_distance.T[static][:, None]
             exact[static] = True
@@ -344,14 +354,12 @@ class BroadPhase:
                 pose_o = obstacle_poses[o]
                 po = pose_o if pose_o.ndim == 2 else pose_o[idx]
                 if self.closed_form[k, o]:
-                    ps = self.solid_poses(joint_poses, idx, k)
+                    ps = self.solid_poses(frames, idx, k)
                     lower[o, k, idx] = self.closed_form_distance(ps, po, k, o)
                     exact[o, k, idx] = True
                 else:
-                    sub = frames[self.parents[k]][:, idx]
-                    lower[o, k, idx] = self._refine(
-                        lower[o, k, idx], sub, joint_poses, idx, po, k, o
-                    )
+                    sub = rows[self.parents[k]][:, idx]
+                    lower[o, k, idx] = self._refine(lower[o, k, idx], sub, frames, idx, po, k, o)
         return Bounds(
             np.ascontiguousarray(lower.transpose(2, 1, 0)),
             np.ascontiguousarray(exact.transpose(2, 1, 0)),
@@ -372,18 +380,19 @@ class BroadPhase:
     def _refine(
         self,
         bound: np.ndarray,
+        rows: np.ndarray,
         frames: np.ndarray,
-        joint_poses: np.ndarray,
         idx: np.ndarray,
         po: np.ndarray,
         k: int,
         o: int,
     ) -> np.ndarray:
-        """Levels 3 and 4 for solid ``k`` at the samples ``idx`` (parent joint ``frames``
-        (12, R)) and obstacle ``o`` (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
+        """Levels 3 and 4 for solid ``k`` at the samples ``idx`` (its parent joint's frame
+        as ``rows`` (12, R); all joint ``frames`` (njoints, 3, 4, N)) and obstacle ``o``
+        (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
         centres = self._cover_in_joint[k]
         if len(centres) > 1:
-            points = _points_in_joint(frames, centres)
+            points = _points_in_joint(rows, centres)
             cover = obstacle_signed_distance(self.obstacle_shape[o], points, po).min(axis=0)
             cover -= self._cover_radii[k][0]  # equal radii
             bound = np.where(cover > 0.0, np.maximum(cover, bound), bound)
@@ -391,7 +400,7 @@ class BroadPhase:
         still = np.flatnonzero(bound <= self.influence)
         if still.size == 0 or kind_s is None or kind_o is None:
             return bound
-        ps = self.solid_poses(joint_poses, idx[still], k)
+        ps = self.solid_poses(frames, idx[still], k)
         po = po if po.ndim == 2 else po[still]
         rot_o = np.broadcast_to(po[..., :3, :3], (still.size, 3, 3))
         delta = ps[:, :3, 3] - po[..., :3, 3]
@@ -409,9 +418,3 @@ class BroadPhase:
         bound = bound.copy()
         bound[still] = np.where(gap > 0.0, np.maximum(gap, bound[still]), bound[still])
         return bound
-
-
-def _frames(joint_poses: np.ndarray, p: int) -> np.ndarray:
-    """The 3 × 4 top of joint ``p``'s poses in (N, njoints, 4, 4), as (12, N) rows
-    (component-major, contiguous)."""
-    return np.ascontiguousarray(joint_poses[:, p, :3, :].reshape(-1, 12).T)

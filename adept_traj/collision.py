@@ -174,7 +174,7 @@ class CollisionChecker:
             ) from None
         return qa, ta
 
-    def min_distances(self, q: Any, t: Any, joint_poses: np.ndarray | None = None) -> MinDistances:
+    def min_distances(self, q: Any, t: Any, joint_frames: np.ndarray | None = None) -> MinDistances:
         """Per motion and obstacle, the smallest solid–obstacle distance over all samples.
 
         ``q`` (..., n_t, nq) [rad | m] and ``t`` (..., n_t) [s]: the leading axes ``...``
@@ -182,13 +182,20 @@ class CollisionChecker:
         are computed by coal in increasing order of their broad-phase lower bound until the
         best exact distance is below the next bound, so the result is the exact minimum
         (when ≤ ``influence``, penetration depths included) with few coal calls.
-        ``joint_poses`` (..., n_t, njoints, 4, 4) may pass the robot's joint poses
-        (:attr:`~adept_traj.robot.ForwardKinematics.joint_poses`) if already computed.
+        ``joint_frames`` (njoints, 3, 4, N), N = ∏ q.shape[:-1], may pass the robot's joint
+        frames (:attr:`~adept_traj.robot.ForwardKinematics.joint_frames`) if already
+        computed.
         """
         qa, ta = self._check(q, t)
-        if joint_poses is None:
-            joint_poses = self.robot.kinematics.joint_poses(qa)
-        return self._min_distances(qa, ta, joint_poses)
+        if joint_frames is None:
+            joint_frames = self.robot.kinematics.joint_frames(qa)
+        expected = (self.robot.model.njoints, 3, 4, ta.size)
+        if np.shape(joint_frames) != expected:
+            raise InputShapeError(
+                f"joint_frames must have shape {expected} for q of shape {qa.shape}; "
+                f"got {np.shape(joint_frames)}"
+            )
+        return self._min_distances(qa, ta, joint_frames)
 
     # ------------------------------------------------------------------ private hooks
     def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
@@ -223,19 +230,19 @@ class CollisionChecker:
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
     def _narrow_at(
-        self, flat_joints: np.ndarray, obstacle_poses: list[np.ndarray], base: int, c: int, o: int
+        self, frames: np.ndarray, obstacle_poses: list[np.ndarray], base: int, c: int, o: int
     ) -> float:
         """Coal distance of candidate ``c`` (= sample · n_solids + solid) of the motion whose
         first sample is ``base`` in the flattened arrays, to obstacle ``o``."""
         k, s = divmod(c, self.n_solids)
         n = base + k
-        pose = self._broad.solid_poses(flat_joints, n, s)
+        pose = self._broad.solid_poses(frames, n, s)
         return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
 
-    def _min_distances(self, q: np.ndarray, t: np.ndarray, joint_poses: np.ndarray) -> MinDistances:
+    def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
-        flat_j = joint_poses.reshape(n_motions * n_t, *joint_poses.shape[-3:])
+        flat_j = frames
         obstacle_poses = self._obstacle_poses(t)
         bounds = self._broad.bounds(flat_j, obstacle_poses)
         lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
@@ -294,12 +301,11 @@ class CollisionChecker:
         )
 
     def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
-        joint_poses = self.robot.kinematics.joint_poses(q)  # (..., n_t, njoints, 4, 4)
+        flat_j = self.robot.kinematics.joint_frames(q)  # (njoints, 3, 4, N)
         obstacle_poses = self._obstacle_poses(t)
-        flat_j = joint_poses.reshape(-1, *joint_poses.shape[-3:])
         broad = self._broad
         if exact:
-            n = flat_j.shape[0]
+            n = flat_j.shape[-1]
             flat_d = np.empty((n, self.n_solids, self.n_obstacles))
             known = np.ones(flat_d.shape, dtype=bool)
             every = np.arange(n)

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from .errors import RobotModelError
 
-__all__ = ["BatchKinematics"]
+__all__ = ["BatchKinematics", "compose", "frames_to_poses"]
 
 
 @dataclass(frozen=True)
@@ -104,61 +104,94 @@ class BatchKinematics:
             self.support[i, j.index] = True
         self.revolute = np.array([j.revolute for j in joints])
 
-    def joint_poses(self, q: np.ndarray) -> np.ndarray:
-        """World poses (..., njoints, 4, 4) of every joint frame (index 0 = universe)
-        for configurations ``q`` (..., nq) [rad | m].
+    def joint_frames(self, q: np.ndarray) -> np.ndarray:
+        """Joint frames, component-major: (njoints, 3, 4, N) — the top three rows of the
+        world pose of every joint frame (index 0 = universe) for the N = ∏ q.shape[:-1]
+        configurations ``q`` (..., nq) [rad | m] (flattened), the samples innermost.
 
         .. math::
             {}^0T_i = {}^0T_{p(i)}\\, P_i\\, U_i\\, R_z(q_i)\\, U_i^\\top \\ \\text{(revolute)},
             \\qquad {}^0T_{p(i)}\\, P_i\\, \\mathrm{Trans}(a_i q_i) \\ \\text{(prismatic)}
 
         with :math:`P_i` the joint placement and :math:`U_i` a constant rotation taking
-        :math:`e_z` to the joint axis (the identity for z axes): the product by
-        :math:`R_z(q)` only mixes two columns, no per-sample matrix product.
+        :math:`e_z` to the joint axis (the identity for z axes): the product by the
+        constant :math:`P_i U_i` is one small GEMM over all samples per row, and the one by
+        :math:`R_z(q)` only mixes two columns. Every component is a contiguous (N,) array,
+        so the elementwise work streams (≈ 2× faster than stacked 4 × 4 products).
         """
-        batch = q.shape[:-1]
         qf = q.reshape(-1, q.shape[-1])
         n = qf.shape[0]
-        out = np.empty((n, len(self._joints) + 1, 4, 4))
-        out[:, 0] = np.eye(4)
+        frames = np.empty((len(self._joints) + 1, 3, 4, n))
+        frames[0] = np.eye(4)[:3, :, None]
         for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
-            a = np.broadcast_to(pre, (n, 4, 4)) if j.parent == 0 else out[:, j.parent] @ pre
-            qi = qf[:, j.index, None]
-            dst = out[:, i]
+            a = compose(frames[j.parent], pre)
+            dst = frames[i]
+            qi = qf[:, j.index]
             if j.revolute:
                 c, s = np.cos(qi), np.sin(qi)
-                a0, a1 = a[:, :, 0], a[:, :, 1]
-                dst[:, :, 0] = c * a0 + s * a1
-                dst[:, :, 1] = c * a1 - s * a0
-                dst[:, :, 2:] = a[:, :, 2:]
+                dst[:, 0] = c * a[:, 0] + s * a[:, 1]
+                dst[:, 1] = c * a[:, 1] - s * a[:, 0]
+                dst[:, 2:] = a[:, 2:]
                 if post is not None:
-                    dst[:] = dst @ post
+                    dst[:] = compose(dst, post)
             else:
                 dst[:] = a
-                dst[:, :3, 3] += (a[:, :3, :3] @ j.axis) * qi
-        return out.reshape(*batch, len(self._joints) + 1, 4, 4)
+                dst[:, 3] += np.tensordot(j.axis, a[:, :3], axes=([0], [1])) * qi
+        return frames
+
+    def joint_poses(self, q: np.ndarray) -> np.ndarray:
+        """World poses (..., njoints, 4, 4) of every joint frame (index 0 = universe)
+        for configurations ``q`` (..., nq) [rad | m] (:meth:`joint_frames`, sample-major)."""
+        return frames_to_poses(self.joint_frames(q), q.shape[:-1])
 
     def jacobian(self, joint_poses: np.ndarray, point_joint: int, point: np.ndarray) -> np.ndarray:
         r"""Jacobians (..., 6, nq) of a point rigidly attached to joint frame ``point_joint``.
 
         ``joint_poses`` are from :meth:`joint_poses`; ``point`` (..., 3) is the point's world
-        position [m]. Columns: revolute :math:`[z_k \times (p - o_k);\ z_k]`, prismatic
-        :math:`[z_k;\ 0]`, zero for joints not supporting ``point_joint``.
+        position [m]. See :meth:`frame_jacobian` (the same, component-major).
         """
         batch = joint_poses.shape[:-3]
-        jac = np.zeros((*batch, 6, self.nq))
+        flat = joint_poses.reshape(-1, *joint_poses.shape[-3:])
+        frames = np.ascontiguousarray(flat[:, :, :3, :].transpose(1, 2, 3, 0))
+        points = np.ascontiguousarray(np.reshape(point, (-1, 3)).T)
+        jac = self.frame_jacobian(frames, point_joint, points)  # (6, nq, N)
+        return np.moveaxis(jac, -1, 0).reshape(*batch, 6, self.nq)
+
+    def frame_jacobian(self, frames: np.ndarray, point_joint: int, point: np.ndarray) -> np.ndarray:
+        r"""Jacobians (6, nq, N), component-major, of a point rigidly attached to joint frame
+        ``point_joint``, from :meth:`joint_frames` ``frames`` (njoints, 3, 4, N) and the
+        point's world positions ``point`` (3, N) [m]. Rows (v_x, v_y, v_z, ω_x, ω_y, ω_z);
+        columns: revolute :math:`[z_k \times (p - o_k);\ z_k]`, prismatic
+        :math:`[z_k;\ 0]`, zero for joints not supporting ``point_joint``.
+        """
+        n = frames.shape[-1]
+        jac = np.zeros((6, self.nq, n))
         for i, j in enumerate(self._joints, start=1):
             if not self.support[point_joint, j.index]:
                 continue
-            z = joint_poses[..., i, :3, :3] @ j.axis
+            z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
             if j.revolute:
-                r = point - joint_poses[..., i, :3, 3]
-                zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
-                rx, ry, rz = r[..., 0], r[..., 1], r[..., 2]
-                jac[..., 0, j.index] = zy * rz - zz * ry  # z × r
-                jac[..., 1, j.index] = zz * rx - zx * rz
-                jac[..., 2, j.index] = zx * ry - zy * rx
-                jac[..., 3:, j.index] = z
+                r = point - frames[i, :, 3]
+                jac[0, j.index] = z[1] * r[2] - z[2] * r[1]  # z × r
+                jac[1, j.index] = z[2] * r[0] - z[0] * r[2]
+                jac[2, j.index] = z[0] * r[1] - z[1] * r[0]
+                jac[3:, j.index] = z
             else:
-                jac[..., :3, j.index] = z
+                jac[:3, j.index] = z
         return jac
+
+
+def compose(frames: np.ndarray, transform: np.ndarray) -> np.ndarray:
+    """Component-major frames (3, 4, N) times a constant homogeneous ``transform`` (4, 4):
+    row r of the product is :math:`T^\\top` applied to row r, one GEMM over the samples."""
+    return np.matmul(transform.T, frames)
+
+
+def frames_to_poses(frames: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
+    """Poses (``*batch``, k, 4, 4) from component-major frames (k, 3, 4, N), N = ∏ ``batch``."""
+    k, n = frames.shape[0], frames.shape[-1]
+    out = np.empty((n, k, 4, 4))
+    out[:, :, :3, :] = frames.transpose(3, 0, 1, 2)
+    out[:, :, 3, :3] = 0.0
+    out[:, :, 3, 3] = 1.0
+    return out.reshape(*batch, k, 4, 4)

@@ -336,7 +336,7 @@ class TrajectoryProblem(Problem):
         z4 = fk.manipulability.min(axis=-1)
         integ = traj.integrals(x)
         bounds = traj.bounds(x)
-        mind = self.checker.min_distances(smp.q, smp.t, joint_poses=fk.joint_poses)
+        mind = self.checker.min_distances(smp.q, smp.t, joint_frames=fk.joint_frames)
         z3 = self._z3(mind.distance, smp, fk.tool_pose)
         f = np.stack([T, z2, z3, z4, integ.z5, integ.z6], axis=-1)
         g = self._constraints(

@@ -25,7 +25,7 @@ import pinocchio as pin
 
 from ._validation import as_batch
 from .errors import InputShapeError, InvalidInputError, RobotModelError
-from .kinematics import BatchKinematics
+from .kinematics import BatchKinematics, compose, frames_to_poses
 from .limits import JointLimits
 from .parameters import TASK_ROWS, RobotParameters
 
@@ -62,7 +62,10 @@ class ForwardKinematics:
 
     Attributes
     ----------
-    joint_poses: (..., njoints, 4, 4) joint frames in the base frame (index 0 = universe).
+    joint_frames: (njoints, 3, 4, N) joint frames in the base frame, component-major
+        (:meth:`~adept_traj.kinematics.BatchKinematics.joint_frames`; N = ∏ ``...``).
+    joint_poses: (..., njoints, 4, 4) the same as poses (index 0 = universe; formed on
+        first access).
     tool_pose: (..., 4, 4) tool frame in the base frame.
     manipulability: (...) as :meth:`Robot.manipulability` [m² for the SCARA], or ``None``
         when the robot has no task rows.
@@ -71,11 +74,15 @@ class ForwardKinematics:
         poses only near obstacles).
     """
 
-    joint_poses: np.ndarray
+    joint_frames: np.ndarray
     tool_pose: np.ndarray
     manipulability: np.ndarray | None
     #: (parent joint per solid (n_geom,), solid placements in them (n_geom, 4, 4)).
     solid_frames: tuple[np.ndarray, np.ndarray] = field(repr=False)
+
+    @cached_property
+    def joint_poses(self) -> np.ndarray:
+        return frames_to_poses(self.joint_frames, self.tool_pose.shape[:-2])
 
     @cached_property
     def geometry_poses(self) -> np.ndarray:
@@ -364,13 +371,14 @@ class Robot:
         kinematics pass (what :meth:`geometry_poses`, :meth:`tool_pose` and
         :meth:`manipulability` would each recompute)."""
         qa = as_batch(q, "q", self.nq, "[rad | m]")
-        poses = self.kinematics.joint_poses(qa)
-        f = self.model.frames[self._tool_id]
-        tool = poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
-        w = None if self.task_rows is None else self._manipulability_from(poses, tool)
+        frames = self.kinematics.joint_frames(qa)
+        tool = self._tool_frames(frames)
+        w = None
+        if self.task_rows is not None:
+            w = self._manipulability_from(frames, tool).reshape(qa.shape[:-1])
         return ForwardKinematics(
-            joint_poses=poses,
-            tool_pose=tool,
+            joint_frames=frames,
+            tool_pose=frames_to_poses(tool[None], qa.shape[:-1])[..., 0, :, :],
             manipulability=w,
             solid_frames=solid_frames(self.collision_model),
         )
@@ -396,24 +404,28 @@ class Robot:
         tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
         return tau.reshape(shape)
 
-    def _tool_jacobian(self, q: np.ndarray) -> np.ndarray:
+    def _tool_frames(self, frames: np.ndarray) -> np.ndarray:
+        """Tool frame (3, 4, N), component-major, from joint frames (njoints, 3, 4, N)."""
         f = self.model.frames[self._tool_id]
-        poses = self.kinematics.joint_poses(q)
-        tool = poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
-        return self.kinematics.jacobian(poses, f.parentJoint, tool[..., :3, 3])
+        return compose(frames[f.parentJoint], f.placement.homogeneous)
+
+    def _tool_jacobian(self, q: np.ndarray) -> np.ndarray:
+        frames = self.kinematics.joint_frames(q)
+        parent = self.model.frames[self._tool_id].parentJoint
+        jac = self.kinematics.frame_jacobian(frames, parent, self._tool_frames(frames)[:, 3])
+        return np.moveaxis(jac, -1, 0).reshape(*q.shape[:-1], 6, self.nq)
 
     def _manipulability(self, q: np.ndarray) -> np.ndarray:
-        poses = self.kinematics.joint_poses(q)
-        f = self.model.frames[self._tool_id]
-        return self._manipulability_from(
-            poses, poses[..., f.parentJoint, :, :] @ f.placement.homogeneous
-        )
+        frames = self.kinematics.joint_frames(q)
+        return self._manipulability_from(frames, self._tool_frames(frames)).reshape(q.shape[:-1])
 
-    def _manipulability_from(self, joint_poses: np.ndarray, tool: np.ndarray) -> np.ndarray:
+    def _manipulability_from(self, frames: np.ndarray, tool: np.ndarray) -> np.ndarray:
+        """(N,) manipulability from joint frames (njoints, 3, 4, N) and the tool frame
+        (3, 4, N), component-major (the determinant reads contiguous entries)."""
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
-        f = self.model.frames[self._tool_id]
-        jac = self.kinematics.jacobian(joint_poses, f.parentJoint, tool[..., :3, 3])
-        return manipulability_measure(jac[..., rows, :])
+        parent = self.model.frames[self._tool_id].parentJoint
+        jac = self.kinematics.frame_jacobian(frames, parent, tool[:, 3])  # (6, nq, N)
+        return manipulability_measure(np.moveaxis(jac[rows], -1, 0))
 
 
 def manipulability_measure(jt: np.ndarray) -> np.ndarray:

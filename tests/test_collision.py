@@ -411,17 +411,19 @@ def test_min_distances_batched_equals_per_motion(
             np.testing.assert_array_equal(one.solid, m.solid[i, j])
 
 
-def test_min_distances_accepts_precomputed_joint_poses(
+def test_min_distances_accepts_precomputed_joint_frames(
     robot: Robot, paper_checker: CollisionChecker
 ) -> None:
     rng = np.random.default_rng(23)
     q = random_q(robot, rng, (2, 5))
     t = rng.uniform(0.0, 3.0, size=5)
     a = paper_checker.min_distances(q, t)
-    b = paper_checker.min_distances(q, t, joint_poses=robot.kinematics.joint_poses(q))
+    b = paper_checker.min_distances(q, t, joint_frames=robot.forward_kinematics(q).joint_frames)
     np.testing.assert_array_equal(a.distance, b.distance)
     np.testing.assert_array_equal(a.sample, b.sample)
     np.testing.assert_array_equal(a.solid, b.solid)
+    with pytest.raises(InputShapeError, match=r"joint_frames must have shape \(5, 3, 4, 10\)"):
+        paper_checker.min_distances(q, t, joint_frames=robot.kinematics.joint_frames(q[0]))
 
 
 def test_min_distances_penetration_depth_is_exact(robot: Robot) -> None:
