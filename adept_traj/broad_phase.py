@@ -11,7 +11,11 @@ Levels, each on the rows the previous one left within ``influence``:
 
 0. **Static pairs** — a solid fixed to the base (the SCARA's column) and a fixed obstacle:
    the distance never changes; it is computed once (coal, or the closed form below) and
-   is exact everywhere.
+   is exact everywhere. A solid moved by **one joint only** (its parent joint hangs from
+   the base: the SCARA's inner arm) and a fixed obstacle: a
+   :class:`~adept_traj.distance_table.DistanceTable` of exact distances over that joint's
+   range bounds the distance to within about 0.5 mm (when the configurations ``q`` are
+   given), the larger of it and level 1 is kept.
 1. **Enclosing ball** of each solid (centre ``c``, radius ``R``), from the joint poses
    directly (no solid pose is formed for far samples):
 
@@ -26,8 +30,12 @@ Levels, each on the rows the previous one left within ``influence``:
    longest side, :math:`\\min_i d(c_i, B) - r_i`, kept where positive (a positive value
    proves separation by at least that much).
 4. **Separating axes**: the gap between the projections of solid and obstacle on the
-   obstacle's axes and on the line joining their centres, kept where positive; for a SCARA
-   solid hovering over a box it is the exact distance.
+   obstacle's axes and on the line joining their centres; for a SCARA solid hovering over
+   a box it is the exact distance. It is a lower bound under penetration too: the
+   penetration depth of two convex shapes is the smallest overlap of their projections
+   over all directions, so it is at most the overlap on any one axis,
+   :math:`d \\ge \\max_u \\text{gap}_u` (this bounds deep candidates tightly, and the
+   branch and bound computes few of them).
 
 Everything is numpy on whole arrays; the Python loops run over solids and obstacles
 (7 × 4 for the AdeptOne XL scene), never over samples.
@@ -40,6 +48,7 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
+from .distance_table import DistanceTable
 from .errors import InvalidInputError
 from .kinematics import compose
 from .robot import Robot, solid_frames
@@ -47,6 +56,9 @@ from .scene import Scene
 from .shapes import Box, Capsule, Cylinder, Sphere
 
 __all__ = ["Bounds", "BroadPhase", "point_signed_distance"]
+
+#: Grid step [rad | m] of the single-joint distance tables (level 0).
+TABLE_STEP = 1e-3
 
 #: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
 #: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
@@ -285,6 +297,12 @@ class BroadPhase:
             self.static_distance[k, o] = self.exact_distance(
                 self.local[k], pose_o, int(k), int(o), objects[int(k)].geometry
             )
+        #: Single-joint distance tables by (solid, obstacle) (level 0).
+        self.tables: dict[tuple[int, int], DistanceTable] = {}
+        for k in range(self.n_solids):
+            for o in range(self.n_obstacles):
+                if self._tabulable(robot, k, o):
+                    self.tables[k, o] = self._table(robot, scene, k, o, objects[k].geometry)
 
     # ------------------------------------------------------------------ exact pieces
     def closed_form_distance(
@@ -324,7 +342,7 @@ class BroadPhase:
         """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of the joint frames
         ``frames`` (njoints, 3, 4, N); one pose (4, 4) for a single sample index."""
         parent, local = frames[self.parents[k]], self.local[k]
-        if np.ndim(rows) == 0:
+        if isinstance(rows, int | np.integer):
             pose = np.empty((4, 4))
             pose[:3] = parent[:, :, rows] @ local
         else:
@@ -333,10 +351,64 @@ class BroadPhase:
         pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
         return pose
 
+    def _tabulable(self, robot: Robot, k: int, o: int) -> bool:
+        """Solid ``k`` is a primitive moved by one joint hanging from the base, obstacle
+        ``o`` is fixed and no other exact level covers the pair."""
+        p = int(self.parents[k])
+        return (
+            p > 0
+            and robot.kinematics.parents[p - 1] == 0
+            and not self.moving[o]
+            and not self.closed_form[k, o]
+            and self.solid_kind[k] is not None
+            and self.obstacle_kind[o] is not None
+        )
+
+    def _table(
+        self, robot: Robot, scene: Scene, k: int, o: int, geometry: coal.CollisionGeometry
+    ) -> DistanceTable:
+        """Exact distances of solid ``k`` and obstacle ``o`` over the range of the joint
+        that moves the solid (its limits, one step beyond each end)."""
+        p = int(self.parents[k])
+        kin = robot.kinematics
+        j = int(np.flatnonzero(kin.support[p])[0])  # the only joint moving frame p
+        lo = robot.limits.lower[j] - TABLE_STEP
+        count = int(np.ceil((robot.limits.upper[j] - robot.limits.lower[j]) / TABLE_STEP)) + 3
+        q = np.zeros((count, robot.nq))
+        q[:, j] = lo + TABLE_STEP * np.arange(count)
+        frames = kin.joint_frames(q)
+        poses = self.solid_poses(frames, np.arange(count), k)
+        pose_o = scene.base_from_world @ scene.obstacles[o].pose(0.0)
+        functor = coal.ComputeDistance(geometry, self.obstacle_geometry[o])
+        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        tf_o = coal.Transform3s(pose_o[:3, :3], pose_o[:3, 3])
+        tf_s = coal.Transform3s()
+        values = np.empty(count)
+        for i, ps in enumerate(poses):
+            tf_s.setRotation(ps[:3, :3])
+            tf_s.setTranslation(ps[:3, 3])
+            result.clear()
+            values[i] = functor(tf_s, tf_o, request, result)
+        if kin.revolute[p - 1]:
+            origin, rot = frames[p, :, 3, 0], frames[p, :, :3, 0]
+            axis = rot @ kin.axes[p - 1]
+            centre = rot @ self._ball_in_joint[k] + origin
+            rho = np.linalg.norm(np.cross(centre - origin, axis))
+            lipschitz = float(rho + self._ball_radius[k])
+        else:
+            lipschitz = 1.0
+        return DistanceTable(j, float(lo), TABLE_STEP, values, lipschitz)
+
     # ------------------------------------------------------------------ bounds
-    def bounds(self, frames: np.ndarray, obstacle_poses: list[np.ndarray]) -> Bounds:
+    def bounds(
+        self,
+        frames: np.ndarray,
+        obstacle_poses: list[np.ndarray],
+        q: np.ndarray | None = None,
+    ) -> Bounds:
         """Lower bounds for joint frames (njoints, 3, 4, N) (component-major) and obstacle
-        poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4))."""
+        poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
+        configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too."""
         n = frames.shape[-1]
         # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
         lower = np.empty((self.n_obstacles, self.n_solids, n))
@@ -344,6 +416,9 @@ class BroadPhase:
         if self.n_obstacles and n:
             rows = {p: frames[p].reshape(12, n) for p, _ in self._by_parent}
             self._ball_bounds(lower, rows, obstacle_poses)
+            if q is not None:
+                for (k, o), table in self.tables.items():
+                    np.maximum(lower[o, k], table.lower_bound(q[:, table.joint]), out=lower[o, k])
             static = self.static.T  # (n_obstacles, n_solids)
             lower[static] = self.static_distance.T[static][:, None]
             exact[static] = True
@@ -416,5 +491,5 @@ class BroadPhase:
             - _half_extent(*kind_o, n_o)
         ).max(axis=-1)
         bound = bound.copy()
-        bound[still] = np.where(gap > 0.0, np.maximum(gap, bound[still]), bound[still])
+        bound[still] = np.maximum(gap, bound[still])  # valid for overlaps too (module doc)
         return bound

@@ -239,12 +239,22 @@ class CollisionChecker:
         pose = self._broad.solid_poses(frames, n, s)
         return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
 
+    def _first_poses(
+        self, frames: np.ndarray, samples: np.ndarray, solids: np.ndarray
+    ) -> np.ndarray:
+        """Poses (n, 4, 4) of ``solids`` (n,) at flat ``samples`` (n,), batched per solid."""
+        poses = np.empty((len(samples), 4, 4))
+        for k in np.unique(solids).tolist():
+            sel = np.flatnonzero(solids == k)
+            poses[sel] = self._broad.solid_poses(frames, samples[sel], k)
+        return poses
+
     def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         flat_j = frames
         obstacle_poses = self._obstacle_poses(t)
-        bounds = self._broad.bounds(flat_j, obstacle_poses)
+        bounds = self._broad.bounds(flat_j, obstacle_poses, q.reshape(-1, q.shape[-1]))
         lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
         known = bounds.exact.reshape(lower.shape)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
@@ -264,12 +274,17 @@ class CollisionChecker:
         second = (
             np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
         )
+        # Poses of the first candidates (solid and obstacle), formed together.
+        first_sample = pm * n_t + first // self.n_solids
+        first_solid = first % self.n_solids
+        solid_at = self._first_poses(flat_j, first_sample, first_solid)
         for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
             bounds_mo = rows[i]
             if known[m, c0, o]:
                 value = float(bounds_mo[c0])  # exact already
             else:
-                value = self._narrow_at(flat_j, obstacle_poses, m * n_t, c0, o)
+                pose_o = self._pose_at(obstacle_poses[o], int(first_sample[i]))
+                value = self._narrow(solid_at[i], pose_o, int(first_solid[i]), o)
                 calls += 1
             where[m, o] = c0
             if second[i] < value and second[i] <= self.influence:
@@ -318,7 +333,7 @@ class CollisionChecker:
                         flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
             todo = ~(broad.static | broad.closed_form)[None] & known
         else:
-            bounds = broad.bounds(flat_j, obstacle_poses)
+            bounds = broad.bounds(flat_j, obstacle_poses, q.reshape(-1, q.shape[-1]))
             flat_d, known = bounds.lower, bounds.exact.copy()
             todo = (flat_d <= self.influence) & ~known
         samples, solids, obstacles = np.nonzero(todo)

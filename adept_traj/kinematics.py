@@ -103,6 +103,10 @@ class BatchKinematics:
             self.support[i] = self.support[j.parent]
             self.support[i, j.index] = True
         self.revolute = np.array([j.revolute for j in joints])
+        #: Unit axis (njoints - 1, 3) of every joint in its own frame.
+        self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
+        #: Parent frame (njoints - 1,) of every joint (0 = universe).
+        self.parents = np.array([j.parent for j in joints], dtype=int)
 
     def joint_frames(self, q: np.ndarray) -> np.ndarray:
         """Joint frames, component-major: (njoints, 3, 4, N) — the top three rows of the

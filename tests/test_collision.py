@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import coal
 import numpy as np
 import pytest
 
+from adept_traj.broad_phase import BroadPhase
 from adept_traj.collision import CollisionChecker, paper_penalty, point_signed_distance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.motion import FixedPose, PendulumMotion
@@ -335,6 +337,66 @@ def test_broad_phase_is_sound_for_every_shape_kind(robot: Robot, influence: floa
         np.testing.assert_allclose(m.distance[close], best[close], atol=1e-12)
         assert np.all(m.distance[~close] > influence)
         assert np.all(m.distance[~close] <= best[~close])
+
+
+def broad_bounds_and_exact(
+    robot: Robot, scene: Scene, q: np.ndarray, t: np.ndarray, influence: float
+) -> tuple[Any, np.ndarray]:
+    """BroadPhase bounds (N, n_solids, n_obs) of flat samples q (N, nq) at times t (N,) and
+    the exact distances from the checker (coal for every pair)."""
+    broad = BroadPhase(robot, scene, influence)
+    poses = scene.obstacle_poses(t, in_base_frame=True)  # (n_obs, N, 4, 4)
+    per_obstacle = [p[0] if not ob.is_moving else p for p, ob in zip(poses, scene.obstacles)]
+    bounds = broad.bounds(robot.kinematics.joint_frames(q), per_obstacle, q)
+    exact = CollisionChecker(robot, scene, influence).distances(q, t, exact=True).distance
+    return bounds, exact
+
+
+@pytest.mark.parametrize("influence", [0.0, INFLUENCE, 0.3])
+def test_broad_phase_bounds_hold_under_penetration(robot: Robot, influence: float) -> None:
+    """Every bound (separating axes included, negative ones too) is at most the exact signed
+    distance; where a solid penetrates an obstacle the separating-axis bound is much
+    tighter than the enclosing ball's (that is what keeps deep searches short)."""
+    rng = np.random.default_rng(31)
+    base = transform_from_xyz_rpy((0.2, -0.1, 0.05), (0.05, -0.03, 0.7))
+    scenes = [Scene.paper()] + [
+        Scene(obstacles=random_obstacles(rng, base), robot_base=base) for _ in range(6)
+    ]
+    slack = []
+    for scene in scenes:
+        q = random_q(robot, rng, (300,))
+        t = rng.uniform(0.0, 4.0, size=300)
+        bounds, exact = broad_bounds_and_exact(robot, scene, q, t, influence)
+        assert np.all(bounds.lower <= exact + 1e-9)
+        np.testing.assert_allclose(bounds.lower[bounds.exact], exact[bounds.exact], atol=1e-12)
+        inside = (exact < -0.005) & ~bounds.exact
+        slack.append((exact - bounds.lower)[inside])
+    slack = np.concatenate(slack)
+    assert len(slack) > 100  # penetrations were exercised
+    # measured: 75th percentile 0.3 mm (18 mm with the balls and covers alone)
+    assert np.percentile(slack, 75) < 0.005
+
+
+def test_single_joint_tables_bound_the_inner_arm(robot: Robot) -> None:
+    """The inner arm (joint 1 only) and the fixed cubes: tabulated, within 1 mm of the
+    exact distance, and no information outside the joint range."""
+    scene = Scene.paper()
+    broad = BroadPhase(robot, scene, INFLUENCE)
+    arm_solids = {k for k in range(broad.n_solids) if broad.parents[k] == 1}
+    cubes = {o for o, ob in enumerate(scene.obstacles) if not ob.is_moving}
+    assert arm_solids
+    assert cubes
+    assert set(broad.tables) == {(k, o) for k in arm_solids for o in cubes}
+    rng = np.random.default_rng(8)
+    q = random_q(robot, rng, (400,))
+    exact = CollisionChecker(robot, scene, INFLUENCE).distances(q, 0.0, exact=True).distance
+    for (k, o), table in broad.tables.items():
+        assert table.joint == 0
+        bound = table.lower_bound(q[:, 0])
+        assert np.all(bound <= exact[:, k, o])
+        assert np.all(exact[:, k, o] - bound < 1e-3)
+        outside = np.array([robot.limits.lower[0] - 0.01, robot.limits.upper[0] + 0.01])
+        assert np.all(table.lower_bound(outside) == -np.inf)
 
 
 def test_narrow_phase_matches_independent_coal(

@@ -1,0 +1,65 @@
+r"""Single-joint distance tables: a broad-phase level for solids moved by one joint only.
+
+A solid whose parent joint hangs directly from the fixed base (the SCARA's inner arm, on
+joint 1) has a pose that depends on that one joint value :math:`q_j`; against a fixed
+obstacle its signed distance is a function :math:`d(q_j)` of one variable. It is
+tabulated once, exactly (coal), on a grid :math:`q_i = q_0 + i h` over the joint's range,
+and bounded between grid points by its Lipschitz constant:
+
+.. math::
+    d(q) \ge \max\big(d(q_i) - L\,(q - q_i),\ d(q_{i+1}) - L\,(q_{i+1} - q)\big) - \epsilon,
+    \qquad q_i \le q \le q_{i+1},
+
+with :math:`L = \rho + R` for a revolute joint (ρ the distance of the solid's enclosing-ball
+centre from the joint axis, R the ball's radius: no point of the solid moves faster than
+:math:`L\,|\dot q|`) and :math:`L = 1` for a prismatic one, and ε = 1e-6 m for the
+tolerance of coal's distances. A signed distance changes by at most the largest
+displacement of the moving convex solid (for separation and for penetration depth alike),
+so the bound is valid everywhere; with h = 1 mrad it is within about
+:math:`L h / 2 \approx 0.5` mm of the exact distance. Outside the grid the bound is
+:math:`-\infty` (no information), so the other levels decide there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["DistanceTable"]
+
+#: Subtracted from every bound: coal's distances between primitives are exact to well
+#: below this (GJK/EPA tolerances), so a tabulated value never exceeds the true distance.
+_SLACK = 1e-6
+
+
+@dataclass(frozen=True)
+class DistanceTable:
+    """Exact signed distances [m] of one solid–obstacle pair over one joint's range.
+
+    Attributes
+    ----------
+    joint: index in q of the joint that moves the solid.
+    start: joint value [rad | m] of the first grid point.
+    step: grid step h [rad | m] (> 0).
+    values: (G,) exact signed distances [m] at the G ≥ 2 grid points.
+    lipschitz: L [m/rad | m/m], a bound on how fast the distance changes with the joint.
+    """
+
+    joint: int
+    start: float
+    step: float
+    values: np.ndarray
+    lipschitz: float
+
+    def lower_bound(self, q: np.ndarray) -> np.ndarray:
+        """(N,) lower bound [m] of the signed distance at joint values ``q`` (N,)
+        [rad | m] (see the module docstring); ``-inf`` outside the grid."""
+        u = (q - self.start) / self.step
+        last = len(self.values) - 1
+        inside = (u >= 0.0) & (u <= last)
+        i = np.clip(np.floor(u), 0, last - 1).astype(np.intp)
+        frac = np.clip(u - i, 0.0, 1.0)
+        slope = self.lipschitz * self.step
+        bound = np.maximum(self.values[i] - slope * frac, self.values[i + 1] - slope * (1.0 - frac))
+        return np.where(inside, bound - _SLACK, -np.inf)
