@@ -415,13 +415,16 @@ class BroadPhase:
         exact = np.zeros(lower.shape, dtype=bool)
         if self.n_obstacles and n:
             rows = {p: frames[p].reshape(12, n) for p, _ in self._by_parent}
-            self._ball_bounds(lower, rows, obstacle_poses)
-            if q is not None:
-                for (k, o), table in self.tables.items():
-                    np.maximum(lower[o, k], table.lower_bound(q[:, table.joint]), out=lower[o, k])
+            # Level 0 first; level 1 only for the pairs (and samples) it leaves open.
             static = self.static.T  # (n_obstacles, n_solids)
             lower[static] = self.static_distance.T[static][:, None]
             exact[static] = True
+            done = static.copy()
+            if q is not None:
+                for (k, o), table in self.tables.items():
+                    lower[o, k] = table.lower_bound(q[:, table.joint])
+                    done[o, k] = True
+            self._ball_bounds(lower, rows, obstacle_poses, done)
             close = lower <= self.influence
             close[static] = False
             for o, k in zip(*np.nonzero(close.any(axis=-1))):
@@ -441,16 +444,32 @@ class BroadPhase:
         )
 
     def _ball_bounds(
-        self, lower: np.ndarray, frames: dict[int, np.ndarray], obstacle_poses: list[np.ndarray]
+        self,
+        lower: np.ndarray,
+        frames: dict[int, np.ndarray],
+        obstacle_poses: list[np.ndarray],
+        done: np.ndarray,
     ) -> None:
         """Level 1 in place (``lower`` (n_obstacles, n_solids, N)): enclosing balls against
-        every obstacle."""
+        every obstacle, for the pairs not ``done`` (n_obstacles, n_solids) by level 0 and
+        for the samples where a table gave no bound (``-inf``: outside its grid)."""
         balls = np.empty((3, self.n_solids, lower.shape[-1]))
         for p, ks in self._by_parent:
             balls[:, ks] = _points_in_joint(frames[p], self._ball_in_joint[ks])
         radius = self._ball_radius[:, None]
         for o, shape in enumerate(self.obstacle_shape):
-            lower[o] = obstacle_signed_distance(shape, balls, obstacle_poses[o]) - radius
+            ks = np.flatnonzero(~done[o])
+            if len(ks):
+                lower[o, ks] = obstacle_signed_distance(shape, balls[:, ks], obstacle_poses[o])
+                lower[o, ks] -= radius[ks]
+            for k in np.flatnonzero(done[o] & ~self.static[:, o]):
+                gap = np.flatnonzero(np.isneginf(lower[o, k]))
+                if len(gap):
+                    pose_o = obstacle_poses[o]  # fixed: tables are for fixed obstacles only
+                    lower[o, k, gap] = (
+                        obstacle_signed_distance(shape, balls[:, [k]][:, :, gap], pose_o)[0]
+                        - radius[k]
+                    )
 
     def _refine(
         self,

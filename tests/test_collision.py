@@ -397,6 +397,13 @@ def test_single_joint_tables_bound_the_inner_arm(robot: Robot) -> None:
         assert np.all(exact[:, k, o] - bound < 1e-3)
         outside = np.array([robot.limits.lower[0] - 0.01, robot.limits.upper[0] + 0.01])
         assert np.all(table.lower_bound(outside) == -np.inf)
+    # beyond the joint range the tables know nothing: level 1 (the ball) bounds those samples
+    q_out = q[:50].copy()
+    q_out[:, 0] = np.where(np.arange(50) % 2, robot.limits.upper[0], robot.limits.lower[0])
+    q_out[:, 0] += np.where(np.arange(50) % 2, 0.2, -0.2)
+    bounds, exact = broad_bounds_and_exact(robot, scene, q_out, np.zeros(50), INFLUENCE)
+    assert np.all(np.isfinite(bounds.lower))
+    assert np.all(bounds.lower <= exact + 1e-9)
 
 
 def test_narrow_phase_matches_independent_coal(
