@@ -27,8 +27,8 @@ ramps** from :class:`~adept_traj.sampling.RampSampling`, also at their own kinem
 time (random immigrants at the fast end). Perturbations refine the fastest shapes found so
 far; immigrants keep sampling new ones, so the search does not stay in the basin of the
 first feasible fast move (measured on the paper scenario with NSGA-II at the paper's
-settings, seeds 1–5: the fastest verified move went from 1.18–1.25 × the kinematic bound
-without immigrants to 1.07–1.11 × with them, see ``docs/engine.md``). Immigrants are made
+settings, seeds 1–3: the fastest verified move went from 1.18–1.25 × the kinematic lower
+bound without immigrants to 1.04–1.07 × with them, see ``docs/engine.md``). Immigrants are made
 even before any member is feasible; perturbations only after.
 The number of offspring, hence of evaluations per generation, is unchanged; randomness
 comes from the algorithm's seeded generator (same seed, same front; exact resume).
