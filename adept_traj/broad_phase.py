@@ -14,8 +14,9 @@ Levels, each on the rows the previous one left within ``influence``:
    is exact everywhere. A solid moved by **one joint only** (its parent joint hangs from
    the base: the SCARA's inner arm) and a fixed obstacle: a
    :class:`~adept_traj.distance_table.DistanceTable` of exact distances over that joint's
-   range bounds the distance to within about 0.5 mm (when the configurations ``q`` are
-   given), the larger of it and level 1 is kept.
+   range bounds the distance to within about 0.6 mm (when the configurations ``q`` are
+   given); level 1 is then skipped for the pair, except at samples outside the table's
+   grid. (Not for joints with an infinite or very long range, nor for sphere shapes.)
 1. **Enclosing ball** of each solid (centre ``c``, radius ``R``), from the joint poses
    directly (no solid pose is formed for far samples):
 
@@ -59,6 +60,8 @@ __all__ = ["Bounds", "BroadPhase", "point_signed_distance"]
 
 #: Grid step [rad | m] of the single-joint distance tables (level 0).
 TABLE_STEP = 1e-3
+#: Joints with a longer range (e.g. unlimited) get no table.
+_TABLE_MAX_POINTS = 20_000
 
 #: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
 #: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
@@ -254,6 +257,7 @@ class BroadPhase:
         self.influence = float(influence)
         objects = robot.collision_model.geometryObjects
         self.n_solids, self.n_obstacles = len(objects), len(scene.obstacles)
+        self.nq = robot.nq
         #: Parent joint of each solid (n_solids,) and its placement there (n_solids, 4, 4).
         self.parents, self.local = solid_frames(robot.collision_model)
         covers = [_covering_spheres(g.geometry) for g in objects]
@@ -342,9 +346,9 @@ class BroadPhase:
         """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of the joint frames
         ``frames`` (njoints, 3, 4, N); one pose (4, 4) for a single sample index."""
         parent, local = frames[self.parents[k]], self.local[k]
-        if isinstance(rows, int | np.integer):
+        if np.ndim(rows) == 0:
             pose = np.empty((4, 4))
-            pose[:3] = parent[:, :, rows] @ local
+            pose[:3] = parent[:, :, int(rows)] @ local
         else:
             pose = np.empty((len(rows), 4, 4))
             pose[:, :3] = compose(parent[..., rows], local).transpose(2, 0, 1)
@@ -355,13 +359,18 @@ class BroadPhase:
         """Solid ``k`` is a primitive moved by one joint hanging from the base, obstacle
         ``o`` is fixed and no other exact level covers the pair."""
         p = int(self.parents[k])
+        if p == 0 or robot.kinematics.parents[p - 1] != 0:
+            return False
+        j = int(np.flatnonzero(robot.kinematics.support[p])[0])
+        span = robot.limits.upper[j] - robot.limits.lower[j]
+        kinds = (self.solid_kind[k], self.obstacle_kind[o])
         return (
-            p > 0
-            and robot.kinematics.parents[p - 1] == 0
+            bool(np.isfinite(span))
+            and span / TABLE_STEP <= _TABLE_MAX_POINTS
             and not self.moving[o]
             and not self.closed_form[k, o]
-            and self.solid_kind[k] is not None
-            and self.obstacle_kind[o] is not None
+            and None not in kinds
+            and all(kind[0] != "sphere" for kind in kinds)  # coal's sphere depths: see _refine
         )
 
     def _table(
@@ -410,6 +419,11 @@ class BroadPhase:
         poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
         configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too."""
         n = frames.shape[-1]
+        if q is not None and np.shape(q) != (n, self.nq):
+            raise InvalidInputError(
+                f"q must have shape {(n, self.nq)} (one configuration per sample); "
+                f"got {np.shape(q)}"
+            )
         # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
         lower = np.empty((self.n_obstacles, self.n_solids, n))
         exact = np.zeros(lower.shape, dtype=bool)
@@ -503,12 +517,18 @@ class BroadPhase:
         axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
         n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (R, 4, 3)
         n_o = axes @ rot_o  # axes in the obstacle frame
-        gap = (
+        gaps = (
             np.abs(np.einsum("nai,ni->na", axes, delta))
             - _ROUNDING
             - _half_extent(*kind_s, n_s)
             - _half_extent(*kind_o, n_o)
-        ).max(axis=-1)
+        )
+        gaps[norm[:, 0] == 0.0, 3] = -np.inf  # coincident centres: no centre line, no axis
+        gap = gaps.max(axis=-1)
+        if "sphere" in (kind_s[0], kind_o[0]):
+            # coal 3.0.3 overstates some sphere penetration depths (sphere–cylinder near a
+            # cap): a true bound could exceed coal's value, so overlaps are not used here.
+            gap = np.where(gap > 0.0, gap, -np.inf)
         bound = bound.copy()
         bound[still] = np.maximum(gap, bound[still])  # valid for overlaps too (module doc)
         return bound

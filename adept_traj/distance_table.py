@@ -15,9 +15,10 @@ centre from the joint axis, R the ball's radius: no point of the solid moves fas
 :math:`L\,|\dot q|`) and :math:`L = 1` for a prismatic one, and ε = 1e-6 m for the
 tolerance of coal's distances. A signed distance changes by at most the largest
 displacement of the moving convex solid (for separation and for penetration depth alike),
-so the bound is valid everywhere; with h = 1 mrad it is within about
-:math:`L h / 2 \approx 0.5` mm of the exact distance. Outside the grid the bound is
-:math:`-\infty` (no information), so the other levels decide there.
+so the bound is valid everywhere; with h = 1 mrad it is at most :math:`L h` below the
+exact distance (≈ 0.6 mm for the AdeptOne's inner arm; about :math:`L h / 2` typically).
+Outside the grid the bound is :math:`-\infty` (no information), so the other levels
+decide there.
 """
 
 from __future__ import annotations

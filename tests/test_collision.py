@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -397,13 +398,46 @@ def test_single_joint_tables_bound_the_inner_arm(robot: Robot) -> None:
         assert np.all(exact[:, k, o] - bound < 1e-3)
         outside = np.array([robot.limits.lower[0] - 0.01, robot.limits.upper[0] + 0.01])
         assert np.all(table.lower_bound(outside) == -np.inf)
-    # beyond the joint range the tables know nothing: level 1 (the ball) bounds those samples
+    # beyond the joint range the tables know nothing: there the bounds are those without
+    # tables (level 1 and its refinements), and still valid
     q_out = q[:50].copy()
     q_out[:, 0] = np.where(np.arange(50) % 2, robot.limits.upper[0], robot.limits.lower[0])
     q_out[:, 0] += np.where(np.arange(50) % 2, 0.2, -0.2)
     bounds, exact = broad_bounds_and_exact(robot, scene, q_out, np.zeros(50), INFLUENCE)
-    assert np.all(np.isfinite(bounds.lower))
+    poses = [p[0] for p in scene.obstacle_poses(np.zeros(50), in_base_frame=True)]
+    untabled = broad.bounds(robot.kinematics.joint_frames(q_out), poses, None)
+    for k, o in broad.tables:
+        np.testing.assert_array_equal(bounds.lower[:, k, o], untabled.lower[:, k, o])
     assert np.all(bounds.lower <= exact + 1e-9)
+    with pytest.raises(InvalidInputError, match=r"q must have shape \(50, 4\)"):
+        broad.bounds(robot.kinematics.joint_frames(q_out), poses, q_out[:1])
+
+
+def test_no_table_for_an_unlimited_joint(robot: Robot) -> None:
+    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    lower[0], upper[0] = -np.inf, np.inf
+    limits = dataclasses.replace(robot.limits, lower=lower, upper=upper)
+    free = Robot(
+        robot.model, robot.collision_model, robot.visual_model, limits,
+        robot.tool_frame, robot.task_rows, robot.name,
+    )  # fmt: skip
+    assert BroadPhase(free, Scene.paper(), INFLUENCE).tables == {}
+
+
+def test_coincident_centres_are_no_separating_axis(robot: Robot) -> None:
+    """A box centred exactly on the gripper's centre: the centre line is undefined and must
+    not give a bound (it once gave -1e-9 for a 5 cm penetration)."""
+    q0 = np.array([0.3, 0.4, 0.1, 0.2])
+    k = solid_index(CollisionChecker(robot, Scene.paper()), "link4/gripper")
+    pose = np.eye(4)
+    pose[:3, 3] = robot.geometry_poses(q0)[k][:3, 3]
+    scene = Scene(obstacles=(Obstacle("box", Box((0.5, 0.5, 0.05)), FixedPose(pose)),))
+    checker = CollisionChecker(robot, scene, INFLUENCE)
+    q = np.stack([q0, q0 + np.array([0.0, 0.0, 0.03, 0.0])])[None]
+    t = np.zeros((1, 2))
+    exact = checker.distances(q, t, exact=True).distance
+    assert exact.min() < -0.04
+    np.testing.assert_allclose(checker.min_distances(q, t).distance[0], exact.min(), atol=1e-12)
 
 
 def test_narrow_phase_matches_independent_coal(
