@@ -305,8 +305,9 @@ class BroadPhase:
         self.tables: dict[tuple[int, int], DistanceTable] = {}
         for k in range(self.n_solids):
             for o in range(self.n_obstacles):
-                if self._tabulable(robot, k, o):
-                    self.tables[k, o] = self._table(robot, scene, k, o, objects[k].geometry)
+                j = self._table_joint(robot, k, o)
+                if j is not None:
+                    self.tables[k, o] = self._table(robot, scene, k, o, j, objects[k].geometry)
 
     # ------------------------------------------------------------------ exact pieces
     def closed_form_distance(
@@ -355,16 +356,17 @@ class BroadPhase:
         pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
         return pose
 
-    def _tabulable(self, robot: Robot, k: int, o: int) -> bool:
-        """Solid ``k`` is a primitive moved by one joint hanging from the base, obstacle
-        ``o`` is fixed and no other exact level covers the pair."""
+    def _table_joint(self, robot: Robot, k: int, o: int) -> int | None:
+        """The joint (index in q) to tabulate solid ``k`` and obstacle ``o`` over, or None:
+        a table needs a primitive solid moved by one joint hanging from the base (with a
+        finite range), a fixed obstacle, and no other exact level for the pair."""
         p = int(self.parents[k])
         if p == 0 or robot.kinematics.parents[p - 1] != 0:
-            return False
-        j = int(np.flatnonzero(robot.kinematics.support[p])[0])
+            return None
+        j = int(np.flatnonzero(robot.kinematics.support[p])[0])  # the only joint moving p
         span = robot.limits.upper[j] - robot.limits.lower[j]
         kinds = (self.solid_kind[k], self.obstacle_kind[o])
-        return (
+        tabulable = (
             bool(np.isfinite(span))
             and span / TABLE_STEP <= _TABLE_MAX_POINTS
             and not self.moving[o]
@@ -372,15 +374,21 @@ class BroadPhase:
             and None not in kinds
             and all(kind[0] != "sphere" for kind in kinds)  # coal's sphere depths: see _refine
         )
+        return j if tabulable else None
 
     def _table(
-        self, robot: Robot, scene: Scene, k: int, o: int, geometry: coal.CollisionGeometry
+        self,
+        robot: Robot,
+        scene: Scene,
+        k: int,
+        o: int,
+        j: int,
+        geometry: coal.CollisionGeometry,
     ) -> DistanceTable:
-        """Exact distances of solid ``k`` and obstacle ``o`` over the range of the joint
-        that moves the solid (its limits, one step beyond each end)."""
+        """Exact distances of solid ``k`` and obstacle ``o`` over the range of joint ``j``
+        (from :meth:`_table_joint`; its limits, one step beyond each end)."""
         p = int(self.parents[k])
         kin = robot.kinematics
-        j = int(np.flatnonzero(kin.support[p])[0])  # the only joint moving frame p
         lo = robot.limits.lower[j] - TABLE_STEP
         count = int(np.ceil((robot.limits.upper[j] - robot.limits.lower[j]) / TABLE_STEP)) + 3
         q = np.zeros((count, robot.nq))

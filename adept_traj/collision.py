@@ -252,9 +252,8 @@ class CollisionChecker:
     def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
-        flat_j = frames
         obstacle_poses = self._obstacle_poses(t)
-        bounds = self._broad.bounds(flat_j, obstacle_poses, q.reshape(-1, q.shape[-1]))
+        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
         lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
         known = bounds.exact.reshape(lower.shape)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
@@ -277,7 +276,7 @@ class CollisionChecker:
         # Poses of the first candidates (solid and obstacle), formed together.
         first_sample = pm * n_t + first // self.n_solids
         first_solid = first % self.n_solids
-        solid_at = self._first_poses(flat_j, first_sample, first_solid)
+        solid_at = self._first_poses(frames, first_sample, first_solid)
         for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
             bounds_mo = rows[i]
             if known[m, c0, o]:
@@ -295,7 +294,7 @@ class CollisionChecker:
                     if known[m, c, o]:
                         d = float(bounds_mo[c])
                     else:
-                        d = self._narrow_at(flat_j, obstacle_poses, m * n_t, int(c), o)
+                        d = self._narrow_at(frames, obstacle_poses, m * n_t, int(c), o)
                         calls += 1
                     if d < value:
                         value, where[m, o] = d, c
@@ -316,16 +315,16 @@ class CollisionChecker:
         )
 
     def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
-        flat_j = self.robot.kinematics.joint_frames(q)  # (njoints, 3, 4, N)
+        frames = self.robot.kinematics.joint_frames(q)  # (njoints, 3, 4, N)
         obstacle_poses = self._obstacle_poses(t)
         broad = self._broad
         if exact:
-            n = flat_j.shape[-1]
+            n = frames.shape[-1]
             flat_d = np.empty((n, self.n_solids, self.n_obstacles))
             known = np.ones(flat_d.shape, dtype=bool)
             every = np.arange(n)
             for k in range(self.n_solids):
-                poses = broad.solid_poses(flat_j, every, k)
+                poses = broad.solid_poses(frames, every, k)
                 for o in range(self.n_obstacles):
                     if broad.static[k, o]:
                         flat_d[:, k, o] = broad.static_distance[k, o]
@@ -333,12 +332,12 @@ class CollisionChecker:
                         flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
             todo = ~(broad.static | broad.closed_form)[None] & known
         else:
-            bounds = broad.bounds(flat_j, obstacle_poses, q.reshape(-1, q.shape[-1]))
+            bounds = broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
             flat_d, known = bounds.lower, bounds.exact.copy()
             todo = (flat_d <= self.influence) & ~known
         samples, solids, obstacles = np.nonzero(todo)
         for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
-            pose = self._broad.solid_poses(flat_j, n, s)
+            pose = self._broad.solid_poses(frames, n, s)
             flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
         known |= todo
         shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)

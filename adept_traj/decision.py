@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 
 from ._validation import as_finite_array, as_vector, readonly_copy
 from .errors import InputShapeError, InvalidInputError
-from .metrics import MAXIMISED, _as_objectives, _as_sense
+from .metrics import MAXIMISED, _as_objectives, _as_sense, _fraction_towards
 
 __all__ = [
     "MAXIMISED",
@@ -99,10 +99,7 @@ def normalise(
     m = arr.shape[1]
     sense = _as_sense(maximised, m)
     lo, hi = _bounds(arr, z_min, z_max)
-    span = hi - lo
-    safe = np.where(span > 0, span, 1.0)
-    score = np.where(sense, (arr - lo) / safe, (hi - arr) / safe)
-    return np.where(span > 0, score, 1.0)
+    return _fraction_towards(arr, lo, hi, sense, flat=1.0)
 
 
 def average_fitness(

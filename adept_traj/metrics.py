@@ -582,11 +582,20 @@ def to_unit_minimisation(
         raise InvalidInputError(
             f"lower must not exceed upper; objective {j}: lower={lo[j]!r} > upper={hi[j]!r}"
         )
-    sense = _as_sense(maximised, m)
+    return _fraction_towards(arr, lo, hi, ~_as_sense(maximised, m), flat=0.0)
+
+
+def _fraction_towards(
+    arr: np.ndarray, lo: np.ndarray, hi: np.ndarray, up: np.ndarray, flat: float
+) -> np.ndarray:
+    """Where each value of ``arr`` (n, m) lies between ``lo`` and ``hi`` (m,): the fraction
+    of the way from ``lo`` up (columns where ``up``), else from ``hi`` down; ``flat`` in a
+    column where lo == hi. Shared by :func:`to_unit_minimisation` and
+    :func:`adept_traj.decision.normalise`."""
     span = hi - lo
     safe = np.where(span > 0, span, 1.0)
-    u = np.where(sense, (hi - arr) / safe, (arr - lo) / safe)
-    return np.where(span > 0, u, 0.0)
+    frac = np.where(up, (arr - lo) / safe, (hi - arr) / safe)
+    return np.where(span > 0, frac, flat)
 
 
 def normalised_hypervolume(
