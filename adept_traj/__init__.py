@@ -6,10 +6,15 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
-from .algorithms import ALGORITHMS, make_algorithm
-from .collision import CollisionChecker, paper_penalty
-from .decision import PAPER_WEIGHTS, average_fitness, best_tradeoff, combined_objective
-from .errors import (
+from adept_traj.analysis.certificate import Certificate, certify
+from adept_traj.analysis.decision import (
+    PAPER_WEIGHTS,
+    average_fitness,
+    best_tradeoff,
+    combined_objective,
+)
+from adept_traj.collision.checker import CollisionChecker, paper_penalty
+from adept_traj.errors import (
     AdeptTrajError,
     ConfigurationError,
     InputShapeError,
@@ -18,18 +23,18 @@ from .errors import (
     RobotModelError,
     SceneError,
 )
-from .limits import JointLimits
-from .motion import FixedPose, MotionLaw, PendulumMotion
-from .parameters import RobotParameters
-from .planner import plan
-from .problem import Evaluation, ProblemSettings, TrajectoryProblem
-from .results import PlanningResult, ResultFormatError
-from .robot import ForwardKinematics, Robot
-from .run import PlanningInterrupted
-from .scene import Obstacle, Scene
-from .shapes import Box, Capsule, Cylinder, Shape, Sphere
-from .trajectory import BSplineTrajectory, KinematicBound, kinematic_lower_bound
-from .verification import Certificate, certify
+from adept_traj.optimise.algorithms import ALGORITHMS, make_algorithm
+from adept_traj.optimise.loop import PlanningInterrupted
+from adept_traj.optimise.planner import plan
+from adept_traj.problem.bspline import BSplineTrajectory, KinematicBound, kinematic_lower_bound
+from adept_traj.problem.trajectory_problem import Evaluation, ProblemSettings, TrajectoryProblem
+from adept_traj.results.record import PlanningResult, ResultFormatError
+from adept_traj.robot.limits import JointLimits
+from adept_traj.robot.parameter_file import RobotParameters
+from adept_traj.robot.robot import ForwardKinematics, Robot
+from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
+from adept_traj.scene.scene import Obstacle, Scene
+from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
 
 __version__ = "0.1.0"
 

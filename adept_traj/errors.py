@@ -7,14 +7,21 @@ can catch them all with one clause. Input errors also derive from :class:`ValueE
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 __all__ = [
     "AdeptTrajError",
     "ConfigurationError",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
+    "MeshcatServerError",
+    "PlanningInterrupted",
+    "ResultFormatError",
     "RobotModelError",
     "SceneError",
+    "SceneFileNotFoundError",
 ]
 
 
@@ -44,3 +51,36 @@ class SceneError(AdeptTrajError):
 
 class ConfigurationError(InvalidInputError):
     """Settings of a problem, an algorithm or a run are inconsistent."""
+
+
+class PlanningInterrupted(AdeptTrajError):
+    """The run was interrupted (Ctrl-C); the last finished generation is checkpointed."""
+
+    def __init__(self, message: str, checkpoint: Path | None) -> None:
+        super().__init__(message)
+        self.checkpoint = checkpoint
+
+
+class ResultFormatError(AdeptTrajError, ValueError):
+    """A result folder is missing a file, or a file is malformed.
+
+    Attributes
+    ----------
+    file: path of the offending file.
+    field: dotted path of the offending field (e.g. ``"front[3].x"``, ``"certificate"``),
+        or ``None`` when the whole file is at fault.
+    """
+
+    def __init__(self, file: str | os.PathLike[str], field: str | None, message: str) -> None:
+        self.file = str(file)
+        self.field = field
+        where = f"{self.file}: field '{field}'" if field else self.file
+        super().__init__(f"{where}: {message}")
+
+
+class SceneFileNotFoundError(SceneError, FileNotFoundError):
+    """A scene file does not exist (both a :class:`SceneError` and a FileNotFoundError)."""
+
+
+class MeshcatServerError(AdeptTrajError, RuntimeError):
+    """The local meshcat server could not be started or does not answer."""

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_batch, as_finite_array
-from .errors import InputShapeError, InvalidInputError
+from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.validation import as_batch, as_finite_array
 
 __all__ = [
     "as_rigid_transform",

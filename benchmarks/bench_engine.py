@@ -18,7 +18,7 @@ import argparse
 import numpy as np
 
 from adept_traj import Robot, Scene, TrajectoryProblem, certify, plan
-from adept_traj.metrics import normalised_hypervolume, objective_bounds
+from adept_traj.analysis import normalised_hypervolume, objective_bounds
 
 
 def main() -> None:

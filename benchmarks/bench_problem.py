@@ -20,18 +20,14 @@ evaluation of the population (tracemalloc: numpy allocations).
 from __future__ import annotations
 
 import argparse
-import sys
 import tracemalloc
-from pathlib import Path
 
 import numpy as np
 from _timing import best_of  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
 from adept_traj.problem import TrajectoryProblem
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from paper_moves import lift_then_lower  # a hand-made collision-free move
+from adept_traj.testing.paper_moves import lift_then_lower  # a hand-made collision-free move
 
 
 def main() -> None:

@@ -1,4 +1,4 @@
-"""Tests of adept_traj.collision: point distances, solid–obstacle distances, paper penalty."""
+"""Tests of the collision checker: point distances, solid–obstacle distances, paper penalty."""
 
 from __future__ import annotations
 
@@ -10,13 +10,21 @@ import coal
 import numpy as np
 import pytest
 
-from adept_traj.broad_phase import BroadPhase
-from adept_traj.collision import CollisionChecker, paper_penalty, point_signed_distance
+from adept_traj.collision import BroadPhase, CollisionChecker, paper_penalty, point_signed_distance
 from adept_traj.errors import InputShapeError, InvalidInputError
-from adept_traj.motion import FixedPose, PendulumMotion
 from adept_traj.robot import Robot
-from adept_traj.scene import Obstacle, Scene, pendulum_obstacles
-from adept_traj.shapes import Box, Capsule, Cylinder, Sphere, coal_transform
+from adept_traj.scene import (
+    Box,
+    Capsule,
+    Cylinder,
+    FixedPose,
+    Obstacle,
+    PendulumMotion,
+    Scene,
+    Sphere,
+    coal_transform,
+    pendulum_obstacles,
+)
 from adept_traj.transforms import transform_from_xyz_rpy
 
 INFLUENCE = 0.05

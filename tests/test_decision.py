@@ -1,4 +1,4 @@
-"""Tests of adept_traj.decision: normalisation, F_avg (paper Table 3), f_c, best trade-off."""
+"""Tests of decision making: normalisation, F_avg (paper Table 3), f_c, best trade-off."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from adept_traj.decision import (
+from adept_traj.analysis import (
     MAXIMISED,
     PAPER_WEIGHTS,
     BestTradeoff,

@@ -150,17 +150,17 @@ def test_docs_build_without_warnings(html):
 def test_api_page_documents_the_public_api(html):
     api = (html / "api.html").read_text(encoding="utf-8")
     for anchor in (
-        'id="adept_traj.problem.TrajectoryProblem"',
-        'id="adept_traj.robot.Robot"',
-        'id="adept_traj.robot.Robot.inverse_dynamics"',
-        'id="adept_traj.scene.Scene"',
-        'id="adept_traj.planner.plan"',
-        'id="adept_traj.results.PlanningResult"',
-        'id="adept_traj.verification.certify"',
-        'id="adept_traj.trajectory.BSplineTrajectory"',
-        'id="adept_traj.collision.CollisionChecker"',
-        'id="module-adept_traj.metrics"',
-        'id="module-adept_traj.decision"',
+        'id="adept_traj.problem.trajectory_problem.TrajectoryProblem"',
+        'id="adept_traj.robot.robot.Robot"',
+        'id="adept_traj.robot.robot.Robot.inverse_dynamics"',
+        'id="adept_traj.scene.scene.Scene"',
+        'id="adept_traj.optimise.planner.plan"',
+        'id="adept_traj.results.record.PlanningResult"',
+        'id="adept_traj.analysis.certificate.certify"',
+        'id="adept_traj.problem.bspline.BSplineTrajectory"',
+        'id="adept_traj.collision.checker.CollisionChecker"',
+        'id="module-adept_traj.analysis.indicators"',
+        'id="module-adept_traj.analysis.decision"',
     ):
         assert anchor in api, anchor
     # Napoleon turned the numpy sections into fields (not literal "Parameters" headings).

@@ -1,4 +1,4 @@
-"""adept_traj.export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
+"""adept_traj.results.ros_export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
 dictionary and JSON file carry the dense trajectory exactly, with a correct
 time_from_start, or the spline resampled at a given rate; bad inputs are refused."""
 
@@ -13,18 +13,18 @@ from typing import Any
 
 import numpy as np
 import pytest
-from paper_moves import lift_then_lower, single_result
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.export import (
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import PlanningResult
+from adept_traj.results.ros_export import (
     MAX_ROS_POINTS,
     _duration,
     save_ros_joint_trajectory,
     to_csv,
     to_ros_joint_trajectory,
 )
-from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import PlanningResult
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 
 
 @pytest.fixture(scope="module")

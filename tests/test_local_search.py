@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from paper_moves import lift_then_lower
 from pymoo.core.evaluator import Evaluator
 from pymoo.core.population import Population
 
 from adept_traj import TrajectoryProblem
-from adept_traj.algorithms import make_algorithm
 from adept_traj.errors import ConfigurationError
-from adept_traj.local_search import FastEndSearch
-from adept_traj.repair import kinematic_time
+from adept_traj.optimise import FastEndSearch, kinematic_time, make_algorithm
+from adept_traj.testing.paper_moves import lift_then_lower
 
 
 class Recorder:

@@ -1,4 +1,4 @@
-"""Tests of adept_traj.metrics against hand values and an independent library (moocore)."""
+"""Tests of the indicators against hand values and an independent library (moocore)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,7 @@ import moocore
 import numpy as np
 import pytest
 
-from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
-from adept_traj.metrics import (
+from adept_traj.analysis import (
     MAXIMISED,
     algorithm_effort,
     hypervolume,
@@ -23,6 +22,7 @@ from adept_traj.metrics import (
     spread,
     to_unit_minimisation,
 )
+from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
 
 SQ2 = np.sqrt(2.0)
 

@@ -43,7 +43,7 @@ def test_result_is_verified_and_consistent(problem: at.TrajectoryProblem, small_
     if res.warning is None:
         assert res.front.feasible.all()
         # Front members do not dominate each other.
-        assert at.metrics.non_dominated(res.front.objectives).all()
+        assert at.analysis.non_dominated(res.front.objectives).all()
 
 
 def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem) -> None:

@@ -199,7 +199,7 @@ def test_objective_labels_have_units() -> None:
 
 def test_matplotlib_is_imported_lazily() -> None:
     code = (
-        "import sys, adept_traj.viz.plots, adept_traj.export\n"
+        "import sys, adept_traj.viz.plots, adept_traj.results.ros_export\n"
         "assert 'matplotlib' not in sys.modules, 'matplotlib imported eagerly'\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

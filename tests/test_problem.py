@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from paper_moves import lift_then_lower
 
 from adept_traj import Robot, Scene
 from adept_traj.collision import CollisionChecker
@@ -15,6 +14,7 @@ from adept_traj.errors import (
     RobotModelError,
 )
 from adept_traj.problem import TrajectoryProblem
+from adept_traj.testing.paper_moves import lift_then_lower
 
 
 @pytest.fixture(scope="module")

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 import pytest
-from paper_moves import lift_then_lower
 
 from adept_traj import Robot, Scene
+from adept_traj.analysis import certify
 from adept_traj.errors import AdeptTrajError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import (
@@ -30,7 +30,7 @@ from adept_traj.results import (
     RobotInfo,
     Timing,
 )
-from adept_traj.verification import certify
+from adept_traj.testing.paper_moves import lift_then_lower
 
 
 def make_result(problem: TrajectoryProblem, x: np.ndarray, **overrides: Any) -> PlanningResult:

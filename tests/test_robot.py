@@ -21,7 +21,7 @@ from adept_traj.errors import (
     JointLimitError,
     RobotModelError,
 )
-from adept_traj.parameters import RobotParameters
+from adept_traj.robot import RobotParameters
 
 DATA = Path(__file__).parent / "data"
 A1, A2, D1, D4 = 0.425, 0.375, 0.876, 0.204
@@ -427,7 +427,7 @@ def test_more_task_rows_than_joints_and_read_only_tool_frame() -> None:
 def test_batch_kinematics_any_axis_matches_pinocchio() -> None:
     """Joint poses and Jacobians of a chain with x, y, oblique revolute and prismatic axes
     (the z-axis fast path and the general U Rz U^T path) against Pinocchio, per sample."""
-    from adept_traj.kinematics import BatchKinematics
+    from adept_traj.robot import BatchKinematics
 
     model = pin.Model()
     oblique = np.array([1.0, -2.0, 0.5]) / np.linalg.norm([1.0, -2.0, 0.5])
@@ -466,7 +466,7 @@ def test_batch_kinematics_any_axis_matches_pinocchio() -> None:
 
 @pytest.mark.parametrize("k", [1, 2, 3, 4, 5])
 def test_small_determinants_match_lapack(k: int) -> None:
-    from adept_traj.robot import _det
+    from adept_traj.robot.robot import _det
 
     a = np.random.default_rng(k).normal(size=(7, 3, k, k))
     np.testing.assert_allclose(_det(a), np.linalg.det(a), rtol=1e-12, atol=1e-12)

@@ -8,11 +8,15 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem
-from adept_traj.algorithms import ALGORITHMS, make_algorithm
 from adept_traj.errors import ConfigurationError
-from adept_traj.repair import kinematic_time
-from adept_traj.run import PlanningInterrupted, optimise
-from adept_traj.sampling import RampSampling
+from adept_traj.optimise import (
+    ALGORITHMS,
+    PlanningInterrupted,
+    RampSampling,
+    kinematic_time,
+    make_algorithm,
+    optimise,
+)
 
 
 @pytest.mark.parametrize("name", ["nsga2", "mode"])

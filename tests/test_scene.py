@@ -1,4 +1,4 @@
-"""Tests of adept_traj.shapes, adept_traj.motion and adept_traj.scene."""
+"""Tests of adept_traj.scene.shapes, adept_traj.scene.motion_laws and adept_traj.scene.scene."""
 
 from __future__ import annotations
 
@@ -10,9 +10,19 @@ import numpy as np
 import pytest
 
 from adept_traj.errors import InputShapeError, InvalidInputError, SceneError
-from adept_traj.motion import FixedPose, PendulumMotion
-from adept_traj.scene import Obstacle, Scene, SceneFileNotFoundError, pendulum_obstacles
-from adept_traj.shapes import Box, Capsule, Cylinder, Sphere, coal_transform
+from adept_traj.scene import (
+    Box,
+    Capsule,
+    Cylinder,
+    FixedPose,
+    Obstacle,
+    PendulumMotion,
+    Scene,
+    SceneFileNotFoundError,
+    Sphere,
+    coal_transform,
+    pendulum_obstacles,
+)
 from adept_traj.transforms import rotation_from_rpy, transform_from_xyz_rpy, xyz_rpy_from_transform
 
 RNG = np.random.default_rng(20240611)

@@ -1,4 +1,4 @@
-"""Tests of adept_traj.trajectory against independent references.
+"""Tests of adept_traj.problem.bspline against independent references.
 
 References used: a Cox–de Boor B-spline evaluation written here, scipy.interpolate.BSpline,
 central finite differences, dense sampling, composite Simpson integration, monomial
@@ -19,7 +19,7 @@ from adept_traj.errors import (
     InputShapeError,
     InvalidInputError,
 )
-from adept_traj.trajectory import (
+from adept_traj.problem import (
     BSplineTrajectory,
     KinematicBound,
     TrajectoryBounds,

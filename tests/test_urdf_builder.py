@@ -9,10 +9,16 @@ import pinocchio as pin
 import pytest
 
 from adept_traj.errors import InvalidInputError, RobotModelError
-from adept_traj.inertia import box_inertia, combine, cylinder_inertia, sphere_inertia
-from adept_traj.parameters import RobotParameters
+from adept_traj.robot import (
+    RobotParameters,
+    box_inertia,
+    build_urdf,
+    combine,
+    cylinder_inertia,
+    link_mass_properties,
+    sphere_inertia,
+)
 from adept_traj.transforms import rotation_from_rpy
-from adept_traj.urdf_builder import build_urdf, link_mass_properties
 
 ROOT = Path(__file__).resolve().parents[1]
 TOML = ROOT / "urdf" / "adept_one_xl.toml"

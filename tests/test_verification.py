@@ -8,12 +8,12 @@ import coal
 import numpy as np
 import pinocchio as pin
 import pytest
-from paper_moves import lift_then_lower
 
 from adept_traj import Scene
+from adept_traj.analysis import LIMIT_KINDS, Certificate, certify
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.verification import LIMIT_KINDS, Certificate, certify
+from adept_traj.testing.paper_moves import lift_then_lower
 
 
 @pytest.fixture(scope="module")

@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import umsgpack
-from paper_moves import lift_then_lower, single_result
 
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 from adept_traj.viz import meshcat_view as mv
 
 CHROMIUM_FLAGS = [

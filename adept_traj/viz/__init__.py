@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 __all__ = ["meshcat_view", "plots"]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers only
-    from . import meshcat_view, plots
+    from adept_traj.viz import meshcat_view, plots
 
 
 def __getattr__(name: str) -> ModuleType:

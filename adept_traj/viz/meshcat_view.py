@@ -53,11 +53,11 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     from meshcat.path import Path as MeshcatPath
     from meshcat.visualizer import ViewerWindow
 
-from .._validation import readonly_copy
-from ..errors import AdeptTrajError, InvalidInputError
-from ..results import PlanningResult
-from ..scene import Obstacle
-from ..shapes import Box, Capsule, Cylinder, Shape, Sphere
+from adept_traj.errors import InvalidInputError, MeshcatServerError
+from adept_traj.results.record import PlanningResult
+from adept_traj.scene.scene import Obstacle
+from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
+from adept_traj.validation import readonly_copy
 
 __all__ = [
     "BACKGROUND_RGB",
@@ -99,10 +99,6 @@ _GRID_STEP = 0.1  # floor grid spacing [m]
 _FLOOR_MARGIN = 0.3  # floor beyond the drawn scene [m]
 FLOOR_COLOR = 0xE5E7E9
 GRID_COLOR = 0xB3B6B7  # camera offset direction from the target
-
-
-class MeshcatServerError(AdeptTrajError, RuntimeError):
-    """The local meshcat server could not be started or does not answer."""
 
 
 # ============================================================================ data

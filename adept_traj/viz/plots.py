@@ -30,12 +30,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..decision import normalise
-from ..errors import InvalidInputError
-from ..metrics import objective_bounds
-from ..results import PlanningResult
-from ..scene import Scene
-from ..shapes import Box, Capsule, Cylinder, Sphere
+from adept_traj.analysis.decision import normalise
+from adept_traj.analysis.indicators import objective_bounds
+from adept_traj.errors import InvalidInputError
+from adept_traj.results.record import PlanningResult
+from adept_traj.scene.scene import Scene
+from adept_traj.scene.shapes import Box, Capsule, Cylinder, Sphere
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -1,0 +1,67 @@
+"""Analysis of moves and fronts: certificate, decision making, indicators."""
+
+from __future__ import annotations
+
+from adept_traj.analysis.certificate import (
+    DEFAULT_RATE_HZ,
+    DEFAULT_TOLERANCE,
+    LIMIT_KINDS,
+    Certificate,
+    DenseTrajectory,
+    LimitCheck,
+    certify,
+    dense_samples,
+)
+from adept_traj.analysis.decision import (
+    PAPER_WEIGHTS,
+    BestTradeoff,
+    average_fitness,
+    best_tradeoff,
+    combined_objective,
+    normalise,
+    objective_weights,
+)
+from adept_traj.analysis.indicators import (
+    DEFAULT_HV_REFERENCE,
+    MAXIMISED,
+    algorithm_effort,
+    hypervolume,
+    igd,
+    non_dominated,
+    normalised_hypervolume,
+    objective_bounds,
+    optimizer_overhead,
+    ratio_non_dominated,
+    spread,
+    to_unit_minimisation,
+)
+
+__all__ = [
+    "DEFAULT_HV_REFERENCE",
+    "DEFAULT_RATE_HZ",
+    "DEFAULT_TOLERANCE",
+    "LIMIT_KINDS",
+    "MAXIMISED",
+    "PAPER_WEIGHTS",
+    "BestTradeoff",
+    "Certificate",
+    "DenseTrajectory",
+    "LimitCheck",
+    "algorithm_effort",
+    "average_fitness",
+    "best_tradeoff",
+    "certify",
+    "combined_objective",
+    "dense_samples",
+    "hypervolume",
+    "igd",
+    "non_dominated",
+    "normalise",
+    "normalised_hypervolume",
+    "objective_bounds",
+    "objective_weights",
+    "optimizer_overhead",
+    "ratio_non_dominated",
+    "spread",
+    "to_unit_minimisation",
+]

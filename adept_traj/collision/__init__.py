@@ -1,0 +1,29 @@
+"""Exact robot-obstacle distances over time: checker, conservative broad phase, distance tables."""
+
+from __future__ import annotations
+
+from adept_traj.collision.broad_phase import (
+    Bounds,
+    BroadPhase,
+    point_signed_distance,
+)
+from adept_traj.collision.checker import (
+    CollisionChecker,
+    MinDistances,
+    PairDistances,
+    paper_penalty,
+)
+from adept_traj.collision.distance_table import (
+    DistanceTable,
+)
+
+__all__ = [
+    "Bounds",
+    "BroadPhase",
+    "CollisionChecker",
+    "DistanceTable",
+    "MinDistances",
+    "PairDistances",
+    "paper_penalty",
+    "point_signed_distance",
+]

@@ -1,0 +1,451 @@
+"""Signed distances between the robot's link solids and the scene's obstacles over time.
+
+:class:`CollisionChecker` gives, for configurations ``q`` (..., n_t, nq) at times ``t``
+(..., n_t) [s], the signed distance [m] between **every** robot solid and **every** obstacle
+(moving obstacles at their pose at that time; negative = penetration depth), using coal.
+
+The broad phase (:mod:`adept_traj.broad_phase`, numpy, batched) gives a lower bound of
+every distance, exact for sphere obstacles (closed form) and static pairs. Only pairs whose
+bound is ≤ ``influence`` go to coal (narrow phase, one call per close pair: the only Python
+loop, over close pairs, never over all samples). The other entries hold a lower bound
+greater than ``influence``: every quantity built from distances below ``influence`` (the
+constraint, the clearance penalty) is therefore exact.
+
+Also here: :func:`paper_penalty`, the paper's eqs. (13)–(16) (circumscribing spheres or
+ellipsoids around obstacles, tool points), kept for comparison.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import coal
+import numpy as np
+
+from adept_traj.collision.broad_phase import BroadPhase, point_signed_distance
+from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.robot.robot import Robot
+from adept_traj.scene.scene import Scene
+from adept_traj.validation import as_finite_array
+
+__all__ = [
+    "CollisionChecker",
+    "MinDistances",
+    "PairDistances",
+    "paper_penalty",
+    "point_signed_distance",
+]
+
+
+@dataclass(frozen=True)
+class PairDistances:
+    """Distances between robot solids and obstacles.
+
+    Attributes
+    ----------
+    distance:
+        (..., n_t, n_solids, n_obstacles) signed distance [m] where ``exact``, else a lower
+        bound greater than the checker's ``influence``.
+    exact:
+        (..., n_t, n_solids, n_obstacles) bool, where the distance is exact (computed by
+        coal, or in closed form for a sphere obstacle).
+    n_narrow:
+        Number of coal distance calls made.
+    """
+
+    distance: np.ndarray
+    exact: np.ndarray
+    n_narrow: int
+
+    @property
+    def min_distance(self) -> np.ndarray:
+        """(..., n_t) smallest distance over all pairs [m] (exact when ≤ ``influence``)."""
+        return self.distance.min(axis=(-2, -1))
+
+    @property
+    def per_obstacle(self) -> np.ndarray:
+        """(..., n_obstacles) smallest distance over time and solids to each obstacle [m]."""
+        return self.distance.min(axis=(-3, -2))
+
+
+@dataclass(frozen=True)
+class MinDistances:
+    """Smallest distance to each obstacle over a whole motion.
+
+    Attributes
+    ----------
+    distance:
+        (..., n_obstacles) smallest signed distance [m] over the motion's samples and the
+        robot solids; exact when ≤ ``influence``, else a lower bound greater than it.
+    sample, solid:
+        (..., n_obstacles) int, where the smallest exact distance was found (-1 if the
+        distance is only a lower bound above ``influence``).
+    n_narrow:
+        Number of coal distance calls made.
+    """
+
+    distance: np.ndarray
+    sample: np.ndarray
+    solid: np.ndarray
+    n_narrow: int
+
+
+class CollisionChecker:
+    """Distances between a robot's collision solids and a scene's obstacles (see module doc).
+
+    Parameters
+    ----------
+    robot:
+        The robot; its :attr:`~adept_traj.robot.Robot.collision_model` gives the solids.
+    scene:
+        The obstacles and the robot base pose in the world.
+    influence:
+        Distance [m] below which distances are computed exactly (default 0.05 m). Must be
+        ≥ 0; it should be at least the safety margin used with the distances.
+    """
+
+    def __init__(self, robot: Robot, scene: Scene, influence: float = 0.05) -> None:
+        if not (np.isfinite(influence) and influence >= 0):
+            raise InvalidInputError(f"influence must be a finite distance ≥ 0 [m]; got {influence}")
+        self.robot, self.scene, self.influence = robot, scene, float(influence)
+        objects = robot.collision_model.geometryObjects
+        self.solid_names = tuple(g.name for g in objects)
+        self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
+        self._broad = BroadPhase(robot, scene, self.influence)
+        self._robot_geoms = [g.geometry for g in objects]
+        self._functors = [
+            [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
+            for g in self._robot_geoms
+        ]
+        self._request = coal.DistanceRequest()
+        self._result = coal.DistanceResult()
+        self._tf = (coal.Transform3s(), coal.Transform3s())
+
+    @property
+    def solid_shapes(self) -> tuple[object | None, ...]:
+        """The robot solids as :mod:`adept_traj.shapes` objects (``None`` if not a primitive)."""
+        return tuple(self._broad.solid_shape)
+
+    @property
+    def closed_form(self) -> np.ndarray:
+        """(n_solids, n_obstacles) bool: pairs whose distance is computed in closed form
+        (a sphere obstacle and a primitive solid) instead of by coal."""
+        return self._broad.closed_form.copy()
+
+    @property
+    def static_pairs(self) -> np.ndarray:
+        """(n_solids, n_obstacles) bool: pairs of a solid fixed to the base and a fixed
+        obstacle, whose constant distance is computed once (at construction)."""
+        return self._broad.static.copy()
+
+    @property
+    def n_solids(self) -> int:
+        """Number of robot solids."""
+        return len(self.solid_names)
+
+    @property
+    def n_obstacles(self) -> int:
+        """Number of obstacles."""
+        return len(self.obstacle_names)
+
+    def distances(self, q: Any, t: Any, *, exact: bool = False) -> PairDistances:
+        """Solid–obstacle distances for configurations ``q`` (..., n_t, nq) [rad | m] at
+        times ``t`` (..., n_t) [s] (broadcast against q's leading axes).
+
+        With ``exact=True`` every pair is computed exactly: by coal, in closed form for a
+        sphere obstacle, once for a static pair (for verification).
+        """
+        qa, ta = self._check(q, t)
+        return self._distances(qa, ta, exact)
+
+    def _check(self, q: Any, t: Any) -> tuple[np.ndarray, np.ndarray]:
+        qa = as_finite_array(q, "q")
+        ta = as_finite_array(t, "t")
+        if qa.ndim < 2 or qa.shape[-1] != self.robot.nq:
+            raise InputShapeError(
+                f"q must have shape (..., n_t, {self.robot.nq}); got shape {qa.shape}"
+            )
+        try:
+            ta = np.broadcast_to(ta, qa.shape[:-1])
+        except ValueError:
+            raise InputShapeError(
+                f"t must broadcast to q's leading shape {qa.shape[:-1]}; got shape {ta.shape}"
+            ) from None
+        return qa, ta
+
+    def min_distances(self, q: Any, t: Any, joint_frames: np.ndarray | None = None) -> MinDistances:
+        """Per motion and obstacle, the smallest solid–obstacle distance over all samples.
+
+        ``q`` (..., n_t, nq) [rad | m] and ``t`` (..., n_t) [s]: the leading axes ``...``
+        are motions (e.g. the population). Branch and bound: candidates (sample, solid)
+        are computed by coal in increasing order of their broad-phase lower bound until the
+        best exact distance is below the next bound, so the result is the exact minimum
+        (when ≤ ``influence``, penetration depths included) with few coal calls.
+        ``joint_frames`` (njoints, 3, 4, N), N = ∏ q.shape[:-1], may pass the robot's joint
+        frames (:attr:`~adept_traj.robot.ForwardKinematics.joint_frames`) if already
+        computed.
+        """
+        qa, ta = self._check(q, t)
+        if joint_frames is None:
+            joint_frames = self.robot.kinematics.joint_frames(qa)
+        expected = (self.robot.model.njoints, 3, 4, ta.size)
+        if np.shape(joint_frames) != expected:
+            raise InputShapeError(
+                f"joint_frames must have shape {expected} for q of shape {qa.shape}; "
+                f"got {np.shape(joint_frames)}"
+            )
+        return self._min_distances(qa, ta, joint_frames)
+
+    # ------------------------------------------------------------------ private hooks
+    def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
+        """Obstacle poses in the robot base frame at the flattened times ``t``: per obstacle
+        one (4, 4) pose if it is fixed, else (N, 4, 4) with N = ``t.size``."""
+        to_base = self.scene.base_from_world
+        flat_t = t.reshape(-1)
+        laws: dict[int, np.ndarray] = {}  # a pendulum's rod and bob share one motion law
+        poses = []
+        for ob in self.scene.obstacles:
+            if not ob.is_moving:
+                poses.append(to_base @ ob.pose(0.0))
+                continue
+            key = id(ob.motion)
+            if key not in laws:
+                laws[key] = _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
+            poses.append(_right(laws[key], ob.offset))  # = to_base @ ob.pose(t)
+        return poses
+
+    @staticmethod
+    def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:
+        return poses if poses.ndim == 2 else poses[n]
+
+    def _narrow(self, solid_pose: np.ndarray, obstacle_pose: np.ndarray, s: int, o: int) -> float:
+        """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses."""
+        tf_solid, tf_obstacle = self._tf
+        tf_solid.setRotation(solid_pose[:3, :3])
+        tf_solid.setTranslation(solid_pose[:3, 3])
+        tf_obstacle.setRotation(obstacle_pose[:3, :3])
+        tf_obstacle.setTranslation(obstacle_pose[:3, 3])
+        self._result.clear()
+        return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
+
+    def _narrow_at(
+        self, frames: np.ndarray, obstacle_poses: list[np.ndarray], base: int, c: int, o: int
+    ) -> float:
+        """Coal distance of candidate ``c`` (= sample · n_solids + solid) of the motion whose
+        first sample is ``base`` in the flattened arrays, to obstacle ``o``."""
+        k, s = divmod(c, self.n_solids)
+        n = base + k
+        pose = self._broad.solid_poses(frames, n, s)
+        return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+
+    def _first_poses(
+        self, frames: np.ndarray, samples: np.ndarray, solids: np.ndarray
+    ) -> np.ndarray:
+        """Poses (n, 4, 4) of ``solids`` (n,) at flat ``samples`` (n,), batched per solid."""
+        poses = np.empty((len(samples), 4, 4))
+        for k in np.unique(solids).tolist():
+            sel = np.flatnonzero(solids == k)
+            poses[sel] = self._broad.solid_poses(frames, samples[sel], k)
+        return poses
+
+    def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
+        batch, n_t = q.shape[:-2], q.shape[-2]
+        n_motions = int(np.prod(batch))
+        obstacle_poses = self._obstacle_poses(t)
+        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
+        lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
+        known = bounds.exact.reshape(lower.shape)
+        best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
+        where = np.full(best.shape, -1)
+        closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
+        # Every pair within influence of such an obstacle is exact already: the argmin is
+        # exact when at most influence; above, it may be a level-1 bound (then -1).
+        first = lower[:, :, closed].argmin(axis=1)  # (n_motions, n_closed)
+        is_exact = np.take_along_axis(known[:, :, closed], first[:, None, :], axis=1)[:, 0]
+        where[:, closed] = np.where(is_exact, first, -1)
+        calls = 0
+        pm, po = np.nonzero((best <= self.influence) & ~closed)
+        # First candidate of every (motion, obstacle) at once: the smallest bound. Most
+        # searches end there (the second smallest bound is at least its exact distance).
+        rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
+        first = rows.argmin(axis=1)
+        second = (
+            np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
+        )
+        # Poses of the first candidates (solid and obstacle), formed together.
+        first_sample = pm * n_t + first // self.n_solids
+        first_solid = first % self.n_solids
+        solid_at = self._first_poses(frames, first_sample, first_solid)
+        for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
+            bounds_mo = rows[i]
+            if known[m, c0, o]:
+                value = float(bounds_mo[c0])  # exact already
+            else:
+                pose_o = self._pose_at(obstacle_poses[o], int(first_sample[i]))
+                value = self._narrow(solid_at[i], pose_o, int(first_solid[i]), o)
+                calls += 1
+            where[m, o] = c0
+            if second[i] < value and second[i] <= self.influence:
+                near = np.flatnonzero(bounds_mo <= self.influence)
+                for c in near[np.argsort(bounds_mo[near], kind="stable")][1:]:
+                    if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune
+                        break
+                    if known[m, c, o]:
+                        d = float(bounds_mo[c])
+                    else:
+                        d = self._narrow_at(frames, obstacle_poses, m * n_t, int(c), o)
+                        calls += 1
+                    if d < value:
+                        value, where[m, o] = d, c
+            if value > self.influence:
+                # Not exact: candidates with a bound in (influence, value) were not computed;
+                # the smallest of value and those bounds is a lower bound above influence.
+                value = min(value, bounds_mo.min(initial=np.inf, where=bounds_mo > self.influence))
+                where[m, o] = -1  # only a bound is known
+            best[m, o] = value
+        sample = np.where(where >= 0, where // self.n_solids, -1)
+        solid = np.where(where >= 0, where % self.n_solids, -1)
+        shape = (*batch, self.n_obstacles)
+        return MinDistances(
+            distance=best.reshape(shape),
+            sample=sample.reshape(shape),
+            solid=solid.reshape(shape),
+            n_narrow=calls,
+        )
+
+    def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
+        frames = self.robot.kinematics.joint_frames(q)  # (njoints, 3, 4, N)
+        obstacle_poses = self._obstacle_poses(t)
+        broad = self._broad
+        if exact:
+            n = frames.shape[-1]
+            flat_d = np.empty((n, self.n_solids, self.n_obstacles))
+            known = np.ones(flat_d.shape, dtype=bool)
+            every = np.arange(n)
+            for k in range(self.n_solids):
+                poses = broad.solid_poses(frames, every, k)
+                for o in range(self.n_obstacles):
+                    if broad.static[k, o]:
+                        flat_d[:, k, o] = broad.static_distance[k, o]
+                    elif broad.closed_form[k, o]:
+                        flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
+            todo = ~(broad.static | broad.closed_form)[None] & known
+        else:
+            bounds = broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
+            flat_d, known = bounds.lower, bounds.exact.copy()
+            todo = (flat_d <= self.influence) & ~known
+        samples, solids, obstacles = np.nonzero(todo)
+        for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
+            pose = self._broad.solid_poses(frames, n, s)
+            flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+        known |= todo
+        shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)
+        return PairDistances(
+            distance=flat_d.reshape(shape), exact=known.reshape(shape), n_narrow=len(samples)
+        )
+
+
+def _left(a: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """``a @ poses`` for a constant (4, 4) ``a`` and poses (N, 4, 4), as one GEMM (numpy's
+    stacked product of small matrices is several times slower)."""
+    return (poses.transpose(0, 2, 1).reshape(-1, 4) @ a.T).reshape(-1, 4, 4).transpose(0, 2, 1)
+
+
+def _right(poses: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``poses @ b`` for poses (N, 4, 4) and a constant (4, 4) ``b``, as one GEMM."""
+    return (poses.reshape(-1, 4) @ b).reshape(poses.shape)
+
+
+def paper_penalty(
+    points: Any,
+    centres: Any,
+    semi_axes: Any,
+    *,
+    rotations: Any = None,
+    equation: int = 16,
+) -> np.ndarray:
+    r"""The paper's collision penalty :math:`f_{dis}` (eqs. 13–16), batched.
+
+    Each obstacle is replaced by a circumscribing sphere of radius :math:`r_0` or an
+    ellipsoid with semi-axes a, b, c (in the obstacle's own axes); a trajectory point inside
+    it penalises the motion. Eq. 14 (spheres, ``equation=14``; the semi-axes must be equal):
+
+    .. math::
+        r_t = \lVert x - x_0 \rVert, \qquad
+        f_{dis} = \sum_{o:\ \min_t r_{t,o} \le r_{0,o}} \frac{1}{(\min_t r_{t,o})^2}
+
+    Eq. 16 (ellipsoids, ``equation=16``), with :math:`u = R_o^\top (x - x_0)` the point in
+    the obstacle's axes:
+
+    .. math::
+        r_e = \sum_k \frac{u_k^2}{a_k^2}, \qquad
+        f_{dis} = \sum_{o:\ \min_t r_{e,o} \le 1} \frac{1}{(\min_t r_{e,o})^2}
+
+    Parameters
+    ----------
+    points:
+        (..., n_t, 3) trajectory points (the tool) [m].
+    centres:
+        (n_obs, ..., n_t, 3) obstacle centres at the same times [m] (broadcastable).
+    semi_axes:
+        (n_obs, 3) semi-axes [m] (:math:`r_0` three times for a sphere).
+    rotations:
+        (n_obs, ..., n_t, 3, 3) obstacle orientations (columns: the obstacle's axes in the
+        points' frame), aligned like ``centres``; ``None``: axis-aligned.
+    equation:
+        14 or 16 (see above).
+
+    Returns
+    -------
+    numpy.ndarray
+        (...) penalty [m⁻² for eq. 14, dimensionless for eq. 16], 0 when no point enters any
+        circumscribing volume.
+    """
+    p = as_finite_array(points, "points")
+    c = as_finite_array(centres, "centres")
+    ax = as_finite_array(semi_axes, "semi_axes")
+    if equation not in (14, 16):
+        raise InvalidInputError(f"equation must be 14 (spheres) or 16 (ellipsoids); got {equation}")
+    if ax.ndim != 2 or ax.shape[1] != 3 or (ax <= 0).any():
+        raise InvalidInputError(f"semi_axes must be (n_obs, 3) positive [m]; got {ax.shape}")
+    if equation == 14 and not np.allclose(ax, ax[:, :1]):
+        raise InvalidInputError("equation 14 needs spheres: equal semi-axes per obstacle")
+    if p.ndim < 2 or p.shape[-1] != 3 or c.ndim < 2 or c.shape[-1] != 3:
+        raise InputShapeError(
+            f"points must be (..., n_t, 3) and centres (n_obs, ..., n_t, 3) [m]; got "
+            f"{p.shape} and {c.shape}"
+        )
+    if c.shape[0] != ax.shape[0]:
+        raise InputShapeError(f"centres has {c.shape[0]} obstacles but semi_axes has {ax.shape[0]}")
+    # Align the centres' (..., n_t) with the points' from the right, after the obstacle axis.
+    missing = p.ndim - (c.ndim - 1)
+    if missing < 0:
+        raise InputShapeError(
+            f"centres {c.shape} has more batch axes than points {p.shape} (n_obs first)"
+        )
+    c = c.reshape(c.shape[0], *([1] * missing), *c.shape[1:])
+    try:
+        np.broadcast_shapes(p.shape, c.shape[1:])
+    except ValueError:
+        raise InputShapeError(
+            f"centres (n_obs, ..., n_t, 3) must broadcast with points (..., n_t, 3); got "
+            f"{c.shape} and {p.shape}"
+        ) from None
+    d = p[None] - c  # (n_obs, ..., n_t, 3)
+    if rotations is not None:
+        rot = as_finite_array(rotations, "rotations")
+        if rot.shape[:1] != c.shape[:1] or rot.shape[-2:] != (3, 3):
+            raise InputShapeError(
+                f"rotations must be (n_obs, ..., n_t, 3, 3) like centres; got {rot.shape}"
+            )
+        rot = rot.reshape(rot.shape[0], *([1] * missing), *rot.shape[1:])
+        d = (d[..., None, :] @ rot)[..., 0, :]  # R^T d as a row vector
+    if equation == 14:
+        r_t = np.min(np.linalg.norm(d, axis=-1), axis=-1)  # (n_obs, ...)
+        inside = r_t <= ax[:, 0].reshape(-1, *([1] * (r_t.ndim - 1)))
+        return np.sum(np.where(inside, 1.0 / np.maximum(r_t, 1e-12) ** 2, 0.0), axis=0)
+    scaled = d / ax.reshape(ax.shape[0], *([1] * (c.ndim - 2)), 3)
+    r_e = np.min(np.sum(scaled**2, axis=-1), axis=-1)  # (n_obs, ...)
+    inside = r_e <= 1.0
+    return np.sum(np.where(inside, 1.0 / np.maximum(r_e, 1e-12) ** 2, 0.0), axis=0)

@@ -1,0 +1,1 @@
+"""Shipped data files (scenes), read with :mod:`importlib.resources`."""

@@ -1,0 +1,226 @@
+"""``plan()``: run an algorithm on a trajectory problem and return a verified result.
+
+Steps:
+
+1. :func:`~adept_traj.algorithms.make_algorithm` (paper settings by default) and
+   :func:`~adept_traj.run.optimise` (seeded; optional checkpoints and exact resume).
+2. **Front**: the feasible non-dominated members of the final population. If no member is
+   feasible, the least-infeasible ones (the 10 with the smallest total violation) with a
+   warning — never an empty result.
+3. **Best trade-off**: :func:`~adept_traj.decision.best_tradeoff` (f_c and F_avg ranks,
+   paper weights by default) on the front.
+4. **Certificate**: the chosen solution is re-verified on a ≥ 1 kHz grid
+   (:func:`~adept_traj.verification.certify`). If it fails (e.g. a torque peak between
+   samples), the next candidates in the trade-off order are certified, and the first that
+   passes is reported (up to ``max_certify`` tries); if none passes, the trade-off choice
+   is reported with its failing certificate.
+5. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
+   population), OO and AE (from measured times), HV of the front normalised on its own
+   objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from adept_traj.analysis.certificate import certify
+from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff
+from adept_traj.analysis.indicators import (
+    DEFAULT_HV_REFERENCE,
+    algorithm_effort,
+    non_dominated,
+    normalised_hypervolume,
+    objective_bounds,
+    optimizer_overhead,
+    ratio_non_dominated,
+    spread,
+)
+from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.algorithms import make_algorithm
+from adept_traj.optimise.loop import GenerationInfo, optimise
+from adept_traj.problem.trajectory_problem import TrajectoryProblem
+from adept_traj.results.record import (
+    NO_FEASIBLE_WARNING,
+    BestSolution,
+    Front,
+    GenerationRecord,
+    Metrics,
+    PlanningResult,
+    Timing,
+)
+
+__all__ = ["plan"]
+
+#: Size of the fallback front when nothing is feasible.
+_LEAST_INFEASIBLE = 10
+
+
+def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[str, Any]:
+    """What a checkpoint must match to be resumed by this run."""
+    return json.loads(
+        json.dumps(
+            {
+                "start": problem.start.tolist(),
+                "goal": problem.goal.tolist(),
+                # workers change nothing in the results: a run may resume with others.
+                "problem_settings": {
+                    k: v for k, v in problem.settings.__dict__.items() if k != "workers"
+                },
+                "scene": problem.scene.to_dict(),
+                "robot": problem.robot.name,
+                "algorithm": settings.to_dict(),
+                "seed": seed,
+            },
+            default=str,
+        )
+    )
+
+
+#: Most generations whose hypervolume is recorded in the history (evenly spread + last).
+_HV_GENERATIONS = 25
+
+
+def _z4_positive(F: np.ndarray) -> np.ndarray:
+    """pymoo's objectives (z4 negated) as reported (z4 positive)."""
+    out = np.array(F, dtype=float)
+    out[:, 3] = -out[:, 3]
+    return out
+
+
+def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecord]:
+    """Generation records with the hypervolume of each generation's feasible front, on the
+    bounds of the final front and of every generation's front (reference point 1.1), for
+    up to ``_HV_GENERATIONS`` generations of this session (a resumed run has none for the
+    generations before)."""
+    n = len(state.history)
+    offset = n - len(state.fronts)  # generations restored from a checkpoint
+    chosen = set()
+    if final_front is not None and len(state.fronts):
+        k = len(state.fronts)
+        chosen = {int(i) for i in np.linspace(0, k - 1, min(k, _HV_GENERATIONS)).round()}
+        positive = [_z4_positive(F) for F in state.fronts if len(F)]
+        lo, hi = objective_bounds(final_front, *positive)  # a one-point front would collapse
+    records = []
+    for i, h in enumerate(state.history):
+        hv = None
+        j = i - offset
+        if j in chosen and len(state.fronts[j]):
+            hv = normalised_hypervolume(_z4_positive(state.fronts[j]), lo, hi)
+        records.append(
+            GenerationRecord(
+                generation=h["generation"],
+                n_evaluations=h["n_evaluations"],
+                n_feasible=h["n_feasible"],
+                hypervolume=hv,
+            )
+        )
+    return records
+
+
+def plan(
+    problem: TrajectoryProblem,
+    algorithm: str = "nsga2",
+    seed: int = 1,
+    *,
+    pop_size: int | None = None,
+    n_gen: int | None = None,
+    weights: Sequence[float] = PAPER_WEIGHTS,
+    checkpoint: str | Path | None = None,
+    resume: bool = False,
+    progress: Callable[[GenerationInfo], None] | None = None,
+    rate_hz: float = 1000.0,
+    max_certify: int = 10,
+    **params: Any,
+) -> PlanningResult:
+    """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name).
+
+    Parameters
+    ----------
+    problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
+    algorithm, pop_size, n_gen, params: see :func:`~adept_traj.algorithms.make_algorithm`.
+    seed: random seed (the same seed gives the same front).
+    weights: the six weights of f_c (default: the paper's).
+    checkpoint, resume: checkpoint folder and whether to resume from it.
+    progress: called after every generation.
+    rate_hz: rate of the dense verification (≥ 1000 Hz recommended).
+    max_certify: how many trade-off candidates to certify before giving up.
+
+    Returns
+    -------
+    PlanningResult
+        Never empty; ``result.feasible`` is the dense certificate's verdict.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ConfigurationError(f"seed must be an integer ≥ 0; got {seed!r}")
+    alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
+    state = optimise(
+        problem,
+        alg,
+        settings.n_gen,
+        int(seed),
+        checkpoint=checkpoint,
+        resume=resume,
+        fingerprint=_fingerprint(problem, settings, int(seed)),
+        progress=progress,
+    )
+    # The final population's values as the run computed them (z4 back to positive).
+    objectives = _z4_positive(state.F)
+    constraints = np.asarray(state.G, dtype=float)
+    feasible = np.all(constraints <= 0.0, axis=1)
+    if feasible.any():
+        rows = np.flatnonzero(feasible)
+        rows = rows[non_dominated(objectives[rows])]
+        warning = None
+    else:
+        violation = np.maximum(constraints, 0.0).sum(axis=1)
+        rows = np.argsort(violation, kind="stable")[:_LEAST_INFEASIBLE]
+        warning = NO_FEASIBLE_WARNING
+    rows = np.unique(rows)  # deterministic order
+    front = Front(
+        x=state.X[rows],
+        objectives=objectives[rows],
+        constraints=constraints[rows],
+        feasible=feasible[rows],
+    )
+    choice = best_tradeoff(front.objectives, weights)
+    certificate, index = None, choice.index
+    for k in choice.order[: max(1, max_certify)]:
+        candidate = certify(problem, front.x[k], rate_hz=rate_hz)
+        if certificate is None or (candidate.feasible and not certificate.feasible):
+            certificate, index = candidate, int(k)
+        if candidate.feasible:
+            break
+    lo, hi = objective_bounds(front.objectives)
+    metrics = Metrics(
+        ssm=spread(front.objectives) if len(rows) > 1 else None,
+        rni=ratio_non_dominated(objectives),
+        oo=optimizer_overhead(state.total_s, state.evaluation_s),
+        ae=algorithm_effort(state.total_s, state.n_evaluations),
+        hv=normalised_hypervolume(front.objectives, lo, hi) if feasible.any() else None,
+        hv_reference_point=np.full(6, DEFAULT_HV_REFERENCE) if feasible.any() else None,
+    )
+    return PlanningResult.from_problem(
+        problem,
+        algorithm=settings.name,
+        algorithm_settings=settings.to_dict(),
+        seed=int(seed),
+        front=front,
+        best=BestSolution(
+            index=index, f_c=float(choice.f_c[index]), f_avg=float(choice.F_avg[index])
+        ),
+        certificate=certificate,
+        timing=Timing(
+            total_s=state.total_s,
+            evaluation_s=state.evaluation_s,
+            n_evaluations=state.n_evaluations,
+            n_generations=state.n_generations,
+        ),
+        metrics=metrics,
+        history=_history(state, front.objectives if feasible.any() else None),
+        warning=warning,
+    )

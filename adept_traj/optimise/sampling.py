@@ -1,0 +1,133 @@
+r"""Initial populations for trajectory problems.
+
+pymoo's default :class:`~pymoo.operators.sampling.rnd.FloatRandomSampling` draws every
+control point uniformly inside the joint limits: such trajectories shake between the limits
+and violate the velocity, acceleration and jerk limits by orders of magnitude, so a run
+spends most of its budget finding the feasible region. :class:`RampSampling` (the default)
+draws **rest-to-rest ramps with random timing and a random detour per joint**:
+
+.. math::
+    P_{c,j} = q_{s,j} + \Delta_j\,\sigma\!\left(\frac{\xi_c - a_j}{b_j - a_j}\right)
+              + \beta_j \sin(\pi \xi_c)\,(\bar q_j - \underline q_j),
+
+with :math:`\xi_c` the control points' Greville abscissae in [0, 1], σ a normalised
+S-curve — the position profile of a trapezoidal acceleration (jerk phases of a random
+fraction r ∈ [0.05, 0.25] of the move, r = 0.25 being a triangular acceleration), the shape
+of time-optimal jerk-limited moves — a window
+:math:`0 \le a_j < b_j \le 1` (the whole motion with probability ``full_window``, else
+random) and a random detour amplitude
+:math:`\beta_j \sim \mathcal N(0, \text{detour}^2)` (with probability ``detour_prob``,
+else 0); T is uniform in its bounds. The straight
+joint-space move is always included. Control points are clipped to the decision bounds.
+Travel times: half the individuals get T uniform in its bounds, the other half T just above
+their own kinematic minimum (:func:`~adept_traj.repair.kinematic_time` × U[1, 1.3]), so the
+fast end of the front is explored from the start. Nothing about a particular scene is
+assumed.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pymoo.core.sampling import Sampling
+
+from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.repair import kinematic_time
+
+__all__ = ["RampSampling"]
+
+
+_GRID = np.linspace(0.0, 1.0, 2001)
+
+
+def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Normalised S-curves σ(u) (σ(0) = 0, σ(1) = 1, rest to rest) with jerk-phase fraction
+    ``r``: acceleration ramps up over r, holds, ramps down over r (first half), mirrored
+    negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast."""
+    r = np.asarray(r, dtype=float)[..., None]
+    g = _GRID
+    half = np.minimum(g, 1.0 - g)  # symmetric shape, sign from the half
+    acc = np.minimum(np.clip(half / r, 0.0, 1.0), np.clip((0.5 - half) / r, 0.0, 1.0))
+    acc = np.where(g < 0.5, acc, -acc)
+    vel = np.cumsum(acc, axis=-1)
+    pos = np.cumsum(vel, axis=-1)
+    pos = (pos - pos[..., :1]) / (pos[..., -1:] - pos[..., :1])
+    uu = np.clip(u, 0.0, 1.0)
+    idx = np.minimum((uu * (len(g) - 1)).astype(int), len(g) - 2)
+    w = uu * (len(g) - 1) - idx
+    take = np.take_along_axis
+    return take(pos, idx, axis=-1) * (1 - w) + take(pos, idx + 1, axis=-1) * w
+
+
+class RampSampling(Sampling):
+    """Random rest-to-rest ramps with random per-joint timing and detours (see module doc).
+
+    Parameters
+    ----------
+    detour:
+        Standard deviation of the detour amplitude, as a fraction of each joint's range
+        (default 0.05).
+    detour_prob:
+        Probability that a joint makes a detour at all (default 0.25): detours explore
+        around obstacles but slow a move down, so most ramps go straight.
+    min_window:
+        Smallest fraction of the control polygon over which a joint moves (default 0.3).
+    full_window:
+        Probability that a joint moves over the whole motion (window [0, 1], the shape of
+        time-optimal moves) instead of a random sub-window (default 0.5).
+    """
+
+    def __init__(
+        self,
+        detour: float = 0.05,
+        min_window: float = 0.3,
+        full_window: float = 0.5,
+        detour_prob: float = 0.25,
+    ) -> None:
+        super().__init__()
+        if not (np.isfinite(detour) and detour >= 0):
+            raise ConfigurationError(f"detour must be ≥ 0; got {detour}")
+        if not 0 < min_window <= 1:
+            raise ConfigurationError(f"min_window must be in (0, 1]; got {min_window}")
+        if not 0 <= detour_prob <= 1:
+            raise ConfigurationError(f"detour_prob must be in [0, 1]; got {detour_prob}")
+        if not 0 <= full_window <= 1:
+            raise ConfigurationError(f"full_window must be in [0, 1]; got {full_window}")
+        self.detour, self.min_window = float(detour), float(min_window)
+        self.full_window, self.detour_prob = float(full_window), float(detour_prob)
+
+    def _do(self, problem: Any, n_samples: int, random_state: Any = None, **kwargs: Any):
+        rng = random_state if random_state is not None else np.random.default_rng()
+        x = self.ramps(problem, n_samples, rng)
+        if n_samples > 0:
+            x[0] = problem.trajectory.straight_line(0.5 * (problem.xl[0] + problem.xu[0]))
+        return np.clip(x, problem.xl, problem.xu)
+
+    def ramps(self, problem: Any, n_samples: int, rng: np.random.Generator) -> np.ndarray:
+        """(n_samples, n_var) random ramps (the module's distribution, without the straight
+        move), clipped to the decision bounds; randomness from ``rng`` only."""
+        traj = problem.trajectory
+        nq = traj.nq
+        xi = traj.free_abscissae
+        span = problem.robot.limits.upper - problem.robot.limits.lower
+        T = rng.uniform(problem.xl[0], problem.xu[0], size=n_samples)
+        a = rng.uniform(0.0, 1.0 - self.min_window, size=(n_samples, nq))
+        b = a + rng.uniform(self.min_window, 1.0, size=(n_samples, nq)) * (1.0 - a)
+        b = np.maximum(b, a + self.min_window)
+        full = rng.uniform(size=(n_samples, nq)) < self.full_window
+        a, b = np.where(full, 0.0, a), np.where(full, 1.0, b)
+        r = rng.uniform(0.05, 0.25, size=(n_samples, nq))
+        u = (xi[None, None, :] - a[:, :, None]) / (b - a)[:, :, None]  # (n, nq, n_free)
+        ramp = np.swapaxes(_s_curve(u, r), 1, 2)  # (n, n_free, nq)
+        detour = rng.normal(0.0, self.detour, size=(n_samples, 1, nq)) * span
+        detour *= rng.uniform(size=(n_samples, 1, nq)) < self.detour_prob
+        free = (
+            traj.start
+            + (traj.goal - traj.start) * ramp
+            + detour * np.sin(np.pi * xi)[None, :, None]
+        )  # (n_samples, n_free, nq)
+        x = traj.encode(T, free)
+        fast = rng.uniform(size=n_samples) < 0.5
+        x[fast, 0] = kinematic_time(problem, x[fast]) * rng.uniform(1.0, 1.3, size=fast.sum())
+        return np.clip(x, problem.xl, problem.xu)

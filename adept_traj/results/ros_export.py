@@ -1,0 +1,222 @@
+"""Export the best trajectory of a planning result: CSV and ROS ``JointTrajectory`` JSON.
+
+- :func:`to_csv` writes the certified dense trajectory in exactly the format of the result
+  folder's ``best_trajectory.csv`` (``docs/results.md``): header ``t, q_<joint>…,
+  qd_<joint>…, qdd_<joint>…, qddd_<joint>…, tau_<joint>…, min_distance``, one row per
+  sample, floats in Python's shortest round-trip form.
+- :func:`to_ros_joint_trajectory` builds a dictionary shaped like a ROS 2
+  ``trajectory_msgs/msg/JointTrajectory`` (``time_from_start`` as
+  ``builtin_interfaces/Duration``: ``sec``, ``nanosec``); :func:`save_ros_joint_trajectory`
+  writes it as JSON. The points are the certificate's dense samples, or the spline
+  resampled at a given rate. Units are SI, as ROS expects: rad, m, rad/s, m/s, rad/s²,
+  m/s², N·m, N.
+
+The ROS export refuses a best trade-off whose dense certificate failed
+(``result.feasible`` false) unless ``allow_infeasible=True``: the file is meant to be sent
+to a controller. See ``docs/plots-and-export.md``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from adept_traj.analysis.certificate import dense_samples
+from adept_traj.errors import InvalidInputError
+from adept_traj.files import write_text_atomic
+from adept_traj.results.record import PlanningResult, _trajectory_csv
+
+__all__ = [
+    "MAX_ROS_POINTS",
+    "save_ros_joint_trajectory",
+    "to_csv",
+    "to_ros_joint_trajectory",
+]
+
+#: Largest number of points :func:`to_ros_joint_trajectory` resamples (T · rate_hz + 1).
+MAX_ROS_POINTS = 1_000_000
+_NS_PER_S = 1_000_000_000
+
+
+def _as_result(result: Any) -> PlanningResult:
+    if not isinstance(result, PlanningResult):
+        raise InvalidInputError(f"result must be a PlanningResult; got {type(result).__name__}")
+    return result
+
+
+def _as_path(path: Any, name: str = "path") -> Path:
+    try:
+        return Path(os.fspath(path))
+    except TypeError:
+        raise InvalidInputError(f"{name} must be a file path; got {type(path).__name__}") from None
+
+
+# ============================================================================ CSV
+def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
+    """Write the certified best trajectory as CSV, in the format of ``best_trajectory.csv``.
+
+    Columns: ``t`` [s], ``q_<joint>`` [rad | m], ``qd_<joint>`` [rad/s | m/s],
+    ``qdd_<joint>`` [rad/s² | m/s²], ``qddd_<joint>`` [rad/s³ | m/s³], ``tau_<joint>``
+    [N·m | N], ``min_distance`` [m] (``inf`` when the scene has no obstacle); one row per
+    dense sample (``result.best_trajectory``), values exact (shortest round-trip floats).
+    The file is byte-identical to the one :meth:`PlanningResult.save` writes.
+
+    Parameters
+    ----------
+    result: the planning result.
+    path: the file to write (folders created, an existing file replaced).
+
+    Returns
+    -------
+    The path written.
+    """
+    r = _as_result(result)
+    return write_text_atomic(_as_path(path), _trajectory_csv(r))
+
+
+# ============================================================================ ROS
+def _rate(rate_hz: Any) -> float:
+    if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float, np.integer, np.floating)):
+        raise InvalidInputError(f"rate_hz must be a number [Hz] or None; got {rate_hz!r}")
+    rate = float(rate_hz)
+    if not (math.isfinite(rate) and rate > 0.0):
+        raise InvalidInputError(f"rate_hz must be finite and > 0 [Hz]; got {rate_hz!r}")
+    return rate
+
+
+def _duration(t: float) -> dict[str, int]:
+    """ROS 2 ``builtin_interfaces/Duration`` of ``t`` ≥ 0 seconds, rounded to 1 ns."""
+    sec, nanosec = divmod(round(t * _NS_PER_S), _NS_PER_S)
+    return {"sec": int(sec), "nanosec": int(nanosec)}
+
+
+def _resample(r: PlanningResult, rate: float) -> tuple[np.ndarray, ...]:
+    """(t, q, qd, qdd, tau) of the best trajectory on ``ceil(T·rate) + 1`` uniform samples."""
+    x = r.best_x
+    T = float(x[0])
+    n = dense_samples(T, rate)  # the grid of verification.certify
+    if n > MAX_ROS_POINTS:
+        raise InvalidInputError(
+            f"rate_hz = {rate:g} Hz gives {n} points over T = {T:.6g} s; at most "
+            f"{MAX_ROS_POINTS} are exported"
+        )
+    problem = r.problem()
+    try:
+        smp = problem.trajectory.sample(x, np.linspace(0.0, 1.0, n), orders=(0, 1, 2))
+        tau = problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)
+    finally:
+        problem.close()
+    return smp.t, smp.q, smp.qd, smp.qdd, tau
+
+
+def to_ros_joint_trajectory(
+    result: PlanningResult, *, rate_hz: float | None = None, allow_infeasible: bool = False
+) -> dict[str, Any]:
+    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary.
+
+    Shape::
+
+        {
+            "header": {"frame_id": ""},
+            "joint_names": ["joint1", ...],
+            "points": [
+                {
+                    "positions": [...],
+                    "velocities": [...],
+                    "accelerations": [...],
+                    "effort": [...],
+                    "time_from_start": {"sec": 0, "nanosec": 0},
+                },
+                ...,
+            ],
+        }
+
+    ``header.stamp`` is left out (zero: start on receipt). ``time_from_start`` is the
+    sample time rounded to the nanosecond, split into whole seconds and nanoseconds
+    (0 ≤ nanosec < 10⁹). ROS 1's ``duration`` names the fields ``secs``/``nsecs``.
+
+    Parameters
+    ----------
+    result: the planning result.
+    rate_hz: ``None`` (default): the certificate's dense samples
+        (``result.best_trajectory``, ≥ ``certificate.rate_hz``), values exactly as stored.
+        A rate [Hz] (> 0): the B-spline of the best solution resampled on
+        ``ceil(T·rate_hz) + 1`` uniform samples over [0, T] (both ends included, spacing
+        ≤ 1/rate_hz; the grid of the dense verification), exact positions, velocities and
+        accelerations from the spline and efforts from the robot's inverse dynamics.
+    allow_infeasible: export even when the dense certificate of the best trade-off failed.
+
+    Returns
+    -------
+    A JSON-compatible dictionary (plain ``str``, ``int``, ``float``, lists; no NaN).
+
+    Raises
+    ------
+    InvalidInputError
+        ``rate_hz`` not a finite number > 0, or more than :data:`MAX_ROS_POINTS` points;
+        the best trade-off is not verified feasible and ``allow_infeasible`` is false.
+    """
+    r = _as_result(result)
+    if not r.feasible and not allow_infeasible:
+        detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
+        raise InvalidInputError(
+            "the best trade-off is not verified feasible (" + detail + "); refusing to export "
+            "it for a robot controller (pass allow_infeasible=True to export anyway)"
+        )
+    if rate_hz is None:
+        d = r.best_trajectory
+        t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
+    else:
+        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz))
+    for name, arr in (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("t", t)):
+        if not np.isfinite(arr).all():
+            raise InvalidInputError(f"the trajectory's {name} is not finite; cannot export")
+    points = [
+        {
+            "positions": q[k].tolist(),
+            "velocities": qd[k].tolist(),
+            "accelerations": qdd[k].tolist(),
+            "effort": tau[k].tolist(),
+            "time_from_start": _duration(float(t[k])),
+        }
+        for k in range(t.shape[0])
+    ]
+    return {
+        "header": {"frame_id": ""},
+        "joint_names": list(r.robot.joint_names),
+        "points": points,
+    }
+
+
+def save_ros_joint_trajectory(
+    result: PlanningResult,
+    path: str | os.PathLike[str],
+    *,
+    rate_hz: float | None = None,
+    allow_infeasible: bool = False,
+) -> Path:
+    """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one point per line,
+    floats in shortest round-trip form, no NaN); folders are created, an existing file
+    replaced. Returns the path written. Arguments and errors as
+    :func:`to_ros_joint_trajectory`."""
+    out = _as_path(path)
+    msg = to_ros_joint_trajectory(result, rate_hz=rate_hz, allow_infeasible=allow_infeasible)
+
+    def dump(value: Any) -> str:
+        return json.dumps(value, allow_nan=False, ensure_ascii=False)
+
+    lines = [
+        "{",
+        f'  "header": {dump(msg["header"])},',
+        f'  "joint_names": {dump(msg["joint_names"])},',
+        '  "points": [',
+        ",\n".join(f"    {dump(p)}" for p in msg["points"]),
+        "  ]",
+        "}",
+    ]
+    return write_text_atomic(out, "\n".join(lines) + "\n")

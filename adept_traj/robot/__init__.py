@@ -1,0 +1,67 @@
+"""The robot.
+
+URDF + parameter file -> Pinocchio model, batched kinematics, joint limits, URDF builder."""
+
+from __future__ import annotations
+
+from adept_traj.robot.inertia import (
+    MassProperties,
+    box_inertia,
+    combine,
+    cylinder_inertia,
+    sphere_inertia,
+)
+from adept_traj.robot.kinematics import (
+    BatchKinematics,
+    compose,
+    frames_to_poses,
+)
+from adept_traj.robot.limits import (
+    JointLimits,
+)
+from adept_traj.robot.parameter_file import (
+    TASK_ROWS,
+    FrameParameters,
+    JointParameters,
+    LinkParameters,
+    RobotParameters,
+    SolidParameters,
+)
+from adept_traj.robot.robot import (
+    VELOCITY_AT_REST,
+    ForwardKinematics,
+    Robot,
+    coulomb_sign,
+    manipulability_measure,
+)
+from adept_traj.robot.urdf_builder import (
+    build_urdf,
+    link_mass_properties,
+    solid_inertia,
+)
+
+__all__ = [
+    "TASK_ROWS",
+    "VELOCITY_AT_REST",
+    "BatchKinematics",
+    "ForwardKinematics",
+    "FrameParameters",
+    "JointLimits",
+    "JointParameters",
+    "LinkParameters",
+    "MassProperties",
+    "Robot",
+    "RobotParameters",
+    "SolidParameters",
+    "box_inertia",
+    "build_urdf",
+    "combine",
+    "compose",
+    "coulomb_sign",
+    "cylinder_inertia",
+    "frames_to_poses",
+    "link_mass_properties",
+    "manipulability_measure",
+    "solid_inertia",
+    "sphere_inertia",
+]

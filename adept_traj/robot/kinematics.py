@@ -1,0 +1,201 @@
+"""Batched forward kinematics and frame Jacobians of a Pinocchio chain, in numpy.
+
+Pinocchio's Python API works one configuration per call (≈ 1.4 µs plus Python overhead);
+a planner evaluates 10⁴–10⁶ configurations per generation. :class:`BatchKinematics` reads
+the joint placements and axes of a Pinocchio model once and then evaluates whole
+``(..., nq)`` batches with a few array operations per joint. It supports trees of 1-DoF
+revolute and prismatic joints (any axis), which covers serial industrial arms; other joint
+types raise :class:`~adept_traj.errors.RobotModelError`. Tests check it against Pinocchio.
+
+Conventions: world = the robot base frame (Pinocchio's universe); poses ``(..., 4, 4)``;
+Jacobians ``(..., 6, nq)`` with rows (v_x, v_y, v_z, ω_x, ω_y, ω_z) of the frame origin,
+expressed in world axes (Pinocchio's ``LOCAL_WORLD_ALIGNED``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from adept_traj.errors import RobotModelError
+
+__all__ = ["BatchKinematics", "compose", "frames_to_poses"]
+
+
+@dataclass(frozen=True)
+class _Joint:
+    parent: int
+    placement: np.ndarray  # (4, 4) in the parent joint frame
+    axis: np.ndarray  # (3,) unit, in the joint frame
+    revolute: bool
+    index: int  # index in q
+
+
+def _rotation_to_axis(axis: np.ndarray) -> np.ndarray:
+    """A rotation (3, 3) whose third column is the unit ``axis`` (identity for e_z)."""
+    z = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    if np.array_equal(z, [0.0, 0.0, 1.0]):
+        return np.eye(3)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+class BatchKinematics:
+    """Forward kinematics and Jacobians over batches (see the module docstring).
+
+    Parameters
+    ----------
+    model:
+        A Pinocchio model whose joints are all 1-DoF revolute or prismatic.
+    """
+
+    def __init__(self, model: pin.Model) -> None:
+        data = model.createData()
+        q0 = pin.neutral(model)
+        pin.computeJointJacobians(model, data, q0)
+        joints: list[_Joint] = []
+        for i in range(1, model.njoints):
+            jm = model.joints[i]
+            if jm.nq != 1 or jm.nv != 1:
+                raise RobotModelError(
+                    f"joint '{model.names[i]}' is a {jm.shortname()} (nq={jm.nq}, nv={jm.nv}); "
+                    "only 1-DoF revolute and prismatic joints are supported"
+                )
+            # The joint's motion subspace in its own frame: [v; ω] = [axis; 0] or [0; axis].
+            s = pin.getJointJacobian(model, data, i, pin.LOCAL)[:, jm.idx_v]
+            lin, ang = np.linalg.norm(s[:3]), np.linalg.norm(s[3:])
+            revolute = ang > 0.5
+            if not (np.isclose(max(lin, ang), 1.0) and min(lin, ang) < 1e-12):
+                raise RobotModelError(
+                    f"joint '{model.names[i]}' ({jm.shortname()}) is neither a pure revolute "
+                    "nor a pure prismatic joint"
+                )
+            joints.append(
+                _Joint(
+                    parent=model.parents[i],
+                    placement=model.jointPlacements[i].homogeneous.copy(),
+                    axis=(s[3:] if revolute else s[:3]).copy(),
+                    revolute=bool(revolute),
+                    index=jm.idx_q,
+                )
+            )
+        self._joints = tuple(joints)
+        # Revolute: T = P U Rz(q) U^T with U e_z = axis (pre = P U, post = U^T or None).
+        self._pre, self._post = [], []
+        for j in joints:
+            u = _rotation_to_axis(j.axis) if j.revolute else np.eye(3)
+            pre = j.placement.copy()
+            pre[:3, :3] = j.placement[:3, :3] @ u
+            self._pre.append(pre)
+            post = None
+            if j.revolute and not np.allclose(u, np.eye(3), atol=0.0, rtol=0.0):
+                post = np.eye(4)
+                post[:3, :3] = u.T
+            self._post.append(post)
+        self.nq = model.nq
+        #: ``support[i, k]`` is true when q_k moves joint frame i (row 0 = universe).
+        self.support = np.zeros((model.njoints, model.nq), dtype=bool)
+        for i, j in enumerate(joints, start=1):
+            self.support[i] = self.support[j.parent]
+            self.support[i, j.index] = True
+        self.revolute = np.array([j.revolute for j in joints])
+        #: Unit axis (njoints - 1, 3) of every joint in its own frame.
+        self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
+        #: Parent frame (njoints - 1,) of every joint (0 = universe).
+        self.parents = np.array([j.parent for j in joints], dtype=int)
+
+    def joint_frames(self, q: np.ndarray) -> np.ndarray:
+        """Joint frames, component-major: (njoints, 3, 4, N) — the top three rows of the
+        world pose of every joint frame (index 0 = universe) for the N = ∏ q.shape[:-1]
+        configurations ``q`` (..., nq) [rad | m] (flattened), the samples innermost.
+
+        .. math::
+            {}^0T_i = {}^0T_{p(i)}\\, P_i\\, U_i\\, R_z(q_i)\\, U_i^\\top \\ \\text{(revolute)},
+            \\qquad {}^0T_{p(i)}\\, P_i\\, \\mathrm{Trans}(a_i q_i) \\ \\text{(prismatic)}
+
+        with :math:`P_i` the joint placement and :math:`U_i` a constant rotation taking
+        :math:`e_z` to the joint axis (the identity for z axes): the product by the
+        constant :math:`P_i U_i` is one small GEMM over all samples per row, and the one by
+        :math:`R_z(q)` only mixes two columns. Every component is a contiguous (N,) array,
+        so the elementwise work streams (≈ 2× faster than stacked 4 × 4 products).
+        """
+        qf = q.reshape(-1, q.shape[-1])
+        n = qf.shape[0]
+        frames = np.empty((len(self._joints) + 1, 3, 4, n))
+        frames[0] = np.eye(4)[:3, :, None]
+        for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
+            a = compose(frames[j.parent], pre)
+            dst = frames[i]
+            qi = qf[:, j.index]
+            if j.revolute:
+                c, s = np.cos(qi), np.sin(qi)
+                dst[:, 0] = c * a[:, 0] + s * a[:, 1]
+                dst[:, 1] = c * a[:, 1] - s * a[:, 0]
+                dst[:, 2:] = a[:, 2:]
+                if post is not None:
+                    dst[:] = compose(dst, post)
+            else:
+                dst[:] = a
+                dst[:, 3] += np.tensordot(j.axis, a[:, :3], axes=([0], [1])) * qi
+        return frames
+
+    def joint_poses(self, q: np.ndarray) -> np.ndarray:
+        """World poses (..., njoints, 4, 4) of every joint frame (index 0 = universe)
+        for configurations ``q`` (..., nq) [rad | m] (:meth:`joint_frames`, sample-major)."""
+        return frames_to_poses(self.joint_frames(q), q.shape[:-1])
+
+    def jacobian(self, joint_poses: np.ndarray, point_joint: int, point: np.ndarray) -> np.ndarray:
+        r"""Jacobians (..., 6, nq) of a point rigidly attached to joint frame ``point_joint``.
+
+        ``joint_poses`` are from :meth:`joint_poses`; ``point`` (..., 3) is the point's world
+        position [m]. See :meth:`frame_jacobian` (the same, component-major).
+        """
+        batch = joint_poses.shape[:-3]
+        flat = joint_poses.reshape(-1, *joint_poses.shape[-3:])
+        frames = np.ascontiguousarray(flat[:, :, :3, :].transpose(1, 2, 3, 0))
+        points = np.ascontiguousarray(np.reshape(point, (-1, 3)).T)
+        jac = self.frame_jacobian(frames, point_joint, points)  # (6, nq, N)
+        return np.moveaxis(jac, -1, 0).reshape(*batch, 6, self.nq)
+
+    def frame_jacobian(self, frames: np.ndarray, point_joint: int, point: np.ndarray) -> np.ndarray:
+        r"""Jacobians (6, nq, N), component-major, of a point rigidly attached to joint frame
+        ``point_joint``, from :meth:`joint_frames` ``frames`` (njoints, 3, 4, N) and the
+        point's world positions ``point`` (3, N) [m]. Rows (v_x, v_y, v_z, ω_x, ω_y, ω_z);
+        columns: revolute :math:`[z_k \times (p - o_k);\ z_k]`, prismatic
+        :math:`[z_k;\ 0]`, zero for joints not supporting ``point_joint``.
+        """
+        n = frames.shape[-1]
+        jac = np.zeros((6, self.nq, n))
+        for i, j in enumerate(self._joints, start=1):
+            if not self.support[point_joint, j.index]:
+                continue
+            z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
+            if j.revolute:
+                r = point - frames[i, :, 3]
+                jac[0, j.index] = z[1] * r[2] - z[2] * r[1]  # z × r
+                jac[1, j.index] = z[2] * r[0] - z[0] * r[2]
+                jac[2, j.index] = z[0] * r[1] - z[1] * r[0]
+                jac[3:, j.index] = z
+            else:
+                jac[:3, j.index] = z
+        return jac
+
+
+def compose(frames: np.ndarray, transform: np.ndarray) -> np.ndarray:
+    """Component-major frames (3, 4, N) times a constant homogeneous ``transform`` (4, 4):
+    row r of the product is :math:`T^\\top` applied to row r, one GEMM over the samples."""
+    return np.matmul(transform.T, frames)
+
+
+def frames_to_poses(frames: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
+    """Poses (``*batch``, k, 4, 4) from component-major frames (k, 3, 4, N), N = ∏ ``batch``."""
+    k, n = frames.shape[0], frames.shape[-1]
+    out = np.empty((n, k, 4, 4))
+    out[:, :, :3, :] = frames.transpose(3, 0, 1, 2)
+    out[:, :, 3, :3] = 0.0
+    out[:, :, 3, 3] = 1.0
+    return out.reshape(*batch, k, 4, 4)

@@ -1,0 +1,545 @@
+"""The robot: a Pinocchio model with collision geometry, limits and batched evaluations.
+
+:class:`Robot` loads a URDF (plus an optional parameter file, see
+:mod:`adept_traj.parameters`) into Pinocchio and offers the quantities the planner needs,
+batched over any leading axes (population, time, …):
+
+- :meth:`Robot.inverse_dynamics` — joint torques/forces with rotor inertia and friction;
+- :meth:`Robot.manipulability` — the paper's z4 = ``|det J|`` (eq. 4);
+- :meth:`Robot.tool_pose`, :meth:`Robot.tool_jacobian`, :meth:`Robot.geometry_poses`.
+
+Joint values are in SI units: [rad] for revolute joints, [m] for prismatic ones. For the
+AdeptOne XL they are exactly the DH variables (θ1, θ2, d3, θ4) of the paper's Table 1.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
+from adept_traj.robot.kinematics import BatchKinematics, compose, frames_to_poses
+from adept_traj.robot.limits import JointLimits
+from adept_traj.robot.parameter_file import TASK_ROWS, RobotParameters
+from adept_traj.validation import as_batch
+
+__all__ = [
+    "VELOCITY_AT_REST",
+    "ForwardKinematics",
+    "Robot",
+    "coulomb_sign",
+    "manipulability_measure",
+]
+
+#: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
+#: friction (sign 0): a joint held still must not flip ±F_c on rounding noise (1e-17).
+VELOCITY_AT_REST = 1e-9
+
+#: Below this many configurations a plain loop over ``pinocchio.rnea`` is used.
+_PARALLEL_MIN_BATCH = 16
+
+
+def shipped_file(name: str) -> Path:
+    """Path of a shipped robot file (``adept_one_xl.urdf``, ``adept_one_xl.toml``).
+
+    The top-level ``urdf/`` folder is packaged as ``adept_traj.urdf``; it is found with
+    :mod:`importlib.resources` in a wheel or an editable install, and as ``urdf/`` beside the
+    package in a plain source checkout.
+    """
+    candidates = []
+    with contextlib.suppress(ModuleNotFoundError):
+        candidates.append(Path(str(resources.files("adept_traj.urdf").joinpath(name))))
+    candidates.append(Path(__file__).resolve().parents[2] / "urdf" / name)
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise RobotModelError(
+        f"shipped robot file '{name}' not found (looked in {', '.join(map(str, candidates))})"
+    )
+
+
+@dataclass(frozen=True)
+class ForwardKinematics:
+    """Everything the planner needs from one forward-kinematics pass over ``q`` (..., nq).
+
+    Attributes
+    ----------
+    joint_frames: (njoints, 3, 4, N) joint frames in the base frame, component-major
+        (:meth:`~adept_traj.kinematics.BatchKinematics.joint_frames`; N = ∏ ``...``).
+    joint_poses: (..., njoints, 4, 4) the same as poses (index 0 = universe; formed on
+        first access).
+    tool_pose: (..., 4, 4) tool frame in the base frame.
+    manipulability: (...) as :meth:`Robot.manipulability` [m² for the SCARA], or ``None``
+        when the robot has no task rows.
+    geometry_poses: (..., n_geom, 4, 4) collision solids in the base frame (computed on
+        first access: the collision checker works from the joint poses and forms solid
+        poses only near obstacles).
+    """
+
+    joint_frames: np.ndarray
+    tool_pose: np.ndarray
+    manipulability: np.ndarray | None
+    #: (parent joint per solid (n_geom,), solid placements in them (n_geom, 4, 4)).
+    solid_frames: tuple[np.ndarray, np.ndarray] = field(repr=False)
+
+    @cached_property
+    def joint_poses(self) -> np.ndarray:
+        return frames_to_poses(self.joint_frames, self.tool_pose.shape[:-2])
+
+    @cached_property
+    def geometry_poses(self) -> np.ndarray:
+        return place_solids(self.joint_poses, self.solid_frames)
+
+
+def solid_frames(gm: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
+    """(parent joint of each object (n_geom,), its placement in that joint's frame
+    (n_geom, 4, 4)) of a geometry model."""
+    parents = np.array([g.parentJoint for g in gm.geometryObjects], dtype=int)
+    local = np.array([g.placement.homogeneous for g in gm.geometryObjects]).reshape(-1, 4, 4)
+    return parents, local
+
+
+def place_solids(joint_poses: np.ndarray, frames: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Poses (..., n_geom, 4, 4) of the objects of :func:`solid_frames` ``frames`` for joint
+    poses (..., njoints, 4, 4)."""
+    parents, local = frames
+    return joint_poses[..., parents, :, :] @ local
+
+
+class Robot:
+    """A serial robot: Pinocchio model, collision model, limits and batched evaluations.
+
+    Build one with :meth:`adept_one_xl` or :meth:`from_urdf`.
+
+    Attributes
+    ----------
+    model : pinocchio.Model
+        The kinematic and dynamic model. Rotor inertia is in ``model.armature``, viscous
+        friction in ``model.damping`` and Coulomb friction in ``model.friction`` (joint
+        side), so every Pinocchio algorithm sees them; :meth:`inverse_dynamics` reads them
+        at each call.
+    collision_model : pinocchio.GeometryModel
+        The link solids, named ``"<link>/<solid>"`` when the URDF names its collisions.
+    visual_model : pinocchio.GeometryModel
+        The visual geometry (same solids for the AdeptOne XL), for display.
+    limits : JointLimits
+        Position, velocity, acceleration, jerk and effort limits (``inf`` when unknown).
+    tool_frame : str
+        Name of the tool frame used by :meth:`tool_pose` and :meth:`manipulability`.
+    task_rows : tuple of str or None
+        Rows of the tool Jacobian (among ``vx vy vz wx wy wz``) used by
+        :meth:`manipulability`.
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        collision_model: pin.GeometryModel,
+        visual_model: pin.GeometryModel,
+        limits: JointLimits,
+        tool_frame: str,
+        task_rows: tuple[str, ...] | None,
+        name: str,
+        urdf_path: Path | None = None,
+        params_path: Path | None = None,
+    ) -> None:
+        self.model = model
+        self.collision_model = collision_model
+        self.visual_model = visual_model
+        self.limits = limits
+        self.name = name
+        self.urdf_path = urdf_path
+        self.params_path = params_path
+        if not model.existFrame(tool_frame):
+            frames = [f.name for f in model.frames]
+            raise RobotModelError(f"robot '{name}': no frame '{tool_frame}'; frames are {frames}")
+        self._tool_frame = tool_frame
+        if task_rows is not None:
+            task_rows = tuple(task_rows)
+            if not task_rows or any(r not in TASK_ROWS for r in task_rows):
+                raise RobotModelError(
+                    f"robot '{name}': task_rows must be names from {list(TASK_ROWS)}; "
+                    f"got {list(task_rows)}"
+                )
+        self.task_rows = task_rows
+        self.kinematics = BatchKinematics(model)
+        self._tool_id = model.getFrameId(tool_frame)
+        self._data = model.createData()
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def adept_one_xl(cls) -> Robot:
+        """The AdeptOne XL SCARA shipped with the library (``urdf/adept_one_xl.urdf`` and
+        its parameter file ``urdf/adept_one_xl.toml``; see ``docs/robot-model.md``)."""
+        return cls.from_urdf(shipped_file("adept_one_xl.urdf"), shipped_file("adept_one_xl.toml"))
+
+    @classmethod
+    def from_urdf(
+        cls,
+        urdf: str | Path,
+        params: str | Path | RobotParameters | None = None,
+        *,
+        tool_frame: str | None = None,
+        task_rows: Sequence[str] | None = None,
+    ) -> Robot:
+        """Load a robot from a URDF file and an optional parameter file.
+
+        Parameters
+        ----------
+        urdf:
+            Path of the URDF. Its ``<inertial>``, ``<limit>`` and ``<dynamics damping
+            friction>`` give masses, position/velocity/effort limits and friction.
+        params:
+            Optional parameter file (TOML path or :class:`RobotParameters`): acceleration
+            and jerk limits, rotor inertia × gear ratio² (→ ``model.armature``), and
+            overrides of any URDF joint value. See :mod:`adept_traj.parameters`.
+        tool_frame:
+            Tool frame name; default: the parameter file's ``tool_frame``, else the last
+            frame of the model.
+        task_rows:
+            Jacobian rows for :meth:`manipulability`; default: the parameter file's, else
+            all six rows for robots with ≥ 6 joints.
+
+        Raises
+        ------
+        RobotModelError
+            Missing or malformed URDF or parameter file, unsupported joint types, a
+            parameter file naming a joint the URDF does not have, an unknown tool frame.
+        """
+        path = Path(urdf)
+        if not path.is_file():
+            raise RobotModelError(f"URDF not found: {path}")
+        try:
+            root = ET.parse(path).getroot()
+        except ET.ParseError as exc:
+            raise RobotModelError(f"{path}: malformed XML: {exc}") from None
+        if root.tag != "robot":
+            raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
+        try:
+            model = pin.buildModelFromUrdf(str(path))
+            collision = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION)
+            visual = pin.buildGeomFromUrdf(model, str(path), pin.VISUAL)
+        except (RuntimeError, ValueError) as exc:
+            raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
+        if model.nq == 0:
+            raise RobotModelError(f"{path}: the robot has no moving joint")
+        _name_geometries(collision, root, "collision")
+        _name_geometries(visual, root, "visual")
+
+        if params is not None and not isinstance(params, RobotParameters):
+            params_path: Path | None = Path(params)
+            params = RobotParameters.from_file(params_path)
+        else:
+            params_path = None
+        acceleration, jerk = _apply_parameters(model, params, path)
+        limits = JointLimits(
+            names=tuple(model.names[1:]),
+            units=tuple(_joint_unit(model, i) for i in range(1, model.njoints)),
+            lower=model.lowerPositionLimit,
+            upper=model.upperPositionLimit,
+            velocity=model.velocityLimit,
+            acceleration=acceleration,
+            jerk=jerk,
+            effort=model.effortLimit,
+        )
+        if tool_frame is None:
+            tool_frame = params.tool_frame if params and params.tool_frame else None
+        if tool_frame is None:
+            tool_frame = model.frames[len(model.frames) - 1].name
+        if task_rows is None and params is not None and params.task_rows is not None:
+            task_rows = params.task_rows
+        if task_rows is None and model.nq >= 6:
+            task_rows = TASK_ROWS
+        return cls(
+            model=model,
+            collision_model=collision,
+            visual_model=visual,
+            limits=limits,
+            tool_frame=tool_frame,
+            task_rows=tuple(task_rows) if task_rows is not None else None,
+            name=root.get("name", path.stem),
+            urdf_path=path,
+            params_path=params_path,
+        )
+
+    # ------------------------------------------------------------------ basic facts
+    @property
+    def tool_frame(self) -> str:
+        """Name of the tool frame (fixed at construction; build another Robot to change it)."""
+        return self._tool_frame
+
+    @property
+    def nq(self) -> int:
+        """Number of joint variables."""
+        return self.model.nq
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Joint names in the order of q."""
+        return self.limits.names
+
+    def __repr__(self) -> str:
+        return f"Robot(name={self.name!r}, nq={self.nq}, tool_frame={self.tool_frame!r})"
+
+    # ------------------------------------------------------------------ public, batched
+    def inverse_dynamics(self, q: object, v: object, a: object) -> np.ndarray:
+        r"""Joint torques/forces (..., nq) [N·m | N] to follow ``q, v, a``.
+
+        .. math::
+            u = M(q)\,\ddot q + C(q,\dot q)\,\dot q + g(q)
+                + \operatorname{diag}(J_a)\,\ddot q + F_v\,\dot q + F_c \operatorname{sign}(\dot q)
+
+        (the paper's Euler–Lagrange model "with actuator inertia and friction"): rigid-body
+        terms by Pinocchio's RNEA, rotor inertia :math:`J_a` = ``model.armature`` (added by
+        RNEA), viscous :math:`F_v` = ``model.damping``, Coulomb :math:`F_c` =
+        ``model.friction``. At rest (:math:`|\dot q_i| \le` ``VELOCITY_AT_REST`` = 1e-9) the
+        Coulomb term is 0: static friction is indeterminate, and rounding noise must not
+        switch ±F_c on and off.
+
+        Parameters
+        ----------
+        q, v, a:
+            Positions [rad | m], velocities [rad/s | m/s], accelerations [rad/s² | m/s²],
+            each (..., nq); they are broadcast against each other.
+
+        Returns
+        -------
+        numpy.ndarray
+            (..., nq) with the broadcast leading shape.
+        """
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
+        va = as_batch(v, "v", self.nq, "[rad/s | m/s]")
+        aa = as_batch(a, "a", self.nq, "[rad/s² | m/s²]")
+        try:
+            qa, va, aa = np.broadcast_arrays(qa, va, aa)
+        except ValueError:
+            raise InputShapeError(
+                f"q, v, a must broadcast together; got shapes {qa.shape}, {va.shape}, {aa.shape}"
+            ) from None
+        return self._inverse_dynamics(qa, va, aa)
+
+    def manipulability(self, q: object) -> np.ndarray:
+        r"""Manipulability (...) of configurations ``q`` (..., nq) [rad | m].
+
+        With the task Jacobian :math:`J_t` = the rows :attr:`task_rows` of the tool frame's
+        Jacobian (world axes at the tool point):
+
+        .. math::
+            w = |\det J_t| \ \text{(square } J_t\text{, the paper's eq. 4)}, \qquad
+            w = \sqrt{\det(J_t J_t^\top)} \ \text{(Yoshikawa, fewer rows than joints)}
+
+        and :math:`\sqrt{\det(J_t^\top J_t)}` with more rows than joints
+        (:func:`manipulability_measure`).
+
+        For the AdeptOne XL (rows v_x, v_y, v_z, ω_z) this is :math:`a_1 a_2 |\sin\theta_2|`
+        [m²].
+        """
+        if self.task_rows is None:
+            raise RobotModelError(
+                f"robot '{self.name}' has {self.nq} joints and no task_rows: give them in the "
+                "parameter file or Robot.from_urdf(..., task_rows=[...]), e.g. ['vx', 'vy']"
+            )
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
+        return self._manipulability(qa)
+
+    def tool_pose(self, q: object) -> np.ndarray:
+        """Tool frame poses (..., 4, 4) in the robot base frame for ``q`` (..., nq)."""
+        return self.frame_pose(q, self.tool_frame)
+
+    def frame_pose(self, q: object, frame: str) -> np.ndarray:
+        """Poses (..., 4, 4) of the named frame in the base frame for ``q`` (..., nq)."""
+        if not self.model.existFrame(frame):
+            raise InvalidInputError(
+                f"frame '{frame}' does not exist; frames are {[f.name for f in self.model.frames]}"
+            )
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
+        f = self.model.frames[self.model.getFrameId(frame)]
+        return self.kinematics.joint_poses(qa)[..., f.parentJoint, :, :] @ f.placement.homogeneous
+
+    def tool_jacobian(self, q: object) -> np.ndarray:
+        """Tool Jacobians (..., 6, nq): rows (v_x, v_y, v_z, ω_x, ω_y, ω_z) of the tool point
+        in base-frame axes (Pinocchio's ``LOCAL_WORLD_ALIGNED``) for ``q`` (..., nq)."""
+        return self._tool_jacobian(as_batch(q, "q", self.nq, "[rad | m]"))
+
+    def geometry_poses(self, q: object, model: pin.GeometryModel | None = None) -> np.ndarray:
+        """Poses (..., n_geom, 4, 4) in the base frame of every object of ``model`` (default:
+        :attr:`collision_model`) for ``q`` (..., nq)."""
+        gm = self.collision_model if model is None else model
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
+        return self._geometry_poses(self.kinematics.joint_poses(qa), gm)
+
+    def forward_kinematics(self, q: object) -> ForwardKinematics:
+        """Joint, solid and tool poses and the manipulability of ``q`` (..., nq) from one
+        kinematics pass (what :meth:`geometry_poses`, :meth:`tool_pose` and
+        :meth:`manipulability` would each recompute)."""
+        qa = as_batch(q, "q", self.nq, "[rad | m]")
+        frames = self.kinematics.joint_frames(qa)
+        tool = self._tool_frames(frames)
+        w = None
+        if self.task_rows is not None:
+            w = self._manipulability_from(frames, tool).reshape(qa.shape[:-1])
+        return ForwardKinematics(
+            joint_frames=frames,
+            tool_pose=frames_to_poses(tool[None], qa.shape[:-1])[..., 0, :, :],
+            manipulability=w,
+            solid_frames=solid_frames(self.collision_model),
+        )
+
+    # ------------------------------------------------------------------ private hooks
+    def _geometry_poses(self, joint_poses: np.ndarray, gm: pin.GeometryModel) -> np.ndarray:
+        return place_solids(joint_poses, solid_frames(gm))
+
+    def _inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        shape = q.shape
+        qf, vf, af = (x.reshape(-1, self.nq) for x in (q, v, a))
+        n = qf.shape[0]
+        if n < _PARALLEL_MIN_BATCH:
+            tau = np.array([pin.rnea(self.model, self._data, *row) for row in zip(qf, vf, af)])
+            tau = tau.reshape(n, self.nq)
+        else:
+            # A fresh pool each call: it copies the model, so later edits of
+            # model.armature etc. are always seen (≈ 40 µs, negligible for a batch).
+            pool = pin.ModelPool(self.model, 1)
+            tau = pin.rneaInParallel(
+                1, pool, np.asfortranarray(qf.T), np.asfortranarray(vf.T), np.asfortranarray(af.T)
+            ).T
+        tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
+        return tau.reshape(shape)
+
+    def _tool_frames(self, frames: np.ndarray) -> np.ndarray:
+        """Tool frame (3, 4, N), component-major, from joint frames (njoints, 3, 4, N)."""
+        f = self.model.frames[self._tool_id]
+        return compose(frames[f.parentJoint], f.placement.homogeneous)
+
+    def _tool_jacobian(self, q: np.ndarray) -> np.ndarray:
+        frames = self.kinematics.joint_frames(q)
+        parent = self.model.frames[self._tool_id].parentJoint
+        jac = self.kinematics.frame_jacobian(frames, parent, self._tool_frames(frames)[:, 3])
+        return np.moveaxis(jac, -1, 0).reshape(*q.shape[:-1], 6, self.nq)
+
+    def _manipulability(self, q: np.ndarray) -> np.ndarray:
+        frames = self.kinematics.joint_frames(q)
+        return self._manipulability_from(frames, self._tool_frames(frames)).reshape(q.shape[:-1])
+
+    def _manipulability_from(self, frames: np.ndarray, tool: np.ndarray) -> np.ndarray:
+        """(N,) manipulability from joint frames (njoints, 3, 4, N) and the tool frame
+        (3, 4, N), component-major (the determinant reads contiguous entries)."""
+        rows = [TASK_ROWS.index(r) for r in self.task_rows]
+        parent = self.model.frames[self._tool_id].parentJoint
+        jac = self.kinematics.frame_jacobian(frames, parent, tool[:, 3])  # (6, nq, N)
+        return manipulability_measure(np.moveaxis(jac[rows], -1, 0))
+
+
+def manipulability_measure(jt: np.ndarray) -> np.ndarray:
+    r"""Manipulability (...) of task Jacobians ``jt`` (..., m, n).
+
+    .. math::
+        w = |\det J_t| \ (m = n), \qquad
+        w = \sqrt{\det(J_t J_t^\top)} \ (m < n, \text{Yoshikawa}), \qquad
+        w = \sqrt{\det(J_t^\top J_t)} \ (m > n)
+
+    (with more task rows than joints :math:`J_t J_t^\top` is singular; the volume of the
+    n-dimensional velocity ellipsoid is :math:`\sqrt{\det J_t^\top J_t}`).
+    """
+    m, n = jt.shape[-2:]
+    if m == n:
+        return np.abs(_det(jt))
+    jt_t = np.swapaxes(jt, -1, -2)
+    gram = jt @ jt_t if m < n else jt_t @ jt
+    return np.sqrt(np.maximum(_det(gram), 0.0))
+
+
+def _det(a: np.ndarray) -> np.ndarray:
+    """Determinants (...) of square matrices (..., k, k): closed forms up to k = 4 (the
+    Laplace expansion in 2 × 2 minors; elementwise over the batch, several times faster
+    than a batched LU for small matrices), :func:`numpy.linalg.det` beyond."""
+    k = a.shape[-1]
+    if k == 1:
+        return a[..., 0, 0].copy()
+    if k == 2:
+        return a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
+    if k == 3:
+        return (
+            a[..., 0, 0] * (a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1])
+            - a[..., 0, 1] * (a[..., 1, 0] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 0])
+            + a[..., 0, 2] * (a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0])
+        )
+    if k == 4:
+        r = [[a[..., i, j] for j in range(4)] for i in range(4)]
+        # det = Σ over column pairs (i, j) of ± (minor of rows 0, 1) × (complementary minor)
+        det = np.zeros(a.shape[:-2])
+        pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+        for (i, j), sign in zip(pairs, (1, -1, 1, 1, -1, 1)):
+            k0, k1 = (c for c in range(4) if c not in (i, j))
+            top = r[0][i] * r[1][j] - r[0][j] * r[1][i]
+            bottom = r[2][k0] * r[3][k1] - r[2][k1] * r[3][k0]
+            det = det + sign * top * bottom
+        return det
+    return np.linalg.det(a)
+
+
+def coulomb_sign(v: np.ndarray) -> np.ndarray:
+    """sign(v) with a dead band: 0 where ``|v| ≤ VELOCITY_AT_REST`` (a joint at rest)."""
+    return np.where(np.abs(v) > VELOCITY_AT_REST, np.sign(v), 0.0)
+
+
+def _joint_unit(model: pin.Model, i: int) -> str:
+    short = model.joints[i].shortname()
+    return "m" if "Prismatic" in short or short.startswith("JointModelP") else "rad"
+
+
+def _name_geometries(gm: pin.GeometryModel, root: ET.Element, tag: str) -> None:
+    """Rename Pinocchio's ``<link>_<k>`` geometry objects to ``<link>/<name>`` when the URDF
+    names its ``<collision>``/``<visual>`` elements."""
+    names = {}
+    for link in root.iter("link"):
+        for k, element in enumerate(link.findall(tag)):
+            if element.get("name"):
+                names[f"{link.get('name')}_{k}"] = f"{link.get('name')}/{element.get('name')}"
+    for obj in gm.geometryObjects:
+        obj.name = names.get(obj.name, obj.name)
+
+
+def _apply_parameters(
+    model: pin.Model, params: RobotParameters | None, path: Path
+) -> tuple[np.ndarray, np.ndarray]:
+    """Write a parameter file's values into ``model``; return acceleration and jerk limits."""
+    acceleration = np.full(model.nq, np.inf)
+    jerk = np.full(model.nq, np.inf)
+    if params is None:
+        return acceleration, jerk
+    known = set(model.names[1:])
+    unknown = [j.name for j in params.joints if j.name not in known]
+    if unknown:
+        raise RobotModelError(
+            f"{params.source}: joint(s) {unknown} are not in {path}; its joints are {sorted(known)}"
+        )
+    for j in params.joints:
+        k = model.joints[model.getJointId(j.name)].idx_q
+        targets = {
+            "lower": model.lowerPositionLimit,
+            "upper": model.upperPositionLimit,
+            "velocity": model.velocityLimit,
+            "effort": model.effortLimit,
+            "coulomb": model.friction,
+            "viscous": model.damping,
+        }
+        for key, vector in targets.items():
+            value = getattr(j, key)
+            if value is not None:
+                vector[k] = value
+        if j.armature is not None:
+            model.armature[k] = j.armature
+        if j.acceleration is not None:
+            acceleration[k] = j.acceleration
+        if j.jerk is not None:
+            jerk[k] = j.jerk
+    return acceleration, jerk

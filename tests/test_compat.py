@@ -1,0 +1,29 @@
+"""A result folder written before the subpackage layout (commit 2ec18c4, flat modules) loads
+and re-verifies after it: the on-disk format did not change."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+import adept_traj as at
+from adept_traj.cli import main
+
+OLD = Path(__file__).parent / "data" / "result_v1"
+
+
+def test_result_saved_by_the_flat_layout_loads():
+    raw = json.loads((OLD / "result.json").read_text(encoding="utf-8"))
+    result = at.PlanningResult.load(OLD)
+    assert result.algorithm == raw["algorithm"]["name"] == "nsga2"
+    np.testing.assert_array_equal(result.front.x, raw["front"]["x"])
+    np.testing.assert_array_equal(result.best_objectives, raw["best"]["objectives"])
+    assert result.feasible is False  # the tiny run (pop 12, 3 generations) hits cube 1
+
+
+def test_result_saved_by_the_flat_layout_reverifies(capsys):
+    assert main(["verify", str(OLD)]) == 1  # not feasible, as stored
+    out = capsys.readouterr().out
+    assert "distance: -0.01492 m < margin 0.01 m at t = 0.684 s (link4/gripper – cube1)" in out
