@@ -18,7 +18,7 @@ def test_result_saved_by_the_flat_layout_loads():
     raw = json.loads((OLD / "result.json").read_text(encoding="utf-8"))
     result = at.PlanningResult.load(OLD)
     assert result.algorithm == raw["algorithm"]["name"] == "nsga2"
-    np.testing.assert_array_equal(result.front.x, raw["front"]["x"])
+    np.testing.assert_array_equal(result.front.x, [m["x"] for m in raw["front"]])
     np.testing.assert_array_equal(result.best_objectives, raw["best"]["objectives"])
     assert result.feasible is False  # the tiny run (pop 12, 3 generations) hits cube 1
 
