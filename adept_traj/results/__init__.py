@@ -20,6 +20,9 @@ from adept_traj.results.record import (
     Timing,
     software_versions,
 )
+from adept_traj.results.replay import (
+    Replay,
+)
 from adept_traj.results.ros_export import (
     MAX_ROS_POINTS,
     save_ros_joint_trajectory,
@@ -41,6 +44,7 @@ __all__ = [
     "GenerationRecord",
     "Metrics",
     "PlanningResult",
+    "Replay",
     "ResultFormatError",
     "RobotInfo",
     "Timing",

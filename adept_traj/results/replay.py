@@ -1,0 +1,130 @@
+"""The motion of a result, built once for playback, plots and export.
+
+A :class:`Replay` holds the three objects a view of a result needs — the robot, the scene
+and the B-spline trajectory of a decision vector — and nothing of the optimisation: no
+collision tables, no evaluator, no worker pool. Build it once from a
+:class:`~adept_traj.results.PlanningResult` (which loads the robot files and parses the
+stored scene) or hand it the robot and scene you already have; the viewers, the plots and
+the ROS export then only resample the spline.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.problem import BSplineTrajectory, TrajectorySamples
+from adept_traj.results.record import PlanningResult
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
+from adept_traj.validation import as_finite_array, readonly_copy
+
+__all__ = ["Replay"]
+
+
+@dataclass(frozen=True, eq=False)
+class Replay:
+    """Robot, scene and trajectory of one move.
+
+    Attributes
+    ----------
+    robot: the :class:`~adept_traj.robot.Robot`.
+    scene: the :class:`~adept_traj.scene.Scene` (obstacles at their pose at each time).
+    trajectory: the :class:`~adept_traj.problem.BSplineTrajectory` (start, goal, knots).
+    x: (n_var,) the decision vector ``[T, free control points]`` of the move.
+    """
+
+    robot: Robot
+    scene: Scene
+    trajectory: BSplineTrajectory
+    x: np.ndarray
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.robot, Robot):
+            raise InvalidInputError(f"robot must be a Robot; got {type(self.robot).__name__}")
+        if not isinstance(self.scene, Scene):
+            raise InvalidInputError(f"scene must be a Scene; got {type(self.scene).__name__}")
+        if not isinstance(self.trajectory, BSplineTrajectory):
+            raise InvalidInputError(
+                f"trajectory must be a BSplineTrajectory; got {type(self.trajectory).__name__}"
+            )
+        if self.trajectory.nq != self.robot.nq:
+            raise InputShapeError(
+                f"trajectory has {self.trajectory.nq} joints, the robot {self.robot.nq}"
+            )
+        x = as_finite_array(self.x, "x")
+        if x.shape != (self.trajectory.n_var,):
+            raise InputShapeError(f"x must have shape ({self.trajectory.n_var},); got {x.shape}")
+        object.__setattr__(self, "x", readonly_copy(x))
+
+    @classmethod
+    def of(
+        cls,
+        result: PlanningResult,
+        x: Any = None,
+        *,
+        robot: Robot | None = None,
+        scene: Scene | None = None,
+    ) -> Replay:
+        """The replay of ``x`` (default: the result's best solution).
+
+        Parameters
+        ----------
+        result: the planning result.
+        x: (n_var,) a decision vector, e.g. a row of ``result.front.x``; default
+            ``result.best_x``.
+        robot, scene: the run's robot and scene when the caller has them (no reload);
+            by default the robot files named in ``result.robot`` are loaded and the stored
+            scene is parsed, once.
+        """
+        if not isinstance(result, PlanningResult):
+            raise InvalidInputError(f"result must be a PlanningResult; got {type(result).__name__}")
+        robot = result.robot.load() if robot is None else robot
+        scene = Scene.from_dict(result.scene, source="result scene") if scene is None else scene
+        trajectory = BSplineTrajectory(
+            result.start, result.goal, n_knots=int(result.problem_settings.n_knots)
+        )
+        return cls(robot, scene, trajectory, result.best_x if x is None else x)
+
+    @property
+    def duration(self) -> float:
+        """Travel time T [s] of the move."""
+        return float(self.x[0])
+
+    def sample(self, times: Any, orders: tuple[int, ...] = (0, 1, 2)) -> TrajectorySamples:
+        """Joint positions and derivatives at ``times``.
+
+        Parameters
+        ----------
+        times: (n,) times in [0, T] [s].
+        orders: derivative orders to compute (subset of ``(0, 1, 2, 3)``).
+
+        Returns
+        -------
+        :class:`~adept_traj.problem.TrajectorySamples`: ``t`` (n,) [s]; ``q``, ``qd``,
+        ``qdd``, ``qddd`` (n, nq) [rad | m per s^r].
+        """
+        t = as_finite_array(times, "times")
+        if t.ndim != 1:
+            raise InputShapeError(f"times must have shape (n,); got {t.shape}")
+        T = self.duration
+        if t.size and (t.min() < 0.0 or t.max() > T * (1 + 1e-12)):
+            raise InvalidInputError(
+                f"times must lie in [0, T = {T:.6g} s]; got [{t.min():.6g}, {t.max():.6g}]"
+            )
+        return self.trajectory.sample(self.x, np.clip(t / T, 0.0, 1.0), orders=orders)
+
+    def torques(self, samples: TrajectorySamples) -> np.ndarray:
+        """Joint torques and forces along ``samples`` (from :meth:`sample` with orders 0–2),
+        by the robot's inverse dynamics with friction and rotor inertia.
+
+        Returns
+        -------
+        (n, nq) [N·m | N].
+        """
+        if samples.q is None or samples.qd is None or samples.qdd is None:
+            raise InvalidInputError("samples must hold q, qd and qdd (orders 0, 1, 2)")
+        return self.robot.inverse_dynamics(samples.q, samples.qd, samples.qdd)
