@@ -13,7 +13,7 @@ from adept_traj.analysis.decision import (
     best_tradeoff,
     combined_objective,
 )
-from adept_traj.collision.checker import CollisionChecker, paper_penalty
+from adept_traj.collision.checker import CollisionChecker
 from adept_traj.errors import (
     AdeptTrajError,
     ConfigurationError,
@@ -27,6 +27,7 @@ from adept_traj.optimise.algorithms import ALGORITHMS, make_algorithm
 from adept_traj.optimise.loop import PlanningInterrupted
 from adept_traj.optimise.planner import plan
 from adept_traj.problem.bspline import BSplineTrajectory, KinematicBound, kinematic_lower_bound
+from adept_traj.problem.objectives import paper_penalty
 from adept_traj.problem.trajectory_problem import Evaluation, ProblemSettings, TrajectoryProblem
 from adept_traj.results.record import PlanningResult, ResultFormatError
 from adept_traj.robot.limits import JointLimits

@@ -10,7 +10,7 @@ import coal
 import numpy as np
 import pytest
 
-from adept_traj.collision import BroadPhase, CollisionChecker, paper_penalty, point_signed_distance
+from adept_traj.collision import BroadPhase, CollisionChecker, point_signed_distance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot import Robot
 from adept_traj.scene import (
@@ -674,133 +674,6 @@ def test_pendulum_closed_forms_at_two_times(robot: Robot) -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# 6. paper_penalty
-# ---------------------------------------------------------------------------------------
-SPHERE_AXES = np.array([[0.5, 0.5, 0.5]])
-CENTRE = np.array([1.0, 2.0, 3.0])
-
-
-def test_paper_penalty_zero_outside() -> None:
-    pts = CENTRE + np.array([[0.6, 0, 0], [0, -0.51, 0], [0.3, 0.3, 0.3], [2, 2, 2]])
-    c = np.broadcast_to(CENTRE, (1, 4, 3))
-    out = paper_penalty(pts, c, SPHERE_AXES)
-    assert np.ndim(out) == 0
-    assert float(out) == 0.0
-
-
-def test_paper_penalty_sphere() -> None:
-    # nearest point at r = 0.2 from the centre: r_e = (0.2 / 0.5)² = 0.16 → 1 / 0.16²
-    pts = CENTRE + np.array([[0.4, 0, 0], [0, 0.2, 0], [0, 0, -0.3], [1, 1, 1]])
-    c = np.broadcast_to(CENTRE, (1, 4, 3))
-    assert float(paper_penalty(pts, c, SPHERE_AXES)) == pytest.approx(1.0 / 0.16**2, rel=1e-12)
-    # on the surface: r_e = 1 counts as inside, penalty 1
-    on = CENTRE + np.array([[0.5, 0.0, 0.0]])
-    assert float(paper_penalty(on, c[:, :1], SPHERE_AXES)) == pytest.approx(1.0, rel=1e-12)
-
-
-def test_paper_penalty_ellipsoid_and_moving_centre() -> None:
-    axes = np.array([[0.5, 0.25, 1.0]])
-    # r_e = 0.1²/0.5² + 0.1²/0.25² + 0.5²/1 = 0.04 + 0.16 + 0.25 = 0.45
-    pts = np.zeros((3, 3))
-    centres = -np.array([[[2.0, 0, 0], [0.1, 0.1, 0.5], [0, 0, 1.5]]])  # moves over time
-    out = paper_penalty(pts, centres, axes)
-    assert float(out) == pytest.approx(1.0 / 0.45**2, rel=1e-12)
-    # along the long axis a point 0.9 away is inside, across it it is not
-    assert float(paper_penalty([[0, 0, 0.9]], np.zeros((1, 1, 3)), axes)) == pytest.approx(
-        1.0 / 0.81**2, rel=1e-12
-    )
-    assert float(paper_penalty([[0.9, 0, 0]], np.zeros((1, 1, 3)), axes)) == 0.0
-
-
-def test_paper_penalty_sums_over_obstacles() -> None:
-    pts = np.array([[0.2, 0, 0], [5.0, 5.0, 5.3]])
-    centres = np.array([[[0, 0, 0]] * 2, [[5.0, 5.0, 5.0]] * 2, [[9.0, 9.0, 9.0]] * 2])
-    axes = np.array([[0.5, 0.5, 0.5], [1.0, 1.0, 0.6], [0.1, 0.1, 0.1]])
-    expected = 1.0 / (0.2 / 0.5) ** 4 + 1.0 / (0.3 / 0.6) ** 4
-    assert float(paper_penalty(pts, centres, axes)) == pytest.approx(expected, rel=1e-12)
-
-
-def test_paper_penalty_batched() -> None:
-    rng = np.random.default_rng(41)
-    n_obs, n_t = 2, 5
-    pts = rng.uniform(-1, 1, size=(3, 4, n_t, 3))
-    centres = rng.uniform(-1, 1, size=(n_obs, 3, 4, n_t, 3))
-    axes = np.array([[0.6, 0.5, 0.7], [0.8, 0.8, 0.8]])
-    out = paper_penalty(pts, centres, axes)
-    assert out.shape == (3, 4)
-    assert (out > 0).any()
-    assert (out == 0).any()
-    for i in range(3):
-        for j in range(4):
-            one = paper_penalty(pts[i, j], centres[:, i, j], axes)
-            assert float(out[i, j]) == pytest.approx(float(one), rel=1e-12)
-    # centres shared by every motion, given with singleton batch axes
-    shared = centres[:, :1, :1]
-    out = paper_penalty(pts, shared, axes)
-    for i in range(3):
-        for j in range(4):
-            one = paper_penalty(pts[i, j], shared[:, 0, 0], axes)
-            assert float(out[i, j]) == pytest.approx(float(one), rel=1e-12)
-
-
-def test_paper_penalty_centres_broadcast_over_motions() -> None:
-    pts = np.array([[[0.0, 0.0, 0.0]], [[0.1, 0.0, 0.0]]])  # 2 motions, 1 sample
-    centres = np.array([[[0.0, 0.0, 0.0]], [[10.0, 10.0, 10.0]]])  # 2 obstacles, 1 time
-    axes = np.full((2, 3), 0.5)
-    out = paper_penalty(pts, centres, axes)
-    expected = [float(paper_penalty(p, centres, axes)) for p in pts]  # [1e24, 625]
-    np.testing.assert_allclose(out, expected, rtol=1e-12)
-
-
-@pytest.mark.parametrize(
-    "axes",
-    [
-        np.array([[0.5, 0.0, 0.5]]),
-        np.array([[0.5, -0.1, 0.5]]),
-        np.array([0.5, 0.5, 0.5]),  # missing the obstacle axis
-        np.array([[0.5, 0.5]]),
-        np.array([[0.5, np.nan, 0.5]]),
-    ],
-)
-def test_paper_penalty_bad_semi_axes(axes: np.ndarray) -> None:
-    with pytest.raises(InvalidInputError):
-        paper_penalty(np.zeros((2, 3)), np.zeros((1, 2, 3)), axes)
-
-
-@pytest.mark.parametrize(
-    ("points", "centres"),
-    [
-        (np.zeros((2, 2)), np.zeros((1, 2, 3))),  # points not (..., 3)
-        (np.zeros((2, 3)), np.zeros((1, 2, 4))),  # centres not (..., 3)
-        (np.zeros((2, 3)), np.zeros((2, 2, 3))),  # 2 centres for 1 obstacle
-    ],
-)
-def test_paper_penalty_bad_shapes(points: np.ndarray, centres: np.ndarray) -> None:
-    with pytest.raises(InputShapeError):
-        paper_penalty(points, centres, SPHERE_AXES)
-
-
-def test_paper_penalty_mismatched_times_is_a_shape_error() -> None:
-    with pytest.raises(InputShapeError):
-        paper_penalty(np.zeros((4, 3)), np.zeros((1, 5, 3)), SPHERE_AXES)
-    with pytest.raises(InputShapeError):
-        paper_penalty(np.zeros((2, 4, 3)), np.zeros((1, 3, 4, 3)), SPHERE_AXES)
-
-
-def test_paper_penalty_points_need_a_time_axis() -> None:
-    centres = np.array([[0.1, 0.0, 0.0], [0.3, 0.0, 0.0]])
-    with pytest.raises(InputShapeError):
-        paper_penalty(np.zeros(3), centres, np.full((2, 3), 0.5))
-
-
-def test_paper_penalty_rejects_nan() -> None:
-    with pytest.raises(InvalidInputError, match="points"):
-        paper_penalty([[np.nan, 0, 0]], np.zeros((1, 1, 3)), SPHERE_AXES)
-    with pytest.raises(InvalidInputError, match="centres"):
-        paper_penalty([[0, 0, 0]], np.full((1, 1, 3), np.inf), SPHERE_AXES)
-
-
-# ---------------------------------------------------------------------------------------
 # 7. Bad input to the checker
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("method", ["distances", "min_distances"])
@@ -887,22 +760,3 @@ def test_sphere_obstacles_are_closed_form_and_match_coal_outside(robot: Robot) -
             assert ours[idx][k] == pytest.approx(d, abs=1e-9)
             separated += 1
     assert separated > 500
-
-
-def test_paper_penalty_equation_14_and_rotated_ellipsoids() -> None:
-    # Eq. 14: a point at r_t = 0.5 inside a sphere of r0 = 1 gives 1 / 0.5**2 = 4.
-    pts = np.array([[0.5, 0.0, 0.0], [2.0, 0.0, 0.0]])
-    centre = np.zeros((1, 1, 3))
-    assert float(paper_penalty(pts, centre, np.ones((1, 3)), equation=14)) == pytest.approx(4.0)
-    with pytest.raises(InvalidInputError, match="equal semi-axes"):
-        paper_penalty(pts, centre, np.array([[1.0, 2.0, 1.0]]), equation=14)
-    with pytest.raises(InvalidInputError, match="equation must be 14"):
-        paper_penalty(pts, centre, np.ones((1, 3)), equation=15)
-    # A long ellipsoid along its own x axis, turned 90° about z: a point on the world y axis
-    # is inside only when the rotation is taken into account.
-    axes = np.array([[1.0, 0.1, 0.1]])
-    point = np.array([[0.0, 0.5, 0.0]])
-    turn = np.array([[[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]]])  # Rz(90°)
-    assert float(paper_penalty(point, centre, axes)) == 0.0  # axis-aligned: outside
-    inside = float(paper_penalty(point, centre, axes, rotations=turn))
-    assert inside == pytest.approx(1.0 / 0.25**2)  # r_e = 0.5² / 1²

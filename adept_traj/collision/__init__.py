@@ -11,7 +11,6 @@ from adept_traj.collision.checker import (
     CollisionChecker,
     MinDistances,
     PairDistances,
-    paper_penalty,
 )
 from adept_traj.collision.distance_table import (
     DistanceTable,
@@ -24,6 +23,5 @@ __all__ = [
     "DistanceTable",
     "MinDistances",
     "PairDistances",
-    "paper_penalty",
     "point_signed_distance",
 ]

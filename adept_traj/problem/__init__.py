@@ -12,6 +12,9 @@ from adept_traj.problem.bspline import (
     TrajectorySamples,
     kinematic_lower_bound,
 )
+from adept_traj.problem.objectives import (
+    paper_penalty,
+)
 from adept_traj.problem.trajectory_problem import (
     OBJECTIVE_NAMES,
     Evaluation,
@@ -30,4 +33,5 @@ __all__ = [
     "TrajectoryProblem",
     "TrajectorySamples",
     "kinematic_lower_bound",
+    "paper_penalty",
 ]
