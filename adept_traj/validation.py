@@ -1,4 +1,4 @@
-"""Input checks shared by the public methods (private module).
+"""Input checks shared by the public methods of every subpackage.
 
 Public methods normalise their inputs with these helpers and then call private hooks that
 assume clean, float64, finite arrays. Every failure raises an :mod:`adept_traj.errors`
@@ -7,13 +7,26 @@ exception whose message names the argument, the value found and what was expecte
 
 from __future__ import annotations
 
+import dataclasses
+import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from adept_traj.errors import InputShapeError, InvalidInputError
 
-__all__ = ["as_batch", "as_finite_array", "as_vector", "describe_bad_values", "readonly_copy"]
+__all__ = [
+    "as_batch",
+    "as_finite_array",
+    "as_integer",
+    "as_scalar",
+    "as_vector",
+    "check_type",
+    "deep_equal",
+    "describe_bad_values",
+    "readonly_copy",
+]
 
 
 def describe_bad_values(x: np.ndarray, bad: np.ndarray, limit: int = 3) -> str:
@@ -65,3 +78,91 @@ def readonly_copy(value: Any) -> np.ndarray:
     out = np.array(value, dtype=np.float64, copy=True)
     out.setflags(write=False)
     return out
+
+
+def as_scalar(
+    value: Any,
+    name: str,
+    unit: str = "",
+    *,
+    minimum: float = -math.inf,
+    strict: bool = False,
+    error: type[InvalidInputError] = InvalidInputError,
+) -> float:
+    """Return ``value`` as a finite float ≥ ``minimum`` (> ``minimum`` when ``strict``).
+
+    Booleans, strings, arrays of another shape than ``()`` and NaN/inf are refused with
+    ``error`` (an :class:`~adept_traj.errors.InvalidInputError` subclass) naming ``name``,
+    the value found, its ``unit`` (e.g. ``"[s]"``) and the valid range.
+    """
+    units = f" {unit}" if unit else ""
+    bound = "" if minimum == -math.inf else f" {'>' if strict else '≥'} {minimum:g}"
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise error(f"{name} must be a finite number{bound}{units}; got {value!r}")
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be a finite number{bound}{units}; got {value!r}") from None
+    if arr.ndim != 0:
+        raise InputShapeError(f"{name} must be a scalar{units}; got shape {arr.shape}")
+    x = float(arr)
+    if not math.isfinite(x) or x < minimum or (strict and x == minimum):
+        raise error(f"{name} must be a finite number{bound}{units}; got {value!r}")
+    return x
+
+
+def as_integer(
+    value: Any,
+    name: str,
+    *,
+    minimum: int | None = None,
+    maximum: int | None = None,
+    error: type[InvalidInputError] = InvalidInputError,
+) -> int:
+    """Return ``value`` (a Python or numpy integer, not a bool) as an ``int`` in
+    [``minimum``, ``maximum``]; raise ``error`` naming ``name``, the value and the range."""
+    lo = "-∞" if minimum is None else str(minimum)
+    hi = "∞" if maximum is None else str(maximum)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise error(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
+    out = int(value)
+    if (minimum is not None and out < minimum) or (maximum is not None and out > maximum):
+        raise error(f"{name} must be an integer in [{lo}, {hi}]; got {out}")
+    return out
+
+
+def check_type(value: Any, kind: type | tuple[type, ...], name: str) -> None:
+    """Raise :class:`~adept_traj.errors.InvalidInputError` unless ``value`` is a ``kind``."""
+    if not isinstance(value, kind):
+        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise InvalidInputError(f"{name} must be a {names}; got {type(value).__name__}")
+
+
+def deep_equal(a: Any, b: Any) -> bool:
+    """Deep equality for the frozen records of the package: arrays element-wise (same shape;
+    NaN ≠ NaN as in numpy), dataclasses of the same type field by field, mappings and
+    sequences item by item, anything else by ``==``."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (
+            isinstance(a, np.ndarray)
+            and isinstance(b, np.ndarray)
+            and a.shape == b.shape
+            and bool(np.array_equal(a, b))
+        )
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        return type(a) is type(b) and all(
+            deep_equal(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a)
+        )
+    if isinstance(a, Mapping):
+        return (
+            isinstance(b, Mapping)
+            and a.keys() == b.keys()
+            and all(deep_equal(a[k], b[k]) for k in a)
+        )
+    if isinstance(a, (list, tuple)):
+        return (
+            isinstance(b, (list, tuple))
+            and len(a) == len(b)
+            and all(deep_equal(x, y) for x, y in zip(a, b))
+        )
+    return bool(a == b)
