@@ -39,7 +39,7 @@ def dense_check(problem: TrajectoryProblem, x: np.ndarray, rate: float = 1000.0)
     lim = problem.robot.limits
     return {
         "per_obstacle": pairs.per_obstacle[0],
-        "torque_ratio": np.abs(tau).max(0) / lim.effort,
+        "torque_ratio": np.abs(tau).max(0) / lim.torque,
         "q_in_limits": bool(np.all((smp.q >= lim.lower - 1e-12) & (smp.q <= lim.upper + 1e-12))),
         "qd_ratio": np.abs(smp.qd).max(0) / lim.velocity,
         "qdd_ratio": np.abs(smp.qdd).max(0) / lim.acceleration,

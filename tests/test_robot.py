@@ -133,9 +133,9 @@ def test_limits_are_table_2_in_si(robot: Robot) -> None:
     np.testing.assert_allclose(lim.velocity, [11.3446, 16.057, 1.2, 57.5959])
     np.testing.assert_allclose(lim.acceleration, [9.5] * 4)
     np.testing.assert_allclose(lim.jerk, [50.0] * 4)
-    np.testing.assert_allclose(lim.effort, [400, 280, 100, 100])
+    np.testing.assert_allclose(lim.torque, [400, 280, 100, 100])
     with pytest.raises(ValueError, match="read-only"):
-        lim.effort[0] = 1.0
+        lim.torque[0] = 1.0
 
 
 def test_check_position_names_joint_value_and_range(robot: Robot) -> None:
@@ -312,7 +312,7 @@ def test_planar_arm_against_textbook_closed_form(planar: Robot) -> None:
 def test_planar_arm_limits_tool_and_manipulability(planar: Robot) -> None:
     assert planar.tool_frame == "hand"
     np.testing.assert_allclose(planar.limits.acceleration, [20.0, 30.0])
-    np.testing.assert_allclose(planar.limits.effort, [50.0, 20.0])
+    np.testing.assert_allclose(planar.limits.torque, [50.0, 20.0])
     q = np.array([[0.3, 0.9], [1.0, -0.4]])
     pose = planar.tool_pose(q)
     x = 0.6 * np.cos(q[:, 0]) + 0.4 * np.cos(q.sum(1))

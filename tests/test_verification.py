@@ -119,7 +119,7 @@ def test_dense_torques_and_ratios(problem: TrajectoryProblem, feasible: Certific
     np.testing.assert_allclose(
         dense.tau, robot.inverse_dynamics(dense.q, dense.qd, dense.qdd), rtol=1e-12
     )
-    ratio = np.abs(dense.tau) / robot.limits.effort
+    ratio = np.abs(dense.tau) / robot.limits.torque
     np.testing.assert_allclose(feasible.torque.dense, ratio.max(axis=0), rtol=1e-15)
     np.testing.assert_array_equal(feasible.torque.t_worst, dense.t[ratio.argmax(axis=0)])
     samples = problem.trajectory.sample(feasible.x, np.linspace(0, 1, dense.n_samples))

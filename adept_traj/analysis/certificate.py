@@ -410,7 +410,7 @@ def certify(
             "acceleration", qdd, bounds.qdd_abs_max, lim.acceleration, t, tol
         ),
         "jerk": _ratio_check("jerk", qddd, bounds.qddd_abs_max, lim.jerk, t, tol),
-        "torque": _ratio_check("torque", tau, None, lim.effort, t, tol),
+        "torque": _ratio_check("torque", tau, None, lim.torque, t, tol),
     }
     violations = [
         message
@@ -464,7 +464,7 @@ def _limits(lim: Any) -> np.ndarray:
             f"position limits must be finite with lower < upper; got lower={lim.lower.tolist()}, "
             f"upper={lim.upper.tolist()}"
         )
-    for name in ("velocity", "acceleration", "jerk", "effort"):
+    for name in ("velocity", "acceleration", "jerk", "torque"):
         value = np.asarray(getattr(lim, name), dtype=float)
         if not np.all(value > 0):  # NaN, 0 and negative values; inf is allowed
             raise ConfigurationError(

@@ -467,7 +467,7 @@ def _robot_demo(args: argparse.Namespace) -> int:
         print(
             f"  {name:<8}{np.abs(v[:, k]).max():>9.3f} {unit + '/s':<6}"
             f"{np.abs(a[:, k]).max():>9.3f} {unit + '/s²':<7}{peak_u:>9.2f} {force:<4}"
-            f"{lim.effort[k]:>6.0f}{peak_u / lim.effort[k]:>8.3f}"
+            f"{lim.torque[k]:>6.0f}{peak_u / lim.torque[k]:>8.3f}"
         )
     dt = np.diff(t)
     energy = np.sum(0.5 * ((u[1:] ** 2).sum(1) + (u[:-1] ** 2).sum(1)) * dt)

@@ -391,7 +391,7 @@ class TrajectoryProblem(Problem):
         lim, st = self.robot.limits, self.settings
         span = lim.upper - lim.lower
         g_q = np.maximum(q_max - lim.upper, lim.lower - q_min) / span
-        scales = [lim.velocity, lim.acceleration, lim.jerk, lim.effort]
+        scales = [lim.velocity, lim.acceleration, lim.jerk, lim.torque]
         g_rest = [m / s - 1.0 for m, s in zip(abs_max, scales)]
         g_d = (st.margin - np.minimum(min_dist, st.influence)) / st.influence
         return np.concatenate([g_q, *g_rest, g_d[:, None]], axis=-1)

@@ -599,7 +599,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
             "qd": _floats(lim.velocity),
             "qdd": _floats(lim.acceleration),
             "qddd": _floats(lim.jerk),
-            "tau": _floats(lim.effort),
+            "tau": _floats(lim.torque),
         },
         "lower_bound": {
             "T_min": _float(lb.T_min),
@@ -959,7 +959,7 @@ def _decode(data: Any, rd: _Reader) -> PlanningResult:
         velocity=lim("qd"),
         acceleration=lim("qdd"),
         jerk=lim("qddd"),
-        effort=lim("tau"),
+        torque=lim("tau"),
     )
 
     lbd = rd.get(top, "lower_bound", "")

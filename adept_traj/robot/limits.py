@@ -1,15 +1,61 @@
-"""Joint limits of a robot (paper Table 2, constraints (7)–(11)), as a frozen dataclass."""
+"""Joint limits of a robot (paper Table 2, constraints (7)–(11)) and the one vocabulary of
+limit kinds used across the package.
+
+A *limit kind* is one of ``position``, ``velocity``, ``acceleration``, ``jerk``, ``torque``
+(:data:`LIMIT_KINDS`). Each kind bounds one quantity along a trajectory, whose values are held
+in arrays named by its symbol — ``q``, ``qd``, ``qdd``, ``qddd``, ``tau`` (the fields of
+sampled trajectories, the CSV columns and result.json) — and is called QC, VC, WC, JC, UC in
+the paper. :data:`LIMITS` is the single table that links the three; no other module spells
+these lists out. External formats keep their own words at their boundary only: URDF and ROS
+say ``effort`` for the torque limit and the torques.
+"""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from adept_traj.errors import JointLimitError
+from adept_traj.errors import InvalidInputError, JointLimitError
 from adept_traj.validation import as_batch, readonly_copy
 
-__all__ = ["JointLimits"]
+__all__ = ["LIMITS", "LIMIT_KINDS", "JointLimits", "LimitKind"]
+
+
+@dataclass(frozen=True)
+class LimitKind:
+    """One kind of joint limit.
+
+    Attributes
+    ----------
+    name: the kind (``"position"``, ``"velocity"``, ``"acceleration"``, ``"jerk"``,
+        ``"torque"``); also the :class:`JointLimits` field holding its bound, except
+        ``position``, bounded by ``lower`` and ``upper``.
+    symbol: the name of the bounded quantity's arrays (``"q"``, ``"qd"``, ``"qdd"``,
+        ``"qddd"``, ``"tau"``).
+    order: the derivative order of q it bounds (0–3), ``None`` for the torque.
+    paper: the paper's label (Table 2): ``"QC"``, ``"VC"``, ``"WC"``, ``"JC"``, ``"UC"``.
+    units: the unit of the bound for a revolute and for a prismatic joint.
+    """
+
+    name: str
+    symbol: str
+    order: int | None
+    paper: str
+    units: tuple[str, str]
+
+
+#: The limit kinds in the order of the paper's constraints (7)–(11).
+LIMITS: tuple[LimitKind, ...] = (
+    LimitKind("position", "q", 0, "QC", ("rad", "m")),
+    LimitKind("velocity", "qd", 1, "VC", ("rad/s", "m/s")),
+    LimitKind("acceleration", "qdd", 2, "WC", ("rad/s²", "m/s²")),
+    LimitKind("jerk", "qddd", 3, "JC", ("rad/s³", "m/s³")),
+    LimitKind("torque", "tau", None, "UC", ("N·m", "N")),
+)
+#: The names of :data:`LIMITS`, in order.
+LIMIT_KINDS: tuple[str, ...] = tuple(kind.name for kind in LIMITS)
 
 
 @dataclass(frozen=True)
@@ -24,7 +70,7 @@ class JointLimits:
     velocity: max ``|q̇|`` [rad/s | m/s] (VC).
     acceleration: max ``|q̈|`` [rad/s² | m/s²] (WC); ``inf`` when unknown.
     jerk: max ``|q⃛|`` [rad/s³ | m/s³] (JC); ``inf`` when unknown.
-    effort: max ``|u|`` [N·m | N] (UC).
+    torque: max ``|τ|`` [N·m | N] (UC); URDF calls it ``effort``.
     """
 
     names: tuple[str, ...]
@@ -34,11 +80,31 @@ class JointLimits:
     velocity: np.ndarray
     acceleration: np.ndarray
     jerk: np.ndarray
-    effort: np.ndarray
+    torque: np.ndarray
 
     def __post_init__(self) -> None:
-        for field in ("lower", "upper", "velocity", "acceleration", "jerk", "effort"):
+        for field in ("lower", "upper", "velocity", "acceleration", "jerk", "torque"):
             object.__setattr__(self, field, readonly_copy(getattr(self, field)))
+
+    @property
+    def effort(self) -> np.ndarray:
+        """Deprecated name of :attr:`torque` (URDF's word); use ``torque``."""
+        warnings.warn(
+            "JointLimits.effort is deprecated; use JointLimits.torque",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.torque
+
+    def bound(self, kind: str) -> np.ndarray:
+        """The (nq,) bound on ``|value|`` of a limit kind other than ``position``
+        [unit of the kind]; ``inf`` where a joint has none."""
+        if kind not in LIMIT_KINDS or kind == "position":
+            raise InvalidInputError(
+                f"kind must be one of {LIMIT_KINDS[1:]} (position has lower and upper); "
+                f"got {kind!r}"
+            )
+        return getattr(self, kind)
 
     @property
     def nq(self) -> int:

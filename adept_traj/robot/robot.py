@@ -248,7 +248,7 @@ class Robot:
             velocity=model.velocityLimit,
             acceleration=acceleration,
             jerk=jerk,
-            effort=model.effortLimit,
+            torque=model.effortLimit,
         )
         if tool_frame is None:
             tool_frame = params.tool_frame if params and params.tool_frame else None

@@ -78,7 +78,7 @@ _KINDS = (
     ("qd", "velocity", ("rad/s", "m/s"), "velocity"),
     ("qdd", "acceleration", ("rad/s²", "m/s²"), "acceleration"),
     ("qddd", "jerk", ("rad/s³", "m/s³"), "jerk"),
-    ("tau", "torque / force", ("N·m", "N"), "effort"),
+    ("tau", "torque / force", ("N·m", "N"), "torque"),
 )
 
 
