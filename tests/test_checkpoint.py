@@ -20,10 +20,12 @@ from pymoo.core.evaluator import Evaluator
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.core.repair import Repair
+from pymoo.operators.sampling.rnd import FloatRandomSampling
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     CHECKPOINT_VERSION,
+    PlanningInterrupted,
     load_checkpoint,
     make_algorithm,
     optimise,
@@ -242,3 +244,45 @@ def test_load_refuses_a_foreign_or_torn_checkpoint(tmp_path: Path) -> None:
     (tmp_path / "checkpoint.json").write_text(json.dumps(meta))
     with pytest.raises(ConfigurationError, match=r"incomplete checkpoint, missing \['rng'\]"):
         load_checkpoint(tmp_path)
+
+
+def _interrupt_at(generation: int):
+    def progress(info) -> None:
+        if info.generation == generation:
+            raise KeyboardInterrupt
+
+    return progress
+
+
+@pytest.mark.parametrize("name", ["nsga2", "mode"])
+def test_resume_from_a_population_of_feasible_and_infeasible_members(
+    name: str, tmp_path: Path
+) -> None:
+    """NSGA-II ranks only the feasible members; their ranks and crowding distances are
+    checkpointed too (resuming once failed with a TypeError in the tournament)."""
+    settings = {"sampling": FloatRandomSampling(), "repair": False, "fast_end": 0}
+
+    def algorithm():
+        return make_algorithm(name, 10, 6, **settings)[0]
+
+    full = optimise(Toy(), algorithm(), 6, seed=2)
+    with pytest.raises(PlanningInterrupted):
+        optimise(Toy(), algorithm(), 6, seed=2, checkpoint=tmp_path, progress=_interrupt_at(2))
+    _, arrays = load_checkpoint(tmp_path)
+    feasible = arrays["CV"][:, 0] <= 0
+    assert 0 < feasible.sum() < len(feasible)  # a mixed population is checkpointed
+    resumed = optimise(Toy(), algorithm(), 6, seed=2, checkpoint=tmp_path, resume=True)
+    np.testing.assert_array_equal(resumed.X, full.X)
+    np.testing.assert_array_equal(resumed.F, full.F)
+
+
+def test_resume_after_the_last_generation_runs_no_further_one(tmp_path: Path) -> None:
+    full = optimise(Toy(), NSGA2(pop_size=10), 3, seed=1)
+    with pytest.raises(PlanningInterrupted, match="after generation 3"):
+        optimise(
+            Toy(), NSGA2(pop_size=10), 3, seed=1, checkpoint=tmp_path, progress=_interrupt_at(3)
+        )
+    resumed = optimise(Toy(), NSGA2(pop_size=10), 3, seed=1, checkpoint=tmp_path, resume=True)
+    assert resumed.n_generations == 3
+    assert resumed.n_evaluations == full.n_evaluations == 30
+    np.testing.assert_array_equal(resumed.X, full.X)

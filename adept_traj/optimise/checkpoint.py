@@ -55,13 +55,23 @@ _EVALUATED = ("F", "G", "H")
 
 def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
     """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint), with the
-    generation counter so that the two checkpoint files can be checked against each other."""
+    generation counter so that the two checkpoint files can be checked against each other.
+
+    An attribute that only some members have (NSGA-II ranks only the feasible ones) is
+    stored with the mask ``absent.<key>`` (pop,) of the members without it."""
     out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
     out["n_iter"] = np.array(n_iter)
-    for key in pop[0].data if len(pop) else ():
-        values = pop.get(key)
-        if values.dtype != object and key not in out:
-            out[f"data.{key}"] = values
+    for key in sorted({key for ind in pop for key in ind.data}):
+        values = [ind.data.get(key) for ind in pop]
+        have = np.array([v is not None for v in values])
+        present = np.array([v for v in values if v is not None])
+        if present.dtype == object:
+            continue  # not storable without pickle (and not needed by pymoo's operators)
+        full = np.zeros((len(pop), *present.shape[1:]), dtype=present.dtype)
+        full[have] = present
+        out[f"data.{key}"] = full
+        if not have.all():
+            out[f"absent.{key}"] = ~have
     return out
 
 
@@ -69,9 +79,11 @@ def _restore_population(arrays: dict[str, np.ndarray]) -> Population:
     """The population of ``arrays``, marked evaluated (the evaluator skips its members)."""
     pop = Population.new(X=arrays["X"])
     pop.set("F", arrays["F"], "G", arrays["G"], "CV", arrays["CV"])
-    for key, values in arrays.items():
-        if key.startswith("data."):  # (n_iter is checked by load_checkpoint, not stored)
-            pop.set(key[5:], values)
+    for name, values in arrays.items():
+        if name.startswith("data."):  # (n_iter is checked by load_checkpoint, not stored)
+            key = name.removeprefix("data.")
+            have = ~arrays.get(f"absent.{key}", np.zeros(len(pop), dtype=bool))
+            pop[have].set(key, values[have])
     for ind in pop:
         ind.evaluated.update(_EVALUATED)
     return pop
@@ -158,7 +170,12 @@ def restore_algorithm(algorithm: Any, meta: dict[str, Any], arrays: dict[str, np
     algorithm._initialize()
     algorithm.pop = _restore_population(arrays)
     algorithm.is_initialized = True
-    algorithm.n_iter = meta["n_iter"]
     algorithm.evaluator.n_eval = meta["n_eval"]
     algorithm.random_state.bit_generator.state = meta["rng"]
+    # What pymoo does after finishing generation g = n_iter - 1, in its order: the optimum,
+    # the termination's progress (so a checkpoint of the last generation runs no further
+    # one), then the count.
+    algorithm.n_iter = meta["n_iter"] - 1
     algorithm._set_optimum()
+    algorithm.termination.update(algorithm)
+    algorithm.n_iter = meta["n_iter"]
