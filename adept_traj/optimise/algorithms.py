@@ -21,13 +21,13 @@ Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``rvea`` (pymoo's MOEA/D handle
 constraints, so it is not offered)
 (reference directions: Das–Dennis with 3 partitions for 6 objectives when needed).
 
-Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless another
+Every algorithm starts from :class:`~adept_traj.optimise.RampSampling` unless another
 ``sampling`` is given, repairs travel times with
-:class:`~adept_traj.repair.KinematicTimeRepair`, makes 30 % of its offspring by
-:class:`~adept_traj.local_search.FastEndSearch` (local search at the fast end of the front;
+:class:`~adept_traj.optimise.KinematicTimeRepair`, makes 30 % of its offspring by
+:class:`~adept_traj.optimise.FastEndSearch` (local search at the fast end of the front;
 same number of evaluations; a third of those are fresh ramps from the sampling, at their
 kinematic minimum time), and eliminates duplicates. Randomness comes only from pymoo's
-per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.planner`).
+per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.optimise.planner`).
 """
 
 from __future__ import annotations
@@ -106,13 +106,13 @@ def make_algorithm(
         population of at least 56.
     sampling:
         Initial population (pymoo sampling, array or population); default
-        :class:`~adept_traj.sampling.RampSampling`.
+        :class:`~adept_traj.optimise.RampSampling`.
     repair:
-        Apply :class:`~adept_traj.repair.KinematicTimeRepair` to every candidate (default;
+        Apply :class:`~adept_traj.optimise.KinematicTimeRepair` to every candidate (default;
         ``False`` runs the plain algorithm).
     fast_end:
         Share of each generation's offspring made by
-        :class:`~adept_traj.local_search.FastEndSearch` (local perturbations of the fastest
+        :class:`~adept_traj.optimise.FastEndSearch` (local perturbations of the fastest
         feasible members and fresh ramps at their kinematic minimum time; default 0.3,
         ``0`` runs the algorithm's own mating only). The number of evaluations is unchanged.
     params:

@@ -19,11 +19,11 @@ a smooth bump per joint j at a random centre :math:`c_j \in [0, 1]` and half-wid
 :math:`\log\sigma \sim \mathcal U(\log\sigma_{lo}, \log\sigma_{hi})`;
 P the control points of one of the ``n_elite`` fastest feasible members (uniformly
 chosen); the child is clipped to the bounds, and the travel time set to the child's own kinematic
-minimum :math:`T_{kin}(P')` (:func:`~adept_traj.repair.kinematic_time`), the fastest move
+minimum :math:`T_{kin}(P')` (:func:`~adept_traj.optimise.kinematic_time`), the fastest move
 of that shape. Survival then keeps a child only if it is better (e.g. feasible and faster).
 
 A share ``immigrants`` (default 1/3) of these local children are instead **fresh random
-ramps** from :class:`~adept_traj.sampling.RampSampling`, also at their own kinematic minimum
+ramps** from :class:`~adept_traj.optimise.RampSampling`, also at their own kinematic minimum
 time (random immigrants at the fast end). Perturbations refine the fastest shapes found so
 far; immigrants keep sampling new ones, so the search does not stay in the basin of the
 first feasible fast move (measured on the paper scenario with NSGA-II at the paper's
@@ -49,7 +49,7 @@ from adept_traj.optimise.sampling import RampSampling
 
 __all__ = ["FastEndSearch"]
 
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.repair`).
+#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.repair`).
 _SLACK = 1e-9
 
 
@@ -72,7 +72,7 @@ class FastEndSearch:
         Share of the local children that are fresh ramps instead of perturbations, in
         [0, 1] (default 1/3; 0 disables them).
     sampling:
-        Where immigrants come from (default: a :class:`~adept_traj.sampling.RampSampling`
+        Where immigrants come from (default: a :class:`~adept_traj.optimise.RampSampling`
         with its default parameters).
     """
 

@@ -20,7 +20,7 @@ random) and a random detour amplitude
 else 0); T is uniform in its bounds. The straight
 joint-space move is always included. Control points are clipped to the decision bounds.
 Travel times: half the individuals get T uniform in its bounds, the other half T just above
-their own kinematic minimum (:func:`~adept_traj.repair.kinematic_time` × U[1, 1.3]), so the
+their own kinematic minimum (:func:`~adept_traj.optimise.kinematic_time` × U[1, 1.3]), so the
 fast end of the front is explored from the start. Nothing about a particular scene is
 assumed.
 """
