@@ -46,6 +46,7 @@ from pymoo.core.population import Population
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["FastEndSearch"]
 
@@ -85,18 +86,20 @@ class FastEndSearch:
         immigrants: float = 1.0 / 3.0,
         sampling: RampSampling | None = None,
     ) -> None:
-        if not 0.0 <= fraction <= 1.0:
-            raise ConfigurationError(f"fast_end fraction must be in [0, 1]; got {fraction}")
-        if not 0.0 <= immigrants <= 1.0:
-            raise ConfigurationError(f"immigrants must be in [0, 1]; got {immigrants}")
-        if isinstance(n_elite, bool) or not isinstance(n_elite, int) or n_elite < 1:
-            raise ConfigurationError(f"n_elite must be an integer ≥ 1; got {n_elite!r}")
-        lo, hi = (float(v) for v in sigma)
+        fraction = as_scalar(fraction, "fast_end fraction", minimum=0.0, error=ConfigurationError)
+        immigrants = as_scalar(immigrants, "immigrants", minimum=0.0, error=ConfigurationError)
+        for name, value in (("fast_end fraction", fraction), ("immigrants", immigrants)):
+            if value > 1.0:
+                raise ConfigurationError(f"{name} must be a number in [0, 1]; got {value}")
+        n_elite = as_integer(n_elite, "n_elite", minimum=1, error=ConfigurationError)
+        if len(sigma) != 2:
+            raise ConfigurationError(f"sigma must be (lo, hi) with 0 < lo ≤ hi; got {sigma}")
+        lo, hi = (as_scalar(v, "sigma", minimum=0.0, error=ConfigurationError) for v in sigma)
         if not 0.0 < lo <= hi:
             raise ConfigurationError(f"sigma must be (lo, hi) with 0 < lo ≤ hi; got {sigma}")
-        self.mating, self.fraction = mating, float(fraction)
+        self.mating, self.fraction = mating, fraction
         self.n_elite, self.sigma = n_elite, (lo, hi)
-        self.immigrants = float(immigrants)
+        self.immigrants = immigrants
         self.sampling = RampSampling() if sampling is None else sampling
 
     def __getattr__(self, name: str) -> Any:

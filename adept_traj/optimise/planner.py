@@ -54,6 +54,7 @@ from adept_traj.results.record import (
     PlanningResult,
     Timing,
 )
+from adept_traj.validation import as_integer
 
 __all__ = ["plan"]
 
@@ -145,7 +146,7 @@ def _certified_choice(
     if certificate.feasible:
         return certificate, first
     further = [int(k) for k in order[1:] if front.feasible[k]]
-    for k in further[: max(1, max_certify) - 1]:
+    for k in further[: max_certify - 1]:
         candidate = certify(problem, front.x[k], rate_hz=rate_hz)
         if candidate.feasible:
             return candidate, k
@@ -186,17 +187,17 @@ def plan(
     PlanningResult
         Never empty; ``result.feasible`` is the dense certificate's verdict.
     """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ConfigurationError(f"seed must be an integer ≥ 0; got {seed!r}")
+    seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
+    max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
     state = optimise(
         problem,
         alg,
         settings.n_gen,
-        int(seed),
+        seed,
         checkpoint=checkpoint,
         resume=resume,
-        fingerprint=_fingerprint(problem, settings, int(seed)),
+        fingerprint=_fingerprint(problem, settings, seed),
         progress=progress,
     )
     # The final population's values as the run computed them (z4 back to positive).
@@ -233,7 +234,7 @@ def plan(
         problem,
         algorithm=settings.name,
         algorithm_settings=settings.to_dict(),
-        seed=int(seed),
+        seed=seed,
         front=front,
         best=BestSolution(
             index=index, f_c=float(choice.f_c[index]), f_avg=float(choice.F_avg[index])
