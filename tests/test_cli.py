@@ -107,7 +107,7 @@ def test_compare_writes_tables(tmp_path: Path, capsys: pytest.CaptureFixture[str
     ("argv", "message"),
     [
         (["plan", "--algorithm", "foo", "--out", "x"], "unknown algorithm 'foo'"),
-        (["plan", "--pop", "1", "--out", "x"], "pop_size must be an integer ≥ 2"),
+        (["plan", "--pop", "1", "--out", "x"], "pop_size must be an integer in [2, ∞]; got 1"),
         (["plan", "--weights", "1,1,1,1,1,-1", "--out", "x"], "--weights must be 6"),
         (["plan", "--weights", "1,1,1", "--out", "x"], "--weights must be 6"),
         (["plan", "--start", "0,0,0.3,0", "--out", "x"], "outside its limits"),

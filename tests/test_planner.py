@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import adept_traj as at
+from adept_traj.analysis import certify
+from adept_traj.optimise import planner
 from adept_traj.results import NO_FEASIBLE_WARNING
 
 
@@ -40,18 +43,58 @@ def test_result_is_verified_and_consistent(problem: at.TrajectoryProblem, small_
     assert 0 < res.metrics.rni <= 1
     assert res.gap == pytest.approx(res.best_objectives[0] / problem.lower_bound.T_min)
     assert res.best_objectives[0] >= problem.lower_bound.T_min
-    if res.warning is None:
-        assert res.front.feasible.all()
-        # Front members do not dominate each other.
-        assert at.analysis.non_dominated(res.front.objectives).all()
+    # seed 2 with 40 x 25 finds feasible members, and the trade-off choice passes
+    assert res.warning is None
+    assert res.feasible
+    assert res.front.feasible.all()
+    # Front members do not dominate each other.
+    assert at.analysis.non_dominated(res.front.objectives).all()
 
 
-def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem) -> None:
+def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monkeypatch) -> None:
+    certified = []
+
+    def counting(problem, x, **kwargs):
+        certified.append(x)
+        return certify(problem, x, **kwargs)
+
+    monkeypatch.setattr(planner, "certify", counting)
+    # MODE with 12 x 2 finds no feasible member (seed 1)
     res = at.plan(problem, "mode", seed=1, pop_size=12, n_gen=2)
-    assert len(res.front) >= 1  # never empty
-    if not res.front.feasible.any():
-        assert res.warning == NO_FEASIBLE_WARNING
-        assert not res.feasible
+    assert len(res.front) == 10  # never empty: the 10 least infeasible
+    assert not res.front.feasible.any()
+    assert res.warning == NO_FEASIBLE_WARNING
+    assert not res.feasible
+    # only the trade-off choice is certified: no other member is feasible at the samples
+    assert len(certified) == 1
+    np.testing.assert_array_equal(certified[0], res.best_x)
+
+
+@pytest.mark.parametrize(
+    ("passes", "max_certify", "expected_tries", "reported"),
+    [
+        ({3}, 10, [2, 1, 3], 3),  # 0 is infeasible at the samples: not tried
+        ({3}, 2, [2, 1], 2),  # out of tries: the trade-off choice, failing
+        ({2, 3}, 10, [2], 2),  # the trade-off choice passes
+        (set(), 10, [2, 1, 3], 2),  # none passes
+    ],
+)
+def test_further_candidates_are_feasible_members(
+    monkeypatch, passes, max_certify, expected_tries, reported
+) -> None:
+    tried = []
+
+    def fake_certify(problem, x, rate_hz):
+        tried.append(int(x[0]))
+        return SimpleNamespace(feasible=int(x[0]) in passes, index=int(x[0]))
+
+    monkeypatch.setattr(planner, "certify", fake_certify)
+    front = SimpleNamespace(x=np.arange(4.0)[:, None], feasible=np.array([False, True, True, True]))
+    certificate, index = planner._certified_choice(
+        None, front, np.array([2, 0, 1, 3]), 1000.0, max_certify
+    )
+    assert tried == expected_tries
+    assert (index, certificate.index) == (reported, reported)
 
 
 def test_save_load_verify_round_trip(small_run, tmp_path: Path) -> None:

@@ -7,10 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import adept_traj as at
 from adept_traj import TrajectoryProblem
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     ALGORITHMS,
+    FastEndSearch,
+    KinematicTimeRepair,
     PlanningInterrupted,
     RampSampling,
     kinematic_time,
@@ -109,7 +112,7 @@ def test_paper_settings_and_names() -> None:
         make_algorithm(name, pop_size=12, n_gen=1)
     with pytest.raises(ConfigurationError, match="unknown algorithm 'cmaes'"):
         make_algorithm("cmaes")
-    with pytest.raises(ConfigurationError, match="pop_size must be an integer ≥ 2"):
+    with pytest.raises(ConfigurationError, match=r"pop_size must be an integer in \[2, ∞\]; got 1"):
         make_algorithm("nsga2", pop_size=1)
     with pytest.raises(ConfigurationError, match="unknown parameter"):
         make_algorithm("mode", eta=3)
@@ -120,3 +123,32 @@ def test_other_pymoo_algorithms_run(problem: TrajectoryProblem, name: str) -> No
     state = optimise(problem, make_algorithm(name, 12, 2)[0], 2, seed=1)
     assert state.n_generations == 2
     assert state.X.shape[1] == problem.n_var
+
+
+def test_settings_are_checked_with_the_library_error(problem: TrajectoryProblem) -> None:
+    """Every setting of the optimiser goes through adept_traj.validation: booleans, strings,
+    NaN and out-of-range values raise ConfigurationError naming the setting; numpy numbers
+    are accepted."""
+    _, settings = make_algorithm("nsga2", pop_size=np.int64(10), n_gen=np.int32(2))
+    assert (settings.pop_size, settings.n_gen) == (10, 2)
+    assert type(settings.pop_size) is int
+    _, settings = make_algorithm("mode", F=np.float32(0.25), CR=1)
+    assert (settings.params["F"], settings.params["CR"]) == (0.25, 1.0)
+    bad = [
+        (lambda: make_algorithm("nsga2", pop_size=True), "pop_size"),
+        (lambda: make_algorithm("nsga2", n_gen=2.0), "n_gen"),
+        (lambda: make_algorithm("mode", F=float("nan")), "mode parameter F"),
+        (lambda: make_algorithm("mode", CR="0.9"), "mode parameter CR"),
+        (lambda: FastEndSearch(None, fraction=True), "fast_end fraction"),
+        (lambda: FastEndSearch(None, n_elite=2.0), "n_elite"),
+        (lambda: FastEndSearch(None, sigma=(0.0, 0.1)), "sigma"),
+        (lambda: RampSampling(detour="x"), "detour"),
+        (lambda: RampSampling(min_window=0.0), "min_window"),
+        (lambda: RampSampling(detour_prob=1.5), "detour_prob"),
+        (lambda: KinematicTimeRepair(snap=float("inf")), "snap"),
+        (lambda: at.plan(problem, max_certify=0, pop_size=4, n_gen=1), "max_certify"),
+        (lambda: at.plan(problem, seed=1.0, pop_size=4, n_gen=1), "seed"),
+    ]
+    for call, name in bad:
+        with pytest.raises(ConfigurationError, match=name):
+            call()

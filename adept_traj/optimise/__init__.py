@@ -1,6 +1,7 @@
 """The optimiser.
 
-algorithms, sampling, repair, fast-end search, the loop, checkpoints, :func:`plan`."""
+Algorithms, sampling, repair, fast-end search, the generation loop, its checkpoints and
+:func:`plan`."""
 
 from __future__ import annotations
 
@@ -8,6 +9,12 @@ from adept_traj.optimise.algorithms import (
     ALGORITHMS,
     AlgorithmSettings,
     make_algorithm,
+)
+from adept_traj.optimise.checkpoint import (
+    CHECKPOINT_VERSION,
+    load_checkpoint,
+    restore_algorithm,
+    save_checkpoint,
 )
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
@@ -31,6 +38,7 @@ from adept_traj.optimise.sampling import (
 
 __all__ = [
     "ALGORITHMS",
+    "CHECKPOINT_VERSION",
     "AlgorithmSettings",
     "FastEndSearch",
     "GenerationInfo",
@@ -39,7 +47,10 @@ __all__ = [
     "RampSampling",
     "RunState",
     "kinematic_time",
+    "load_checkpoint",
     "make_algorithm",
     "optimise",
     "plan",
+    "restore_algorithm",
+    "save_checkpoint",
 ]

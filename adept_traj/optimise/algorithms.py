@@ -21,18 +21,17 @@ Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``rvea`` (pymoo's MOEA/D handle
 constraints, so it is not offered)
 (reference directions: Das–Dennis with 3 partitions for 6 objectives when needed).
 
-Every algorithm starts from :class:`~adept_traj.sampling.RampSampling` unless another
+Every algorithm starts from :class:`~adept_traj.optimise.RampSampling` unless another
 ``sampling`` is given, repairs travel times with
-:class:`~adept_traj.repair.KinematicTimeRepair`, makes 30 % of its offspring by
-:class:`~adept_traj.local_search.FastEndSearch` (local search at the fast end of the front;
+:class:`~adept_traj.optimise.KinematicTimeRepair`, makes 30 % of its offspring by
+:class:`~adept_traj.optimise.FastEndSearch` (local search at the fast end of the front;
 same number of evaluations; a third of those are fresh ramps from the sampling, at their
 kinematic minimum time), and eliminates duplicates. Randomness comes only from pymoo's
-per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.planner`).
+per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.optimise.planner`).
 """
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,6 +41,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
 
@@ -77,12 +77,6 @@ class AlgorithmSettings:
         return {"name": self.name, "pop_size": self.pop_size, "n_gen": self.n_gen, **self.params}
 
 
-def _positive_int(value: Any, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise ConfigurationError(f"{name} must be an integer ≥ {minimum}; got {value!r}")
-    return value
-
-
 def make_algorithm(
     name: str = "nsga2",
     pop_size: int | None = None,
@@ -106,13 +100,13 @@ def make_algorithm(
         population of at least 56.
     sampling:
         Initial population (pymoo sampling, array or population); default
-        :class:`~adept_traj.sampling.RampSampling`.
+        :class:`~adept_traj.optimise.RampSampling`.
     repair:
-        Apply :class:`~adept_traj.repair.KinematicTimeRepair` to every candidate (default;
+        Apply :class:`~adept_traj.optimise.KinematicTimeRepair` to every candidate (default;
         ``False`` runs the plain algorithm).
     fast_end:
         Share of each generation's offspring made by
-        :class:`~adept_traj.local_search.FastEndSearch` (local perturbations of the fastest
+        :class:`~adept_traj.optimise.FastEndSearch` (local perturbations of the fastest
         feasible members and fresh ramps at their kinematic minimum time; default 0.3,
         ``0`` runs the algorithm's own mating only). The number of evaluations is unchanged.
     params:
@@ -130,29 +124,28 @@ def make_algorithm(
         raise ConfigurationError(f"unknown algorithm {name!r}; choose one of {list(ALGORITHMS)}")
     defaults = dict(_PAPER.get(key, {"pop_size": 100, "n_gen": 100}))
     default_pop, default_gens = defaults.pop("pop_size"), defaults.pop("n_gen")
-    pop = _positive_int(default_pop if pop_size is None else pop_size, "pop_size", 2)
-    gens = _positive_int(default_gens if n_gen is None else n_gen, "n_gen", 1)
+    pop_size = default_pop if pop_size is None else pop_size
+    n_gen = default_gens if n_gen is None else n_gen
+    pop = as_integer(pop_size, "pop_size", minimum=2, error=ConfigurationError)
+    gens = as_integer(n_gen, "n_gen", minimum=1, error=ConfigurationError)
     unknown = sorted(set(params) - set(defaults))
     if unknown:
         raise ConfigurationError(
             f"unknown parameter(s) {unknown} for {key}; accepted: {sorted(defaults)}"
         )
-    settings = {**defaults, **params}
-    for k, v in settings.items():
-        if not isinstance(v, int | float) or isinstance(v, bool) or not v >= 0:
-            raise ConfigurationError(f"{key} parameter {k} must be a number ≥ 0; got {v!r}")
+    settings = {
+        k: as_scalar(v, f"{key} parameter {k}", minimum=0.0, error=ConfigurationError)
+        for k, v in {**defaults, **params}.items()
+    }
     sampling = RampSampling() if sampling is None else sampling
     fix = KinematicTimeRepair() if repair else None
-    if (
-        isinstance(fast_end, bool)
-        or not isinstance(fast_end, numbers.Real)
-        or not 0.0 <= fast_end <= 1.0
-    ):
+    fast_end = as_scalar(fast_end, "fast_end", minimum=0.0, error=ConfigurationError)
+    if fast_end > 1.0:
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
     if fast_end > 0 and hasattr(algorithm, "mating"):
         ramps = sampling if isinstance(sampling, RampSampling) else None
-        algorithm.mating = FastEndSearch(algorithm.mating, fraction=float(fast_end), sampling=ramps)
+        algorithm.mating = FastEndSearch(algorithm.mating, fraction=fast_end, sampling=ramps)
     settings["kinematic_time_repair"] = bool(repair)
     mating = getattr(algorithm, "mating", None)
     search = mating if isinstance(mating, FastEndSearch) else None

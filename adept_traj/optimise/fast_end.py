@@ -19,11 +19,11 @@ a smooth bump per joint j at a random centre :math:`c_j \in [0, 1]` and half-wid
 :math:`\log\sigma \sim \mathcal U(\log\sigma_{lo}, \log\sigma_{hi})`;
 P the control points of one of the ``n_elite`` fastest feasible members (uniformly
 chosen); the child is clipped to the bounds, and the travel time set to the child's own kinematic
-minimum :math:`T_{kin}(P')` (:func:`~adept_traj.repair.kinematic_time`), the fastest move
+minimum :math:`T_{kin}(P')` (:func:`~adept_traj.optimise.kinematic_time`), the fastest move
 of that shape. Survival then keeps a child only if it is better (e.g. feasible and faster).
 
 A share ``immigrants`` (default 1/3) of these local children are instead **fresh random
-ramps** from :class:`~adept_traj.sampling.RampSampling`, also at their own kinematic minimum
+ramps** from :class:`~adept_traj.optimise.RampSampling`, also at their own kinematic minimum
 time (random immigrants at the fast end). Perturbations refine the fastest shapes found so
 far; immigrants keep sampling new ones, so the search does not stay in the basin of the
 first feasible fast move (measured on the paper scenario with NSGA-II at the paper's
@@ -46,10 +46,11 @@ from pymoo.core.population import Population
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["FastEndSearch"]
 
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.repair`).
+#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.repair`).
 _SLACK = 1e-9
 
 
@@ -72,7 +73,7 @@ class FastEndSearch:
         Share of the local children that are fresh ramps instead of perturbations, in
         [0, 1] (default 1/3; 0 disables them).
     sampling:
-        Where immigrants come from (default: a :class:`~adept_traj.sampling.RampSampling`
+        Where immigrants come from (default: a :class:`~adept_traj.optimise.RampSampling`
         with its default parameters).
     """
 
@@ -85,18 +86,20 @@ class FastEndSearch:
         immigrants: float = 1.0 / 3.0,
         sampling: RampSampling | None = None,
     ) -> None:
-        if not 0.0 <= fraction <= 1.0:
-            raise ConfigurationError(f"fast_end fraction must be in [0, 1]; got {fraction}")
-        if not 0.0 <= immigrants <= 1.0:
-            raise ConfigurationError(f"immigrants must be in [0, 1]; got {immigrants}")
-        if isinstance(n_elite, bool) or not isinstance(n_elite, int) or n_elite < 1:
-            raise ConfigurationError(f"n_elite must be an integer ≥ 1; got {n_elite!r}")
-        lo, hi = (float(v) for v in sigma)
+        fraction = as_scalar(fraction, "fast_end fraction", minimum=0.0, error=ConfigurationError)
+        immigrants = as_scalar(immigrants, "immigrants", minimum=0.0, error=ConfigurationError)
+        for name, value in (("fast_end fraction", fraction), ("immigrants", immigrants)):
+            if value > 1.0:
+                raise ConfigurationError(f"{name} must be a number in [0, 1]; got {value}")
+        n_elite = as_integer(n_elite, "n_elite", minimum=1, error=ConfigurationError)
+        if len(sigma) != 2:
+            raise ConfigurationError(f"sigma must be (lo, hi) with 0 < lo ≤ hi; got {sigma}")
+        lo, hi = (as_scalar(v, "sigma", minimum=0.0, error=ConfigurationError) for v in sigma)
         if not 0.0 < lo <= hi:
             raise ConfigurationError(f"sigma must be (lo, hi) with 0 < lo ≤ hi; got {sigma}")
-        self.mating, self.fraction = mating, float(fraction)
+        self.mating, self.fraction = mating, fraction
         self.n_elite, self.sigma = n_elite, (lo, hi)
-        self.immigrants = float(immigrants)
+        self.immigrants = immigrants
         self.sampling = RampSampling() if sampling is None else sampling
 
     def __getattr__(self, name: str) -> Any:

@@ -1,7 +1,8 @@
-"""The optimisation loop: ask/tell with timings, progress, checkpoints and exact resume.
+"""The generation loop: ask/tell with timings, progress, checkpoints and exact resume.
 
-:func:`optimise` runs a pymoo algorithm on a problem generation by generation. After every
-generation it can write a checkpoint folder (``checkpoint.json`` + ``checkpoint.npz``, no
+:func:`optimise` runs a pymoo algorithm on a problem generation by generation, through
+pymoo's public ask/tell interface only. After every generation it can write a checkpoint
+folder (:mod:`adept_traj.optimise.checkpoint`: ``checkpoint.json`` + ``checkpoint.npz``, no
 pickle): the population with every per-individual attribute the algorithm keeps (F, G, CV,
 rank, crowding, …), the generation and evaluation counters, the state of the algorithm's
 random generator and the timings so far. :func:`optimise` with ``resume=True`` restores all
@@ -20,15 +21,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pymoo.core.population import Population
 
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.errors import ConfigurationError, PlanningInterrupted
-from adept_traj.files import write_atomic
+from adept_traj.optimise.checkpoint import load_checkpoint, restore_algorithm, save_checkpoint
 
 __all__ = ["GenerationInfo", "PlanningInterrupted", "RunState", "optimise"]
-
-_CHECKPOINT_VERSION = 1
 
 
 @dataclass(frozen=True)
@@ -39,7 +37,9 @@ class GenerationInfo:
     n_gen: int
     n_evaluations: int
     n_feasible: int
-    best_time: float | None  # smallest z1 [s] among feasible individuals, if any
+    #: Smallest travel time z1 [s] among the feasible individuals (None if none is feasible).
+    best_time: float | None
+    #: Wall time [s] since the run started (a resumed run includes the earlier sessions).
     elapsed_s: float
 
 
@@ -48,7 +48,9 @@ class RunState:
     """Final population and bookkeeping of a run.
 
     ``X`` (pop, n_var), ``F`` (pop, n_obj) as pymoo sees them (z4 negated), ``G``
-    (pop, n_constr), ``CV`` (pop,) total constraint violation.
+    (pop, n_constr), ``CV`` (pop,) total constraint violation; ``total_s`` and
+    ``evaluation_s`` [s] the wall time of the run and the part spent evaluating (earlier
+    sessions of a resumed run included); ``history`` one dict per generation.
     """
 
     X: np.ndarray
@@ -63,81 +65,6 @@ class RunState:
     #: Per generation of this session (not restored on resume): the objectives (pymoo's
     #: sense) of the population's feasible non-dominated members, for hypervolume history.
     fronts: list[np.ndarray] = field(default_factory=list)
-
-
-def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
-    """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint), with the
-    generation counter so that the two checkpoint files can be checked against each other."""
-    out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
-    out["n_iter"] = np.array(n_iter)
-    for key in pop[0].data if len(pop) else ():
-        values = pop.get(key)
-        if values.dtype != object and key not in out:
-            out[f"data.{key}"] = values
-    return out
-
-
-def _restore_population(arrays: dict[str, np.ndarray]) -> Population:
-    pop = Population.new(X=arrays["X"])
-    pop.set("F", arrays["F"], "G", arrays["G"], "CV", arrays["CV"])
-    for key, values in arrays.items():
-        if key.startswith("data."):  # (n_iter is checked by load_checkpoint, not stored)
-            pop.set(key[5:], values)
-    for ind in pop:
-        ind.evaluated.update({"F", "G", "H"})
-    return pop
-
-
-def _json_state(rng: np.random.Generator) -> dict[str, Any]:
-    state = rng.bit_generator.state
-    return json.loads(json.dumps(state, default=int))
-
-
-def _save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
-    folder.mkdir(parents=True, exist_ok=True)
-    arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
-
-    def write_npz(path: Path) -> None:
-        with path.open("wb") as fh:
-            np.savez(fh, **arrays)
-
-    write_atomic(folder / "checkpoint.npz", write_npz)
-    state = {
-        "format": "adept_traj.checkpoint",
-        "version": _CHECKPOINT_VERSION,
-        "n_iter": int(algorithm.n_iter),
-        "n_eval": int(algorithm.evaluator.n_eval),
-        "rng": _json_state(algorithm.random_state),
-        **meta,
-    }
-    write_atomic(folder / "checkpoint.json", lambda p: p.write_text(json.dumps(state, indent=1)))
-
-
-def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """Read a checkpoint folder: (metadata, population arrays)."""
-    meta_path, npz_path = folder / "checkpoint.json", folder / "checkpoint.npz"
-    if not meta_path.is_file() or not npz_path.is_file():
-        raise ConfigurationError(f"{folder}: no checkpoint to resume (checkpoint.json/.npz)")
-    try:
-        meta = json.loads(meta_path.read_text())
-        with np.load(npz_path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
-    version = _CHECKPOINT_VERSION
-    if meta.get("format") != "adept_traj.checkpoint" or meta.get("version") != version:
-        raise ConfigurationError(f"{meta_path}: not an adept_traj checkpoint of version {version}")
-    needed = {"n_iter", "n_eval", "rng", "fingerprint", "total_s", "evaluation_s", "history"}
-    missing = sorted(needed - set(meta)) + sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays))
-    if missing:
-        raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {missing}")
-    if int(arrays["n_iter"]) != meta["n_iter"]:
-        # Interrupted between the two atomic renames: the files are from two generations.
-        raise ConfigurationError(
-            f"{folder}: checkpoint.npz (generation {int(arrays['n_iter']) - 1}) and "
-            f"checkpoint.json (generation {meta['n_iter'] - 1}) disagree; cannot resume exactly"
-        )
-    return meta, arrays
 
 
 def optimise(
@@ -155,6 +82,15 @@ def optimise(
 
     Parameters
     ----------
+    problem:
+        A pymoo problem (e.g. :class:`~adept_traj.problem.TrajectoryProblem`).
+    algorithm:
+        A pymoo algorithm, not yet set up (e.g. from
+        :func:`~adept_traj.optimise.make_algorithm`); it is set up here.
+    n_gen:
+        Generations in total (a resumed run counts the checkpointed ones).
+    seed:
+        Seed of the algorithm's random generator.
     checkpoint:
         Folder for per-generation checkpoints (none if ``None``).
     resume:
@@ -164,6 +100,18 @@ def optimise(
         JSON-ready description of the run, stored in and compared with the checkpoint.
     progress:
         Called after every generation with a :class:`GenerationInfo`.
+
+    Returns
+    -------
+    RunState
+        The final population and the timings.
+
+    Raises
+    ------
+    ConfigurationError
+        ``resume`` without a usable checkpoint, or a checkpoint of another run.
+    PlanningInterrupted
+        On Ctrl-C; the last finished generation is in ``checkpoint`` (if given).
     """
     folder = Path(checkpoint) if checkpoint is not None else None
     fingerprint = fingerprint or {}
@@ -179,13 +127,7 @@ def optimise(
                 f"{folder}: the checkpoint belongs to another run (problem, algorithm, seed "
                 "or budget differ); start a new run or pass the same settings"
             )
-        algorithm._initialize()
-        algorithm.pop = _restore_population(arrays)
-        algorithm.is_initialized = True
-        algorithm.n_iter = meta["n_iter"]
-        algorithm.evaluator.n_eval = meta["n_eval"]
-        algorithm.random_state.bit_generator.state = meta["rng"]
-        algorithm._set_optimum()
+        restore_algorithm(algorithm, meta, arrays)
         spent_total, spent_eval = meta["total_s"], meta["evaluation_s"]
         history = meta["history"]
     start = time.perf_counter() - spent_total
@@ -231,7 +173,7 @@ def optimise(
                     "evaluation_s": evaluation_s,
                     "history": history,
                 }
-                _save_checkpoint(folder, algorithm, meta)
+                save_checkpoint(folder, algorithm, meta)
             if progress is not None:
                 progress(info)
     except KeyboardInterrupt:

@@ -2,18 +2,19 @@
 
 Steps:
 
-1. :func:`~adept_traj.algorithms.make_algorithm` (paper settings by default) and
-   :func:`~adept_traj.run.optimise` (seeded; optional checkpoints and exact resume).
+1. :func:`~adept_traj.optimise.make_algorithm` (paper settings by default) and
+   :func:`~adept_traj.optimise.optimise` (seeded; optional checkpoints and exact resume).
 2. **Front**: the feasible non-dominated members of the final population. If no member is
    feasible, the least-infeasible ones (the 10 with the smallest total violation) with a
    warning — never an empty result.
-3. **Best trade-off**: :func:`~adept_traj.decision.best_tradeoff` (f_c and F_avg ranks,
+3. **Best trade-off**: :func:`~adept_traj.analysis.best_tradeoff` (f_c and F_avg ranks,
    paper weights by default) on the front.
 4. **Certificate**: the chosen solution is re-verified on a ≥ 1 kHz grid
-   (:func:`~adept_traj.verification.certify`). If it fails (e.g. a torque peak between
-   samples), the next candidates in the trade-off order are certified, and the first that
-   passes is reported (up to ``max_certify`` tries); if none passes, the trade-off choice
-   is reported with its failing certificate.
+   (:func:`~adept_traj.analysis.certify`). If it fails (e.g. a torque peak between
+   samples), the next candidates in the trade-off order that the optimiser marked
+   feasible are certified, and the first that passes is reported (up to ``max_certify``
+   certificates in all); if none passes, the trade-off choice is reported with its
+   failing certificate. A front of least-infeasible members thus costs one certificate.
 5. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
@@ -28,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import certify
+from adept_traj.analysis.certificate import Certificate, certify
 from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
@@ -53,6 +54,7 @@ from adept_traj.results.record import (
     PlanningResult,
     Timing,
 )
+from adept_traj.validation import as_integer
 
 __all__ = ["plan"]
 
@@ -122,6 +124,35 @@ def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecor
     return records
 
 
+def _certified_choice(
+    problem: TrajectoryProblem,
+    front: Front,
+    order: np.ndarray,
+    rate_hz: float,
+    max_certify: int,
+) -> tuple[Certificate, int]:
+    """(certificate, front index) of the reported solution.
+
+    The best trade-off ``order[0]`` is certified; if it fails, the next members in the
+    trade-off ``order`` (n,) **that the optimiser marked feasible** are, up to
+    ``max_certify`` certificates in all, and the first that passes is reported. A member
+    that violates a constraint at the optimiser's samples is not tried: the dense check
+    (the same limits at ≥ ``rate_hz`` [Hz], samples and exact kinematic extrema) rejects it
+    anyway, and each certificate costs about a second. If none passes, the best trade-off
+    is reported with its failing certificate.
+    """
+    first = int(order[0])
+    certificate = certify(problem, front.x[first], rate_hz=rate_hz)
+    if certificate.feasible:
+        return certificate, first
+    further = [int(k) for k in order[1:] if front.feasible[k]]
+    for k in further[: max_certify - 1]:
+        candidate = certify(problem, front.x[k], rate_hz=rate_hz)
+        if candidate.feasible:
+            return candidate, k
+    return certificate, first
+
+
 def plan(
     problem: TrajectoryProblem,
     algorithm: str = "nsga2",
@@ -142,30 +173,31 @@ def plan(
     Parameters
     ----------
     problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
-    algorithm, pop_size, n_gen, params: see :func:`~adept_traj.algorithms.make_algorithm`.
+    algorithm, pop_size, n_gen, params: see :func:`~adept_traj.optimise.make_algorithm`.
     seed: random seed (the same seed gives the same front).
     weights: the six weights of f_c (default: the paper's).
     checkpoint, resume: checkpoint folder and whether to resume from it.
     progress: called after every generation.
     rate_hz: rate of the dense verification (≥ 1000 Hz recommended).
-    max_certify: how many trade-off candidates to certify before giving up.
+    max_certify: most certificates made: the trade-off choice and, if it fails, further
+        candidates among the members the optimiser marked feasible.
 
     Returns
     -------
     PlanningResult
         Never empty; ``result.feasible`` is the dense certificate's verdict.
     """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ConfigurationError(f"seed must be an integer ≥ 0; got {seed!r}")
+    seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
+    max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
     state = optimise(
         problem,
         alg,
         settings.n_gen,
-        int(seed),
+        seed,
         checkpoint=checkpoint,
         resume=resume,
-        fingerprint=_fingerprint(problem, settings, int(seed)),
+        fingerprint=_fingerprint(problem, settings, seed),
         progress=progress,
     )
     # The final population's values as the run computed them (z4 back to positive).
@@ -188,13 +220,7 @@ def plan(
         feasible=feasible[rows],
     )
     choice = best_tradeoff(front.objectives, weights)
-    certificate, index = None, choice.index
-    for k in choice.order[: max(1, max_certify)]:
-        candidate = certify(problem, front.x[k], rate_hz=rate_hz)
-        if certificate is None or (candidate.feasible and not certificate.feasible):
-            certificate, index = candidate, int(k)
-        if candidate.feasible:
-            break
+    certificate, index = _certified_choice(problem, front, choice.order, rate_hz, max_certify)
     lo, hi = objective_bounds(front.objectives)
     metrics = Metrics(
         ssm=spread(front.objectives) if len(rows) > 1 else None,
@@ -208,7 +234,7 @@ def plan(
         problem,
         algorithm=settings.name,
         algorithm_settings=settings.to_dict(),
-        seed=int(seed),
+        seed=seed,
         front=front,
         best=BestSolution(
             index=index, f_c=float(choice.f_c[index]), f_avg=float(choice.F_avg[index])

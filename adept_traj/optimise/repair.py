@@ -26,6 +26,7 @@ import numpy as np
 from pymoo.core.repair import Repair
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.validation import as_scalar
 
 __all__ = ["KinematicTimeRepair", "kinematic_time"]
 
@@ -64,9 +65,10 @@ class KinematicTimeRepair(Repair):
 
     def __init__(self, snap: float = 0.2) -> None:
         super().__init__()
-        if not 0.0 <= snap <= 1.0:
+        snap = as_scalar(snap, "snap", minimum=0.0, error=ConfigurationError)
+        if snap > 1.0:
             raise ConfigurationError(f"snap must be a probability in [0, 1]; got {snap}")
-        self.snap = float(snap)
+        self.snap = snap
 
     def _do(self, problem: Any, X: np.ndarray, **kwargs: Any) -> np.ndarray:
         X = np.array(X, dtype=float)

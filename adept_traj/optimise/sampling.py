@@ -20,7 +20,7 @@ random) and a random detour amplitude
 else 0); T is uniform in its bounds. The straight
 joint-space move is always included. Control points are clipped to the decision bounds.
 Travel times: half the individuals get T uniform in its bounds, the other half T just above
-their own kinematic minimum (:func:`~adept_traj.repair.kinematic_time` × U[1, 1.3]), so the
+their own kinematic minimum (:func:`~adept_traj.optimise.kinematic_time` × U[1, 1.3]), so the
 fast end of the front is explored from the start. Nothing about a particular scene is
 assumed.
 """
@@ -34,6 +34,7 @@ from pymoo.core.sampling import Sampling
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.repair import kinematic_time
+from adept_traj.validation import as_scalar
 
 __all__ = ["RampSampling"]
 
@@ -86,16 +87,20 @@ class RampSampling(Sampling):
         detour_prob: float = 0.25,
     ) -> None:
         super().__init__()
-        if not (np.isfinite(detour) and detour >= 0):
-            raise ConfigurationError(f"detour must be ≥ 0; got {detour}")
-        if not 0 < min_window <= 1:
-            raise ConfigurationError(f"min_window must be in (0, 1]; got {min_window}")
-        if not 0 <= detour_prob <= 1:
-            raise ConfigurationError(f"detour_prob must be in [0, 1]; got {detour_prob}")
-        if not 0 <= full_window <= 1:
-            raise ConfigurationError(f"full_window must be in [0, 1]; got {full_window}")
-        self.detour, self.min_window = float(detour), float(min_window)
-        self.full_window, self.detour_prob = float(full_window), float(detour_prob)
+        bad = ConfigurationError
+        detour = as_scalar(detour, "detour", minimum=0.0, error=bad)
+        min_window = as_scalar(min_window, "min_window", minimum=0.0, strict=True, error=bad)
+        full_window = as_scalar(full_window, "full_window", minimum=0.0, error=bad)
+        detour_prob = as_scalar(detour_prob, "detour_prob", minimum=0.0, error=bad)
+        for name, value in (
+            ("min_window", min_window),
+            ("full_window", full_window),
+            ("detour_prob", detour_prob),
+        ):
+            if value > 1.0:
+                raise bad(f"{name} must be a number ≤ 1; got {value}")
+        self.detour, self.min_window = detour, min_window
+        self.full_window, self.detour_prob = full_window, detour_prob
 
     def _do(self, problem: Any, n_samples: int, random_state: Any = None, **kwargs: Any):
         rng = random_state if random_state is not None else np.random.default_rng()

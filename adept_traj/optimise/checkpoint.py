@@ -1,0 +1,181 @@
+"""Checkpoints of a pymoo run without pickle, and the exact restore of the algorithm.
+
+A checkpoint folder holds two files, each written atomically:
+
+``checkpoint.npz`` (``np.savez``, read with ``allow_pickle=False``)
+    ``X`` (pop, n_var), ``F`` (pop, n_obj), ``G`` (pop, n_constr), ``CV`` (pop, 1) of the
+    population, ``n_iter`` (0-d, the generation counter, to match the two files), and
+    ``data.<key>`` for every numeric per-individual attribute the algorithm keeps (e.g.
+    ``data.rank`` (pop,), ``data.crowding`` (pop,)), and ``absent.<key>`` (pop,) bool for
+    an attribute that only some members have (the members without it).
+``checkpoint.json``
+    ``format`` = ``"adept_traj.checkpoint"``, ``version`` = 1, ``n_iter``, ``n_eval`` (the
+    evaluation counter), ``rng`` (the state of the algorithm's ``numpy`` generator), and what
+    the loop adds: ``fingerprint``, ``total_s`` [s], ``evaluation_s`` [s], ``history``.
+
+This module is the **only** one that relies on pymoo's internals (tested by
+``tests/test_checkpoint.py``, so that a pymoo upgrade that changes them fails there with a
+clear message):
+
+- ``Algorithm._initialize()`` (resets ``n_iter``, ``pop`` and ``opt`` before a restore) and
+  ``Algorithm._set_optimum()`` (recomputes ``opt`` from the restored population);
+- the attributes ``Algorithm.pop``, ``n_iter`` (the generation being run: a finished
+  generation g leaves g + 1), ``is_initialized``, ``random_state`` (the
+  ``numpy.random.Generator`` from which every operator draws), ``evaluator.n_eval`` and
+  ``termination`` (its ``update(algorithm)`` sets the progress from ``n_iter``, before
+  pymoo counts the generation);
+- ``Individual.data`` (the dict of per-individual attributes such as rank and crowding) and
+  ``Individual.evaluated`` (the set of evaluated values; the evaluator skips an individual
+  whose set holds F, G and H, so restored members are not evaluated again).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pymoo.core.population import Population
+
+from adept_traj.errors import ConfigurationError
+from adept_traj.files import write_atomic
+
+__all__ = ["CHECKPOINT_VERSION", "load_checkpoint", "restore_algorithm", "save_checkpoint"]
+
+#: Version of the checkpoint files (``checkpoint.json`` key ``version``).
+CHECKPOINT_VERSION = 1
+
+_FORMAT = "adept_traj.checkpoint"
+#: Keys the loop stores in ``checkpoint.json`` besides the algorithm's counters.
+_LOOP_KEYS = {"fingerprint", "total_s", "evaluation_s", "history"}
+#: Values the evaluator must not compute again for a restored individual.
+_EVALUATED = ("F", "G", "H")
+
+
+def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
+    """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint), with the
+    generation counter so that the two checkpoint files can be checked against each other.
+
+    An attribute that only some members have (NSGA-II ranks only the feasible ones) is
+    stored with the mask ``absent.<key>`` (pop,) of the members without it."""
+    out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
+    out["n_iter"] = np.array(n_iter)
+    for key in sorted({key for ind in pop for key in ind.data}):
+        values = [ind.data.get(key) for ind in pop]
+        have = np.array([v is not None for v in values])
+        present = np.array([v for v in values if v is not None])
+        if present.dtype == object:
+            continue  # not storable without pickle (and not needed by pymoo's operators)
+        full = np.zeros((len(pop), *present.shape[1:]), dtype=present.dtype)
+        full[have] = present
+        out[f"data.{key}"] = full
+        if not have.all():
+            out[f"absent.{key}"] = ~have
+    return out
+
+
+def _restore_population(arrays: dict[str, np.ndarray]) -> Population:
+    """The population of ``arrays``, marked evaluated (the evaluator skips its members)."""
+    pop = Population.new(X=arrays["X"])
+    pop.set("F", arrays["F"], "G", arrays["G"], "CV", arrays["CV"])
+    for name, values in arrays.items():
+        if name.startswith("data."):  # (n_iter is checked by load_checkpoint, not stored)
+            key = name.removeprefix("data.")
+            have = ~arrays.get(f"absent.{key}", np.zeros(len(pop), dtype=bool))
+            pop[have].set(key, values[have])
+    for ind in pop:
+        ind.evaluated.update(_EVALUATED)
+    return pop
+
+
+def _json_state(rng: np.random.Generator) -> dict[str, Any]:
+    """The generator's state as JSON-ready values (its 128-bit integers as Python ints)."""
+    state = rng.bit_generator.state
+    return json.loads(json.dumps(state, default=int))
+
+
+def save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
+    """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``.
+
+    Parameters
+    ----------
+    folder:
+        Created if missing; ``checkpoint.npz`` and ``checkpoint.json`` are replaced atomically.
+    algorithm:
+        A set-up, initialised pymoo algorithm.
+    meta:
+        JSON-ready values stored with it (the loop's ``fingerprint``, ``total_s`` [s],
+        ``evaluation_s`` [s] and ``history``).
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
+
+    def write_npz(path: Path) -> None:
+        with path.open("wb") as fh:
+            np.savez(fh, **arrays)
+
+    write_atomic(folder / "checkpoint.npz", write_npz)
+    state = {
+        "format": _FORMAT,
+        "version": CHECKPOINT_VERSION,
+        "n_iter": int(algorithm.n_iter),
+        "n_eval": int(algorithm.evaluator.n_eval),
+        "rng": _json_state(algorithm.random_state),
+        **meta,
+    }
+    write_atomic(folder / "checkpoint.json", lambda p: p.write_text(json.dumps(state, indent=1)))
+
+
+def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """Read a checkpoint folder: (metadata of ``checkpoint.json``, arrays of
+    ``checkpoint.npz``).
+
+    Raises
+    ------
+    ConfigurationError
+        No checkpoint in ``folder``, unreadable or incomplete files, another format or
+        version, or files of two different generations (interrupted between the two writes).
+    """
+    meta_path, npz_path = folder / "checkpoint.json", folder / "checkpoint.npz"
+    if not meta_path.is_file() or not npz_path.is_file():
+        raise ConfigurationError(f"{folder}: no checkpoint to resume (checkpoint.json/.npz)")
+    try:
+        meta = json.loads(meta_path.read_text())
+        with np.load(npz_path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
+    version = CHECKPOINT_VERSION
+    if meta.get("format") != _FORMAT or meta.get("version") != version:
+        raise ConfigurationError(f"{meta_path}: not an adept_traj checkpoint of version {version}")
+    needed = {"n_iter", "n_eval", "rng"} | _LOOP_KEYS
+    missing = sorted(needed - set(meta)) + sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays))
+    if missing:
+        raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {missing}")
+    if int(arrays["n_iter"]) != meta["n_iter"]:
+        # Interrupted between the two atomic renames: the files are from two generations.
+        raise ConfigurationError(
+            f"{folder}: checkpoint.npz (generation {int(arrays['n_iter']) - 1}) and "
+            f"checkpoint.json (generation {meta['n_iter'] - 1}) disagree; cannot resume exactly"
+        )
+    return meta, arrays
+
+
+def restore_algorithm(algorithm: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    """Put a freshly set-up ``algorithm`` into the state of a checkpoint (from
+    :func:`load_checkpoint`): population, generation and evaluation counters, random
+    generator and current optimum. The next ``ask`` continues exactly where the
+    checkpointed run stopped."""
+    algorithm._initialize()
+    algorithm.pop = _restore_population(arrays)
+    algorithm.is_initialized = True
+    algorithm.evaluator.n_eval = meta["n_eval"]
+    algorithm.random_state.bit_generator.state = meta["rng"]
+    # What pymoo does after finishing generation g = n_iter - 1, in its order: the optimum,
+    # the termination's progress (so a checkpoint of the last generation runs no further
+    # one), then the count.
+    algorithm.n_iter = meta["n_iter"] - 1
+    algorithm._set_optimum()
+    algorithm.termination.update(algorithm)
+    algorithm.n_iter = meta["n_iter"]
