@@ -25,7 +25,7 @@ import numpy as np
 from adept_traj.collision import point_signed_distance
 from adept_traj.collision.broad_phase import coal_kind, shape_of
 from adept_traj.robot import Robot
-from adept_traj.scene import Scene, Shape, Sphere, coal_transform
+from adept_traj.scene import Scene, Shape, Sphere
 
 __all__ = ["closest_points"]
 
@@ -100,16 +100,14 @@ def _coal_pair(
     n = solid.shape[0]
     distance, points = np.empty(n), np.empty((n, 2, 3))
     request, result = coal.DistanceRequest(), coal.DistanceResult()
+    tf_solid, tf_obstacle = coal.Transform3s(), coal.Transform3s()
     for k in range(n):
+        tf_solid.setRotation(solid[k, :3, :3])
+        tf_solid.setTranslation(solid[k, :3, 3])
+        tf_obstacle.setRotation(obstacle_poses[k, :3, :3])
+        tf_obstacle.setTranslation(obstacle_poses[k, :3, 3])
         result.clear()
-        distance[k] = coal.distance(
-            geometry,
-            coal_transform(solid[k]),
-            obstacle,
-            coal_transform(obstacle_poses[k]),
-            request,
-            result,
-        )
+        distance[k] = coal.distance(geometry, tf_solid, obstacle, tf_obstacle, request, result)
         points[k, 0] = result.getNearestPoint1()
         points[k, 1] = result.getNearestPoint2()
     return distance, points
