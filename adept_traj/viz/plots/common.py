@@ -143,7 +143,7 @@ def front_rows(result: PlanningResult) -> np.ndarray:
 
 def padded(lo: float, hi: float, frac: float = 0.06) -> tuple[float, float]:
     """Axis limits around [lo, hi], widened by ``frac`` of the span on each side; a
-    single value v gets ±5 % of |v| (±0.05 for 0)."""
+    single value v gets ±5 % of :math:`|v|` (±0.05 for 0)."""
     span = hi - lo
     if span <= 1e-12 * max(abs(lo), abs(hi)) or span == 0.0:
         pad = 0.05 * abs(lo) if lo != 0.0 else 0.05
