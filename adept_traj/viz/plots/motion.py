@@ -54,7 +54,7 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
 
     Parameters
     ----------
-    result: a :class:`PlanningResult`.
+    result: a :class:`~adept_traj.results.PlanningResult`.
     path: the PNG file to write.
 
     Returns
