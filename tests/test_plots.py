@@ -15,8 +15,11 @@ pytest.importorskip("matplotlib")
 
 import adept_traj as at
 from adept_traj.errors import InvalidInputError
-from adept_traj.results import GenerationRecord, PlanningResult
+from adept_traj.results import GenerationRecord, PlanningResult, Replay, RobotInfo
 from adept_traj.viz import plots
+from adept_traj.viz.plots import all_figures, wireframes
+from adept_traj.viz.plots.common import file_suffix
+from adept_traj.viz.plots.history import _records_hypervolume
 
 
 @pytest.fixture(scope="module")
@@ -112,7 +115,7 @@ def test_one_result_and_the_returned_path(
 def test_history_with_hypervolume(
     results: dict[str, PlanningResult], with_hypervolume: PlanningResult, tmp_path: Path
 ) -> None:
-    assert plots._records_hypervolume([with_hypervolume.history])
+    assert _records_hypervolume([with_hypervolume.history])
     both = {"with": with_hypervolume, "without": results["mode"]}
     assert_picture(plots.hypervolume_history(both, tmp_path / "hv.png"))
     assert_picture(plots.hypervolume_history(with_hypervolume, tmp_path / "hv1.png"))
@@ -121,7 +124,7 @@ def test_history_with_hypervolume(
 def test_history_without_hypervolume(results: dict[str, PlanningResult], tmp_path: Path) -> None:
     none = [dataclasses.replace(rec, hypervolume=None) for rec in results["mode"].history]
     bare = dataclasses.replace(results["mode"], history=none)
-    assert not plots._records_hypervolume([bare.history])
+    assert not _records_hypervolume([bare.history])
     assert_picture(plots.hypervolume_history({"a": bare}, tmp_path / "feasible.png"))
 
 
@@ -132,7 +135,7 @@ def test_history_missing(
     with pytest.raises(InvalidInputError, match="history"):
         plots.hypervolume_history(bare, tmp_path / "hv.png")
     for name in ("pareto_matrix", "best_tradeoffs", "joint_motion", "tool_path_3d"):
-        monkeypatch.setattr(plots, name, lambda _r, path: Path(path))  # no drawing
+        monkeypatch.setattr(all_figures, name, lambda _r, path, **_: Path(path))  # no drawing
     written = plots.save_all({"bare": bare}, tmp_path / "all")
     assert [p.name for p in written] == [
         "pareto_matrix.png",
@@ -142,10 +145,51 @@ def test_history_missing(
     ]  # no hypervolume_history.png
 
 
+def test_tool_path_with_a_replay_loads_nothing(
+    results: dict[str, PlanningResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The robot files are loaded once per figure without a replay, never with one."""
+    result = results["mode"]
+    replay = Replay.of(result)
+    loads = []
+    load = RobotInfo.load
+    monkeypatch.setattr(RobotInfo, "load", lambda info: loads.append(1) or load(info))
+    assert_picture(plots.tool_path_3d(result, tmp_path / "a.png", replay=replay), 1200, 800)
+    assert loads == []
+    assert_picture(plots.tool_path_3d(result, tmp_path / "b.png"), 1200, 800)
+    assert loads == [1]
+    for name in ("pareto_matrix", "best_tradeoffs", "joint_motion"):
+        monkeypatch.setattr(all_figures, name, lambda _r, path, **_: Path(path))  # no drawing
+    drawn = []
+    monkeypatch.setattr(
+        all_figures, "tool_path_3d", lambda _r, path, replay: drawn.append(replay) or path
+    )
+    plots.save_all({"m": result, "n": results["nsga2"]}, tmp_path / "all", replays={"m": replay})
+    assert drawn == [replay, None]
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda res: [], "replays must be a Mapping"),
+        (lambda res: {"other": None}, "names no result"),
+        (lambda res: {"mode": "replay"}, "replay must be a Replay"),
+        (lambda res: {"mode": Replay.of(res["nsga2"])}, "best_x"),  # another result's
+    ],
+    ids=["list", "unknown-name", "not-a-replay", "other-result"],
+)
+def test_bad_replays(
+    results: dict[str, PlanningResult], tmp_path: Path, make: object, match: str
+) -> None:
+    with pytest.raises(InvalidInputError, match=match):
+        plots.save_all(results, tmp_path / "figs", replays=make(results))  # type: ignore[operator]
+    assert not (tmp_path / "figs").exists()  # checked before anything is drawn
+
+
 def test_file_names_are_sanitised(results: dict[str, PlanningResult], tmp_path: Path) -> None:
-    assert plots._file_suffix("run 1/a") == "run_1_a"
-    assert plots._file_suffix("NSGA-II") == "NSGA-II"
-    assert plots._file_suffix("../..") == "result"
+    assert file_suffix("run 1/a") == "run_1_a"
+    assert file_suffix("NSGA-II") == "NSGA-II"
+    assert file_suffix("../..") == "result"
     with pytest.raises(InvalidInputError, match="clashing"):
         plots.save_all({"a b": results["mode"], "a/b": results["nsga2"]}, tmp_path)
     assert not any(tmp_path.iterdir())  # checked before anything is drawn
@@ -209,14 +253,14 @@ def test_matplotlib_is_imported_lazily() -> None:
 def test_wireframes_outline_the_solids() -> None:
     pose = np.eye(4)
     pose[:3, 3] = (1.0, 2.0, 3.0)
-    box = plots._wireframe("box", (0.5, 1.0, 1.5), pose)
+    box = wireframes.wireframe("box", (0.5, 1.0, 1.5), pose)
     assert len(box) == 12
     pts = np.vstack(box)
     np.testing.assert_allclose(pts.min(axis=0), (0.5, 1.0, 1.5))
     np.testing.assert_allclose(pts.max(axis=0), (1.5, 3.0, 4.5))
-    sphere = np.vstack(plots._wireframe("sphere", (0.2,), pose))
+    sphere = np.vstack(wireframes.wireframe("sphere", (0.2,), pose))
     np.testing.assert_allclose(np.linalg.norm(sphere - pose[:3, 3], axis=1), 0.2)
-    cyl = np.vstack(plots._wireframe("cylinder", (0.1, 0.3), pose))
+    cyl = np.vstack(wireframes.wireframe("cylinder", (0.1, 0.3), pose))
     np.testing.assert_allclose(cyl[:, 2].min(), 2.7)
     np.testing.assert_allclose(cyl[:, 2].max(), 3.3)
-    assert plots._wireframe("mesh", (), pose) == []
+    assert wireframes.wireframe("mesh", (), pose) == []

@@ -13,6 +13,7 @@ import sys
 import urllib.request
 from pathlib import Path
 
+import coal
 import numpy as np
 import pytest
 import umsgpack
@@ -20,9 +21,11 @@ import umsgpack
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import PlanningResult
+from adept_traj.results import PlanningResult, Replay, RobotInfo
+from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
 from adept_traj.testing.paper_moves import lift_then_lower, single_result
-from adept_traj.viz import meshcat_view as mv
+from adept_traj.viz import meshcat_scene, playback, server
+from adept_traj.viz.playback import MeshcatPath
 
 CHROMIUM_FLAGS = [
     "--headless",
@@ -47,7 +50,9 @@ def result(problem: TrajectoryProblem) -> PlanningResult:
 
 @pytest.fixture(scope="module")
 def page(result: PlanningResult, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return mv.static_html(result, tmp_path_factory.mktemp("viz") / "run" / "playback.html")
+    return meshcat_scene.static_html(
+        result, tmp_path_factory.mktemp("viz") / "run" / "playback.html"
+    )
 
 
 # ============================================================================ no server
@@ -55,9 +60,10 @@ def test_viz_package_is_lazy() -> None:
     code = (
         "import sys, adept_traj, adept_traj.viz as v\n"
         "assert 'meshcat' not in sys.modules and 'matplotlib' not in sys.modules\n"
-        "assert sorted(v.__all__) == ['meshcat_view', 'plots']\n"
-        "v.meshcat_view\n"
+        "assert v.__all__ == ['meshcat_scene', 'playback', 'plots', 'server']\n"
+        "v.plots, v.playback\n"
         "assert 'meshcat' in sys.modules and 'matplotlib' not in sys.modules\n"
+        "assert v.meshcat_view.static_html is v.meshcat_scene.static_html\n"
         "try:\n    v.nothing\nexcept AttributeError:\n    pass\nelse:\n    raise SystemExit(1)\n"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -65,7 +71,7 @@ def test_viz_package_is_lazy() -> None:
 
 
 def test_frames_and_poses(result: PlanningResult, problem: TrajectoryProblem) -> None:
-    pb = mv.build_animation(result, show_closest=True)
+    pb = playback.build_animation(result, show_closest=True)
     T = float(result.best_x[0])
     assert pytest.approx(2.1) == T
     assert pb.duration == pytest.approx(T)
@@ -109,14 +115,111 @@ def test_frames_and_poses(result: PlanningResult, problem: TrajectoryProblem) ->
     np.testing.assert_allclose(seg.poses[:, :3, 3] + ends[..., 0], pb.closest_points[:, 1])
     # the animation: one clip per moving node, keyframes in frames at the playback fps
     anim = pb.animation()
-    clip = anim.clips[mv.MeshcatPath(("meshcat", "robot", "link4", "gripper"))]
+    clip = anim.clips[MeshcatPath(("meshcat", "robot", "link4", "gripper"))]
     assert clip.fps == 30.0
     assert clip.tracks["position"].frames[-1] == pytest.approx(30 * T)
-    assert mv.MeshcatPath(("meshcat", "obstacles", "cube1")) not in anim.clips
+    assert MeshcatPath(("meshcat", "obstacles", "cube1")) not in anim.clips
+
+
+def coal_nearest(problem: TrajectoryProblem, q: np.ndarray, times: np.ndarray):
+    """Reference: per frame, coal's distance and witness points of the nearest (collision
+    solid, obstacle) pair over every pair, world frame."""
+    robot, scene = problem.robot, problem.scene
+    solids = scene.robot_base @ robot.geometry_poses(q)
+    obstacles = scene.obstacle_poses(times)
+    request, res = coal.DistanceRequest(), coal.DistanceResult()
+    distance, points = np.full(len(q), np.inf), np.zeros((len(q), 2, 3))
+    for k in range(len(q)):
+        for s, g in enumerate(robot.collision_model.geometryObjects):
+            for o, ob in enumerate(scene.obstacles):
+                a, b = solids[k, s], obstacles[o, k]
+                res.clear()
+                d = coal.distance(
+                    g.geometry,
+                    coal.Transform3s(a[:3, :3], a[:3, 3]),
+                    ob.shape.to_coal(),
+                    coal.Transform3s(b[:3, :3], b[:3, 3]),
+                    request,
+                    res,
+                )
+                if d < distance[k]:
+                    distance[k] = d
+                    points[k] = res.getNearestPoint1(), res.getNearestPoint2()
+    return distance, points
+
+
+def test_closest_points_match_coal(result: PlanningResult, problem: TrajectoryProblem) -> None:
+    pb = playback.build_animation(result, fps=10, show_closest=True)
+    distance, points = coal_nearest(problem, pb.q, pb.times)
+    np.testing.assert_allclose(pb.closest_distance, distance, atol=1e-9)
+    np.testing.assert_allclose(pb.closest_points, points, atol=1e-6)
+
+
+def test_closest_penetration_depth_of_a_sphere_in_a_cylinder(
+    problem: TrajectoryProblem,
+) -> None:
+    """A small ball inside the quill (a cylinder) near its upper cap at the start: the drawn
+    depth is the exact one, |z| − h, not coal 3.0.3's radial depth."""
+    robot = problem.robot
+    names = [g.name for g in robot.collision_model.geometryObjects]
+    quill = robot.collision_model.geometryObjects[names.index("link4/quill")].geometry
+    radius, half, ball = float(quill.radius), float(quill.halfLength), 0.004
+    local = np.array([0.3 * radius, 0.0, half - 0.3 * radius])  # inside, 7.5 mm under the cap
+    pose = (
+        problem.scene.robot_base @ robot.geometry_poses(problem.start)[names.index("link4/quill")]
+    )
+    centre = np.eye(4)
+    centre[:3, 3] = pose[:3, :3] @ local + pose[:3, 3]
+    scene = Scene(
+        obstacles=(Obstacle("ball", Sphere(ball), FixedPose(centre)),),
+        robot_base=problem.scene.robot_base,
+    )
+    inside = TrajectoryProblem(robot, scene, problem.start, problem.goal)
+    try:
+        res = single_result(inside, lift_then_lower(inside), rate_hz=100.0)
+    finally:
+        inside.close()
+    pb = playback.build_animation(res, fps=5, show_closest=True)
+    depth = max(math.hypot(local[0], local[1]) - radius, abs(local[2]) - half) - ball
+    assert depth == pytest.approx(-0.0115)
+    assert pb.closest_distance[0] == pytest.approx(depth, abs=1e-9)
+    gap = np.linalg.norm(pb.closest_points[0, 1] - pb.closest_points[0, 0])
+    assert gap == pytest.approx(-depth, abs=1e-9)
+
+
+def test_nothing_is_rebuilt_with_a_replay(
+    result: PlanningResult, problem: TrajectoryProblem, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """No TrajectoryProblem is rebuilt (no collision tables); the robot files are loaded once
+    per call without a replay and never with one."""
+    loads = []
+    load = RobotInfo.load
+    monkeypatch.setattr(RobotInfo, "load", lambda info: loads.append(1) or load(info))
+
+    def no_problem(*_args: object, **_kwargs: object) -> None:
+        raise AssertionError("result.problem() called")
+
+    monkeypatch.setattr(PlanningResult, "problem", no_problem)
+    playback.build_animation(result, show_closest=True)
+    assert len(loads) == 1
+    replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
+    pb = playback.build_animation(result, show_closest=True, replay=replay)
+    assert len(loads) == 1
+    np.testing.assert_allclose(pb.q[[0, -1]], [problem.start, problem.goal], atol=1e-12)
+
+
+def test_replay_of_another_solution(result: PlanningResult, problem: TrajectoryProblem) -> None:
+    x = np.array(result.best_x, dtype=float)
+    x[0] *= 1.5  # a slower move
+    other = Replay.of(result, x, robot=problem.robot, scene=problem.scene)
+    with pytest.raises(InvalidInputError, match="best_x"):
+        playback.build_animation(result, replay=other)
+    with pytest.raises(InvalidInputError, match="replay must be a Replay"):
+        playback.build_animation(result, replay=problem)
 
 
 def test_speed_and_fps(result: PlanningResult) -> None:
-    slow = mv.build_animation(result, speed=0.5, fps=10)
+    slow = playback.build_animation(result, speed=0.5, fps=10)
     T = slow.duration
     assert slow.n_frames == math.ceil(10 * T / 0.5) + 1
     assert slow.playback_duration == pytest.approx(2 * T)
@@ -141,17 +244,17 @@ def test_speed_and_fps(result: PlanningResult) -> None:
 )
 def test_bad_input(result: PlanningResult, kwargs: dict, match: str, tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match=match):
-        mv.build_animation(result, **kwargs)
+        playback.build_animation(result, **kwargs)
     with pytest.raises(InvalidInputError, match=match):
-        mv.static_html(result, tmp_path / "p.html", **kwargs)
+        meshcat_scene.static_html(result, tmp_path / "p.html", **kwargs)
     with pytest.raises(InvalidInputError, match=match):  # before any server starts
-        mv.show(result, **kwargs)
+        server.show(result, **kwargs)
     assert not (tmp_path / "p.html").exists()
 
 
 def test_not_a_result(tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match="PlanningResult"):
-        mv.static_html("out", tmp_path / "p.html")
+        meshcat_scene.static_html("out", tmp_path / "p.html")
 
 
 # ============================================================================ static page
@@ -222,7 +325,7 @@ def test_page_renders_in_headless_chromium(page: Path, tmp_path: Path) -> None:
     for img in shots:
         assert img.shape == (600, 800, 3)
         r, g, b = img[..., 0], img[..., 1], img[..., 2]
-        drawn = np.abs(img - np.array(mv.BACKGROUND_RGB)).max(axis=-1) > 0.03
+        drawn = np.abs(img - np.array(meshcat_scene.BACKGROUND_RGB)).max(axis=-1) > 0.03
         assert drawn.mean() > 0.15  # floor, obstacles and robot cover much of the view
         # the robot, in its own colours: blue elbow housing, orange gripper
         assert ((b > r + 0.25) & (b > g + 0.1)).sum() > 300
@@ -258,7 +361,7 @@ def listening_addresses(pid: int) -> list[tuple[str, str, int]]:
 def test_show_serves_on_localhost_only(
     result: PlanningResult, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    vis = mv.show(result, speed=2.0, show_closest=True)
+    vis = server.show(result, speed=2.0, show_closest=True)
     window = vis.window
     try:
         assert capsys.readouterr().out == ""  # prints nothing (meshcat itself would)

@@ -17,7 +17,10 @@ from adept_traj.robot.kinematics import (
     frames_to_poses,
 )
 from adept_traj.robot.limits import (
+    LIMIT_KINDS,
+    LIMITS,
     JointLimits,
+    LimitKind,
 )
 from adept_traj.robot.parameter_file import (
     TASK_ROWS,
@@ -41,6 +44,8 @@ from adept_traj.robot.urdf_builder import (
 )
 
 __all__ = [
+    "LIMITS",
+    "LIMIT_KINDS",
     "TASK_ROWS",
     "VELOCITY_AT_REST",
     "BatchKinematics",
@@ -48,6 +53,7 @@ __all__ = [
     "FrameParameters",
     "JointLimits",
     "JointParameters",
+    "LimitKind",
     "LinkParameters",
     "MassProperties",
     "Robot",

@@ -1,12 +1,21 @@
-"""Visualisation of planning results: meshcat playback (:mod:`.meshcat_view`) and plots
-(:mod:`.plots`).
+"""Visualisation of planning results: meshcat playback and plots.
+
+================================  ==========================================================
+:mod:`.playback`                  what is drawn and when: frames, poses, closest points
+:mod:`.meshcat_scene`             drawing a playback into meshcat; the self-contained page
+:mod:`.server`                    the live viewer on a local meshcat server (127.0.0.1)
+:mod:`.plots`                     the paper's figures as PNG files (matplotlib)
+================================  ==========================================================
 
 The submodules are imported lazily, on first attribute access, so ``import adept_traj.viz``
 imports neither meshcat nor matplotlib::
 
     from adept_traj import viz
 
-    viz.meshcat_view.static_html(result, "out/playback.html")  # imports meshcat here
+    viz.meshcat_scene.static_html(result, "out/playback.html")  # imports meshcat here
+    viz.plots.save_all(result, "out/figures")  # imports matplotlib here
+
+``viz.meshcat_view`` (the former single module) still re-exports the meshcat names.
 """
 
 from __future__ import annotations
@@ -15,14 +24,17 @@ import importlib
 from types import ModuleType
 from typing import TYPE_CHECKING
 
-__all__ = ["meshcat_view", "plots"]
+__all__ = ["meshcat_scene", "playback", "plots", "server"]
+
+#: Lazily imported as well: the former name of the meshcat modules.
+_FORMER = ("meshcat_view",)
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers only
-    from adept_traj.viz import meshcat_view, plots
+    from adept_traj.viz import meshcat_scene, playback, plots, server
 
 
 def __getattr__(name: str) -> ModuleType:
-    if name in __all__:
+    if name in __all__ or name in _FORMER:
         module = importlib.import_module(f".{name}", __name__)
         globals()[name] = module
         return module
@@ -30,4 +42,4 @@ def __getattr__(name: str) -> ModuleType:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(__all__) | set(_FORMER))

@@ -1,0 +1,399 @@
+"""The playback of a planning result: what is drawn, where, at which frame — independent
+of any visualizer.
+
+:func:`build_animation` turns a result's best trajectory (through its
+:class:`~adept_traj.results.Replay`: robot, scene and B-spline, loaded once) into a
+:class:`Playback`: the frames, the joint positions, and every drawn node with its world
+poses [m]. :mod:`~adept_traj.viz.meshcat_scene` draws a playback into a meshcat visualizer
+or an HTML page; :mod:`~adept_traj.viz.server` serves it live.
+
+What is drawn, all in the **world** frame of the scene [m]: the robot's link solids in the
+colours of its visual model (poses ``scene.robot_base @`` the base-frame poses), the fixed
+obstacles (red), the moving obstacles (purple: the pendulum's rod and bob) at the physical
+time of each frame, the tool path of the best trajectory (a green line with a sphere at the
+start and the goal), the floor z = 0 with a 0.1 m grid and the world axes and, optionally,
+the closest-point segment (yellow) between the robot's collision solids and the nearest
+obstacle at every frame (:mod:`~adept_traj.viz.closest_points`).
+
+Timing: frame ``k`` is shown at playback time ``k / fps`` [s] and shows the physical time
+
+.. math:: t_k = \\min(k \\cdot \\text{speed} / \\text{fps},\\ T)
+
+[s], the last frame exactly at ``T``: ``speed = 1`` is real time, ``speed = 0.5`` half speed.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
+    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
+    import meshcat.geometry as mg
+    from meshcat.animation import Animation, AnimationFrameVisualizer
+    from meshcat.path import Path as MeshcatPath
+
+from adept_traj.errors import InvalidInputError
+from adept_traj.results import PlanningResult, Replay
+from adept_traj.validation import as_scalar, check_type, readonly_copy
+from adept_traj.viz.closest_points import closest_points
+from adept_traj.viz.inputs import as_result, replay_for
+from adept_traj.viz.meshcat_geometry import (
+    Part,
+    hex_colour,
+    shape_parts,
+    solid_parts,
+    translation,
+)
+
+__all__ = [
+    "DEFAULT_ROOT",
+    "MAX_FRAMES",
+    "MAX_PATH_POINTS",
+    "Part",
+    "Playback",
+    "SceneObject",
+    "build_animation",
+    "frame_times",
+]
+
+#: Most frames an animation may have (``fps · T / speed``).
+MAX_FRAMES = 20_000
+#: Points of the drawn tool path at most (the dense trajectory is thinned evenly).
+MAX_PATH_POINTS = 4000
+#: Root path of a meshcat visualizer (``meshcat.Visualizer().path``).
+DEFAULT_ROOT = ("meshcat",)
+FIXED_OBSTACLE_COLOR = 0xC0392B
+MOVING_OBSTACLE_COLOR = 0x7D3C98
+TOOL_PATH_COLOR = 0x1E8449
+START_COLOR = 0x1E8449
+GOAL_COLOR = 0x0B5345
+CLOSEST_COLOR = 0xF1C40F
+FLOOR_COLOR = 0xE5E7E9
+GRID_COLOR = 0xB3B6B7
+
+_MARKER_RADIUS = 0.012  # tool path start/goal spheres [m]
+_SEGMENT_RADIUS = 0.005  # closest-point segment [m]
+_POINT_RADIUS = 0.01  # closest-point end spheres [m]
+_FOV_DEG = 75.0  # meshcat's default camera: vertical field of view
+_VIEW_DIRECTION = np.array([-0.7, -1.2, 0.9])  # camera offset direction from the target
+_GRID_STEP = 0.1  # floor grid spacing [m]
+_FLOOR_MARGIN = 0.3  # floor beyond the drawn scene [m]
+
+
+# ============================================================================ data
+@dataclass(frozen=True, eq=False)
+class SceneObject:
+    """A node of the drawn scene.
+
+    Attributes
+    ----------
+    path: meshcat path below the visualizer's root, e.g. ``"robot/link4/gripper"``.
+    parts: what is drawn in the node's frame (:class:`Part`).
+    poses: world poses of the node's frame: (n_frames, 4, 4) when animated, (4, 4) when
+        fixed [m].
+    scales: (n_frames, 3) per-frame scale of the node (only the closest-point segment), or
+        ``None``.
+    """
+
+    path: str
+    parts: tuple[Part, ...]
+    poses: np.ndarray
+    scales: np.ndarray | None = None
+
+    @property
+    def animated(self) -> bool:
+        """True when the node moves (one pose per frame)."""
+        return self.poses.ndim == 3
+
+    @property
+    def initial_pose(self) -> np.ndarray:
+        """(4, 4) pose at the first frame, scale included."""
+        pose = self.poses[0] if self.animated else self.poses
+        if self.scales is not None:
+            pose = pose @ np.diag([*self.scales[0], 1.0])
+        return pose
+
+
+@dataclass(frozen=True, eq=False)
+class Playback:
+    """Everything drawn and animated, independent of any visualizer.
+
+    Attributes
+    ----------
+    objects: the scene nodes (robot solids, obstacles, tool path, closest segment, floor).
+    times: (n_frames,) physical time of each frame [s], from 0 to ``duration``.
+    frame_numbers: (n_frames,) animation keyframe of each frame, ``times / speed · fps``
+        (integers except possibly the last).
+    q: (n_frames, nq) joint positions at the frames [rad | m].
+    fps: frames per second of playback [1/s].
+    speed: playback rate (1 = real time).
+    duration: travel time T of the best trajectory [s].
+    tool_path: (n_points, 3) world tool positions along the dense trajectory [m].
+    closest_points: (n_frames, 2, 3) world points on the robot and on the nearest obstacle
+        at each frame [m], or ``None`` (not requested, or no obstacle).
+    closest_distance: (n_frames,) their signed distance [m] (negative: penetration), or
+        ``None``.
+    camera_target, camera_position: (3,) world points the camera looks at and from [m].
+    """
+
+    objects: tuple[SceneObject, ...]
+    times: np.ndarray
+    frame_numbers: np.ndarray
+    q: np.ndarray
+    fps: float
+    speed: float
+    duration: float
+    tool_path: np.ndarray
+    closest_points: np.ndarray | None
+    closest_distance: np.ndarray | None
+    camera_target: np.ndarray
+    camera_position: np.ndarray
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames."""
+        return int(self.times.size)
+
+    @property
+    def playback_duration(self) -> float:
+        """Length of one loop of the animation in the browser, ``duration / speed`` [s]."""
+        return self.duration / self.speed
+
+    def animation(self, root: Sequence[str] = DEFAULT_ROOT) -> Animation:
+        """The meshcat animation of the animated nodes, for a visualizer whose path is
+        ``root`` (default: a top-level ``meshcat.Visualizer``)."""
+        anim = Animation(default_framerate=self.fps)
+        base = MeshcatPath(tuple(root))
+        for obj in self.objects:
+            if not obj.animated:
+                continue
+            node = AnimationFrameVisualizer(anim, base, 0)[obj.path]
+            for k, frame in enumerate(self.frame_numbers):
+                at = AnimationFrameVisualizer(anim, node.path, float(frame))
+                at.set_transform(obj.poses[k])
+                if obj.scales is not None:
+                    at.set_property("scale", "vector3", [float(v) for v in obj.scales[k]])
+        return anim
+
+
+# ============================================================================ building
+def frame_times(duration: float, speed: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Keyframes (n,) and physical times (n,) [s] of the frames of a move of ``duration``
+    T [s] played at ``speed`` and ``fps`` [1/s]: keyframes 0, 1, … and a last one exactly
+    at ``T / speed · fps`` (``ceil(fps · T / speed) + 1`` frames).
+
+    Raises
+    ------
+    InvalidInputError
+        More than :data:`MAX_FRAMES` frames.
+    """
+    last = duration / speed * fps  # keyframe of t = T
+    n_whole = math.floor(last + 1e-9)
+    if n_whole + 2 > MAX_FRAMES:
+        raise InvalidInputError(
+            f"fps · T / speed = {last:.0f} frames exceeds MAX_FRAMES = {MAX_FRAMES}; "
+            "lower fps or raise speed"
+        )
+    frames = np.arange(n_whole + 1, dtype=float)
+    if last - n_whole > 1e-9 or n_whole == 0:  # the last frame exactly at t = T
+        frames = np.append(frames, last)
+    times = np.minimum(frames * speed / fps, duration)
+    times[-1] = duration
+    return frames, times
+
+
+def build_animation(
+    result: PlanningResult,
+    *,
+    speed: float = 1.0,
+    fps: float = 30.0,
+    show_closest: bool = False,
+    replay: Replay | None = None,
+) -> Playback:
+    """Compute the scene and the animation of ``result``'s best trajectory.
+
+    Parameters
+    ----------
+    result: the planning result.
+    speed: playback rate, > 0 (1 = real time, 0.5 = half speed).
+    fps: frames per second of playback, > 0 [1/s]; the animation has
+        ``ceil(fps · T / speed) + 1`` frames (at most :data:`MAX_FRAMES`).
+    show_closest: also compute the closest-point segment between the robot's collision
+        solids and the nearest obstacle at each frame.
+    replay: the result's :class:`~adept_traj.results.Replay` if the caller has one (it must
+        replay ``result.best_x``); default ``Replay.of(result)``, which loads the robot
+        files named in the result (they must exist) and parses its stored scene.
+
+    Returns
+    -------
+    Playback
+
+    Raises
+    ------
+    InvalidInputError: ``result`` is not a PlanningResult, ``replay`` not one of its best
+        solution, ``speed`` or ``fps`` is not a positive finite number, too many frames, or
+        a robot solid meshcat cannot draw.
+    """
+    result = as_result(result)
+    speed = as_scalar(speed, "speed", "(playback rate, 1 = real time)", minimum=0, strict=True)
+    fps = as_scalar(fps, "fps", "[frames/s]", minimum=0, strict=True)
+    check_type(show_closest, (bool, np.bool_), "show_closest")
+    replay = replay_for(result, replay)
+    robot, scene, duration = replay.robot, replay.scene, replay.duration
+    frames, times = frame_times(duration, speed, fps)
+    q = replay.sample(times, orders=(0,)).q
+    base = scene.robot_base
+
+    objects: list[SceneObject] = []
+    # --- robot: the visual solids, in the visual model's colours (else the collision solids)
+    visual = robot.visual_model if robot.visual_model.ngeoms else robot.collision_model
+    solid_poses = base @ robot.geometry_poses(q, visual)  # (n, n_geom, 4, 4)
+    for k, g in enumerate(visual.geometryObjects):
+        rgba = np.asarray(g.meshColor, dtype=float)
+        material = mg.MeshLambertMaterial(color=hex_colour(rgba[:3]), opacity=float(rgba[3]))
+        objects.append(SceneObject(f"robot/{g.name}", solid_parts(g, material), solid_poses[:, k]))
+
+    # --- obstacles, at the physical time of each frame
+    obstacle_poses = scene.obstacle_poses(times)  # (n_obs, n, 4, 4)
+    for i, ob in enumerate(scene.obstacles):
+        color = MOVING_OBSTACLE_COLOR if ob.is_moving else FIXED_OBSTACLE_COLOR
+        material = mg.MeshLambertMaterial(color=color, opacity=1.0 if ob.is_moving else 0.85)
+        poses = obstacle_poses[i] if ob.is_moving else obstacle_poses[i, 0]
+        objects.append(SceneObject(f"obstacles/{ob.name}", shape_parts(ob.shape, material), poses))
+
+    # --- tool path of the dense (certified) trajectory
+    tool = _tool_path(result, replay)
+    objects.extend(_tool_path_objects(tool))
+
+    # --- closest-point segment
+    closest = distance = None
+    if show_closest and scene.obstacles:
+        closest, distance = closest_points(robot, scene, q, times)
+        objects.extend(_closest_objects(closest))
+
+    seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
+    seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
+    seen_points = np.vstack(seen)
+    objects.extend(_floor(seen_points))
+    target, position = _camera(seen_points)
+    return Playback(
+        objects=tuple(objects),
+        times=readonly_copy(times),
+        frame_numbers=readonly_copy(frames),
+        q=readonly_copy(q),
+        fps=fps,
+        speed=speed,
+        duration=duration,
+        tool_path=readonly_copy(tool),
+        closest_points=None if closest is None else readonly_copy(closest),
+        closest_distance=None if distance is None else readonly_copy(distance),
+        camera_target=readonly_copy(target),
+        camera_position=readonly_copy(position),
+    )
+
+
+def _tool_path(result: PlanningResult, replay: Replay) -> np.ndarray:
+    """(n, 3) world tool positions [m] at the certified dense samples (at most
+    :data:`MAX_PATH_POINTS`, thinned evenly)."""
+    dense_q = np.asarray(result.best_trajectory.q, dtype=float)
+    if dense_q.shape[0] > MAX_PATH_POINTS:
+        keep = np.unique(np.linspace(0, dense_q.shape[0] - 1, MAX_PATH_POINTS).round().astype(int))
+        dense_q = dense_q[keep]
+    return (replay.scene.robot_base @ replay.robot.tool_pose(dense_q))[:, :3, 3]
+
+
+def _tool_path_objects(tool: np.ndarray) -> list[SceneObject]:
+    line = mg.Line(
+        mg.PointsGeometry(np.ascontiguousarray(tool.T, dtype=np.float32)),
+        mg.LineBasicMaterial(color=TOOL_PATH_COLOR, linewidth=2.0),
+    )
+    objects = [SceneObject("tool_path/line", (Part(line, np.eye(4)),), np.eye(4))]
+    for name, point, color in (("start", tool[0], START_COLOR), ("goal", tool[-1], GOAL_COLOR)):
+        marker = mg.Mesh(mg.Sphere(_MARKER_RADIUS), mg.MeshLambertMaterial(color=color))
+        objects.append(
+            SceneObject(f"tool_path/{name}", (Part(marker, np.eye(4)),), translation(point))
+        )
+    return objects
+
+
+def _rotations_y_to(u: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations taking the y axis onto the unit vectors ``u`` (n, 3) (Rodrigues;
+    a half turn about x for ``u = -y``)."""
+    c = u[:, 1]  # y · u
+    v = np.stack([u[:, 2], np.zeros_like(c), -u[:, 0]], axis=-1)  # y × u
+    vx = np.zeros((len(u), 3, 3))
+    vx[:, 0, 1], vx[:, 0, 2] = -v[:, 2], v[:, 1]
+    vx[:, 1, 0], vx[:, 1, 2] = v[:, 2], -v[:, 0]
+    vx[:, 2, 0], vx[:, 2, 1] = -v[:, 1], v[:, 0]
+    flip = c < -1.0 + 1e-12
+    scale = 1.0 / np.where(flip, 1.0, 1.0 + c)
+    out = np.eye(3) + vx + (vx @ vx) * scale[:, None, None]
+    out[flip] = np.diag([1.0, -1.0, -1.0])
+    return out
+
+
+def _closest_objects(points: np.ndarray) -> list[SceneObject]:
+    """The closest-point segment (a unit cylinder along y, scaled and turned onto the
+    segment at each frame) and its two end spheres, for ``points`` (n, 2, 3) [m]."""
+    n = points.shape[0]
+    d = points[:, 1] - points[:, 0]
+    length = np.linalg.norm(d, axis=-1)
+    seg_poses = np.tile(np.eye(4), (n, 1, 1))
+    seg_poses[:, :3, 3] = 0.5 * (points[:, 0] + points[:, 1])
+    turn = length > 1e-9
+    seg_poses[turn, :3, :3] = _rotations_y_to(d[turn] / length[turn, None])
+    scales = np.ones((n, 3))
+    scales[:, 1] = np.maximum(length, 1e-6)
+    material = mg.MeshLambertMaterial(color=CLOSEST_COLOR)
+    rod = Part(mg.Mesh(mg.Cylinder(1.0, _SEGMENT_RADIUS), material), np.eye(4))  # along y
+    ends = []
+    for i, name in enumerate(("robot_point", "obstacle_point")):
+        poses = np.tile(np.eye(4), (n, 1, 1))
+        poses[:, :3, 3] = points[:, i]
+        ball = Part(mg.Mesh(mg.Sphere(_POINT_RADIUS), material), np.eye(4))
+        ends.append(SceneObject(f"closest/{name}", (ball,), poses))
+    return [SceneObject("closest/segment", (rod,), seg_poses, scales), *ends]
+
+
+def _floor(points: np.ndarray) -> list[SceneObject]:
+    """The floor z = 0 under ``points`` (n, 3) [m]: a light slab with a 0.1 m grid, and the
+    world axes (x red, y green, z blue, 0.2 m) at the origin."""
+    lo = np.floor((points[:, :2].min(axis=0) - _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
+    hi = np.ceil((points[:, :2].max(axis=0) + _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
+    size = hi - lo
+    slab = mg.Mesh(mg.Box([*size, 0.004]), mg.MeshLambertMaterial(color=FLOOR_COLOR))
+    centre = translation([*(0.5 * (lo + hi)), -0.0021])
+    segments: list[Any] = []
+    for axis in (0, 1):
+        n = round(size[axis] / _GRID_STEP)
+        for v in lo[axis] + _GRID_STEP * np.arange(n + 1):
+            a, b = np.zeros(3), np.zeros(3)
+            a[axis] = b[axis] = v
+            a[1 - axis], b[1 - axis] = lo[1 - axis], hi[1 - axis]
+            segments += [a, b]
+    grid = mg.LineSegments(
+        mg.PointsGeometry(np.ascontiguousarray(np.array(segments).T, dtype=np.float32)),
+        mg.LineBasicMaterial(color=GRID_COLOR),
+    )
+    return [
+        SceneObject("floor/slab", (Part(slab, np.eye(4)),), centre),
+        SceneObject("floor/grid", (Part(grid, np.eye(4)),), np.eye(4)),
+        SceneObject("floor/axes", (Part(mg.triad(0.2), np.eye(4)),), np.eye(4)),
+    ]
+
+
+def _camera(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A camera target (the centre of the box around ``points`` (n, 3)) and a position from
+    which all of it is in view [m]."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    target = 0.5 * (lo + hi)
+    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.3) + 0.15
+    distance = 1.05 * radius / math.tan(math.radians(0.5 * _FOV_DEG))
+    direction = _VIEW_DIRECTION / np.linalg.norm(_VIEW_DIRECTION)
+    return target, target + distance * direction
