@@ -219,10 +219,13 @@ def test_rpy_is_urdf_convention_and_round_trips() -> None:
         xyz2, rpy2 = xyz_rpy_from_transform(t)
         np.testing.assert_allclose(rpy2, rpy, atol=1e-12)
         np.testing.assert_array_equal(xyz2, xyz)
-    # gimbal lock: the recovered angles give back the same rotation
-    t = transform_from_xyz_rpy([0, 0, 0], [0.4, math.pi / 2, 0.3])
-    _, rpy = xyz_rpy_from_transform(t)
-    np.testing.assert_allclose(rotation_from_rpy(rpy), t[:3, :3], atol=1e-12)
+    # gimbal lock (both signs): the recovered angles give back the same rotation
+    for pitch in (math.pi / 2, -math.pi / 2):
+        t = transform_from_xyz_rpy([0, 0, 0], [0.4, pitch, 0.3])
+        _, rpy = xyz_rpy_from_transform(t)
+        np.testing.assert_allclose(rpy[1], pitch, atol=1e-7)
+        np.testing.assert_allclose(rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0]), t[:3, :3],
+                                   atol=1e-12)  # fmt: skip
 
 
 def test_transforms_are_batched() -> None:
@@ -232,6 +235,14 @@ def test_transforms_are_batched() -> None:
     for i in range(5):
         np.testing.assert_array_equal(batch[i], rotation_from_rpy(rpy[i]))
     assert transform_from_xyz_rpy(np.zeros((2, 5, 3)), rpy).shape == (2, 5, 4, 4)
+    xyz_b, rpy_b = xyz_rpy_from_transform(transform_from_xyz_rpy(np.zeros((2, 5, 3)), rpy))
+    assert xyz_b.shape == rpy_b.shape == (2, 5, 3)
+    np.testing.assert_allclose(rpy_b[1], rpy, atol=1e-12)
+
+
+def test_transform_shapes_that_do_not_broadcast_are_input_errors() -> None:
+    with pytest.raises(InputShapeError, match=r"xyz \(\.\.\., 3\) and rpy"):
+        transform_from_xyz_rpy(np.zeros((2, 3)), np.zeros((3, 3)))
 
 
 def test_fixed_pose() -> None:
