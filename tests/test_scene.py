@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import coal
 import numpy as np
 import pytest
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
 
 from adept_traj.errors import InputShapeError, InvalidInputError, SceneError
 from adept_traj.scene import (
@@ -505,6 +511,9 @@ def test_save_and_load(tmp_path: Path) -> None:
     scene = example_scene()
     path = tmp_path / "example.toml"
     scene.save(path)
+    text = path.read_text(encoding="utf-8")
+    assert text.startswith("# adept_traj scene file")
+    assert tomllib.loads(text) == scene.to_dict()  # an independent TOML reader
     loaded = Scene.from_file(path)
     assert loaded.to_dict() == Scene.from_dict(scene.to_dict()).to_dict()
     paper = Scene.paper()
