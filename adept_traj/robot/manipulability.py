@@ -1,4 +1,4 @@
-"""Manipulability of task Jacobians: the paper's z4 = |det J| (eq. 4) and Yoshikawa's measure.
+"""Manipulability of task Jacobians: the paper's z4 = ``|det J|`` (eq. 4) and Yoshikawa's.
 
 Batched over leading axes, with closed-form determinants for the small matrices of serial
 arms (k ≤ 4): one expression per batch instead of a batched LU.

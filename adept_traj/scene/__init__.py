@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from adept_traj.errors import SceneFileNotFoundError
 from adept_traj.scene.motion_laws import (
     FixedPose,
     MotionLaw,
@@ -13,7 +14,6 @@ from adept_traj.scene.scene import (
     pendulum_obstacles,
 )
 from adept_traj.scene.scene_file import (
-    SceneFileNotFoundError,
     read_paper_scene,
     read_scene_file,
     scene_from_dict,

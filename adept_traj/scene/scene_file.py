@@ -38,7 +38,6 @@ from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
 from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
 
 __all__ = [
-    "SceneFileNotFoundError",
     "read_paper_scene",
     "read_scene_file",
     "scene_from_dict",
