@@ -6,6 +6,8 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
+from importlib import metadata as _metadata
+
 from adept_traj.analysis.certificate import Certificate, certify
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
@@ -37,7 +39,10 @@ from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
 from adept_traj.scene.scene import Obstacle, Scene
 from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
 
-__version__ = "0.1.0"
+try:  # the installed distribution's version (pyproject.toml), one source of truth
+    __version__ = _metadata.version("adept-traj")
+except _metadata.PackageNotFoundError:  # a source checkout that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "ALGORITHMS",

@@ -1,8 +1,13 @@
-"""Homogeneous transforms: URDF roll-pitch-yaw and back, rotations about an axis, checks.
+r"""Homogeneous transforms: URDF roll-pitch-yaw and back, and the rigid-transform check.
 
 Conventions: a transform is a ``(..., 4, 4)`` array (rotation block, translation [m]);
-``rpy`` follows URDF, R = Rz(yaw) · Ry(pitch) · Rx(roll) [rad].
-All functions are batched over leading axes.
+``rpy`` follows URDF, :math:`R = R_z(\text{yaw})\,R_y(\text{pitch})\,R_x(\text{roll})` [rad].
+
+The conversions are Pinocchio's (``pin.rpy.rpyToMatrix``, ``pin.rpy.matrixToRpy``,
+``pin.SE3``), one call per pose. They serve file reading and writing (scene files, the
+robot's parameter file), a handful of poses at a time: leading batch axes are accepted and
+looped over (≈ 1 µs a pose, against ≈ 0.07 µs a pose for a closed-form numpy batch of 1000;
+no hot path converts batches of angles).
 """
 
 from __future__ import annotations
@@ -10,13 +15,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.validation import as_batch, as_finite_array
 
 __all__ = [
     "as_rigid_transform",
-    "axis_rotation",
     "rotation_from_rpy",
     "transform_from_xyz_rpy",
     "xyz_rpy_from_transform",
@@ -27,10 +32,11 @@ _RIGID_TOL = 1e-6
 
 
 def rotation_from_rpy(rpy: Any) -> np.ndarray:
-    """Rotation matrices from roll-pitch-yaw angles, URDF convention.
+    r"""Rotation matrices from roll-pitch-yaw angles, URDF convention (``pin.rpy.rpyToMatrix``).
 
-    ``R = Rz(yaw) · Ry(pitch) · Rx(roll)``: fixed-axis rotations about world x (roll), then
-    world y (pitch), then world z (yaw).
+    .. math:: R = R_z(\text{yaw})\,R_y(\text{pitch})\,R_x(\text{roll})
+
+    fixed-axis rotations about world x (roll), then world y (pitch), then world z (yaw).
 
     Args:
         rpy: (..., 3) roll, pitch, yaw [rad].
@@ -39,19 +45,8 @@ def rotation_from_rpy(rpy: Any) -> np.ndarray:
         (..., 3, 3) rotation matrices (a new array).
     """
     a = as_batch(rpy, "rpy", 3, "[rad]")
-    cr, cp, cy = np.cos(a[..., 0]), np.cos(a[..., 1]), np.cos(a[..., 2])
-    sr, sp, sy = np.sin(a[..., 0]), np.sin(a[..., 1]), np.sin(a[..., 2])
-    r = np.empty((*a.shape[:-1], 3, 3))
-    r[..., 0, 0] = cy * cp
-    r[..., 0, 1] = cy * sp * sr - sy * cr
-    r[..., 0, 2] = cy * sp * cr + sy * sr
-    r[..., 1, 0] = sy * cp
-    r[..., 1, 1] = sy * sp * sr + cy * cr
-    r[..., 1, 2] = sy * sp * cr - cy * sr
-    r[..., 2, 0] = -sp
-    r[..., 2, 1] = cp * sr
-    r[..., 2, 2] = cp * cr
-    return r + 0.0  # + 0.0 turns -0.0 into 0.0 (cosmetic, in printed matrices)
+    rows = [pin.rpy.rpyToMatrix(r) for r in a.reshape(-1, 3)]
+    return np.array(rows).reshape(*a.shape[:-1], 3, 3) + 0.0  # + 0.0: no -0.0 in printouts
 
 
 def transform_from_xyz_rpy(xyz: Any = (0.0, 0.0, 0.0), rpy: Any = (0.0, 0.0, 0.0)) -> np.ndarray:
@@ -67,7 +62,13 @@ def transform_from_xyz_rpy(xyz: Any = (0.0, 0.0, 0.0), rpy: Any = (0.0, 0.0, 0.0
     """
     p = as_batch(xyz, "xyz", 3, "[m]")
     r = rotation_from_rpy(rpy)
-    batch = np.broadcast_shapes(p.shape[:-1], r.shape[:-2])
+    try:
+        batch = np.broadcast_shapes(p.shape[:-1], r.shape[:-2])
+    except ValueError:
+        raise InputShapeError(
+            f"xyz (..., 3) and rpy (..., 3) must broadcast together; got shapes {p.shape} and "
+            f"{r.shape[:-1]}"
+        ) from None
     t = np.zeros((*batch, 4, 4))
     t[..., :3, :3] = r
     t[..., :3, 3] = p
@@ -76,10 +77,11 @@ def transform_from_xyz_rpy(xyz: Any = (0.0, 0.0, 0.0), rpy: Any = (0.0, 0.0, 0.0
 
 
 def xyz_rpy_from_transform(transform: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Translation and URDF roll-pitch-yaw angles of rigid transforms.
+    """Translation and URDF roll-pitch-yaw angles of rigid transforms (``pin.rpy.matrixToRpy``).
 
-    Inverse of :func:`transform_from_xyz_rpy`, with pitch in [-π/2, π/2] and roll, yaw in
-    (-π, π]. At gimbal lock (``|pitch| = π/2``) roll is set to 0 and yaw carries the rotation.
+    Inverse of :func:`transform_from_xyz_rpy`: pitch in [-π/2, π/2], roll and yaw in [-π, π].
+    At gimbal lock (``|pitch| = π/2``) only roll − yaw (pitch = π/2) or roll + yaw
+    (pitch = −π/2) is determined; the angles returned give back the same rotation.
 
     Args:
         transform: (..., 4, 4) rigid transforms.
@@ -88,17 +90,10 @@ def xyz_rpy_from_transform(transform: Any) -> tuple[np.ndarray, np.ndarray]:
         ``(xyz, rpy)``: (..., 3) translation [m] and (..., 3) roll, pitch, yaw [rad].
     """
     t = as_rigid_transform(transform, "transform", batched=True)
-    r = t[..., :3, :3]
-    cp = np.hypot(r[..., 0, 0], r[..., 1, 0])
-    pitch = np.arctan2(-r[..., 2, 0], cp)
-    locked = cp < 1e-12
-    roll = np.where(locked, 0.0, np.arctan2(r[..., 2, 1], r[..., 2, 2]))
-    yaw = np.where(
-        locked,
-        np.arctan2(-r[..., 0, 1], r[..., 1, 1]),
-        np.arctan2(r[..., 1, 0], r[..., 0, 0]),
-    )
-    return t[..., :3, 3].copy(), np.stack([roll, pitch, yaw], axis=-1)
+    poses = [pin.SE3(m) for m in t.reshape(-1, 4, 4)]
+    xyz = np.array([pose.translation for pose in poses]).reshape(*t.shape[:-2], 3)
+    rpy = np.array([pin.rpy.matrixToRpy(pose.rotation) for pose in poses])
+    return xyz, rpy.reshape(*t.shape[:-2], 3) + 0.0
 
 
 def as_rigid_transform(value: Any, name: str, *, batched: bool = False) -> np.ndarray:
@@ -106,7 +101,8 @@ def as_rigid_transform(value: Any, name: str, *, batched: bool = False) -> np.nd
 
     Raises :class:`InputShapeError` for a wrong shape and :class:`InvalidInputError` when the
     rotation block is not orthonormal with determinant +1 or the last row is not 0 0 0 1
-    (tolerance 1e-6).
+    (tolerance 1e-6). Batched numpy: the check runs on every pose an obstacle or a scene is
+    built with.
     """
     t = as_finite_array(value, name)
     if (batched and (t.ndim < 2 or t.shape[-2:] != (4, 4))) or (not batched and t.shape != (4, 4)):
@@ -122,15 +118,3 @@ def as_rigid_transform(value: Any, name: str, *, batched: bool = False) -> np.nd
             f"last-row error {row_err:.3g}"
         )
     return t
-
-
-def axis_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    r"""Rotations (..., 3, 3) by ``angle`` (...) [rad] about the unit ``axis`` (3,) (Rodrigues).
-
-    .. math:: R = \mathbf{1} + \sin\theta\,[u]_\times + (1-\cos\theta)\,[u]_\times^2
-    """
-    u = np.asarray(axis, dtype=float)
-    k = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-    s = np.sin(angle)[..., None, None]
-    c = np.cos(angle)[..., None, None]
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)

@@ -466,7 +466,7 @@ def test_batch_kinematics_any_axis_matches_pinocchio() -> None:
 
 @pytest.mark.parametrize("k", [1, 2, 3, 4, 5])
 def test_small_determinants_match_lapack(k: int) -> None:
-    from adept_traj.robot.robot import _det
+    from adept_traj.robot.manipulability import _det
 
     a = np.random.default_rng(k).normal(size=(7, 3, k, k))
     np.testing.assert_allclose(_det(a), np.linalg.det(a), rtol=1e-12, atol=1e-12)

@@ -3,11 +3,18 @@
 from __future__ import annotations
 
 import math
+import re
+import sys
 from pathlib import Path
 
 import coal
 import numpy as np
 import pytest
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
 
 from adept_traj.errors import InputShapeError, InvalidInputError, SceneError
 from adept_traj.scene import (
@@ -29,7 +36,7 @@ RNG = np.random.default_rng(20240611)
 
 # The paper's pendulum: l = 1 m, v0 = 2 m/s, ω = 3.14 rad/s, g = 9.81 m/s².
 L, V0, OMEGA, G = 1.0, 2.0, 3.14, 9.81
-PIVOT = np.array([0.9, 1.035, 1.35])
+PIVOT = np.array([0.75, 1.15, 1.45])  # as in adept_traj/data/scenes/paper.toml
 
 
 def paper_pendulum(**kw: object) -> PendulumMotion:
@@ -219,10 +226,13 @@ def test_rpy_is_urdf_convention_and_round_trips() -> None:
         xyz2, rpy2 = xyz_rpy_from_transform(t)
         np.testing.assert_allclose(rpy2, rpy, atol=1e-12)
         np.testing.assert_array_equal(xyz2, xyz)
-    # gimbal lock: the recovered angles give back the same rotation
-    t = transform_from_xyz_rpy([0, 0, 0], [0.4, math.pi / 2, 0.3])
-    _, rpy = xyz_rpy_from_transform(t)
-    np.testing.assert_allclose(rotation_from_rpy(rpy), t[:3, :3], atol=1e-12)
+    # gimbal lock (both signs): the recovered angles give back the same rotation
+    for pitch in (math.pi / 2, -math.pi / 2):
+        t = transform_from_xyz_rpy([0, 0, 0], [0.4, pitch, 0.3])
+        _, rpy = xyz_rpy_from_transform(t)
+        np.testing.assert_allclose(rpy[1], pitch, atol=1e-7)
+        np.testing.assert_allclose(rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0]), t[:3, :3],
+                                   atol=1e-12)  # fmt: skip
 
 
 def test_transforms_are_batched() -> None:
@@ -232,6 +242,14 @@ def test_transforms_are_batched() -> None:
     for i in range(5):
         np.testing.assert_array_equal(batch[i], rotation_from_rpy(rpy[i]))
     assert transform_from_xyz_rpy(np.zeros((2, 5, 3)), rpy).shape == (2, 5, 4, 4)
+    xyz_b, rpy_b = xyz_rpy_from_transform(transform_from_xyz_rpy(np.zeros((2, 5, 3)), rpy))
+    assert xyz_b.shape == rpy_b.shape == (2, 5, 3)
+    np.testing.assert_allclose(rpy_b[1], rpy, atol=1e-12)
+
+
+def test_transform_shapes_that_do_not_broadcast_are_input_errors() -> None:
+    with pytest.raises(InputShapeError, match=r"xyz \(\.\.\., 3\) and rpy"):
+        transform_from_xyz_rpy(np.zeros((2, 3)), np.zeros((3, 3)))
 
 
 def test_fixed_pose() -> None:
@@ -494,6 +512,9 @@ def test_save_and_load(tmp_path: Path) -> None:
     scene = example_scene()
     path = tmp_path / "example.toml"
     scene.save(path)
+    text = path.read_text(encoding="utf-8")
+    assert text.startswith("# adept_traj scene file")
+    assert tomllib.loads(text) == scene.to_dict()  # an independent TOML reader
     loaded = Scene.from_file(path)
     assert loaded.to_dict() == Scene.from_dict(scene.to_dict()).to_dict()
     paper = Scene.paper()
@@ -669,3 +690,65 @@ def test_from_dict_names_its_source() -> None:
         )
     with pytest.raises(SceneError, match=r"^<dict>: scene data must be a table"):
         Scene.from_dict([1, 2])  # type: ignore[arg-type]
+
+
+# ================================================================ docs agree with the file
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _numbers_in(text: str) -> list[float]:
+    """The decimal numbers of a piece of prose ("−" read as a minus, "–" as a range dash)."""
+    return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?", text.replace("−", "-"))]
+
+
+def _table_cell(markdown: str, label: str) -> str:
+    """The second cell of the table row whose first cell is ``label``."""
+    rows = [line for line in markdown.splitlines() if line.startswith(f"| {label} |")]
+    assert len(rows) == 1, f"expected one table row {label!r}; found {rows}"
+    return rows[0].split("|")[2]
+
+
+def test_docs_quote_the_shipped_paper_scene() -> None:
+    """Every number docs/scene-files.md and docs/paper-scenario.md quote from the paper's
+    scene is the number in adept_traj/data/scenes/paper.toml (read with tomllib)."""
+    toml = tomllib.loads((ROOT / "adept_traj/data/scenes/paper.toml").read_text("utf-8"))
+    robot, task, (pendulum,) = toml["robot"], toml["task"], toml["pendulum"]
+    cubes = {ob["name"]: ob for ob in toml["obstacle"]}
+
+    scene_files = (ROOT / "docs/scene-files.md").read_text("utf-8")
+    section = scene_files[scene_files.index("## The paper's scene") :]
+    assert "adept_traj/data/scenes/paper.toml" in section.splitlines()[0]
+    assert "placeholder" not in scene_files
+    quoted = {
+        key: _numbers_in(values)
+        for key, values in re.findall(r"`(\w+) = \[([^\]]*)\]`", section)
+    }  # fmt: skip
+    expected = {
+        "xyz": robot["xyz"], "rpy": robot["rpy"], "start": task["start"],
+        "goal": task["goal"], "pivot": pendulum["pivot"],
+    }  # fmt: skip
+    assert quoted == expected
+    for key in ("bob_radius", "rod_radius"):
+        assert f"`{key} = {pendulum[key]}`" in section
+
+    scenario = (ROOT / "docs/paper-scenario.md").read_text("utf-8")
+    assert "adept_traj/data/scenes/paper.toml" in scenario
+    assert _numbers_in(_table_cell(scenario, "robot base position")) == robot["xyz"]
+    yaw = _numbers_in(_table_cell(scenario, "robot base yaw"))
+    assert robot["rpy"][:2] == [0.0, 0.0]
+    assert yaw == [pytest.approx(math.degrees(robot["rpy"][2]))]
+    assert _numbers_in(_table_cell(scenario, "pendulum pivot")) == pendulum["pivot"]
+    assert _numbers_in(_table_cell(scenario, "start d3")) == [task["start"][2]]
+    assert _numbers_in(_table_cell(scenario, "goal d3")) == [task["goal"][2]]
+    assert _numbers_in(_table_cell(scenario, "bob radius")) == [pendulum["bob_radius"]]
+    assert _numbers_in(_table_cell(scenario, "rod radius")) == [pendulum["rod_radius"]]
+    thetas = _numbers_in(_table_cell(scenario, "θ1, θ2, θ4 of start and goal"))
+    assert thetas == [task[k][i] for k in ("start", "goal") for i in (0, 1, 3)]
+    for label, cube in (("Cube 1", cubes["cube1"]), ("Cube 2", cubes["cube2"])):
+        ranges = _numbers_in(_table_cell(scenario, label).replace("–", " "))
+        assert ranges == [v for lo, hi in zip(cube["min"], cube["max"]) for v in (lo, hi)]
+    law = _table_cell(scenario, "pendulum")
+    for symbol, key in (("l", "length"), ("v0", "v0"), ("g", "g")):
+        assert float(re.search(rf"\b{symbol} = (\d+(?:\.\d+)?)", law)[1]) == pendulum[key]
+    assert float(re.search(r"sin\((\d+(?:\.\d+)?) t\)", law)[1]) == pendulum["omega"]

@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adept_traj.errors import InvalidInputError, RobotModelError
+from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
 from adept_traj.robot import (
     RobotParameters,
     box_inertia,
@@ -57,6 +57,19 @@ def test_cylinder_inertia_against_numerical_integration() -> None:
     np.testing.assert_allclose(sphere_inertia(5.0, 0.2), np.eye(3) * 0.08)
 
 
+def test_solid_inertias_equal_the_closed_forms() -> None:
+    """The textbook formulas (the reference; the library calls pin.Inertia.From*)."""
+    m, (sx, sy, sz) = 2.7, (0.3, 0.5, 0.11)
+    box = np.diag([sy**2 + sz**2, sx**2 + sz**2, sx**2 + sy**2]) * m / 12
+    np.testing.assert_allclose(box_inertia(m, (sx, sy, sz)), box, rtol=1e-14, atol=0)
+    r, length = 0.07, 0.42
+    ixx = m * (3 * r**2 + length**2) / 12
+    cylinder = np.diag([ixx, ixx, m * r**2 / 2])
+    np.testing.assert_allclose(cylinder_inertia(m, r, length), cylinder, rtol=1e-14, atol=0)
+    np.testing.assert_allclose(sphere_inertia(m, r), np.eye(3) * 2 / 5 * m * r**2, rtol=1e-14,
+                               atol=0)  # fmt: skip
+
+
 def test_rotated_box_equals_box_with_permuted_sides() -> None:
     rot = rotation_from_rpy((0.0, 0.0, np.pi / 2))
     turned = combine([(1.0, np.zeros(3), rot, box_inertia(1.0, (0.1, 0.5, 0.2)))])
@@ -84,10 +97,18 @@ def test_model_inertials_are_the_sum_of_link_solids() -> None:
 
 
 def test_inertia_rejects_bad_values() -> None:
-    with pytest.raises(InvalidInputError, match="mass must be a positive"):
+    with pytest.raises(
+        InvalidInputError, match=r"mass must be a finite number > 0 \[kg\]; got -1.0"
+    ):
         box_inertia(-1.0, (1, 1, 1))
-    with pytest.raises(InvalidInputError, match="radius"):
+    with pytest.raises(InvalidInputError, match=r"radius must be a finite number > 0 \[m\]"):
         cylinder_inertia(1.0, 0.0, 1.0)
+    with pytest.raises(InvalidInputError, match=r"size_y must be a finite number > 0 \[m\]"):
+        box_inertia(1.0, (0.1, -0.2, 0.3))
+    with pytest.raises(InputShapeError, match=r"size must have shape \(3,\)"):
+        box_inertia(1.0, (0.1, 0.2))
+    with pytest.raises(InvalidInputError, match="mass"):
+        sphere_inertia(True, 0.1)  # a bool is not a mass
     with pytest.raises(InvalidInputError, match="at least one solid"):
         combine([])
 

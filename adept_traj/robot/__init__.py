@@ -22,6 +22,9 @@ from adept_traj.robot.limits import (
     JointLimits,
     LimitKind,
 )
+from adept_traj.robot.manipulability import (
+    manipulability_measure,
+)
 from adept_traj.robot.parameter_file import (
     TASK_ROWS,
     FrameParameters,
@@ -35,12 +38,16 @@ from adept_traj.robot.robot import (
     ForwardKinematics,
     Robot,
     coulomb_sign,
-    manipulability_measure,
 )
 from adept_traj.robot.urdf_builder import (
     build_urdf,
     link_mass_properties,
     solid_inertia,
+)
+from adept_traj.robot.urdf_loading import (
+    apply_parameters,
+    load_urdf_models,
+    shipped_file,
 )
 
 __all__ = [
@@ -59,6 +66,7 @@ __all__ = [
     "Robot",
     "RobotParameters",
     "SolidParameters",
+    "apply_parameters",
     "box_inertia",
     "build_urdf",
     "combine",
@@ -67,7 +75,9 @@ __all__ = [
     "cylinder_inertia",
     "frames_to_poses",
     "link_mass_properties",
+    "load_urdf_models",
     "manipulability_measure",
+    "shipped_file",
     "solid_inertia",
     "sphere_inertia",
 ]

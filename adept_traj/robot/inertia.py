@@ -8,12 +8,14 @@ All inertia tensors are ``(3, 3)`` arrays in [kg·m²]; positions in [m]; masses
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.validation import as_scalar, as_vector
 
 __all__ = ["MassProperties", "box_inertia", "combine", "cylinder_inertia", "sphere_inertia"]
 
@@ -28,39 +30,43 @@ class MassProperties:
     inertia: np.ndarray
 
 
-def _check_positive(**values: float) -> None:
-    for name, value in values.items():
-        if not (np.isfinite(value) and value > 0):
-            raise InvalidInputError(f"{name} must be a positive finite number; got {value!r}")
+def _positive(value: float, name: str) -> float:
+    return as_scalar(value, name, "[kg]" if name == "mass" else "[m]", minimum=0.0, strict=True)
 
 
-def box_inertia(mass: float, size: Iterable[float]) -> np.ndarray:
-    r"""Inertia (3, 3) [kg·m²] of a uniform box of full side lengths ``size`` (3,) [m]
-    about its centre, in its own axes.
+def box_inertia(mass: float, size: Sequence[float] | np.ndarray) -> np.ndarray:
+    r"""Inertia (3, 3) [kg·m²] of a uniform box of mass ``mass`` [kg] and full side lengths
+    ``size`` (3,) [m] about its centre, in its own axes (``pin.Inertia.FromBox``).
 
-    .. math:: I_{xx} = \tfrac{m}{12}(s_y^2 + s_z^2), \ldots
+    .. math::
+        I = \tfrac{m}{12}\operatorname{diag}\left(s_y^2 + s_z^2,\ s_x^2 + s_z^2,\
+            s_x^2 + s_y^2\right)
     """
-    sx, sy, sz = (float(s) for s in size)
-    _check_positive(mass=mass, size_x=sx, size_y=sy, size_z=sz)
-    return np.diag([sy**2 + sz**2, sx**2 + sz**2, sx**2 + sy**2]) * (mass / 12.0)
+    m = _positive(mass, "mass")
+    sides = as_vector(size, "size", 3, "[m]")
+    sx, sy, sz = (_positive(s, f"size_{axis}") for s, axis in zip(sides, "xyz"))
+    return pin.Inertia.FromBox(m, sx, sy, sz).inertia.copy()
 
 
 def cylinder_inertia(mass: float, radius: float, length: float) -> np.ndarray:
-    r"""Inertia (3, 3) [kg·m²] of a uniform solid cylinder (axis = local z, full
-    ``length`` [m], ``radius`` [m]) about its centre.
+    r"""Inertia (3, 3) [kg·m²] of a uniform solid cylinder of mass ``mass`` [kg] (axis =
+    local z, full ``length`` [m], ``radius`` [m]) about its centre
+    (``pin.Inertia.FromCylinder``).
 
     .. math:: I_{zz} = \tfrac{m r^2}{2}, \quad I_{xx} = I_{yy} = \tfrac{m}{12}(3 r^2 + l^2)
     """
-    _check_positive(mass=mass, radius=radius, length=length)
-    ixx = mass * (3.0 * radius**2 + length**2) / 12.0
-    return np.diag([ixx, ixx, mass * radius**2 / 2.0])
+    m, r, length = _positive(mass, "mass"), _positive(radius, "radius"), _positive(length, "length")
+    return pin.Inertia.FromCylinder(m, r, length).inertia.copy()
 
 
 def sphere_inertia(mass: float, radius: float) -> np.ndarray:
-    r"""Inertia (3, 3) [kg·m²] of a uniform solid sphere about its centre:
-    :math:`\tfrac{2}{5} m r^2 \mathbf{1}`."""
-    _check_positive(mass=mass, radius=radius)
-    return np.eye(3) * (0.4 * mass * radius**2)
+    r"""Inertia (3, 3) [kg·m²] of a uniform solid sphere of mass ``mass`` [kg] and radius
+    ``radius`` [m] about its centre (``pin.Inertia.FromSphere``).
+
+    .. math:: I = \tfrac{2}{5} m r^2 \mathbf{1}
+    """
+    m, r = _positive(mass, "mass"), _positive(radius, "radius")
+    return pin.Inertia.FromSphere(m, r).inertia.copy()
 
 
 def combine(parts: Iterable[tuple[float, np.ndarray, np.ndarray, np.ndarray]]) -> MassProperties:

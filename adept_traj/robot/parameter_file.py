@@ -6,7 +6,7 @@ rotor inertia and gear ratio (their product ``rotor_inertia · gear_ratio²`` be
 Pinocchio's ``model.armature``) and Coulomb/viscous friction; at the top level the tool frame
 and the rows of the square task Jacobian. Values given here override the URDF's. The
 AdeptOne XL file additionally describes the whole chain (joint origins, link solids and
-masses), from which :mod:`adept_traj.urdf_builder` writes the shipped URDF.
+masses), from which :mod:`adept_traj.robot.urdf_builder` writes the shipped URDF.
 
 Units: SI — [m], [rad], [s], [kg], [kg·m²], [N], [N·m].
 """

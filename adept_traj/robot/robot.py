@@ -1,7 +1,7 @@
 """The robot: a Pinocchio model with collision geometry, limits and batched evaluations.
 
 :class:`Robot` loads a URDF (plus an optional parameter file, see
-:mod:`adept_traj.parameters`) into Pinocchio and offers the quantities the planner needs,
+:mod:`adept_traj.robot.parameter_file`) into Pinocchio and offers the quantities the planner needs,
 batched over any leading axes (population, time, …):
 
 - :meth:`Robot.inverse_dynamics` — joint torques/forces with rotor inertia and friction;
@@ -14,12 +14,9 @@ AdeptOne XL they are exactly the DH variables (θ1, θ2, d3, θ4) of the paper's
 
 from __future__ import annotations
 
-import contextlib
-import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +25,9 @@ import pinocchio as pin
 from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
 from adept_traj.robot.kinematics import BatchKinematics, compose, frames_to_poses
 from adept_traj.robot.limits import JointLimits
+from adept_traj.robot.manipulability import manipulability_measure
 from adept_traj.robot.parameter_file import TASK_ROWS, RobotParameters
+from adept_traj.robot.urdf_loading import apply_parameters, load_urdf_models, shipped_file
 from adept_traj.validation import as_batch
 
 __all__ = [
@@ -36,7 +35,6 @@ __all__ = [
     "ForwardKinematics",
     "Robot",
     "coulomb_sign",
-    "manipulability_measure",
 ]
 
 #: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
@@ -47,25 +45,6 @@ VELOCITY_AT_REST = 1e-9
 _PARALLEL_MIN_BATCH = 16
 
 
-def shipped_file(name: str) -> Path:
-    """Path of a shipped robot file (``adept_one_xl.urdf``, ``adept_one_xl.toml``).
-
-    The top-level ``urdf/`` folder is packaged as ``adept_traj.urdf``; it is found with
-    :mod:`importlib.resources` in a wheel or an editable install, and as ``urdf/`` beside the
-    package in a plain source checkout.
-    """
-    candidates = []
-    with contextlib.suppress(ModuleNotFoundError):
-        candidates.append(Path(str(resources.files("adept_traj.urdf").joinpath(name))))
-    candidates.append(Path(__file__).resolve().parents[2] / "urdf" / name)
-    for candidate in candidates:
-        if candidate.is_file():
-            return candidate
-    raise RobotModelError(
-        f"shipped robot file '{name}' not found (looked in {', '.join(map(str, candidates))})"
-    )
-
-
 @dataclass(frozen=True)
 class ForwardKinematics:
     """Everything the planner needs from one forward-kinematics pass over ``q`` (..., nq).
@@ -73,7 +52,7 @@ class ForwardKinematics:
     Attributes
     ----------
     joint_frames: (njoints, 3, 4, N) joint frames in the base frame, component-major
-        (:meth:`~adept_traj.kinematics.BatchKinematics.joint_frames`; N = ∏ ``...``).
+        (:meth:`~adept_traj.robot.kinematics.BatchKinematics.joint_frames`; N = ∏ ``...``).
     joint_poses: (..., njoints, 4, 4) the same as poses (index 0 = universe; formed on
         first access).
     tool_pose: (..., 4, 4) tool frame in the base frame.
@@ -200,7 +179,7 @@ class Robot:
         params:
             Optional parameter file (TOML path or :class:`RobotParameters`): acceleration
             and jerk limits, rotor inertia × gear ratio² (→ ``model.armature``), and
-            overrides of any URDF joint value. See :mod:`adept_traj.parameters`.
+            overrides of any URDF joint value. See :mod:`adept_traj.robot.parameter_file`.
         tool_frame:
             Tool frame name; default: the parameter file's ``tool_frame``, else the last
             frame of the model.
@@ -215,41 +194,14 @@ class Robot:
             parameter file naming a joint the URDF does not have, an unknown tool frame.
         """
         path = Path(urdf)
-        if not path.is_file():
-            raise RobotModelError(f"URDF not found: {path}")
-        try:
-            root = ET.parse(path).getroot()
-        except ET.ParseError as exc:
-            raise RobotModelError(f"{path}: malformed XML: {exc}") from None
-        if root.tag != "robot":
-            raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
-        try:
-            model = pin.buildModelFromUrdf(str(path))
-            collision = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION)
-            visual = pin.buildGeomFromUrdf(model, str(path), pin.VISUAL)
-        except (RuntimeError, ValueError) as exc:
-            raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
-        if model.nq == 0:
-            raise RobotModelError(f"{path}: the robot has no moving joint")
-        _name_geometries(collision, root, "collision")
-        _name_geometries(visual, root, "visual")
+        name, model, collision, visual = load_urdf_models(path)
 
         if params is not None and not isinstance(params, RobotParameters):
             params_path: Path | None = Path(params)
             params = RobotParameters.from_file(params_path)
         else:
             params_path = None
-        acceleration, jerk = _apply_parameters(model, params, path)
-        limits = JointLimits(
-            names=tuple(model.names[1:]),
-            units=tuple(_joint_unit(model, i) for i in range(1, model.njoints)),
-            lower=model.lowerPositionLimit,
-            upper=model.upperPositionLimit,
-            velocity=model.velocityLimit,
-            acceleration=acceleration,
-            jerk=jerk,
-            torque=model.effortLimit,
-        )
+        limits = apply_parameters(model, params, path)
         if tool_frame is None:
             tool_frame = params.tool_frame if params and params.tool_frame else None
         if tool_frame is None:
@@ -265,7 +217,7 @@ class Robot:
             limits=limits,
             tool_frame=tool_frame,
             task_rows=tuple(task_rows) if task_rows is not None else None,
-            name=root.get("name", path.stem),
+            name=name,
             urdf_path=path,
             params_path=params_path,
         )
@@ -438,108 +390,6 @@ class Robot:
         return manipulability_measure(np.moveaxis(jac[rows], -1, 0))
 
 
-def manipulability_measure(jt: np.ndarray) -> np.ndarray:
-    r"""Manipulability (...) of task Jacobians ``jt`` (..., m, n).
-
-    .. math::
-        w = |\det J_t| \ (m = n), \qquad
-        w = \sqrt{\det(J_t J_t^\top)} \ (m < n, \text{Yoshikawa}), \qquad
-        w = \sqrt{\det(J_t^\top J_t)} \ (m > n)
-
-    (with more task rows than joints :math:`J_t J_t^\top` is singular; the volume of the
-    n-dimensional velocity ellipsoid is :math:`\sqrt{\det J_t^\top J_t}`).
-    """
-    m, n = jt.shape[-2:]
-    if m == n:
-        return np.abs(_det(jt))
-    jt_t = np.swapaxes(jt, -1, -2)
-    gram = jt @ jt_t if m < n else jt_t @ jt
-    return np.sqrt(np.maximum(_det(gram), 0.0))
-
-
-def _det(a: np.ndarray) -> np.ndarray:
-    """Determinants (...) of square matrices (..., k, k): closed forms up to k = 4 (the
-    Laplace expansion in 2 × 2 minors; elementwise over the batch, several times faster
-    than a batched LU for small matrices), :func:`numpy.linalg.det` beyond."""
-    k = a.shape[-1]
-    if k == 1:
-        return a[..., 0, 0].copy()
-    if k == 2:
-        return a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
-    if k == 3:
-        return (
-            a[..., 0, 0] * (a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1])
-            - a[..., 0, 1] * (a[..., 1, 0] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 0])
-            + a[..., 0, 2] * (a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0])
-        )
-    if k == 4:
-        r = [[a[..., i, j] for j in range(4)] for i in range(4)]
-        # det = Σ over column pairs (i, j) of ± (minor of rows 0, 1) × (complementary minor)
-        det = np.zeros(a.shape[:-2])
-        pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-        for (i, j), sign in zip(pairs, (1, -1, 1, 1, -1, 1)):
-            k0, k1 = (c for c in range(4) if c not in (i, j))
-            top = r[0][i] * r[1][j] - r[0][j] * r[1][i]
-            bottom = r[2][k0] * r[3][k1] - r[2][k1] * r[3][k0]
-            det = det + sign * top * bottom
-        return det
-    return np.linalg.det(a)
-
-
 def coulomb_sign(v: np.ndarray) -> np.ndarray:
     """sign(v) with a dead band: 0 where ``|v| ≤ VELOCITY_AT_REST`` (a joint at rest)."""
     return np.where(np.abs(v) > VELOCITY_AT_REST, np.sign(v), 0.0)
-
-
-def _joint_unit(model: pin.Model, i: int) -> str:
-    short = model.joints[i].shortname()
-    return "m" if "Prismatic" in short or short.startswith("JointModelP") else "rad"
-
-
-def _name_geometries(gm: pin.GeometryModel, root: ET.Element, tag: str) -> None:
-    """Rename Pinocchio's ``<link>_<k>`` geometry objects to ``<link>/<name>`` when the URDF
-    names its ``<collision>``/``<visual>`` elements."""
-    names = {}
-    for link in root.iter("link"):
-        for k, element in enumerate(link.findall(tag)):
-            if element.get("name"):
-                names[f"{link.get('name')}_{k}"] = f"{link.get('name')}/{element.get('name')}"
-    for obj in gm.geometryObjects:
-        obj.name = names.get(obj.name, obj.name)
-
-
-def _apply_parameters(
-    model: pin.Model, params: RobotParameters | None, path: Path
-) -> tuple[np.ndarray, np.ndarray]:
-    """Write a parameter file's values into ``model``; return acceleration and jerk limits."""
-    acceleration = np.full(model.nq, np.inf)
-    jerk = np.full(model.nq, np.inf)
-    if params is None:
-        return acceleration, jerk
-    known = set(model.names[1:])
-    unknown = [j.name for j in params.joints if j.name not in known]
-    if unknown:
-        raise RobotModelError(
-            f"{params.source}: joint(s) {unknown} are not in {path}; its joints are {sorted(known)}"
-        )
-    for j in params.joints:
-        k = model.joints[model.getJointId(j.name)].idx_q
-        targets = {
-            "lower": model.lowerPositionLimit,
-            "upper": model.upperPositionLimit,
-            "velocity": model.velocityLimit,
-            "effort": model.effortLimit,
-            "coulomb": model.friction,
-            "viscous": model.damping,
-        }
-        for key, vector in targets.items():
-            value = getattr(j, key)
-            if value is not None:
-                vector[k] = value
-        if j.armature is not None:
-            model.armature[k] = j.armature
-        if j.acceleration is not None:
-            acceleration[k] = j.acceleration
-        if j.jerk is not None:
-            jerk[k] = j.jerk
-    return acceleration, jerk

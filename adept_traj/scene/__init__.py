@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from adept_traj.errors import SceneFileNotFoundError
 from adept_traj.scene.motion_laws import (
     FixedPose,
     MotionLaw,
@@ -10,8 +11,15 @@ from adept_traj.scene.motion_laws import (
 from adept_traj.scene.scene import (
     Obstacle,
     Scene,
-    SceneFileNotFoundError,
     pendulum_obstacles,
+)
+from adept_traj.scene.scene_file import (
+    read_paper_scene,
+    read_scene_file,
+    scene_from_dict,
+    scene_to_dict,
+    scene_to_toml,
+    write_scene_file,
 )
 from adept_traj.scene.shapes import (
     Box,
@@ -36,4 +44,10 @@ __all__ = [
     "Sphere",
     "coal_transform",
     "pendulum_obstacles",
+    "read_paper_scene",
+    "read_scene_file",
+    "scene_from_dict",
+    "scene_to_dict",
+    "scene_to_toml",
+    "write_scene_file",
 ]

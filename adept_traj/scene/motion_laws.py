@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.scene.shapes import _positive_scalar, _readonly, _ValueObject
+from adept_traj.scene.shapes import _ValueObject
 from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
-from adept_traj.validation import as_finite_array, as_vector
+from adept_traj.validation import as_finite_array, as_scalar, as_vector, readonly_copy
 
 __all__ = [
     "FixedPose",
@@ -74,11 +74,7 @@ class MotionLaw(_ValueObject, ABC):
 
 
 def _check_ball(point: Any, radius: Any) -> tuple[np.ndarray, float]:
-    p = as_vector(point, "point", 3, "[m]")
-    r = as_finite_array(radius, "radius")
-    if r.ndim != 0 or float(r) < 0.0:
-        raise InvalidInputError(f"radius must be a non-negative scalar [m]; got {radius!r}")
-    return p, float(r)
+    return as_vector(point, "point", 3, "[m]"), as_scalar(radius, "radius", "[m]", minimum=0.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,7 +89,7 @@ class FixedPose(MotionLaw):
 
     def __post_init__(self) -> None:
         t = as_rigid_transform(self.transform, "transform")
-        object.__setattr__(self, "transform", _readonly(t))
+        object.__setattr__(self, "transform", readonly_copy(t))
 
     @classmethod
     def from_xyz_rpy(cls, xyz: Any = (0.0, 0.0, 0.0), rpy: Any = (0.0, 0.0, 0.0)) -> FixedPose:
@@ -173,13 +169,10 @@ class PendulumMotion(MotionLaw):
 
     def __post_init__(self) -> None:
         pivot = as_vector(self.pivot, "pivot", 3, "[m]")
-        length = _positive_scalar(self.length, "length", "[m]")
-        omega = _positive_scalar(self.omega, "omega", "[rad/s]")
-        g = _positive_scalar(self.g, "g", "[m/s²]")
-        v0_arr = as_finite_array(self.v0, "v0")
-        if isinstance(self.v0, bool) or v0_arr.ndim != 0 or float(v0_arr) < 0.0:
-            raise InvalidInputError(f"v0 must be a non-negative number [m/s]; got {self.v0!r}")
-        v0 = float(v0_arr)
+        length = as_scalar(self.length, "length", "[m]", minimum=0.0, strict=True)
+        omega = as_scalar(self.omega, "omega", "[rad/s]", minimum=0.0, strict=True)
+        g = as_scalar(self.g, "g", "[m/s²]", minimum=0.0, strict=True)
+        v0 = as_scalar(self.v0, "v0", "[m/s]", minimum=0.0)
         h_max = v0 * v0 / (2.0 * g)
         if h_max > 2.0 * length:
             raise InvalidInputError(
@@ -197,12 +190,12 @@ class PendulumMotion(MotionLaw):
         if abs(norm - 1.0) > 4.0 * np.finfo(float).eps:
             axis = axis / norm
         axis[2] = 0.0
-        object.__setattr__(self, "pivot", _readonly(pivot))
+        object.__setattr__(self, "pivot", readonly_copy(pivot))
         object.__setattr__(self, "length", length)
         object.__setattr__(self, "v0", v0)
         object.__setattr__(self, "omega", omega)
         object.__setattr__(self, "g", g)
-        object.__setattr__(self, "swing_axis", _readonly(axis))
+        object.__setattr__(self, "swing_axis", readonly_copy(axis))
 
     # ------------------------------------------------------------------ derived constants
     @property

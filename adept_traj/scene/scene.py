@@ -1,42 +1,29 @@
 """Scenes: obstacles with a shape and a motion law, the robot base pose, an optional task.
 
 A :class:`Scene` is a frozen value object. It is built in Python, or read from a TOML scene
-file (:meth:`Scene.from_file`, format in ``docs/scene-files.md``), or taken from the paper's
-numerical application (:meth:`Scene.paper`). Everything is in the *world* frame, SI units:
-obstacle poses are world poses, ``robot_base`` is the pose of the robot's base frame in the
-world.
-
-Every problem found in a scene file or dictionary raises :class:`~adept_traj.errors.SceneError`
-whose message names the source (file), the entry (obstacle or pendulum, by name or by its
-1-based position in the file) and the field, with what was expected and what was found.
+file (:meth:`Scene.from_file`, :meth:`Scene.paper`; reading and writing live in
+:mod:`adept_traj.scene.scene_file`, format in ``docs/scene-files.md``). Everything is in the
+*world* frame, SI units: obstacle poses are world poses, ``robot_base`` is the pose of the
+robot's base frame in the world.
 """
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from importlib import resources
-from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
-from adept_traj.errors import (
-    AdeptTrajError,
-    InputShapeError,
-    InvalidInputError,
-    SceneError,
-    SceneFileNotFoundError,
-)
-from adept_traj.files import parse_toml, read_toml
+from adept_traj.errors import InputShapeError, InvalidInputError, SceneError
 from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
-from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere, _readonly, _ValueObject
-from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
-from adept_traj.validation import as_finite_array
+from adept_traj.scene.shapes import Cylinder, Shape, Sphere, _ValueObject
+from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
+from adept_traj.validation import as_finite_array, check_type, readonly_copy
 
-__all__ = ["Obstacle", "Scene", "SceneFileNotFoundError", "pendulum_obstacles"]
+__all__ = ["Obstacle", "Scene", "pendulum_obstacles"]
 
 #: Suffixes of the two obstacles a pendulum yields.
 _ROD_SUFFIX = ".rod"
@@ -59,7 +46,7 @@ class Obstacle(_ValueObject):
 
     Attributes:
         name: unique (within a scene), non-empty name.
-        shape: the solid, centred on its own frame (see :mod:`adept_traj.shapes`).
+        shape: the solid, centred on its own frame (see :mod:`adept_traj.scene.shapes`).
         motion: world pose of the moving frame over time; default: fixed at the origin.
         offset: (4, 4) rigid pose of the shape's frame in the motion's frame [m]; default
             identity. Lets several obstacles share one motion law (a pendulum's rod and bob).
@@ -73,18 +60,10 @@ class Obstacle(_ValueObject):
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise InvalidInputError(f"name must be a non-empty string; got {self.name!r}")
-        if not isinstance(self.shape, Shape):
-            raise InvalidInputError(
-                f"obstacle {self.name!r}: shape must be an adept_traj.shapes.Shape; "
-                f"got {type(self.shape).__name__}"
-            )
-        if not isinstance(self.motion, MotionLaw):
-            raise InvalidInputError(
-                f"obstacle {self.name!r}: motion must be an adept_traj.motion.MotionLaw; "
-                f"got {type(self.motion).__name__}"
-            )
+        check_type(self.shape, Shape, f"obstacle {self.name!r}: shape")
+        check_type(self.motion, MotionLaw, f"obstacle {self.name!r}: motion")
         offset = as_rigid_transform(self.offset, "offset")
-        object.__setattr__(self, "offset", _readonly(offset))
+        object.__setattr__(self, "offset", readonly_copy(offset))
 
     @property
     def is_moving(self) -> bool:
@@ -130,8 +109,7 @@ def pendulum_obstacles(
         centre: its centre at the middle of pivot–bob, its z axis along the rod. The bob is a
         :class:`Sphere` centred at :meth:`PendulumMotion.bob_position`.
     """
-    if not isinstance(motion, PendulumMotion):
-        raise InvalidInputError(f"motion must be a PendulumMotion; got {type(motion).__name__}")
+    check_type(motion, PendulumMotion, "motion")
     if not isinstance(name, str) or not name:
         raise InvalidInputError(f"name must be a non-empty string; got {name!r}")
     length = motion.length
@@ -157,7 +135,7 @@ def _as_joint_vector(value: Any, name: str) -> np.ndarray:
             f"{name} must be a non-empty joint vector of shape (nq,) [rad | m]; "
             f"got shape {arr.shape}"
         )
-    return _readonly(arr)
+    return readonly_copy(arr)
 
 
 @dataclass(frozen=True, eq=False)
@@ -215,7 +193,7 @@ class Scene(_ValueObject):
                     f"start and goal must have the same length; got {start.size} and {goal.size}"
                 )
         object.__setattr__(self, "obstacles", obstacles)
-        object.__setattr__(self, "robot_base", _readonly(base))
+        object.__setattr__(self, "robot_base", readonly_copy(base))
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "goal", goal)
 
@@ -265,27 +243,24 @@ class Scene(_ValueObject):
 
     @property
     def base_from_world(self) -> np.ndarray:
-        """(4, 4) inverse of ``robot_base``: maps world coordinates to base coordinates."""
-        r = self.robot_base[:3, :3]
-        inv = np.eye(4)
-        inv[:3, :3] = r.T
-        inv[:3, 3] = -r.T @ self.robot_base[:3, 3]
-        return inv
+        """(4, 4) inverse of ``robot_base`` (``pin.SE3.inverse``): maps world coordinates to
+        base coordinates [m]."""
+        return pin.SE3(self.robot_base).inverse().homogeneous
 
-    # ------------------------------------------------------------------ construction
+    # ------------------------------------------------------------------ scene files
+    # The reader and writer (adept_traj.scene.scene_file) build Scenes, so they import this
+    # module; these methods import them when called.
     @classmethod
     def paper(cls) -> Scene:
         """The paper's scene: two fixed cubes and the pendulum (``data/scenes/paper.toml``).
 
-        The cubes and the pendulum law are the paper's; the robot base pose and the pivot are
-        a reconstruction (the paper does not give them), see ``docs/paper-scenario.md``.
+        The cubes and the pendulum law are the paper's; the robot base pose, the task's d3
+        values and the pivot are a reconstruction (the paper does not give them), see
+        ``docs/paper-scenario.md``.
         """
-        resource = resources.files("adept_traj.data").joinpath("scenes", "paper.toml")
-        try:
-            raw = resource.read_bytes()
-        except OSError as exc:
-            raise SceneError(f"adept_traj/data/scenes/paper.toml: cannot read: {exc}") from None
-        return _from_toml_bytes(raw, "adept_traj/data/scenes/paper.toml", "paper")
+        from adept_traj.scene.scene_file import read_paper_scene
+
+        return read_paper_scene()
 
     @classmethod
     def from_file(cls, path: str | os.PathLike[str]) -> Scene:
@@ -294,11 +269,13 @@ class Scene(_ValueObject):
         Raises:
             SceneFileNotFoundError: the file does not exist.
             SceneError: the file cannot be read, is not valid TOML (the message gives the
-                line and column), or does not describe a valid scene.
+                line and column), or does not describe a valid scene; the message names the
+                file, the entry (obstacle or pendulum, by name or 1-based position) and the
+                field.
         """
-        p = Path(path)
-        data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
-        return _parse_scene(data, str(p), p.stem or "scene")
+        from adept_traj.scene.scene_file import read_scene_file
+
+        return read_scene_file(path)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
@@ -308,434 +285,32 @@ class Scene(_ValueObject):
             data: mapping with the scene-file schema (what ``tomllib`` returns).
             source: name used in error messages (a file name).
         """
-        return _parse_scene(data, source, "scene")
+        from adept_traj.scene.scene_file import scene_from_dict
+
+        return scene_from_dict(data, source)
 
     def to_dict(self) -> dict[str, Any]:
         """The scene as a scene-file mapping (plain str, float and list values).
 
-        ``Scene.from_dict(scene.to_dict())`` describes the same scene: fixed obstacles become
-        ``[[obstacle]]`` entries (``size``/``radius``/``length`` + ``xyz`` + ``rpy``; an
-        obstacle's ``offset`` is folded into its pose), pendulums ``[[pendulum]]`` entries.
-        Poses are written as xyz + rpy, so rotations round-trip to rounding (~1e-16).
+        ``Scene.from_dict(scene.to_dict())`` describes the same scene (see
+        :func:`adept_traj.scene.scene_file.scene_to_dict`).
 
         Raises:
-            SceneError: an obstacle cannot be expressed in a scene file: a motion law other
-                than FixedPose / PendulumMotion, or a pendulum-moved obstacle that is not one
-                of a rod/bob pair made by :func:`pendulum_obstacles`.
+            SceneError: an obstacle cannot be expressed in a scene file.
         """
-        out: dict[str, Any] = {"name": self.name}
-        xyz, rpy = xyz_rpy_from_transform(self.robot_base)
-        out["robot"] = {"xyz": _floats(xyz), "rpy": _floats(rpy)}
-        if self.start is not None and self.goal is not None:
-            out["task"] = {"start": _floats(self.start), "goal": _floats(self.goal)}
-        obstacles: list[dict[str, Any]] = []
-        pendulums: list[dict[str, Any]] = []
-        by_name = {ob.name: ob for ob in self.obstacles}
-        done: set[str] = set()
-        for ob in self.obstacles:
-            if ob.name in done:
-                continue
-            if isinstance(ob.motion, FixedPose):
-                obstacles.append(_fixed_obstacle_dict(ob, ob.motion))
-                done.add(ob.name)
-            elif isinstance(ob.motion, PendulumMotion):
-                entry, rod, bob = _pendulum_dict(ob, ob.motion, by_name)
-                pendulums.append(entry)
-                done.update((rod.name, bob.name))
-            else:
-                raise SceneError(
-                    f"obstacle {ob.name!r}: motion law {type(ob.motion).__name__} cannot be "
-                    "written to a scene file"
-                )
-        if obstacles:
-            out["obstacle"] = obstacles
-        if pendulums:
-            out["pendulum"] = pendulums
-        return out
+        from adept_traj.scene.scene_file import scene_to_dict
+
+        return scene_to_dict(self)
 
     def to_toml(self) -> str:
         """The scene as the text of a TOML scene file."""
-        header = (
-            "# adept_traj scene file (format: docs/scene-files.md). World frame, SI units:\n"
-            "# lengths [m], angles [rad], times [s], speeds [m/s].\n"
-        )
-        return header + _dump_toml(self.to_dict())
+        from adept_traj.scene.scene_file import scene_to_toml
+
+        return scene_to_toml(self)
 
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the scene to a TOML scene file (UTF-8); OSError if it cannot be written."""
-        Path(path).write_text(self.to_toml(), encoding="utf-8")
+        """Write the scene to a TOML scene file (UTF-8, atomically); OSError if it cannot be
+        written."""
+        from adept_traj.scene.scene_file import write_scene_file
 
-
-# ====================================================================== writing
-
-
-def _floats(values: Any) -> list[float]:
-    return [float(v) + 0.0 for v in np.asarray(values).ravel()]  # + 0.0 turns -0.0 into 0.0
-
-
-def _shape_fields(shape: Shape) -> dict[str, Any]:
-    if isinstance(shape, Box):
-        return {"size": _floats(shape.size)}
-    if isinstance(shape, Sphere):
-        return {"radius": shape.radius}
-    if isinstance(shape, (Cylinder, Capsule)):
-        return {"radius": shape.radius, "length": shape.length}
-    raise SceneError(f"shape {type(shape).__name__} cannot be written to a scene file")
-
-
-def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
-    if type(ob.shape) not in (Box, Sphere, Cylinder, Capsule):
-        raise SceneError(
-            f"obstacle {ob.name!r}: shape {type(ob.shape).__name__} cannot be written to a "
-            "scene file"
-        )
-    xyz, rpy = xyz_rpy_from_transform(motion.transform @ ob.offset)
-    return {
-        "name": ob.name,
-        "shape": ob.shape.kind,
-        **_shape_fields(ob.shape),
-        "xyz": _floats(xyz),
-        "rpy": _floats(rpy),
-    }
-
-
-def _pendulum_dict(
-    ob: Obstacle, motion: PendulumMotion, by_name: Mapping[str, Obstacle]
-) -> tuple[dict[str, Any], Obstacle, Obstacle]:
-    problem = (
-        f"obstacle {ob.name!r} moves with a PendulumMotion but is not one of a rod/bob pair "
-        "made by pendulum_obstacles(); it cannot be written to a scene file"
-    )
-    base = None
-    for suffix in (_ROD_SUFFIX, _BOB_SUFFIX):
-        if ob.name.endswith(suffix) and len(ob.name) > len(suffix):
-            base = ob.name[: -len(suffix)]
-    if base is None:
-        raise SceneError(problem)
-    rod = by_name.get(base + _ROD_SUFFIX)
-    bob = by_name.get(base + _BOB_SUFFIX)
-    if (
-        rod is None
-        or bob is None
-        or not isinstance(rod.shape, Cylinder)
-        or not isinstance(bob.shape, Sphere)
-    ):
-        raise SceneError(problem)
-    expected = pendulum_obstacles(
-        base, motion, bob_radius=bob.shape.radius, rod_radius=rod.shape.radius
-    )
-    if expected != (rod, bob):
-        raise SceneError(problem)
-    entry = {
-        "name": base,
-        "pivot": _floats(motion.pivot),
-        "length": motion.length,
-        "v0": motion.v0,
-        "omega": motion.omega,
-        "g": motion.g,
-        "swing_axis": _floats(motion.swing_axis),
-        "rod_radius": rod.shape.radius,
-        "bob_radius": bob.shape.radius,
-    }
-    return entry, rod, bob
-
-
-def _toml_string(s: str) -> str:
-    escapes = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f"}
-    escapes["\r"] = "\\r"
-    out = []
-    for ch in s:
-        if ch in escapes:
-            out.append(escapes[ch])
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append(f"\\u{ord(ch):04X}")
-        else:
-            out.append(ch)
-    return '"' + "".join(out) + '"'
-
-
-def _toml_value(v: Any) -> str:
-    if isinstance(v, str):
-        return _toml_string(v)
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return repr(float(v))
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise SceneError(f"cannot write value {v!r} to TOML")  # unreachable for to_dict output
-
-
-def _dump_toml(data: Mapping[str, Any]) -> str:
-    """Serialise the two-level mappings :meth:`Scene.to_dict` produces."""
-    lines: list[str] = []
-    tables: list[tuple[str, Mapping[str, Any]]] = []
-    arrays: list[tuple[str, list[Mapping[str, Any]]]] = []
-    for key, value in data.items():
-        if isinstance(value, Mapping):
-            tables.append((key, value))
-        elif isinstance(value, list) and value and all(isinstance(x, Mapping) for x in value):
-            arrays.append((key, value))
-        else:
-            lines.append(f"{key} = {_toml_value(value)}")
-    for key, table in tables:
-        lines += ["", f"[{key}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
-    for key, entries in arrays:
-        for entry in entries:
-            lines += ["", f"[[{key}]]"] + [f"{k} = {_toml_value(v)}" for k, v in entry.items()]
-    return "\n".join(lines) + "\n"
-
-
-# ====================================================================== reading
-
-_MISSING: Any = object()
-_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum")
-_ROBOT_KEYS = ("xyz", "rpy")
-_TASK_KEYS = ("start", "goal")
-_SHAPE_KEYS = {
-    "box": ("size", "min", "max"),
-    "sphere": ("radius",),
-    "cylinder": ("radius", "length"),
-    "capsule": ("radius", "length"),
-}
-_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy")
-_PENDULUM_KEYS = (
-    "name",
-    "pivot",
-    "length",
-    "v0",
-    "omega",
-    "g",
-    "swing_axis",
-    "rod_radius",
-    "bob_radius",
-)
-
-
-class _Where:
-    """Error context: the source (file) and the entry being read."""
-
-    def __init__(self, source: str, entry: str = "") -> None:
-        self.source = source
-        self.entry = entry
-
-    def error(self, message: str) -> SceneError:
-        where = f"{self.entry}: " if self.entry else ""
-        return SceneError(f"{self.source}: {where}{message}")
-
-    def field_error(self, key: str, expected: str, got: Any) -> SceneError:
-        return self.error(f"field {key!r} must be {expected}; got {got!r}")
-
-
-def _is_number(x: Any) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-
-
-def _check_keys(table: Mapping[str, Any], allowed: Sequence[str], w: _Where) -> None:
-    for key in table:
-        if key not in allowed:
-            raise w.error(
-                f"unknown field {key!r}; allowed fields: {', '.join(repr(a) for a in allowed)}"
-            )
-
-
-def _table(value: Any, key: str, w: _Where) -> Mapping[str, Any]:
-    if not isinstance(value, Mapping):
-        raise w.field_error(key, f"a table ([{key}])", value)
-    return value
-
-
-def _number(
-    table: Mapping[str, Any],
-    key: str,
-    w: _Where,
-    unit: str,
-    *,
-    sign: str = "positive",
-    default: Any = _MISSING,
-) -> float:
-    article = {"positive": "a positive", "non-negative": "a non-negative"}.get(sign, "a")
-    expected = f"{article} number {unit}"
-    if key not in table:
-        if default is _MISSING:
-            raise w.error(f"missing field {key!r} ({expected})")
-        return float(default)
-    v = table[key]
-    if not _is_number(v) or (sign == "positive" and v <= 0) or (sign == "non-negative" and v < 0):
-        raise w.field_error(key, expected, v)
-    return float(v)
-
-
-def _numbers(
-    table: Mapping[str, Any],
-    key: str,
-    w: _Where,
-    n: int | None,
-    unit: str,
-    *,
-    positive: bool = False,
-    default: Any = _MISSING,
-) -> list[float]:
-    count = f"{n}" if n is not None else "a non-empty list of"
-    kind = "positive numbers" if positive else "numbers"
-    expected = f"{count} {kind} {unit}"
-    if key not in table:
-        if default is _MISSING:
-            raise w.error(f"missing field {key!r} ({expected})")
-        return list(default)
-    v = table[key]
-    if (
-        not isinstance(v, list)
-        or (n is not None and len(v) != n)
-        or not v
-        or not all(_is_number(x) for x in v)
-        or (positive and not all(x > 0 for x in v))
-    ):
-        raise w.field_error(key, expected, v)
-    return [float(x) for x in v]
-
-
-def _string(
-    table: Mapping[str, Any],
-    key: str,
-    w: _Where,
-    default: Any = _MISSING,
-    expected: str = "a non-empty string",
-) -> str:
-    if key not in table:
-        if default is _MISSING:
-            raise w.error(f"missing field {key!r} ({expected})")
-        return str(default)
-    v = table[key]
-    if not isinstance(v, str) or not v:
-        raise w.field_error(key, expected, v)
-    return v
-
-
-def _array_of_tables(data: Mapping[str, Any], key: str, w: _Where) -> list[Mapping[str, Any]]:
-    if key not in data:
-        return []
-    v = data[key]
-    if not isinstance(v, list) or not all(isinstance(x, Mapping) for x in v):
-        raise w.field_error(key, f"an array of tables ([[{key}]] entries)", v)
-    return v
-
-
-def _entry_where(source: str, kind: str, index: int, entry: Mapping[str, Any]) -> _Where:
-    name = entry.get("name")
-    if isinstance(name, str) and name:
-        return _Where(source, f"{kind} {name!r}")
-    return _Where(source, f"{kind} #{index + 1} (in file order)")
-
-
-def _build(w: _Where, make: Any, *args: Any, **kwargs: Any) -> Any:
-    """Call a constructor, turning its input errors into SceneErrors with context."""
-    try:
-        return make(*args, **kwargs)
-    except AdeptTrajError as exc:
-        raise w.error(str(exc)) from None
-
-
-def _parse_obstacle(entry: Mapping[str, Any], w: _Where) -> Obstacle:
-    name = _string(entry, "name", w)
-    kinds = f"one of {', '.join(map(repr, _SHAPE_KEYS))}"
-    kind = _string(entry, "shape", w, expected=kinds)
-    if kind not in _SHAPE_KEYS:
-        raise w.field_error("shape", kinds, kind)
-    _check_keys(entry, _OBSTACLE_COMMON + _SHAPE_KEYS[kind], w)
-    shape: Shape
-    if kind == "box" and ("min" in entry or "max" in entry):
-        for other in ("size", "xyz", "rpy"):
-            if other in entry:
-                raise w.error(
-                    f"field {other!r} cannot be combined with 'min'/'max' (a box given by its "
-                    "corners is axis-aligned, centred at (min + max) / 2)"
-                )
-        lo = _numbers(entry, "min", w, 3, "[m] (the lower corner)")
-        hi = _numbers(entry, "max", w, 3, "[m] (the upper corner)")
-        if not all(h > low for h, low in zip(hi, lo, strict=True)):
-            raise w.field_error("max", f"greater than 'min' = {lo} in every axis [m]", hi)
-        size = [h - low for h, low in zip(hi, lo, strict=True)]
-        xyz = [0.5 * (h + low) for h, low in zip(hi, lo, strict=True)]
-        rpy = [0.0, 0.0, 0.0]
-        shape = _build(w, Box, size)
-    else:
-        if kind == "box":
-            shape = _build(w, Box, _numbers(entry, "size", w, 3, "[m]", positive=True))
-        elif kind == "sphere":
-            shape = _build(w, Sphere, _number(entry, "radius", w, "[m]"))
-        else:
-            cls = Cylinder if kind == "cylinder" else Capsule
-            radius = _number(entry, "radius", w, "[m]")
-            length = _number(entry, "length", w, "[m]")
-            shape = _build(w, cls, radius, length)
-        xyz = _numbers(entry, "xyz", w, 3, "[m] (the centre)")
-        rpy = _numbers(entry, "rpy", w, 3, "[rad]", default=(0.0, 0.0, 0.0))
-    motion = _build(w, FixedPose, transform_from_xyz_rpy(xyz, rpy))
-    return _build(w, Obstacle, name, shape, motion)
-
-
-def _parse_pendulum(entry: Mapping[str, Any], w: _Where) -> tuple[Obstacle, Obstacle]:
-    _check_keys(entry, _PENDULUM_KEYS, w)
-    name = _string(entry, "name", w)
-    motion = _build(
-        w,
-        PendulumMotion,
-        pivot=_numbers(entry, "pivot", w, 3, "[m]"),
-        length=_number(entry, "length", w, "[m]"),
-        v0=_number(entry, "v0", w, "[m/s]", sign="non-negative"),
-        omega=_number(entry, "omega", w, "[rad/s]"),
-        g=_number(entry, "g", w, "[m/s²]", default=9.81),
-        swing_axis=_numbers(entry, "swing_axis", w, 3, "(horizontal)", default=(1.0, 0.0, 0.0)),
-    )
-    return _build(
-        w,
-        pendulum_obstacles,
-        name,
-        motion,
-        bob_radius=_number(entry, "bob_radius", w, "[m]"),
-        rod_radius=_number(entry, "rod_radius", w, "[m]", default=0.01),
-    )
-
-
-def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
-    top = _Where(source)
-    if not isinstance(data, Mapping):
-        raise top.error(f"scene data must be a table (mapping); got {type(data).__name__}")
-    _check_keys(data, _TOP_KEYS, top)
-    name = _string(data, "name", top, default=default_name)
-
-    robot = _Where(source, "[robot]")
-    base = np.eye(4)
-    if "robot" in data:
-        table = _table(data["robot"], "robot", top)
-        _check_keys(table, _ROBOT_KEYS, robot)
-        xyz = _numbers(table, "xyz", robot, 3, "[m]", default=(0.0, 0.0, 0.0))
-        rpy = _numbers(table, "rpy", robot, 3, "[rad]", default=(0.0, 0.0, 0.0))
-        base = transform_from_xyz_rpy(xyz, rpy)
-
-    start = goal = None
-    if "task" in data:
-        task = _Where(source, "[task]")
-        table = _table(data["task"], "task", top)
-        _check_keys(table, _TASK_KEYS, task)
-        start = _numbers(table, "start", task, None, "[rad | m]")
-        goal = _numbers(table, "goal", task, None, "[rad | m]")
-        if len(start) != len(goal):
-            raise task.error(
-                f"fields 'start' and 'goal' must have the same length; "
-                f"got {len(start)} and {len(goal)}"
-            )
-
-    obstacles: list[Obstacle] = []
-    for i, entry in enumerate(_array_of_tables(data, "obstacle", top)):
-        obstacles.append(_parse_obstacle(entry, _entry_where(source, "obstacle", i, entry)))
-    for i, entry in enumerate(_array_of_tables(data, "pendulum", top)):
-        obstacles.extend(_parse_pendulum(entry, _entry_where(source, "pendulum", i, entry)))
-    return _build(
-        top, Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
-    )
-
-
-def _from_toml_bytes(raw: bytes, source: str, default_name: str) -> Scene:
-    return _parse_scene(parse_toml(raw, source, SceneError), source, default_name)
+        write_scene_file(self, path)

@@ -21,7 +21,14 @@ import coal
 import numpy as np
 
 from adept_traj.errors import InputShapeError, InvalidInputError
-from adept_traj.validation import as_finite_array, as_vector, describe_bad_values
+from adept_traj.validation import (
+    as_finite_array,
+    as_scalar,
+    as_vector,
+    deep_equal,
+    describe_bad_values,
+    readonly_copy,
+)
 
 __all__ = ["Box", "Capsule", "Cylinder", "Shape", "Sphere", "coal_transform"]
 
@@ -45,41 +52,17 @@ class _ValueObject:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
-            a, b = getattr(self, f.name), getattr(other, f.name)
-            if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-                if not (
-                    isinstance(a, np.ndarray)
-                    and isinstance(b, np.ndarray)
-                    and a.shape == b.shape
-                    and np.array_equal(a, b)
-                ):
-                    return False
-            elif a != b:
-                return False
-        return True
+        return deep_equal(self, other)
 
     def __hash__(self) -> int:
         return hash((type(self).__name__, self._key()))
 
 
-def _readonly(arr: np.ndarray) -> np.ndarray:
-    """Mark ``arr`` (a new array owned by the caller of this helper) read-only and return it."""
-    arr.setflags(write=False)
-    return arr
-
-
-def _positive_scalar(value: Any, name: str, unit: str) -> float:
-    """Return ``value`` as a positive finite float, raising a named error otherwise."""
-    if isinstance(value, bool):
-        raise InvalidInputError(f"{name} must be a positive number {unit}; got {value!r}")
-    arr = as_finite_array(value, name)
-    if arr.ndim != 0:
-        raise InputShapeError(f"{name} must be a scalar {unit}; got shape {arr.shape}")
-    x = float(arr)
-    if x <= 0.0:
-        raise InvalidInputError(f"{name} must be positive {unit}; got {x!r}")
-    return x
+def _store_positive_lengths(shape: Shape, *names: str) -> None:
+    """Replace the named fields of a frozen ``shape`` by positive finite floats [m]."""
+    for name in names:
+        value = as_scalar(getattr(shape, name), name, "[m]", minimum=0.0, strict=True)
+        object.__setattr__(shape, name, value)
 
 
 def coal_transform(transform: np.ndarray) -> coal.Transform3s:
@@ -131,7 +114,7 @@ class Box(Shape):
         if (size <= 0.0).any():
             where = describe_bad_values(size, size <= 0.0)
             raise InvalidInputError(f"size must be 3 positive side lengths [m]; bad: {where}")
-        object.__setattr__(self, "size", _readonly(size))
+        object.__setattr__(self, "size", readonly_copy(size))
 
     def to_coal(self) -> coal.Box:
         """Return a new :class:`coal.Box` (coal takes the full side lengths)."""
@@ -155,7 +138,7 @@ class Sphere(Shape):
     kind: ClassVar[str] = "sphere"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "radius", _positive_scalar(self.radius, "radius", "[m]"))
+        _store_positive_lengths(self, "radius")
 
     def to_coal(self) -> coal.Sphere:
         """Return a new :class:`coal.Sphere`."""
@@ -181,8 +164,7 @@ class Cylinder(Shape):
     kind: ClassVar[str] = "cylinder"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "radius", _positive_scalar(self.radius, "radius", "[m]"))
-        object.__setattr__(self, "length", _positive_scalar(self.length, "length", "[m]"))
+        _store_positive_lengths(self, "radius", "length")
 
     def to_coal(self) -> coal.Cylinder:
         """Return a new :class:`coal.Cylinder` (coal takes the radius and the full length)."""
@@ -210,8 +192,7 @@ class Capsule(Shape):
     kind: ClassVar[str] = "capsule"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "radius", _positive_scalar(self.radius, "radius", "[m]"))
-        object.__setattr__(self, "length", _positive_scalar(self.length, "length", "[m]"))
+        _store_positive_lengths(self, "radius", "length")
 
     def to_coal(self) -> coal.Capsule:
         """Return a new :class:`coal.Capsule` (coal takes the radius and the segment length)."""

@@ -1,0 +1,330 @@
+"""Scene files: reading and writing the TOML form of a :class:`~adept_traj.scene.Scene`.
+
+The format is described in ``docs/scene-files.md``; the paper's scene ships as
+``adept_traj/data/scenes/paper.toml``. Reading checks every field and raises
+:class:`~adept_traj.errors.SceneError` whose message names the source (file), the entry
+(obstacle or pendulum, by name or by its 1-based position in the file) and the field, with
+what was expected and what was found. Writing produces the canonical form (boxes as
+``size`` + ``xyz`` + ``rpy``, every optional field written out) through ``tomli-w``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import tomli_w
+
+from adept_traj.errors import SceneError, SceneFileNotFoundError
+from adept_traj.files import parse_toml, read_toml, write_text_atomic
+from adept_traj.scene._toml_fields import (
+    _array_of_tables,
+    _build,
+    _check_keys,
+    _entry_where,
+    _number,
+    _numbers,
+    _string,
+    _table,
+    _Where,
+)
+from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
+from adept_traj.scene.scene import _BOB_SUFFIX, _ROD_SUFFIX, Obstacle, Scene, pendulum_obstacles
+from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
+from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
+
+__all__ = [
+    "read_paper_scene",
+    "read_scene_file",
+    "scene_from_dict",
+    "scene_to_dict",
+    "scene_to_toml",
+    "write_scene_file",
+]
+
+#: First lines of a written scene file (TOML comments; tomli-w writes none).
+_HEADER = (
+    "# adept_traj scene file (format: docs/scene-files.md). World frame, SI units:\n"
+    "# lengths [m], angles [rad], times [s], speeds [m/s].\n"
+)
+
+
+# ====================================================================== public functions
+
+
+def read_scene_file(path: str | os.PathLike[str]) -> Scene:
+    """Read a TOML scene file (what :meth:`Scene.from_file` does).
+
+    Raises:
+        SceneFileNotFoundError: the file does not exist.
+        SceneError: the file cannot be read, is not valid TOML (the message gives the line
+            and column), or does not describe a valid scene.
+    """
+    p = Path(path)
+    data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
+    return _parse_scene(data, str(p), p.stem or "scene")
+
+
+def read_paper_scene() -> Scene:
+    """The paper's scene, read from the shipped ``adept_traj/data/scenes/paper.toml``."""
+    source = "adept_traj/data/scenes/paper.toml"
+    try:
+        raw = resources.files("adept_traj.data").joinpath("scenes", "paper.toml").read_bytes()
+    except OSError as exc:
+        raise SceneError(f"{source}: cannot read: {exc}") from None
+    return _parse_scene(parse_toml(raw, source, SceneError), source, "paper")
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+    """A scene from the parsed content of a scene file (what ``tomllib`` returns); ``source``
+    names it in error messages."""
+    return _parse_scene(data, source, "scene")
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene as a scene-file mapping (plain str, float and list values).
+
+    ``scene_from_dict(scene_to_dict(scene))`` describes the same scene: fixed obstacles
+    become ``[[obstacle]]`` entries (``size``/``radius``/``length`` + ``xyz`` + ``rpy``; an
+    obstacle's ``offset`` is folded into its pose), pendulums ``[[pendulum]]`` entries.
+    Poses are written as xyz [m] + rpy [rad], so rotations round-trip to rounding (~1e-16).
+
+    Raises:
+        SceneError: an obstacle cannot be expressed in a scene file: a motion law other than
+            FixedPose / PendulumMotion, or a pendulum-moved obstacle that is not one of a
+            rod/bob pair made by :func:`~adept_traj.scene.pendulum_obstacles`.
+    """
+    out: dict[str, Any] = {"name": scene.name}
+    xyz, rpy = xyz_rpy_from_transform(scene.robot_base)
+    out["robot"] = {"xyz": _floats(xyz), "rpy": _floats(rpy)}
+    if scene.start is not None and scene.goal is not None:
+        out["task"] = {"start": _floats(scene.start), "goal": _floats(scene.goal)}
+    obstacles: list[dict[str, Any]] = []
+    pendulums: list[dict[str, Any]] = []
+    by_name = {ob.name: ob for ob in scene.obstacles}
+    done: set[str] = set()
+    for ob in scene.obstacles:
+        if ob.name in done:
+            continue
+        if isinstance(ob.motion, FixedPose):
+            obstacles.append(_fixed_obstacle_dict(ob, ob.motion))
+            done.add(ob.name)
+        elif isinstance(ob.motion, PendulumMotion):
+            entry, rod, bob = _pendulum_dict(ob, ob.motion, by_name)
+            pendulums.append(entry)
+            done.update((rod.name, bob.name))
+        else:
+            raise SceneError(
+                f"obstacle {ob.name!r}: motion law {type(ob.motion).__name__} cannot be "
+                "written to a scene file"
+            )
+    if obstacles:
+        out["obstacle"] = obstacles
+    if pendulums:
+        out["pendulum"] = pendulums
+    return out
+
+
+def scene_to_toml(scene: Scene) -> str:
+    """The text of the TOML scene file of ``scene`` (a comment header, then
+    :func:`scene_to_dict` written by ``tomli_w``)."""
+    return _HEADER + tomli_w.dumps(scene_to_dict(scene))
+
+
+def write_scene_file(scene: Scene, path: str | os.PathLike[str]) -> Path:
+    """Write ``scene`` to the TOML scene file ``path`` (UTF-8; written to a temporary file
+    and renamed, so a reader never sees half a file); return the path. OSError if it
+    cannot be written."""
+    return write_text_atomic(Path(path), scene_to_toml(scene))
+
+
+# ====================================================================== writing
+
+
+def _floats(values: Any) -> list[float]:
+    return [float(v) + 0.0 for v in np.asarray(values).ravel()]  # + 0.0 turns -0.0 into 0.0
+
+
+def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
+    shape = ob.shape
+    if type(shape) is Box:
+        fields: dict[str, Any] = {"size": _floats(shape.size)}
+    elif type(shape) is Sphere:
+        fields = {"radius": shape.radius}
+    elif type(shape) in (Cylinder, Capsule):
+        fields = {"radius": shape.radius, "length": shape.length}  # type: ignore[attr-defined]
+    else:
+        raise SceneError(
+            f"obstacle {ob.name!r}: shape {type(shape).__name__} cannot be written to a scene file"
+        )
+    xyz, rpy = xyz_rpy_from_transform(motion.transform @ ob.offset)
+    return {
+        "name": ob.name,
+        "shape": shape.kind,
+        **fields,
+        "xyz": _floats(xyz),
+        "rpy": _floats(rpy),
+    }
+
+
+def _pendulum_dict(
+    ob: Obstacle, motion: PendulumMotion, by_name: Mapping[str, Obstacle]
+) -> tuple[dict[str, Any], Obstacle, Obstacle]:
+    problem = (
+        f"obstacle {ob.name!r} moves with a PendulumMotion but is not one of a rod/bob pair "
+        "made by pendulum_obstacles(); it cannot be written to a scene file"
+    )
+    base = None
+    for suffix in (_ROD_SUFFIX, _BOB_SUFFIX):
+        if ob.name.endswith(suffix) and len(ob.name) > len(suffix):
+            base = ob.name[: -len(suffix)]
+    if base is None:
+        raise SceneError(problem)
+    rod = by_name.get(base + _ROD_SUFFIX)
+    bob = by_name.get(base + _BOB_SUFFIX)
+    if (
+        rod is None
+        or bob is None
+        or not isinstance(rod.shape, Cylinder)
+        or not isinstance(bob.shape, Sphere)
+    ):
+        raise SceneError(problem)
+    expected = pendulum_obstacles(
+        base, motion, bob_radius=bob.shape.radius, rod_radius=rod.shape.radius
+    )
+    if expected != (rod, bob):
+        raise SceneError(problem)
+    entry = {
+        "name": base,
+        "pivot": _floats(motion.pivot),
+        "length": motion.length,
+        "v0": motion.v0,
+        "omega": motion.omega,
+        "g": motion.g,
+        "swing_axis": _floats(motion.swing_axis),
+        "rod_radius": rod.shape.radius,
+        "bob_radius": bob.shape.radius,
+    }
+    return entry, rod, bob
+
+
+# ====================================================================== reading
+
+_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum")
+_ROBOT_KEYS = ("xyz", "rpy")
+_TASK_KEYS = ("start", "goal")
+_SHAPE_KEYS = {
+    "box": ("size", "min", "max"),
+    "sphere": ("radius",),
+    "cylinder": ("radius", "length"),
+    "capsule": ("radius", "length"),
+}
+_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy")
+_PENDULUM_KEYS = (
+    "name", "pivot", "length", "v0", "omega", "g", "swing_axis", "rod_radius", "bob_radius",
+)  # fmt: skip
+
+
+def _parse_obstacle(entry: Mapping[str, Any], w: _Where) -> Obstacle:
+    name = _string(entry, "name", w)
+    kinds = f"one of {', '.join(map(repr, _SHAPE_KEYS))}"
+    kind = _string(entry, "shape", w, expected=kinds)
+    if kind not in _SHAPE_KEYS:
+        raise w.field_error("shape", kinds, kind)
+    _check_keys(entry, _OBSTACLE_COMMON + _SHAPE_KEYS[kind], w)
+    shape: Shape
+    if kind == "box" and ("min" in entry or "max" in entry):
+        for other in ("size", "xyz", "rpy"):
+            if other in entry:
+                raise w.error(
+                    f"field {other!r} cannot be combined with 'min'/'max' (a box given by its "
+                    "corners is axis-aligned, centred at (min + max) / 2)"
+                )
+        lo = _numbers(entry, "min", w, 3, "[m] (the lower corner)")
+        hi = _numbers(entry, "max", w, 3, "[m] (the upper corner)")
+        if not all(h > low for h, low in zip(hi, lo, strict=True)):
+            raise w.field_error("max", f"greater than 'min' = {lo} in every axis [m]", hi)
+        size = [h - low for h, low in zip(hi, lo, strict=True)]
+        xyz = [0.5 * (h + low) for h, low in zip(hi, lo, strict=True)]
+        rpy = [0.0, 0.0, 0.0]
+        shape = _build(w, Box, size)
+    else:
+        if kind == "box":
+            shape = _build(w, Box, _numbers(entry, "size", w, 3, "[m]", positive=True))
+        elif kind == "sphere":
+            shape = _build(w, Sphere, _number(entry, "radius", w, "[m]"))
+        else:
+            cls = Cylinder if kind == "cylinder" else Capsule
+            radius = _number(entry, "radius", w, "[m]")
+            length = _number(entry, "length", w, "[m]")
+            shape = _build(w, cls, radius, length)
+        xyz = _numbers(entry, "xyz", w, 3, "[m] (the centre)")
+        rpy = _numbers(entry, "rpy", w, 3, "[rad]", default=[0.0, 0.0, 0.0])
+    motion = _build(w, FixedPose, transform_from_xyz_rpy(xyz, rpy))
+    return _build(w, Obstacle, name, shape, motion)
+
+
+def _parse_pendulum(entry: Mapping[str, Any], w: _Where) -> tuple[Obstacle, Obstacle]:
+    _check_keys(entry, _PENDULUM_KEYS, w)
+    name = _string(entry, "name", w)
+    motion = _build(
+        w,
+        PendulumMotion,
+        pivot=_numbers(entry, "pivot", w, 3, "[m]"),
+        length=_number(entry, "length", w, "[m]"),
+        v0=_number(entry, "v0", w, "[m/s]", sign="non-negative"),
+        omega=_number(entry, "omega", w, "[rad/s]"),
+        g=_number(entry, "g", w, "[m/s²]", default=9.81),
+        swing_axis=_numbers(entry, "swing_axis", w, 3, "(horizontal)", default=[1.0, 0.0, 0.0]),
+    )
+    return _build(
+        w,
+        pendulum_obstacles,
+        name,
+        motion,
+        bob_radius=_number(entry, "bob_radius", w, "[m]"),
+        rod_radius=_number(entry, "rod_radius", w, "[m]", default=0.01),
+    )
+
+
+def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
+    top = _Where(source)
+    if not isinstance(data, Mapping):
+        raise top.error(f"scene data must be a table (mapping); got {type(data).__name__}")
+    _check_keys(data, _TOP_KEYS, top)
+    name = _string(data, "name", top, default=default_name)
+
+    robot = _Where(source, "[robot]")
+    base = np.eye(4)
+    if "robot" in data:
+        table = _table(data["robot"], "robot", top)
+        _check_keys(table, _ROBOT_KEYS, robot)
+        xyz = _numbers(table, "xyz", robot, 3, "[m]", default=[0.0, 0.0, 0.0])
+        rpy = _numbers(table, "rpy", robot, 3, "[rad]", default=[0.0, 0.0, 0.0])
+        base = transform_from_xyz_rpy(xyz, rpy)
+
+    start = goal = None
+    if "task" in data:
+        task = _Where(source, "[task]")
+        table = _table(data["task"], "task", top)
+        _check_keys(table, _TASK_KEYS, task)
+        start = _numbers(table, "start", task, None, "[rad | m]")
+        goal = _numbers(table, "goal", task, None, "[rad | m]")
+        if len(start) != len(goal):
+            raise task.error(
+                f"fields 'start' and 'goal' must have the same length; "
+                f"got {len(start)} and {len(goal)}"
+            )
+
+    obstacles: list[Obstacle] = []
+    for i, entry in enumerate(_array_of_tables(data, "obstacle", top)):
+        obstacles.append(_parse_obstacle(entry, _entry_where(source, "obstacle", i, entry)))
+    for i, entry in enumerate(_array_of_tables(data, "pendulum", top)):
+        obstacles.extend(_parse_pendulum(entry, _entry_where(source, "pendulum", i, entry)))
+    return _build(
+        top, Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
+    )
