@@ -29,7 +29,8 @@ import numpy as np
 from adept_traj.analysis.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
-from adept_traj.results.record import PlanningResult, _trajectory_csv
+from adept_traj.results.csv_codec import _write_trajectory_csv
+from adept_traj.results.record import PlanningResult
 
 __all__ = [
     "MAX_ROS_POINTS",
@@ -76,7 +77,7 @@ def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     The path written.
     """
     r = _as_result(result)
-    return write_text_atomic(_as_path(path), _trajectory_csv(r))
+    return _write_trajectory_csv(r, _as_path(path))
 
 
 # ============================================================================ ROS
