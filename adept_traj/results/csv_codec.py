@@ -92,7 +92,8 @@ def _csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = 
 
 
 def _check_csv(path: Path, header: list[str], expected: np.ndarray) -> None:
-    """Check that the CSV file at ``path`` has ``header`` and the values of ``expected``."""
+    """Check that the CSV file at ``path`` has ``header`` and the values of ``expected``
+    (n, m), exactly; raise :class:`ResultFormatError` naming the first bad row and column."""
     rows = list(csv.reader(io.StringIO(_read_text(path))))
     if not rows or rows[0] != header:
         got = rows[0] if rows else "nothing"
@@ -102,17 +103,28 @@ def _check_csv(path: Path, header: list[str], expected: np.ndarray) -> None:
         raise ResultFormatError(
             path, None, f"expected {expected.shape[0]} data rows as in result.json; got {len(body)}"
         )
-    for i, row in enumerate(body):
-        if len(row) != len(header):
-            raise ResultFormatError(path, f"row {i + 1}", f"expected {len(header)} columns")
-        for j, cell in enumerate(row):
-            try:
-                value = float(cell)
-            except ValueError:
-                value = math.nan
-            if math.isnan(value) or value != expected[i, j]:
-                raise ResultFormatError(
-                    path,
-                    f"row {i + 1}, column {header[j]}",
-                    f"{cell!r} is not the number in result.json ({expected[i, j]!r})",
-                )
+    widths = np.fromiter(map(len, body), dtype=int, count=len(body))
+    short = np.flatnonzero(widths != len(header))
+    if short.size:
+        raise ResultFormatError(path, f"row {short[0] + 1}", f"expected {len(header)} columns")
+    cells = np.array(body, dtype=str).reshape(expected.shape)
+    try:
+        values = cells.astype(float)
+    except ValueError:  # a cell numpy does not read: read each as Python does (NaN if bad)
+        values = np.vectorize(_number, otypes=[float])(cells)
+    bad = np.isnan(values) | (values != expected)
+    if bad.any():
+        i, j = (int(k) for k in np.argwhere(bad)[0])
+        raise ResultFormatError(
+            path,
+            f"row {i + 1}, column {header[j]}",
+            f"{body[i][j]!r} is not the number in result.json ({float(expected[i, j])!r})",
+        )
+
+
+def _number(cell: str) -> float:
+    """``float(cell)``, or NaN when the cell is not a number."""
+    try:
+        return float(cell)
+    except ValueError:
+        return math.nan

@@ -125,20 +125,49 @@ class _Reader:
         return None if self.value is None else self.number()
 
     def array(self, shape: tuple[int | None, ...], *, null: float | None = None) -> np.ndarray:
-        """A read-only float array of ``len(shape)`` (1 or 2) dimensions; None: any length."""
-        if len(shape) == 1:
-            arr = np.array(self._row(shape[0], null), dtype=float)
-        else:
-            rows = self.items("a list of rows")
-            if shape[0] is not None and len(rows) != shape[0]:
-                raise self.error(f"expected {shape[0]} rows; got {len(rows)}")
-            width, table = shape[1], []
-            for row in rows:
-                table.append(row._row(width, null))
-                width = len(table[-1])
-            arr = np.array(table, dtype=float).reshape(len(table), width or 0)
+        """A read-only float array of ``len(shape)`` (1 or 2) dimensions; None: any length.
+
+        A well-formed list is converted in one step; anything else is walked item by item
+        so that the error names the first bad entry."""
+        arr = self._well_formed(shape, null)
+        if arr is None:
+            arr = self._walk(shape, null)
         arr.flags.writeable = False
         return arr
+
+    def _walk(self, shape: tuple[int | None, ...], null: float | None) -> np.ndarray:
+        """:meth:`array` item by item: raises at the first bad entry."""
+        if len(shape) == 1:
+            return np.array(self._row(shape[0], null), dtype=float)
+        rows = self.items("a list of rows")
+        if shape[0] is not None and len(rows) != shape[0]:
+            raise self.error(f"expected {shape[0]} rows; got {len(rows)}")
+        width, table = shape[1], []
+        for row in rows:
+            table.append(row._row(width, null))
+            width = len(table[-1])
+        return np.array(table, dtype=float).reshape(len(table), width or 0)
+
+    def _well_formed(self, shape: tuple[int | None, ...], null: float | None) -> Any:
+        """The array when the value is a list (of rows) of the expected shape holding only
+        JSON numbers (and nulls when ``null`` is given); ``None`` otherwise."""
+        if not isinstance(self.value, list):
+            return None
+        try:
+            cells = np.array(self.value, dtype=object)
+        except ValueError:  # ragged
+            return None
+        if cells.ndim != len(shape) or any(
+            want is not None and got != want for got, want in zip(cells.shape, shape, strict=True)
+        ):
+            return None
+        flat = cells.ravel()
+        allowed = {int, float} if null is None else {int, float, type(None)}
+        if not set(map(type, flat)) <= allowed:  # bool is a type of its own: refused
+            return None
+        if null is not None:
+            flat = np.where(np.equal(flat, None), null, flat)
+        return np.array(flat, dtype=float).reshape(cells.shape)
 
     def _row(self, size: int | None, null: float | None) -> list[float]:
         items = self.items("a list of numbers")
