@@ -1,6 +1,8 @@
 """adept_traj.results.ros_export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
 dictionary and JSON file carry the dense trajectory exactly, with a correct
-time_from_start, or the spline resampled at a given rate; bad inputs are refused."""
+time_from_start, or the spline resampled at a given rate; bad inputs are refused.
+adept_traj.results.Replay: its samples are the certificate's, its torques the robot's
+inverse dynamics; the export resamples through it, never through the full problem."""
 
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ import pytest
 
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import PlanningResult
+from adept_traj.results import PlanningResult, Replay, RobotInfo
 from adept_traj.results.ros_export import (
     MAX_ROS_POINTS,
     _duration,
@@ -228,3 +230,101 @@ def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:
     data = json.loads(out.read_text(encoding="utf-8"))
     assert len(data["points"]) == math.ceil(float(result.best_x[0]) * 100 - 1e-9) + 1
     assert data == to_ros_joint_trajectory(result, rate_hz=100)
+
+
+# ============================================================================ Replay
+@pytest.fixture(scope="module")
+def replay(result: PlanningResult) -> Replay:
+    return Replay.of(result)
+
+
+def test_replay_samples_equal_the_certificate(result: PlanningResult, replay: Replay) -> None:
+    d = result.certificate.dense
+    assert replay.duration == float(result.best_x[0])
+    at_times = replay.sample(d.t, orders=(0, 1, 2, 3))
+    for name in ("q", "qd", "qdd", "qddd"):
+        expected = getattr(d, name)
+        scale = np.abs(expected).max()
+        np.testing.assert_allclose(getattr(at_times, name), expected, rtol=0, atol=1e-12 * scale)
+    uniform = replay.sample_uniform(d.t.size, orders=(0, 1, 2, 3))  # the certificate's grid
+    for name in ("t", "q", "qd", "qdd", "qddd"):
+        np.testing.assert_array_equal(getattr(uniform, name), getattr(d, name), err_msg=name)
+
+
+def test_replay_torques_are_the_inverse_dynamics(
+    result: PlanningResult, replay: Replay, problem: TrajectoryProblem
+) -> None:
+    smp = replay.sample(np.linspace(0.0, replay.duration, 57))
+    tau = replay.torques(smp)
+    assert tau.shape == (57, 4)
+    np.testing.assert_array_equal(tau, problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd))
+    d = result.certificate.dense
+    np.testing.assert_array_equal(replay.torques(replay.sample_uniform(d.t.size)), d.tau)
+
+
+def test_replay_of_uses_the_given_robot_and_scene(
+    result: PlanningResult, problem: TrajectoryProblem
+) -> None:
+    r = Replay.of(result, result.front.x[0], robot=problem.robot, scene=problem.scene)
+    assert r.robot is problem.robot
+    assert r.scene is problem.scene
+    np.testing.assert_array_equal(r.x, result.front.x[0])
+    assert not r.x.flags.writeable
+
+
+def test_replay_bad_inputs(result: PlanningResult, replay: Replay) -> None:
+    robot, scene, traj, x = replay.robot, replay.scene, replay.trajectory, replay.x
+    T = replay.duration
+    cases: list[tuple[str, Any]] = [
+        ("result", lambda: Replay.of("result")),  # type: ignore[arg-type]
+        ("robot", lambda: Replay.of(result, robot="robot")),  # type: ignore[arg-type]
+        ("robot", lambda: Replay("robot", scene, traj, x)),  # type: ignore[arg-type]
+        ("scene", lambda: Replay(robot, {}, traj, x)),  # type: ignore[arg-type]
+        ("trajectory", lambda: Replay(robot, scene, None, x)),  # type: ignore[arg-type]
+        ("x", lambda: Replay(robot, scene, traj, x[:-1])),
+        ("x", lambda: Replay(robot, scene, traj, np.full_like(x, np.nan))),
+        ("times", lambda: replay.sample(np.zeros((2, 2)))),
+        ("times", lambda: replay.sample([-0.1, 0.0])),
+        ("times", lambda: replay.sample([0.0, T + 0.1])),
+        ("n_samples", lambda: replay.sample_uniform(1)),
+        ("n_samples", lambda: replay.sample_uniform(2.5)),
+        ("n_samples", lambda: replay.sample_uniform(True)),
+        ("samples", lambda: replay.torques({"q": x})),  # type: ignore[arg-type]
+        ("samples", lambda: replay.torques(replay.sample([0.0, T], orders=(0,)))),
+    ]
+    for name, call in cases:
+        with pytest.raises(InvalidInputError, match=name):
+            call()
+
+
+def test_ros_export_resamples_without_the_problem(
+    result: PlanningResult, replay: Replay, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The export resamples the spline through a Replay: neither result.problem() nor a
+    TrajectoryProblem (collision tables) is built; a given replay spares the robot reload."""
+    expected = to_ros_joint_trajectory(result, rate_hz=100)
+
+    def forbidden(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the export built the full problem")
+
+    monkeypatch.setattr(PlanningResult, "problem", forbidden)
+    monkeypatch.setattr(TrajectoryProblem, "__init__", forbidden)
+    assert to_ros_joint_trajectory(result, rate_hz=100) == expected
+    monkeypatch.setattr(RobotInfo, "load", forbidden)
+    assert to_ros_joint_trajectory(result, rate_hz=100, replay=replay) == expected
+
+
+def test_ros_export_refuses_another_replay(result: PlanningResult, replay: Replay) -> None:
+    other = Replay(replay.robot, replay.scene, replay.trajectory, longer_move(result))
+    for bad in (other, "replay"):
+        with pytest.raises(InvalidInputError, match="replay"):
+            to_ros_joint_trajectory(result, rate_hz=100, replay=bad)  # type: ignore[arg-type]
+        with pytest.raises(InvalidInputError, match="replay"):
+            to_ros_joint_trajectory(result, replay=bad)  # type: ignore[arg-type]
+
+
+def longer_move(result: PlanningResult) -> np.ndarray:
+    """The best solution with a 10 % longer travel time: another move."""
+    x = result.best_x.copy()
+    x[0] *= 1.1
+    return x

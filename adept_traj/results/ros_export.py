@@ -13,7 +13,9 @@
 
 The ROS export refuses a best trade-off whose dense certificate failed
 (``result.feasible`` false) unless ``allow_infeasible=True``: the file is meant to be sent
-to a controller. See ``docs/plots-and-export.md``.
+to a controller. Resampling goes through a :class:`~adept_traj.results.Replay` (robot and
+spline, built once or handed in), never the full problem. See ``docs/plots-and-export.md`` and
+``docs/results.md``.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
 from adept_traj.results.csv_codec import _write_trajectory_csv
 from adept_traj.results.record import PlanningResult
+from adept_traj.results.replay import Replay
+from adept_traj.validation import check_type, deep_equal
 
 __all__ = [
     "MAX_ROS_POINTS",
@@ -96,27 +100,45 @@ def _duration(t: float) -> dict[str, int]:
     return {"sec": int(sec), "nanosec": int(nanosec)}
 
 
-def _resample(r: PlanningResult, rate: float) -> tuple[np.ndarray, ...]:
+def _replay_of(r: PlanningResult, replay: Any) -> Replay:
+    """``replay`` checked to be the motion of ``r``'s best solution (default: built)."""
+    if replay is None:
+        return Replay.of(r)
+    check_type(replay, Replay, "replay")
+    tr = replay.trajectory
+    if not (
+        tuple(replay.robot.joint_names) == r.robot.joint_names
+        and tr.n_knots == int(r.problem_settings.n_knots)
+        and deep_equal(tr.start, r.start)
+        and deep_equal(tr.goal, r.goal)
+        and deep_equal(replay.x, r.best_x)
+    ):
+        raise InvalidInputError(
+            "replay must show the result's best solution (Replay.of(result)); its joints, "
+            "start, goal, n_knots or x differ from the result's"
+        )
+    return replay
+
+
+def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, ...]:
     """(t, q, qd, qdd, tau) of the best trajectory on ``ceil(T·rate) + 1`` uniform samples."""
-    x = r.best_x
-    T = float(x[0])
-    n = dense_samples(T, rate)  # the grid of verification.certify
+    n = dense_samples(float(r.best_x[0]), rate)  # the grid of analysis.certify
     if n > MAX_ROS_POINTS:
         raise InvalidInputError(
-            f"rate_hz = {rate:g} Hz gives {n} points over T = {T:.6g} s; at most "
-            f"{MAX_ROS_POINTS} are exported"
+            f"rate_hz = {rate:g} Hz gives {n} points over T = {float(r.best_x[0]):.6g} s; at "
+            f"most {MAX_ROS_POINTS} are exported"
         )
-    problem = r.problem()
-    try:
-        smp = problem.trajectory.sample(x, np.linspace(0.0, 1.0, n), orders=(0, 1, 2))
-        tau = problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)
-    finally:
-        problem.close()
-    return smp.t, smp.q, smp.qd, smp.qdd, tau
+    motion = _replay_of(r, replay)
+    smp = motion.sample_uniform(n)
+    return smp.t, smp.q, smp.qd, smp.qdd, motion.torques(smp)
 
 
 def to_ros_joint_trajectory(
-    result: PlanningResult, *, rate_hz: float | None = None, allow_infeasible: bool = False
+    result: PlanningResult,
+    *,
+    rate_hz: float | None = None,
+    allow_infeasible: bool = False,
+    replay: Replay | None = None,
 ) -> dict[str, Any]:
     """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary.
 
@@ -151,6 +173,9 @@ def to_ros_joint_trajectory(
         ≤ 1/rate_hz; the grid of the dense verification), exact positions, velocities and
         accelerations from the spline and efforts from the robot's inverse dynamics.
     allow_infeasible: export even when the dense certificate of the best trade-off failed.
+    replay: the :class:`~adept_traj.results.Replay` of the best solution when the caller
+        has one (no robot reload); by default ``Replay.of(result)`` is built when
+        resampling. Never the full problem.
 
     Returns
     -------
@@ -160,7 +185,8 @@ def to_ros_joint_trajectory(
     ------
     InvalidInputError
         ``rate_hz`` not a finite number > 0, or more than :data:`MAX_ROS_POINTS` points;
-        the best trade-off is not verified feasible and ``allow_infeasible`` is false.
+        the best trade-off is not verified feasible and ``allow_infeasible`` is false;
+        ``replay`` not a Replay of the best solution.
     """
     r = _as_result(result)
     if not r.feasible and not allow_infeasible:
@@ -170,10 +196,12 @@ def to_ros_joint_trajectory(
             "it for a robot controller (pass allow_infeasible=True to export anyway)"
         )
     if rate_hz is None:
+        if replay is not None:
+            _replay_of(r, replay)
         d = r.best_trajectory
         t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
     else:
-        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz))
+        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz), replay)
     for name, arr in (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("t", t)):
         if not np.isfinite(arr).all():
             raise InvalidInputError(f"the trajectory's {name} is not finite; cannot export")
@@ -200,21 +228,24 @@ def save_ros_joint_trajectory(
     *,
     rate_hz: float | None = None,
     allow_infeasible: bool = False,
+    replay: Replay | None = None,
 ) -> Path:
-    """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one point per line,
-    floats in shortest round-trip form, no NaN); folders are created, an existing file
-    replaced. Returns the path written. Arguments and errors as
+    """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one entry per line and
+    one point per line, floats in shortest round-trip form, no NaN); folders are created, an
+    existing file replaced. Returns the path written. Arguments and errors as
     :func:`to_ros_joint_trajectory`."""
     out = _as_path(path)
-    msg = to_ros_joint_trajectory(result, rate_hz=rate_hz, allow_infeasible=allow_infeasible)
+    msg = to_ros_joint_trajectory(
+        result, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
+    )
 
     def dump(value: Any) -> str:
         return json.dumps(value, allow_nan=False, ensure_ascii=False)
 
+    head = [f"  {dump(key)}: {dump(value)}," for key, value in msg.items() if key != "points"]
     lines = [
         "{",
-        f'  "header": {dump(msg["header"])},',
-        f'  "joint_names": {dump(msg["joint_names"])},',
+        *head,
         '  "points": [',
         ",\n".join(f"    {dump(p)}" for p in msg["points"]),
         "  ]",
