@@ -86,7 +86,14 @@ def test_csv_bad_input(tmp_path: Path) -> None:
 # ============================================================================ ROS
 def test_ros_dense_round_trip(result: PlanningResult) -> None:
     msg = to_ros_joint_trajectory(result)
-    assert set(msg) == {"header", "joint_names", "points"}
+    assert list(msg) == [
+        "certified",
+        "certificate_rate_hz",
+        "warning",
+        "header",
+        "joint_names",
+        "points",
+    ]
     assert msg["header"] == {"frame_id": ""}
     assert msg["joint_names"] == ["joint1", "joint2", "joint3", "joint4"]
     assert msg["joint_names"] == list(result.robot.joint_names)
@@ -205,6 +212,41 @@ def test_infeasible_is_refused_unless_allowed(infeasible: PlanningResult, tmp_pa
     assert len(msg["points"]) == infeasible.certificate.n_samples
 
 
+def test_certified_export_says_so(result: PlanningResult, tmp_path: Path) -> None:
+    out = save_ros_joint_trajectory(result, tmp_path / "t.json", rate_hz=100)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["certified"] is True
+    assert data["certificate_rate_hz"] == 1000.0  # certified at 1 kHz, exported at 100 Hz
+    assert data["warning"] is None
+    assert out.read_text(encoding="utf-8").splitlines()[1:4] == [
+        '  "certified": true,',
+        '  "certificate_rate_hz": 1000.0,',
+        '  "warning": null,',
+    ]
+
+
+def test_uncertified_export_says_so(infeasible: PlanningResult, tmp_path: Path) -> None:
+    """An export forced with allow_infeasible=True must not look like a certified one."""
+    out = save_ros_joint_trajectory(infeasible, tmp_path / "t.json", allow_infeasible=True)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["certified"] is False
+    assert data["certificate_rate_hz"] == 200.0
+    warning = data["warning"]
+    assert warning.startswith("NOT CERTIFIED")
+    assert infeasible.certificate.violations  # the straight move hits cube 1
+    for violation in infeasible.certificate.violations:
+        assert violation in warning
+    assert "cube1" in warning
+    assert len(data["points"]) == infeasible.certificate.n_samples
+    assert data == to_ros_joint_trajectory(infeasible, allow_infeasible=True)
+
+
+@pytest.mark.parametrize("flag", ["yes", 1, None])
+def test_allow_infeasible_must_be_a_bool(infeasible: PlanningResult, flag: object) -> None:
+    with pytest.raises(InvalidInputError, match="allow_infeasible"):
+        to_ros_joint_trajectory(infeasible, allow_infeasible=flag)  # type: ignore[arg-type]
+
+
 def test_bad_result() -> None:
     with pytest.raises(InvalidInputError, match="PlanningResult"):
         to_ros_joint_trajectory({"points": []})  # type: ignore[arg-type]
@@ -222,7 +264,7 @@ def test_saved_json_is_valid_and_equal(result: PlanningResult, tmp_path: Path) -
     assert "NaN" not in text
     assert "Infinity" not in text
     assert data == to_ros_joint_trajectory(result)  # exact floats after the round trip
-    assert len(text.splitlines()) == len(data["points"]) + 6  # one point per line
+    assert len(text.splitlines()) == len(data["points"]) + 9  # one point per line
 
 
 def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:

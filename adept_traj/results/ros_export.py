@@ -13,8 +13,10 @@
 
 The ROS export refuses a best trade-off whose dense certificate failed
 (``result.feasible`` false) unless ``allow_infeasible=True``: the file is meant to be sent
-to a controller. Resampling goes through a :class:`~adept_traj.results.Replay` (robot and
-spline, built once or handed in), never the full problem. See ``docs/plots-and-export.md`` and
+to a controller. Either way the output says whether it was certified (``"certified"``,
+``"certificate_rate_hz"``) and, when it was not, a ``"warning"`` names the violations.
+Resampling goes through a :class:`~adept_traj.results.Replay` (robot and spline,
+built once or handed in), never the full problem. See ``docs/plots-and-export.md`` and
 ``docs/results.md``.
 """
 
@@ -133,6 +135,19 @@ def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, 
     return smp.t, smp.q, smp.qd, smp.qdd, motion.torques(smp)
 
 
+def _certification(r: PlanningResult) -> dict[str, Any]:
+    """The top-level ``certified``, ``certificate_rate_hz`` and ``warning`` entries."""
+    c = r.certificate
+    warning = None
+    if not c.feasible:
+        found = "; ".join(c.violations) or "see result.certificate"
+        warning = (
+            f"NOT CERTIFIED: the dense check at {c.rate_hz:g} Hz failed ({found}); exported "
+            "with allow_infeasible=True, do not send it to a robot as is"
+        )
+    return {"certified": bool(c.feasible), "certificate_rate_hz": c.rate_hz, "warning": warning}
+
+
 def to_ros_joint_trajectory(
     result: PlanningResult,
     *,
@@ -140,11 +155,15 @@ def to_ros_joint_trajectory(
     allow_infeasible: bool = False,
     replay: Replay | None = None,
 ) -> dict[str, Any]:
-    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary.
+    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary,
+    with whether it was certified.
 
     Shape::
 
         {
+            "certified": true,
+            "certificate_rate_hz": 1000.0,
+            "warning": null,
             "header": {"frame_id": ""},
             "joint_names": ["joint1", ...],
             "points": [
@@ -159,6 +178,12 @@ def to_ros_joint_trajectory(
             ],
         }
 
+    ``certified`` is ``result.feasible`` (the dense certificate of the best trade-off
+    passed) and ``certificate_rate_hz`` the rate [Hz] it was checked at. An uncertified
+    export (``allow_infeasible=True``) has ``"certified": false`` and a ``warning`` that
+    names every violation; a certified one has ``"warning": null``. These three entries
+    are not fields of ``JointTrajectory``: drop them before filling the message.
+
     ``header.stamp`` is left out (zero: start on receipt). ``time_from_start`` is the
     sample time rounded to the nanosecond, split into whole seconds and nanoseconds
     (0 ≤ nanosec < 10⁹). ROS 1's ``duration`` names the fields ``secs``/``nsecs``.
@@ -172,23 +197,26 @@ def to_ros_joint_trajectory(
         ``ceil(T·rate_hz) + 1`` uniform samples over [0, T] (both ends included, spacing
         ≤ 1/rate_hz; the grid of the dense verification), exact positions, velocities and
         accelerations from the spline and efforts from the robot's inverse dynamics.
-    allow_infeasible: export even when the dense certificate of the best trade-off failed.
+    allow_infeasible: export even when the dense certificate of the best trade-off failed
+        (the output then says ``"certified": false`` and why).
     replay: the :class:`~adept_traj.results.Replay` of the best solution when the caller
         has one (no robot reload); by default ``Replay.of(result)`` is built when
         resampling. Never the full problem.
 
     Returns
     -------
-    A JSON-compatible dictionary (plain ``str``, ``int``, ``float``, lists; no NaN).
+    A JSON-compatible dictionary (plain ``str``, ``int``, ``float``, ``bool``, ``None``,
+    lists; no NaN).
 
     Raises
     ------
     InvalidInputError
         ``rate_hz`` not a finite number > 0, or more than :data:`MAX_ROS_POINTS` points;
         the best trade-off is not verified feasible and ``allow_infeasible`` is false;
-        ``replay`` not a Replay of the best solution.
+        ``allow_infeasible`` not a bool; ``replay`` not a Replay of the best solution.
     """
     r = _as_result(result)
+    check_type(allow_infeasible, bool, "allow_infeasible")
     if not r.feasible and not allow_infeasible:
         detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
         raise InvalidInputError(
@@ -216,6 +244,7 @@ def to_ros_joint_trajectory(
         for k in range(t.shape[0])
     ]
     return {
+        **_certification(r),
         "header": {"frame_id": ""},
         "joint_names": list(r.robot.joint_names),
         "points": points,
@@ -232,8 +261,9 @@ def save_ros_joint_trajectory(
 ) -> Path:
     """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one entry per line and
     one point per line, floats in shortest round-trip form, no NaN); folders are created, an
-    existing file replaced. Returns the path written. Arguments and errors as
-    :func:`to_ros_joint_trajectory`."""
+    existing file replaced. The file starts with ``"certified"``,
+    ``"certificate_rate_hz"`` and ``"warning"`` (see :func:`to_ros_joint_trajectory`).
+    Returns the path written. Arguments and errors as :func:`to_ros_joint_trajectory`."""
     out = _as_path(path)
     msg = to_ros_joint_trajectory(
         result, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
