@@ -1,6 +1,8 @@
 """adept_traj.results.ros_export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
 dictionary and JSON file carry the dense trajectory exactly, with a correct
-time_from_start, or the spline resampled at a given rate; bad inputs are refused."""
+time_from_start, or the spline resampled at a given rate; bad inputs are refused.
+adept_traj.results.Replay: its samples are the certificate's, its torques the robot's
+inverse dynamics; the export resamples through it, never through the full problem."""
 
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ import pytest
 
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import PlanningResult
+from adept_traj.results import PlanningResult, Replay, RobotInfo
 from adept_traj.results.ros_export import (
     MAX_ROS_POINTS,
     _duration,
@@ -84,7 +86,14 @@ def test_csv_bad_input(tmp_path: Path) -> None:
 # ============================================================================ ROS
 def test_ros_dense_round_trip(result: PlanningResult) -> None:
     msg = to_ros_joint_trajectory(result)
-    assert set(msg) == {"header", "joint_names", "points"}
+    assert list(msg) == [
+        "certified",
+        "certificate_rate_hz",
+        "warning",
+        "header",
+        "joint_names",
+        "points",
+    ]
     assert msg["header"] == {"frame_id": ""}
     assert msg["joint_names"] == ["joint1", "joint2", "joint3", "joint4"]
     assert msg["joint_names"] == list(result.robot.joint_names)
@@ -203,6 +212,41 @@ def test_infeasible_is_refused_unless_allowed(infeasible: PlanningResult, tmp_pa
     assert len(msg["points"]) == infeasible.certificate.n_samples
 
 
+def test_certified_export_says_so(result: PlanningResult, tmp_path: Path) -> None:
+    out = save_ros_joint_trajectory(result, tmp_path / "t.json", rate_hz=100)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["certified"] is True
+    assert data["certificate_rate_hz"] == 1000.0  # certified at 1 kHz, exported at 100 Hz
+    assert data["warning"] is None
+    assert out.read_text(encoding="utf-8").splitlines()[1:4] == [
+        '  "certified": true,',
+        '  "certificate_rate_hz": 1000.0,',
+        '  "warning": null,',
+    ]
+
+
+def test_uncertified_export_says_so(infeasible: PlanningResult, tmp_path: Path) -> None:
+    """An export forced with allow_infeasible=True must not look like a certified one."""
+    out = save_ros_joint_trajectory(infeasible, tmp_path / "t.json", allow_infeasible=True)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["certified"] is False
+    assert data["certificate_rate_hz"] == 200.0
+    warning = data["warning"]
+    assert warning.startswith("NOT CERTIFIED")
+    assert infeasible.certificate.violations  # the straight move hits cube 1
+    for violation in infeasible.certificate.violations:
+        assert violation in warning
+    assert "cube1" in warning
+    assert len(data["points"]) == infeasible.certificate.n_samples
+    assert data == to_ros_joint_trajectory(infeasible, allow_infeasible=True)
+
+
+@pytest.mark.parametrize("flag", ["yes", 1, None])
+def test_allow_infeasible_must_be_a_bool(infeasible: PlanningResult, flag: object) -> None:
+    with pytest.raises(InvalidInputError, match="allow_infeasible"):
+        to_ros_joint_trajectory(infeasible, allow_infeasible=flag)  # type: ignore[arg-type]
+
+
 def test_bad_result() -> None:
     with pytest.raises(InvalidInputError, match="PlanningResult"):
         to_ros_joint_trajectory({"points": []})  # type: ignore[arg-type]
@@ -220,7 +264,7 @@ def test_saved_json_is_valid_and_equal(result: PlanningResult, tmp_path: Path) -
     assert "NaN" not in text
     assert "Infinity" not in text
     assert data == to_ros_joint_trajectory(result)  # exact floats after the round trip
-    assert len(text.splitlines()) == len(data["points"]) + 6  # one point per line
+    assert len(text.splitlines()) == len(data["points"]) + 9  # one point per line
 
 
 def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:
@@ -228,3 +272,101 @@ def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:
     data = json.loads(out.read_text(encoding="utf-8"))
     assert len(data["points"]) == math.ceil(float(result.best_x[0]) * 100 - 1e-9) + 1
     assert data == to_ros_joint_trajectory(result, rate_hz=100)
+
+
+# ============================================================================ Replay
+@pytest.fixture(scope="module")
+def replay(result: PlanningResult) -> Replay:
+    return Replay.of(result)
+
+
+def test_replay_samples_equal_the_certificate(result: PlanningResult, replay: Replay) -> None:
+    d = result.certificate.dense
+    assert replay.duration == float(result.best_x[0])
+    at_times = replay.sample(d.t, orders=(0, 1, 2, 3))
+    for name in ("q", "qd", "qdd", "qddd"):
+        expected = getattr(d, name)
+        scale = np.abs(expected).max()
+        np.testing.assert_allclose(getattr(at_times, name), expected, rtol=0, atol=1e-12 * scale)
+    uniform = replay.sample_uniform(d.t.size, orders=(0, 1, 2, 3))  # the certificate's grid
+    for name in ("t", "q", "qd", "qdd", "qddd"):
+        np.testing.assert_array_equal(getattr(uniform, name), getattr(d, name), err_msg=name)
+
+
+def test_replay_torques_are_the_inverse_dynamics(
+    result: PlanningResult, replay: Replay, problem: TrajectoryProblem
+) -> None:
+    smp = replay.sample(np.linspace(0.0, replay.duration, 57))
+    tau = replay.torques(smp)
+    assert tau.shape == (57, 4)
+    np.testing.assert_array_equal(tau, problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd))
+    d = result.certificate.dense
+    np.testing.assert_array_equal(replay.torques(replay.sample_uniform(d.t.size)), d.tau)
+
+
+def test_replay_of_uses_the_given_robot_and_scene(
+    result: PlanningResult, problem: TrajectoryProblem
+) -> None:
+    r = Replay.of(result, result.front.x[0], robot=problem.robot, scene=problem.scene)
+    assert r.robot is problem.robot
+    assert r.scene is problem.scene
+    np.testing.assert_array_equal(r.x, result.front.x[0])
+    assert not r.x.flags.writeable
+
+
+def test_replay_bad_inputs(result: PlanningResult, replay: Replay) -> None:
+    robot, scene, traj, x = replay.robot, replay.scene, replay.trajectory, replay.x
+    T = replay.duration
+    cases: list[tuple[str, Any]] = [
+        ("result", lambda: Replay.of("result")),  # type: ignore[arg-type]
+        ("robot", lambda: Replay.of(result, robot="robot")),  # type: ignore[arg-type]
+        ("robot", lambda: Replay("robot", scene, traj, x)),  # type: ignore[arg-type]
+        ("scene", lambda: Replay(robot, {}, traj, x)),  # type: ignore[arg-type]
+        ("trajectory", lambda: Replay(robot, scene, None, x)),  # type: ignore[arg-type]
+        ("x", lambda: Replay(robot, scene, traj, x[:-1])),
+        ("x", lambda: Replay(robot, scene, traj, np.full_like(x, np.nan))),
+        ("times", lambda: replay.sample(np.zeros((2, 2)))),
+        ("times", lambda: replay.sample([-0.1, 0.0])),
+        ("times", lambda: replay.sample([0.0, T + 0.1])),
+        ("n_samples", lambda: replay.sample_uniform(1)),
+        ("n_samples", lambda: replay.sample_uniform(2.5)),
+        ("n_samples", lambda: replay.sample_uniform(True)),
+        ("samples", lambda: replay.torques({"q": x})),  # type: ignore[arg-type]
+        ("samples", lambda: replay.torques(replay.sample([0.0, T], orders=(0,)))),
+    ]
+    for name, call in cases:
+        with pytest.raises(InvalidInputError, match=name):
+            call()
+
+
+def test_ros_export_resamples_without_the_problem(
+    result: PlanningResult, replay: Replay, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The export resamples the spline through a Replay: neither result.problem() nor a
+    TrajectoryProblem (collision tables) is built; a given replay spares the robot reload."""
+    expected = to_ros_joint_trajectory(result, rate_hz=100)
+
+    def forbidden(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the export built the full problem")
+
+    monkeypatch.setattr(PlanningResult, "problem", forbidden)
+    monkeypatch.setattr(TrajectoryProblem, "__init__", forbidden)
+    assert to_ros_joint_trajectory(result, rate_hz=100) == expected
+    monkeypatch.setattr(RobotInfo, "load", forbidden)
+    assert to_ros_joint_trajectory(result, rate_hz=100, replay=replay) == expected
+
+
+def test_ros_export_refuses_another_replay(result: PlanningResult, replay: Replay) -> None:
+    other = Replay(replay.robot, replay.scene, replay.trajectory, longer_move(result))
+    for bad in (other, "replay"):
+        with pytest.raises(InvalidInputError, match="replay"):
+            to_ros_joint_trajectory(result, rate_hz=100, replay=bad)  # type: ignore[arg-type]
+        with pytest.raises(InvalidInputError, match="replay"):
+            to_ros_joint_trajectory(result, replay=bad)  # type: ignore[arg-type]
+
+
+def longer_move(result: PlanningResult) -> np.ndarray:
+    """The best solution with a 10 % longer travel time: another move."""
+    x = result.best_x.copy()
+    x[0] *= 1.1
+    return x

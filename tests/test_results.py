@@ -322,6 +322,13 @@ def test_json_with_nan(saved: Path) -> None:
         (lambda d: d.update(front=[]), "front"),
         (lambda d: d["front"][2].update(feasible="no"), "front[2].feasible"),
         (lambda d: d.update(history={}), "history"),
+        (lambda d: d["start"].__setitem__(1, True), "start[1]"),  # a bool is not a number
+        (lambda d: d["start"].__setitem__(2, None), "start[2]"),  # null: only in limits
+        (
+            lambda d: d["best_trajectory"]["tau"][5].__setitem__(0, "1.0"),
+            "best_trajectory.tau[5][0]",
+        ),
+        (lambda d: d["best_trajectory"]["qd"][7].append(0.0), "best_trajectory.qd[7]"),
     ],
 )
 def test_malformed_fields(saved: Path, edit: Any, field: str) -> None:
@@ -346,6 +353,18 @@ def test_csv_tampered(saved: Path) -> None:
     lines[2] = ",".join(cells)
     (saved / "front.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
     assert "row 2, column z2" in str(expect_error(saved, "front.csv"))
+
+
+def test_csv_cell_not_a_number(saved: Path) -> None:
+    path = saved / "best_trajectory.csv"
+    lines = path.read_text(encoding="utf-8").splitlines()
+    cells = lines[4].split(",")
+    cells[3] = "abc"
+    lines[4] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    assert "'abc' is not the number" in str(
+        expect_error(saved, "best_trajectory.csv", "row 4, column q_joint3")
+    )
 
 
 def test_csv_bad_header_and_rows(saved: Path) -> None:

@@ -26,7 +26,7 @@ from adept_traj.analysis.indicators import non_dominated
 from adept_traj.errors import ConfigurationError, PlanningInterrupted
 from adept_traj.optimise.checkpoint import load_checkpoint, restore_algorithm, save_checkpoint
 
-__all__ = ["GenerationInfo", "PlanningInterrupted", "RunState", "optimise"]
+__all__ = ["GenerationInfo", "RunState", "optimise"]
 
 
 @dataclass(frozen=True)

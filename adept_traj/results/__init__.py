@@ -1,24 +1,30 @@
-"""Planning results: the record, its codecs and the ROS export."""
+"""Planning results: the record (:mod:`~adept_traj.results.record`, its parts in
+:mod:`~adept_traj.results.parts`), its file codecs (:mod:`~adept_traj.results.json_codec`,
+:mod:`~adept_traj.results.csv_codec`), the motion built once for viewing
+(:mod:`~adept_traj.results.replay`) and the ROS export
+(:mod:`~adept_traj.results.ros_export`)."""
 
 from __future__ import annotations
 
+from adept_traj.errors import ResultFormatError
+from adept_traj.results.parts import (
+    SHIPPED_ROBOT,
+    BestSolution,
+    Front,
+    GenerationRecord,
+    Metrics,
+    RobotInfo,
+    Timing,
+    software_versions,
+)
 from adept_traj.results.record import (
     FORMAT,
     FRONT_FILE,
     NO_FEASIBLE_WARNING,
     RESULT_FILE,
-    SHIPPED_ROBOT,
     TRAJECTORY_FILE,
     VERSION,
-    BestSolution,
-    Front,
-    GenerationRecord,
-    Metrics,
     PlanningResult,
-    ResultFormatError,
-    RobotInfo,
-    Timing,
-    software_versions,
 )
 from adept_traj.results.replay import (
     Replay,

@@ -20,7 +20,7 @@ from adept_traj.problem import BSplineTrajectory, TrajectorySamples
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
-from adept_traj.validation import as_finite_array, readonly_copy
+from adept_traj.validation import as_finite_array, as_integer, check_type, readonly_copy
 
 __all__ = ["Replay"]
 
@@ -80,8 +80,14 @@ class Replay:
             by default the robot files named in ``result.robot`` are loaded and the stored
             scene is parsed, once.
         """
-        if not isinstance(result, PlanningResult):
-            raise InvalidInputError(f"result must be a PlanningResult; got {type(result).__name__}")
+        check_type(result, PlanningResult, "result")
+        if robot is not None:
+            check_type(robot, Robot, "robot")
+        if robot is not None and tuple(robot.joint_names) != result.robot.joint_names:
+            raise InvalidInputError(
+                f"robot has the joints {list(robot.joint_names)}, the result "
+                f"{list(result.robot.joint_names)}"
+            )
         robot = result.robot.load() if robot is None else robot
         scene = Scene.from_dict(result.scene, source="result scene") if scene is None else scene
         trajectory = BSplineTrajectory(
@@ -117,14 +123,49 @@ class Replay:
             )
         return self.trajectory.sample(self.x, np.clip(t / T, 0.0, 1.0), orders=orders)
 
+    def sample_uniform(
+        self, n_samples: int, orders: tuple[int, ...] = (0, 1, 2)
+    ) -> TrajectorySamples:
+        r"""Joint positions and derivatives at ``n_samples`` uniform times over [0, T], both
+        ends included.
+
+        .. math::
+
+            t_k = T \, \frac{k}{n - 1}, \qquad k = 0, \dots, n - 1
+
+        The normalised times :math:`s_k = k / (n - 1)` are those of the dense certificate
+        (:func:`~adept_traj.analysis.certify` with
+        ``n = dense_samples(T, rate_hz) = ceil(T·rate_hz) + 1``), so the samples equal the
+        stored ``certificate.dense`` ones.
+
+        Parameters
+        ----------
+        n_samples: number of samples n ≥ 2.
+        orders: derivative orders to compute (subset of ``(0, 1, 2, 3)``).
+
+        Returns
+        -------
+        :class:`~adept_traj.problem.TrajectorySamples`: ``t`` (n,) [s]; ``q``, ``qd``,
+        ``qdd``, ``qddd`` (n, nq) [rad | m per s^r].
+        """
+        n = as_integer(n_samples, "n_samples", minimum=2)
+        return self.trajectory.sample(self.x, np.linspace(0.0, 1.0, n), orders=orders)
+
     def torques(self, samples: TrajectorySamples) -> np.ndarray:
-        """Joint torques and forces along ``samples`` (from :meth:`sample` with orders 0–2),
-        by the robot's inverse dynamics with friction and rotor inertia.
+        """Joint torques and forces along ``samples`` (from :meth:`sample` or
+        :meth:`sample_uniform` with orders 0–2), by the robot's inverse dynamics with
+        friction and rotor inertia (:meth:`Robot.inverse_dynamics`).
+
+        Parameters
+        ----------
+        samples: :class:`~adept_traj.problem.TrajectorySamples` holding ``q``, ``qd`` and
+            ``qdd`` (n, nq).
 
         Returns
         -------
         (n, nq) [N·m | N].
         """
+        check_type(samples, TrajectorySamples, "samples")
         if samples.q is None or samples.qd is None or samples.qdd is None:
             raise InvalidInputError("samples must hold q, qd and qdd (orders 0, 1, 2)")
         return self.robot.inverse_dynamics(samples.q, samples.qd, samples.qdd)

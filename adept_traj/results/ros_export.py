@@ -13,7 +13,11 @@
 
 The ROS export refuses a best trade-off whose dense certificate failed
 (``result.feasible`` false) unless ``allow_infeasible=True``: the file is meant to be sent
-to a controller. See ``docs/plots-and-export.md``.
+to a controller. Either way the output says whether it was certified (``"certified"``,
+``"certificate_rate_hz"``) and, when it was not, a ``"warning"`` names the violations.
+Resampling goes through a :class:`~adept_traj.results.Replay` (robot and spline,
+built once or handed in), never the full problem. See ``docs/plots-and-export.md`` and
+``docs/results.md``.
 """
 
 from __future__ import annotations
@@ -29,7 +33,10 @@ import numpy as np
 from adept_traj.analysis.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
-from adept_traj.results.record import PlanningResult, _trajectory_csv
+from adept_traj.results.csv_codec import _write_trajectory_csv
+from adept_traj.results.record import PlanningResult
+from adept_traj.results.replay import Replay
+from adept_traj.validation import check_type, deep_equal
 
 __all__ = [
     "MAX_ROS_POINTS",
@@ -76,7 +83,7 @@ def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     The path written.
     """
     r = _as_result(result)
-    return write_text_atomic(_as_path(path), _trajectory_csv(r))
+    return _write_trajectory_csv(r, _as_path(path))
 
 
 # ============================================================================ ROS
@@ -95,33 +102,68 @@ def _duration(t: float) -> dict[str, int]:
     return {"sec": int(sec), "nanosec": int(nanosec)}
 
 
-def _resample(r: PlanningResult, rate: float) -> tuple[np.ndarray, ...]:
+def _replay_of(r: PlanningResult, replay: Any) -> Replay:
+    """``replay`` checked to be the motion of ``r``'s best solution (default: built)."""
+    if replay is None:
+        return Replay.of(r)
+    check_type(replay, Replay, "replay")
+    tr = replay.trajectory
+    if not (
+        tuple(replay.robot.joint_names) == r.robot.joint_names
+        and tr.n_knots == int(r.problem_settings.n_knots)
+        and deep_equal(tr.start, r.start)
+        and deep_equal(tr.goal, r.goal)
+        and deep_equal(replay.x, r.best_x)
+    ):
+        raise InvalidInputError(
+            "replay must show the result's best solution (Replay.of(result)); its joints, "
+            "start, goal, n_knots or x differ from the result's"
+        )
+    return replay
+
+
+def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, ...]:
     """(t, q, qd, qdd, tau) of the best trajectory on ``ceil(T·rate) + 1`` uniform samples."""
-    x = r.best_x
-    T = float(x[0])
-    n = dense_samples(T, rate)  # the grid of verification.certify
+    n = dense_samples(float(r.best_x[0]), rate)  # the grid of analysis.certify
     if n > MAX_ROS_POINTS:
         raise InvalidInputError(
-            f"rate_hz = {rate:g} Hz gives {n} points over T = {T:.6g} s; at most "
-            f"{MAX_ROS_POINTS} are exported"
+            f"rate_hz = {rate:g} Hz gives {n} points over T = {float(r.best_x[0]):.6g} s; at "
+            f"most {MAX_ROS_POINTS} are exported"
         )
-    problem = r.problem()
-    try:
-        smp = problem.trajectory.sample(x, np.linspace(0.0, 1.0, n), orders=(0, 1, 2))
-        tau = problem.robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)
-    finally:
-        problem.close()
-    return smp.t, smp.q, smp.qd, smp.qdd, tau
+    motion = _replay_of(r, replay)
+    smp = motion.sample_uniform(n)
+    return smp.t, smp.q, smp.qd, smp.qdd, motion.torques(smp)
+
+
+def _certification(r: PlanningResult) -> dict[str, Any]:
+    """The top-level ``certified``, ``certificate_rate_hz`` and ``warning`` entries."""
+    c = r.certificate
+    warning = None
+    if not c.feasible:
+        found = "; ".join(c.violations) or "see result.certificate"
+        warning = (
+            f"NOT CERTIFIED: the dense check at {c.rate_hz:g} Hz failed ({found}); exported "
+            "with allow_infeasible=True, do not send it to a robot as is"
+        )
+    return {"certified": bool(c.feasible), "certificate_rate_hz": c.rate_hz, "warning": warning}
 
 
 def to_ros_joint_trajectory(
-    result: PlanningResult, *, rate_hz: float | None = None, allow_infeasible: bool = False
+    result: PlanningResult,
+    *,
+    rate_hz: float | None = None,
+    allow_infeasible: bool = False,
+    replay: Replay | None = None,
 ) -> dict[str, Any]:
-    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary.
+    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary,
+    with whether it was certified.
 
     Shape::
 
         {
+            "certified": true,
+            "certificate_rate_hz": 1000.0,
+            "warning": null,
             "header": {"frame_id": ""},
             "joint_names": ["joint1", ...],
             "points": [
@@ -136,6 +178,12 @@ def to_ros_joint_trajectory(
             ],
         }
 
+    ``certified`` is ``result.feasible`` (the dense certificate of the best trade-off
+    passed) and ``certificate_rate_hz`` the rate [Hz] it was checked at. An uncertified
+    export (``allow_infeasible=True``) has ``"certified": false`` and a ``warning`` that
+    names every violation; a certified one has ``"warning": null``. These three entries
+    are not fields of ``JointTrajectory``: drop them before filling the message.
+
     ``header.stamp`` is left out (zero: start on receipt). ``time_from_start`` is the
     sample time rounded to the nanosecond, split into whole seconds and nanoseconds
     (0 ≤ nanosec < 10⁹). ROS 1's ``duration`` names the fields ``secs``/``nsecs``.
@@ -149,19 +197,26 @@ def to_ros_joint_trajectory(
         ``ceil(T·rate_hz) + 1`` uniform samples over [0, T] (both ends included, spacing
         ≤ 1/rate_hz; the grid of the dense verification), exact positions, velocities and
         accelerations from the spline and efforts from the robot's inverse dynamics.
-    allow_infeasible: export even when the dense certificate of the best trade-off failed.
+    allow_infeasible: export even when the dense certificate of the best trade-off failed
+        (the output then says ``"certified": false`` and why).
+    replay: the :class:`~adept_traj.results.Replay` of the best solution when the caller
+        has one (no robot reload); by default ``Replay.of(result)`` is built when
+        resampling. Never the full problem.
 
     Returns
     -------
-    A JSON-compatible dictionary (plain ``str``, ``int``, ``float``, lists; no NaN).
+    A JSON-compatible dictionary (plain ``str``, ``int``, ``float``, ``bool``, ``None``,
+    lists; no NaN).
 
     Raises
     ------
     InvalidInputError
         ``rate_hz`` not a finite number > 0, or more than :data:`MAX_ROS_POINTS` points;
-        the best trade-off is not verified feasible and ``allow_infeasible`` is false.
+        the best trade-off is not verified feasible and ``allow_infeasible`` is false;
+        ``allow_infeasible`` not a bool; ``replay`` not a Replay of the best solution.
     """
     r = _as_result(result)
+    check_type(allow_infeasible, bool, "allow_infeasible")
     if not r.feasible and not allow_infeasible:
         detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
         raise InvalidInputError(
@@ -169,10 +224,12 @@ def to_ros_joint_trajectory(
             "it for a robot controller (pass allow_infeasible=True to export anyway)"
         )
     if rate_hz is None:
+        if replay is not None:
+            _replay_of(r, replay)
         d = r.best_trajectory
         t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
     else:
-        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz))
+        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz), replay)
     for name, arr in (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("t", t)):
         if not np.isfinite(arr).all():
             raise InvalidInputError(f"the trajectory's {name} is not finite; cannot export")
@@ -187,6 +244,7 @@ def to_ros_joint_trajectory(
         for k in range(t.shape[0])
     ]
     return {
+        **_certification(r),
         "header": {"frame_id": ""},
         "joint_names": list(r.robot.joint_names),
         "points": points,
@@ -199,21 +257,25 @@ def save_ros_joint_trajectory(
     *,
     rate_hz: float | None = None,
     allow_infeasible: bool = False,
+    replay: Replay | None = None,
 ) -> Path:
-    """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one point per line,
-    floats in shortest round-trip form, no NaN); folders are created, an existing file
-    replaced. Returns the path written. Arguments and errors as
-    :func:`to_ros_joint_trajectory`."""
+    """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one entry per line and
+    one point per line, floats in shortest round-trip form, no NaN); folders are created, an
+    existing file replaced. The file starts with ``"certified"``,
+    ``"certificate_rate_hz"`` and ``"warning"`` (see :func:`to_ros_joint_trajectory`).
+    Returns the path written. Arguments and errors as :func:`to_ros_joint_trajectory`."""
     out = _as_path(path)
-    msg = to_ros_joint_trajectory(result, rate_hz=rate_hz, allow_infeasible=allow_infeasible)
+    msg = to_ros_joint_trajectory(
+        result, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
+    )
 
     def dump(value: Any) -> str:
         return json.dumps(value, allow_nan=False, ensure_ascii=False)
 
+    head = [f"  {dump(key)}: {dump(value)}," for key, value in msg.items() if key != "points"]
     lines = [
         "{",
-        f'  "header": {dump(msg["header"])},',
-        f'  "joint_names": {dump(msg["joint_names"])},',
+        *head,
         '  "points": [',
         ",\n".join(f"    {dump(p)}" for p in msg["points"]),
         "  ]",

@@ -73,8 +73,9 @@ def load_urdf_models(path: Path) -> tuple[str, pin.Model, pin.GeometryModel, pin
 def apply_parameters(model: pin.Model, params: RobotParameters | None, path: Path) -> JointLimits:
     """Write a parameter file's values into ``model`` (limits, ``friction`` (Coulomb),
     ``damping`` (viscous), ``armature`` (rotor inertia)) and return the joint limits: the
-    model's position [rad | m], velocity and torque (URDF: effort) limits with the file's acceleration and
-    jerk limits (``inf`` where not given). ``path`` (the URDF) names it in error messages."""
+    model's position [rad | m], velocity and torque (URDF: effort) limits with the file's
+    acceleration and jerk limits (``inf`` where not given). ``path`` (the URDF) names it in
+    error messages."""
     acceleration, jerk = _write_parameters(model, params, path)
     return JointLimits(
         names=tuple(model.names[1:]),

@@ -32,7 +32,7 @@ from adept_traj.results import PlanningResult, Replay
 from adept_traj.viz.meshcat_scene import draw
 from adept_traj.viz.playback import build_animation
 
-__all__ = ["SERVER_TIMEOUT_S", "MeshcatServerError", "show"]
+__all__ = ["SERVER_TIMEOUT_S", "show"]
 
 #: Seconds to wait for the meshcat server to start, and for each of its answers.
 SERVER_TIMEOUT_S = 30.0

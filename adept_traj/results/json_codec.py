@@ -1,0 +1,354 @@
+"""``result.json`` (format ``"adept_traj.result"``, version 1): encode a
+:class:`~adept_traj.results.PlanningResult` as JSON text and decode it back.
+
+The schema is in ``docs/results.md``. Floats are written in Python's shortest round-trip
+form, so every value reads back exactly. JSON has no NaN or infinity: NaN is refused and an
+infinite value is written as ``null`` (``-inf`` in ``limits.q_lower``, ``+inf`` everywhere
+else it may occur: infinite joint limits, the distance of a scene without obstacles).
+
+Decoding goes through the one schema reader, ``_Reader``
+(:mod:`~adept_traj.results.reader`): a node of the parsed JSON (its value and its dotted
+path such as ``front[3].x``) with typed accessors; any missing or malformed field or value
+raises :class:`~adept_traj.errors.ResultFormatError` naming the file and the field.
+:meth:`PlanningResult.save <adept_traj.results.PlanningResult.save>` and
+:meth:`~adept_traj.results.PlanningResult.load` are the public entry points.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from adept_traj.analysis.certificate import LIMIT_KINDS, Certificate, DenseTrajectory, LimitCheck
+from adept_traj.errors import InvalidInputError
+from adept_traj.files import write_text_atomic
+from adept_traj.problem.bspline import KinematicBound
+from adept_traj.problem.trajectory_problem import OBJECTIVE_NAMES, ProblemSettings
+from adept_traj.results.parts import (
+    METRIC_NAMES,
+    BestSolution,
+    Front,
+    GenerationRecord,
+    Metrics,
+    RobotInfo,
+    Timing,
+)
+from adept_traj.results.reader import _Reader
+from adept_traj.results.record import FORMAT, VERSION, PlanningResult, _jsonable
+from adept_traj.robot.limits import LIMITS, JointLimits
+from adept_traj.scene.scene import Scene
+from adept_traj.validation import deep_equal
+
+__all__: list[str] = []
+
+#: JSON key of each metric of :class:`Metrics`.
+_JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
+_DENSE_FIELDS = ("t", "q", "qd", "qdd", "qddd", "tau", "min_distance")
+
+
+def _write_json(r: PlanningResult, path: Path) -> Path:
+    """Write ``result.json`` for ``r`` at ``path`` (atomically)."""
+    return write_text_atomic(path, _dumps(_encode(r)) + "\n")
+
+
+def _read_json(path: Path) -> PlanningResult:
+    """The result stored in the ``result.json`` at ``path``."""
+    return _decode(_Reader.open(path))
+
+
+# ============================================================================ encoding
+def _encode(r: PlanningResult) -> dict[str, Any]:
+    lim, lb, c = r.limits, r.lower_bound, r.certificate
+    metrics: dict[str, Any] = {key: getattr(r.metrics, name) for name, key in _JSON_METRICS.items()}
+    ref = r.metrics.hv_reference_point
+    metrics["HV_reference_point"] = None if ref is None else _floats(ref)
+    history = None if r.history is None else [dataclasses.asdict(rec) for rec in r.history]
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "warning": r.warning,
+        "robot": dataclasses.asdict(r.robot) | {"joint_names": list(r.robot.joint_names)},
+        "start": _floats(r.start),
+        "goal": _floats(r.goal),
+        "seed": r.seed,
+        "algorithm": {"name": r.algorithm, "settings": r.algorithm_settings},
+        "problem_settings": _jsonable(dataclasses.asdict(r.problem_settings)),
+        "scene": r.scene,
+        "limits": {
+            "joint_names": list(lim.names),
+            "units": list(lim.units),
+            "q_lower": _floats(lim.lower),
+            "q_upper": _floats(lim.upper),
+            # the other bounds under their quantity's symbol: qd, qdd, qddd, tau
+            **{kind.symbol: _floats(lim.bound(kind.name)) for kind in LIMITS[1:]},
+        },
+        "lower_bound": {
+            "T_min": _float(lb.T_min),
+            "per_joint": _floats(lb.times),
+            "limiting_joint": int(lb.limiting_joint),
+            "delta": _floats(lb.delta),
+            "cases": list(lb.cases),
+        },
+        "gap": r.gap,
+        "best": {
+            "index": r.best.index,
+            "objectives": _floats(r.best_objectives),
+            "f_c": r.best.f_c,
+            "F_avg": r.best.f_avg,
+        },
+        "certificate": _encode_certificate(c),
+        "metrics": metrics,
+        "timing": dataclasses.asdict(r.timing),
+        "versions": dict(r.versions),
+        "front": [
+            {
+                "objectives": _floats(r.front.objectives[i]),
+                "x": _floats(r.front.x[i]),
+                "constraints": _floats(r.front.constraints[i]),
+                "feasible": bool(r.front.feasible[i]),
+            }
+            for i in range(len(r.front))
+        ],
+        "best_trajectory": {name: _floats(getattr(c.dense, name)) for name in _DENSE_FIELDS},
+        "history": history,
+    }
+
+
+def _encode_certificate(c: Certificate) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "feasible": c.feasible,
+        "rate_hz": c.rate_hz,
+        "n_samples": c.n_samples,
+        "margin": c.margin,
+        "min_distance": _float(c.min_distance),
+        "t_min_distance": c.t_min_distance,
+        "closest_pair": None if c.closest_pair is None else list(c.closest_pair),
+        "violations": list(c.violations),
+        "x": _floats(c.x),
+    }
+    for check in c.checks:
+        out[check.kind] = {
+            "limit": check.symbol,
+            "worst": _floats(check.worst),
+            "within": [bool(b) for b in check.within],
+            "dense": _floats(check.dense),
+            "exact": None if check.exact is None else _floats(check.exact),
+            "t_worst": _floats(check.t_worst),
+            "tolerance": check.tolerance,
+        }
+    return out
+
+
+def _float(value: float) -> float | None:
+    """A finite float as is; ±inf as ``None``; NaN refused."""
+    v = float(value)
+    if math.isnan(v):
+        raise InvalidInputError("NaN cannot be saved")
+    return v if math.isfinite(v) else None
+
+
+def _floats(arr: Any) -> Any:
+    """Nested lists of floats (±inf → ``None``) from an array; NaN refused."""
+    a = np.asarray(arr, dtype=float)
+    if np.isnan(a).any():
+        raise InvalidInputError("NaN cannot be saved")
+    return np.where(np.isinf(a), None, a).tolist() if np.isinf(a).any() else a.tolist()
+
+
+def _dumps(value: Any, level: int = 0) -> str:
+    """Pretty JSON: objects one key a line, lists of scalars on one line (a matrix: one row
+    a line). Refuses NaN and infinity."""
+    pad, end = "  " * (level + 1), "  " * level
+    if isinstance(value, dict):
+        if not value:
+            return "{}"
+        items = [f"{pad}{_scalar(str(k))}: {_dumps(v, level + 1)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + "\n" + end + "}"
+    if isinstance(value, list):
+        if all(not isinstance(v, (dict, list)) for v in value):
+            return "[" + ", ".join(_scalar(v) for v in value) + "]"
+        return "[\n" + ",\n".join(pad + _dumps(v, level + 1) for v in value) + "\n" + end + "]"
+    return _scalar(value)
+
+
+def _scalar(value: Any) -> str:
+    return json.dumps(value, allow_nan=False, ensure_ascii=False)
+
+
+# ============================================================================ decoding
+def _decode(top: _Reader) -> PlanningResult:
+    top.obj()
+    fmt = top["format"].value
+    if fmt != FORMAT:
+        raise top.error(f"expected {FORMAT!r}; got {fmt!r}", "format")
+    version = top["version"].value
+    if isinstance(version, bool) or version != VERSION:
+        raise top.error(f"unsupported version {version!r} (this adept_traj reads 1)", "version")
+    rob = top["robot"]
+    robot = rob.build(
+        RobotInfo,
+        name=rob["name"].string(),
+        joint_names=rob["joint_names"].strings(),
+        urdf=rob["urdf"].string(),
+        params=rob.child("params", optional=True).string(nullable=True),
+        tool_frame=rob.child("tool_frame", optional=True).string(nullable=True),
+    )
+    nq = len(robot.joint_names)
+    ps = top["problem_settings"]
+    known = {f.name for f in dataclasses.fields(ProblemSettings)}
+    for key in ps.obj():
+        if key not in known:
+            raise ps.error(f"unknown setting (known: {sorted(known)})", f"{ps.where}.{key}")
+    settings = {k: tuple(v) if isinstance(v, list) else v for k, v in ps.value.items()}
+    scene = top["scene"]
+    scene.build(Scene.from_dict, scene.obj(), source=f"{top.file} (scene)")
+    lim = top["limits"]
+
+    def limit(key: str, null: float = math.inf) -> np.ndarray:
+        return lim[key].array((nq,), null=null)
+
+    limits = lim.build(
+        JointLimits,
+        names=lim["joint_names"].strings(),
+        units=lim["units"].strings(),
+        lower=limit("q_lower", -math.inf),
+        upper=limit("q_upper"),
+        **{kind.name: limit(kind.symbol) for kind in LIMITS[1:]},
+    )
+    lb = top["lower_bound"]
+    lower_bound = lb.build(
+        KinematicBound,
+        times=lb["per_joint"].array((nq,)),
+        delta=lb["delta"].array((nq,)),
+        cases=lb["cases"].strings(),
+        T_min=lb["T_min"].number(),
+        limiting_joint=lb["limiting_joint"].integer(),
+    )
+    front = _decode_front(top["front"])
+    bd = top["best"]
+    best = bd.build(
+        BestSolution,
+        index=bd["index"].integer(),
+        f_c=bd["f_c"].optional_number(),
+        f_avg=bd["F_avg"].optional_number(),
+    )
+    if best.index >= len(front):
+        raise bd.error(f"{best.index} is not a row of the front ({len(front)} rows)", "best.index")
+    certificate = _decode_certificate(top["certificate"], _decode_dense(top["best_trajectory"], nq))
+    if not deep_equal(certificate.x, front.x[best.index]):
+        raise top.error(f"differs from front[{best.index}].x (the best solution)", "certificate.x")
+    md, td, vd = top["metrics"], top["timing"], top["versions"]
+    ref = md["HV_reference_point"]
+    metrics = md.build(
+        Metrics,
+        **{name: md[key].optional_number() for name, key in _JSON_METRICS.items()},
+        hv_reference_point=None if ref.value is None else ref.array((len(OBJECTIVE_NAMES),)),
+    )
+    timing = td.build(
+        Timing,
+        total_s=td["total_s"].number(),
+        evaluation_s=td["evaluation_s"].number(),
+        n_evaluations=td["n_evaluations"].integer(),
+        n_generations=td["n_generations"].integer(),
+    )
+    alg = top["algorithm"]
+    result = top.build(
+        PlanningResult,
+        start=top["start"].array((nq,)),
+        goal=top["goal"].array((nq,)),
+        robot=robot,
+        scene=scene.value,
+        problem_settings=ps.build(ProblemSettings, **settings),
+        limits=limits,
+        lower_bound=lower_bound,
+        algorithm=alg["name"].string(),
+        algorithm_settings=alg["settings"].obj(),
+        seed=top["seed"].integer(nullable=True),
+        front=front,
+        best=best,
+        certificate=certificate,
+        timing=timing,
+        metrics=metrics,
+        history=_decode_history(top.child("history", optional=True)),
+        warning=top.child("warning", optional=True).string(nullable=True),
+        versions={k: vd[k].string() for k in vd.obj()},
+    )
+    stored = top["certificate"]["feasible"]
+    if stored.boolean() != certificate.feasible:
+        raise stored.error(f"is {stored.value} but the stored checks say {certificate.feasible}")
+    return result
+
+
+def _decode_front(node: _Reader) -> Front:
+    if not isinstance(node.value, list) or not node.value:
+        raise node.error(f"expected a non-empty list of solutions; got {node.kind()}")
+    xs, objs, cons, feas = [], [], [], []
+    n_var = n_con = None
+    for item in node.items():
+        xs.append(item["x"].array((n_var,)))
+        objs.append(item["objectives"].array((len(OBJECTIVE_NAMES),)))
+        cons.append(item["constraints"].array((n_con,)))
+        feas.append(item["feasible"].boolean())
+        n_var, n_con = xs[-1].size, cons[-1].size
+    return node.build(
+        Front,
+        x=np.array(xs),
+        objectives=np.array(objs),
+        constraints=np.array(cons),
+        feasible=np.array(feas, dtype=bool),
+    )
+
+
+def _decode_dense(node: _Reader, nq: int) -> DenseTrajectory:
+    t = node["t"].array((None,))
+    arrays = {name: node[name].array((t.size, nq)) for name in _DENSE_FIELDS[1:-1]}
+    distance = node["min_distance"].array((t.size,), null=math.inf)
+    return node.build(DenseTrajectory, t=t, **arrays, min_distance=distance)
+
+
+def _decode_certificate(node: _Reader, dense: DenseTrajectory) -> Certificate:
+    nq, checks = dense.nq, {}
+    for kind in LIMIT_KINDS:
+        cd = node[kind]
+        exact = cd["exact"]
+        checks[kind] = cd.build(
+            LimitCheck,
+            kind=kind,
+            dense=cd["dense"].array((nq,)),
+            exact=None if exact.value is None else exact.array((nq,)),
+            t_worst=cd["t_worst"].array((nq,)),
+            tolerance=cd["tolerance"].number(),
+        )
+    pair = node["closest_pair"]
+    return node.build(
+        Certificate,
+        x=node["x"].array((None,)),
+        rate_hz=node["rate_hz"].number(),
+        margin=node["margin"].number(),
+        min_distance=node["min_distance"].number(null=math.inf),
+        t_min_distance=node["t_min_distance"].optional_number(),
+        closest_pair=None if pair.value is None else pair.strings(),
+        violations=node["violations"].strings(),
+        dense=dense,
+        **checks,
+    )
+
+
+def _decode_history(node: _Reader) -> tuple[GenerationRecord, ...] | None:
+    if node.value is None:
+        return None
+    return tuple(
+        item.build(
+            GenerationRecord,
+            generation=item["generation"].integer(),
+            n_evaluations=item["n_evaluations"].integer(),
+            n_feasible=item["n_feasible"].integer(),
+            hypervolume=item["hypervolume"].optional_number(),
+        )
+        for item in node.items("a list or null")
+    )

@@ -1,0 +1,313 @@
+"""The parts of a :class:`~adept_traj.results.PlanningResult`: the robot's description, the
+final front, the chosen solution, the quality metrics, the cost of the run and its
+per-generation progress.
+
+Every part is a frozen dataclass that checks and normalises its fields when built (arrays
+become read-only float64 copies; NaN is refused, except in a metric, where it means "not
+computed" and becomes ``None``); bad input raises
+:class:`~adept_traj.errors.InvalidInputError` naming the field.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
+from adept_traj.problem.trajectory_problem import OBJECTIVE_NAMES, Evaluation
+from adept_traj.robot.robot import Robot, shipped_file
+from adept_traj.validation import (
+    as_finite_array,
+    as_integer,
+    as_scalar,
+    deep_equal,
+    readonly_copy,
+)
+
+__all__ = [
+    "SHIPPED_ROBOT",
+    "BestSolution",
+    "Front",
+    "GenerationRecord",
+    "Metrics",
+    "RobotInfo",
+    "Timing",
+    "software_versions",
+]
+
+#: Marker stored as ``robot.urdf`` for the shipped AdeptOne XL (URDF + parameter file).
+SHIPPED_ROBOT = "adept_one_xl"
+#: Field names of :class:`Metrics` that hold a number (or ``None``).
+METRIC_NAMES = ("ssm", "rni", "oo", "ae", "hv")
+
+
+def _optional_scalar(value: Any, name: str, unit: str = "", minimum: float = -math.inf) -> Any:
+    """``None`` as is, else a finite float ≥ ``minimum`` (:func:`as_scalar`)."""
+    return None if value is None else as_scalar(value, name, unit, minimum=minimum)
+
+
+def _metric(value: Any, name: str) -> float | None:
+    """A metric: a finite float, or ``None`` (not computed; a float NaN counts as such)."""
+    if isinstance(value, (float, np.floating)) and math.isnan(value):
+        return None
+    return _optional_scalar(value, name)
+
+
+# ============================================================================ robot
+@dataclass(frozen=True)
+class RobotInfo:
+    """How to rebuild the robot of a run.
+
+    Attributes
+    ----------
+    name: the robot's name.
+    joint_names: names of the joints, in the order of q.
+    urdf: ``"adept_one_xl"`` for the shipped AdeptOne XL (:meth:`Robot.adept_one_xl`),
+        else the URDF path as given when the robot was loaded.
+    params: parameter-file path, or ``None`` (no file, the shipped robot, or parameters
+        given as an object, which cannot be recorded).
+    tool_frame: the tool frame's name.
+    """
+
+    name: str
+    joint_names: tuple[str, ...]
+    urdf: str
+    params: str | None = None
+    tool_frame: str | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "joint_names", tuple(str(n) for n in self.joint_names))
+        if not self.joint_names:
+            raise InvalidInputError("joint_names must not be empty")
+
+    @classmethod
+    def of(cls, robot: Robot) -> RobotInfo:
+        """The description of ``robot``."""
+        urdf = str(robot.urdf_path) if robot.urdf_path is not None else robot.name
+        params = str(robot.params_path) if robot.params_path is not None else None
+        if _is_shipped(robot):
+            urdf, params = SHIPPED_ROBOT, None
+        return cls(
+            name=robot.name,
+            joint_names=robot.joint_names,
+            urdf=urdf,
+            params=params,
+            tool_frame=robot.tool_frame,
+        )
+
+    def load(self) -> Robot:
+        """Rebuild the robot (raises :class:`~adept_traj.errors.RobotModelError` when its
+        files are gone)."""
+        if self.urdf == SHIPPED_ROBOT:
+            return Robot.adept_one_xl()
+        return Robot.from_urdf(self.urdf, self.params, tool_frame=self.tool_frame)
+
+
+def _is_shipped(robot: Robot) -> bool:
+    """True for the AdeptOne XL loaded from the shipped URDF and parameter file."""
+    try:
+        urdf, params = shipped_file("adept_one_xl.urdf"), shipped_file("adept_one_xl.toml")
+    except AdeptTrajError:
+        return False
+    if robot.urdf_path is None or robot.params_path is None:
+        return False
+    return (
+        Path(robot.urdf_path).resolve() == urdf.resolve()
+        and Path(robot.params_path).resolve() == params.resolve()
+    )
+
+
+# ============================================================================ front
+@dataclass(frozen=True, eq=False)
+class Front:
+    """A set of solutions: the final non-dominated set of a run.
+
+    Attributes
+    ----------
+    x: (n, n_var) decision vectors ``[T, free control points]``.
+    objectives: (n, 6) z1…z6, **z4 positive** (as reported, not pymoo's negated value).
+    constraints: (n, n_con) normalised constraints g (≤ 0 satisfied), the problem's order.
+    feasible: (n,) bool, as decided by the engine (the certificate for "verified").
+    """
+
+    x: np.ndarray
+    objectives: np.ndarray
+    constraints: np.ndarray
+    feasible: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = None
+        for name, width in (
+            ("x", None),
+            ("objectives", len(OBJECTIVE_NAMES)),
+            ("constraints", None),
+        ):
+            arr = readonly_copy(as_finite_array(getattr(self, name), f"front.{name}"))
+            n = arr.shape[0] if n is None and arr.ndim == 2 else n
+            if arr.ndim != 2 or arr.shape[0] != n or width not in (None, arr.shape[1]):
+                want = f"({n}, {width or 'm'})" if n is not None else "(n, m)"
+                raise InputShapeError(f"front.{name} must have shape {want}; got {arr.shape}")
+            object.__setattr__(self, name, arr)
+        feas = np.array(self.feasible)
+        if feas.shape != (n,) or feas.dtype != bool:
+            raise InputShapeError(
+                f"front.feasible must be a bool array of shape ({n},); got {feas.dtype} "
+                f"{feas.shape}"
+            )
+        feas.flags.writeable = False
+        object.__setattr__(self, "feasible", feas)
+
+    @classmethod
+    def from_evaluation(cls, x: Any, evaluation: Evaluation, feasible: Any | None = None) -> Front:
+        """The front of decision vectors ``x`` (n, n_var) and their :class:`Evaluation`
+        (objectives with z4 positive, constraints); ``feasible`` defaults to
+        ``evaluation.feasible``."""
+        return cls(
+            x=np.atleast_2d(np.asarray(x, dtype=float)),
+            objectives=np.atleast_2d(evaluation.objectives),
+            constraints=np.atleast_2d(evaluation.constraints),
+            feasible=np.atleast_1d(evaluation.feasible if feasible is None else feasible),
+        )
+
+    def __len__(self) -> int:
+        return int(self.x.shape[0])
+
+    def subset(self, mask: Any) -> Front:
+        """The solutions selected by a bool mask or index array."""
+        return Front(
+            self.x[mask], self.objectives[mask], self.constraints[mask], self.feasible[mask]
+        )
+
+    def __eq__(self, other: object) -> bool:
+        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True)
+class BestSolution:
+    """The solution picked from the front.
+
+    Attributes
+    ----------
+    index: its row in the front.
+    f_c: the selection score of the engine's decision rule (``None`` if not used).
+    f_avg: the average fitness ``F_avg`` of the decision rule (``None`` if not used).
+    """
+
+    index: int
+    f_c: float | None = None
+    f_avg: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "index", as_integer(self.index, "best.index", minimum=0))
+        object.__setattr__(self, "f_c", _optional_scalar(self.f_c, "best.f_c"))
+        object.__setattr__(self, "f_avg", _optional_scalar(self.f_avg, "best.f_avg"))
+
+
+# ============================================================================ run
+@dataclass(frozen=True, eq=False)
+class Metrics:
+    """Quality metrics of the front (``None``: not computed; NaN is stored as ``None``).
+
+    Attributes
+    ----------
+    ssm, rni, oo, ae: the paper's spacing (SSM), ratio of non-dominated individuals (RNI),
+        optimiser overhead (OO) and algorithm effort (AE), as the engine defines them.
+    hv: hypervolume of the normalised front w.r.t. ``hv_reference_point``.
+    hv_reference_point: (6,) the reference point, or ``None``.
+    """
+
+    ssm: float | None = None
+    rni: float | None = None
+    oo: float | None = None
+    ae: float | None = None
+    hv: float | None = None
+    hv_reference_point: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for name in METRIC_NAMES:
+            object.__setattr__(self, name, _metric(getattr(self, name), f"metrics.{name}"))
+        if self.hv_reference_point is not None:
+            ref = readonly_copy(as_finite_array(self.hv_reference_point, "hv_reference_point"))
+            if ref.ndim != 1:
+                raise InputShapeError(f"hv_reference_point must be 1-D; got {ref.shape}")
+            object.__setattr__(self, "hv_reference_point", ref)
+
+    def __eq__(self, other: object) -> bool:
+        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Cost of a run.
+
+    Attributes
+    ----------
+    total_s: wall time of the whole run [s].
+    evaluation_s: wall time spent evaluating objectives and constraints [s].
+    n_evaluations: trajectories evaluated.
+    n_generations: generations run.
+    """
+
+    total_s: float
+    evaluation_s: float
+    n_evaluations: int
+    n_generations: int
+
+    def __post_init__(self) -> None:
+        for name in ("total_s", "evaluation_s"):
+            value = as_scalar(getattr(self, name), f"timing.{name}", "[s]", minimum=0.0)
+            object.__setattr__(self, name, value)
+        for name in ("n_evaluations", "n_generations"):
+            value = as_integer(getattr(self, name), f"timing.{name}", minimum=0)
+            object.__setattr__(self, name, value)
+
+
+@dataclass(frozen=True)
+class GenerationRecord:
+    """Progress after one generation.
+
+    Attributes
+    ----------
+    generation: 1-based generation number.
+    n_evaluations: evaluations so far.
+    n_feasible: feasible individuals in the population.
+    hypervolume: hypervolume of the feasible front, or ``None`` (not computed / none).
+    """
+
+    generation: int
+    n_evaluations: int
+    n_feasible: int
+    hypervolume: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("generation", "n_evaluations", "n_feasible"):
+            value = as_integer(getattr(self, name), f"history.{name}", minimum=0)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "hypervolume", _metric(self.hypervolume, "history.hypervolume"))
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of adept_traj, numpy, pinocchio, coal, pymoo and Python."""
+    import coal
+    import pinocchio
+    import pymoo
+
+    from adept_traj import __version__
+
+    return {
+        "adept_traj": str(__version__),
+        "numpy": np.__version__,
+        "pinocchio": str(pinocchio.__version__),
+        "coal": str(getattr(coal, "__version__", "unknown")),
+        "pymoo": str(getattr(pymoo, "__version__", "unknown")),
+        "python": platform.python_version(),
+    }
