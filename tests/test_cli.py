@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from adept_traj.cli.commands import main
+from adept_traj.cli import main
 from adept_traj.results import PlanningResult
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -64,25 +64,19 @@ def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert "re-verified at 1000 Hz" in capsys.readouterr().out
     # An interrupted run (simulated: a checkpoint and run.json left behind) resumes.
     interrupted = tmp_path / "interrupted"
-    import adept_traj.cli.commands as cli
-
-    calls = {"n": 0}
-    real = cli._progress_bar
+    import adept_traj.cli.plan as plan_command
 
     def stop_after_two(label, quiet):
         def progress(info):
-            calls["n"] += 1
             if info.generation == 2:
                 raise KeyboardInterrupt
 
         return progress
 
-    cli._progress_bar = stop_after_two
-    try:
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(plan_command, "progress_reporter", stop_after_two)
         argv = ["plan", "--pop", "12", "--gens", "4", "--out", str(interrupted)]
         assert main(argv) == 130
-    finally:
-        cli._progress_bar = real
     assert "--resume" in capsys.readouterr().err
     assert main(["plan", "--resume", str(interrupted), "--quiet"]) == 0
     resumed = PlanningResult.load(interrupted)
@@ -127,7 +121,7 @@ def test_plan_bad_input(argv, message, capsys: pytest.CaptureFixture[str], tmp_p
 
 def test_console_script_runs_in_a_subprocess() -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "adept_traj.cli.commands", "robot", "--samples", "50"],
+        [sys.executable, "-m", "adept_traj.cli", "robot", "--samples", "50"],
         capture_output=True,
         text=True,
         check=False,
@@ -143,7 +137,7 @@ def test_show_serves_on_localhost_and_stops_on_ctrl_c(tmp_path: Path) -> None:
     assert main(["plan", "--pop", "8", "--gens", "2", "--out", str(out), "--quiet"]) == 0
     assert (out / "playback.html").is_file()  # plan writes the static playback page
     proc = subprocess.Popen(
-        [sys.executable, "-m", "adept_traj.cli.commands", "show", str(out)],
+        [sys.executable, "-m", "adept_traj.cli", "show", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
