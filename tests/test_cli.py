@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import io
+import os
 import re
+import select
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +14,8 @@ import numpy as np
 import pytest
 
 from adept_traj.cli import main
+from adept_traj.cli.progress import ProgressReporter
+from adept_traj.optimise import GenerationInfo
 from adept_traj.results import PlanningResult
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,15 +71,13 @@ def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[st
     interrupted = tmp_path / "interrupted"
     import adept_traj.cli.plan as plan_command
 
-    def stop_after_two(label, quiet):
-        def progress(info):
+    class StopAfterTwo(plan_command.ProgressReporter):
+        def __call__(self, info):
             if info.generation == 2:
                 raise KeyboardInterrupt
 
-        return progress
-
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(plan_command, "progress_reporter", stop_after_two)
+        patch.setattr(plan_command, "ProgressReporter", StopAfterTwo)
         argv = ["plan", "--pop", "12", "--gens", "4", "--out", str(interrupted)]
         assert main(argv) == 130
     assert "--resume" in capsys.readouterr().err
@@ -150,3 +153,119 @@ def test_show_serves_on_localhost_and_stops_on_ctrl_c(tmp_path: Path) -> None:
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+# ------------------------------------------------------------------------------ progress
+class _Terminal(io.StringIO):
+    """A stream that says it is a terminal."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+def _generations(n_gen: int, first: int = 1) -> list[GenerationInfo]:
+    return [
+        GenerationInfo(
+            generation=g,
+            n_gen=n_gen,
+            n_evaluations=10 * g,
+            n_feasible=g,
+            best_time=None if g < 3 else 1.5,
+            elapsed_s=0.25 * g,
+        )
+        for g in range(first, n_gen + 1)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("n_gen", "printed"),
+    [
+        (100, list(range(10, 101, 10))),
+        (3, [1, 2, 3]),
+        (15, [2, 4, 6, 8, 10, 12, 14, 15]),
+        (1, [1]),
+    ],
+)
+def test_progress_in_a_log_is_about_ten_plain_lines(n_gen: int, printed: list[int]) -> None:
+    stream = io.StringIO()
+    reporter = ProgressReporter("nsga2", stream)
+    for info in _generations(n_gen):
+        reporter(info)
+    reporter.close()
+    text = stream.getvalue()
+    assert "\r" not in text
+    lines = text.splitlines()
+    assert [line.split()[2] for line in lines] == [f"{g}/{n_gen}" for g in printed]
+    g = printed[-1]
+    best = "-" if g < 3 else "1.500 s"
+    assert lines[-1] == (
+        f"nsga2 gen {g}/{n_gen}  evals {10 * g}  feasible {g}  best T {best}  {0.25 * g:.1f} s"
+    )
+
+
+def test_progress_on_a_terminal_is_one_bar() -> None:
+    stream = _Terminal()
+    reporter = ProgressReporter("mode", stream)
+    for info in _generations(5):
+        reporter(info)
+    text = stream.getvalue()
+    assert text.count("\n") == 1  # one bar, redrawn in place, its line ended at the end
+    assert text.endswith("\n")
+    last = text.rstrip("\n").split("\r")[-1]
+    assert last.startswith("mode")
+    assert "5/5" in last
+    assert "evals 50  feasible 5  best T 1.500 s" in last
+
+
+@pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal (POSIX)")
+def test_progress_bar_is_drawn_on_a_terminal_that_reports_no_size(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    master, slave = os.openpty()  # a new pty reports 0 columns × 0 rows
+    try:
+        with os.fdopen(slave, "w", closefd=False) as stream:
+            monkeypatch.setattr(sys, "stderr", stream)  # tqdm sizes only stdout/stderr
+            reporter = ProgressReporter("nsga2")
+            for info in _generations(4):
+                reporter(info)
+        text = b""
+        while select.select([master], [], [], 0.5)[0]:
+            text += os.read(master, 65536)
+    finally:
+        os.close(slave)
+        os.close(master)
+    last = text.decode().rstrip("\r\n").split("\r")[-1]
+    assert last.startswith("nsga2: 100%")
+    assert "4/4" in last
+
+
+def test_progress_bar_of_a_resumed_run_starts_part_way_and_ends_its_line() -> None:
+    stream = _Terminal()
+    with ProgressReporter("nsga2", stream) as reporter:
+        reporter(_generations(10, first=4)[0])  # interrupted after one generation
+    text = stream.getvalue()
+    assert text.endswith("\n")
+    assert "4/10" in text.split("\r")[-1]
+    assert "1/10" not in text
+
+
+def test_quiet_reports_nothing() -> None:
+    for stream in (io.StringIO(), _Terminal()):
+        with ProgressReporter("nsga2", stream, quiet=True) as reporter:
+            for info in _generations(20):
+                reporter(info)
+        assert stream.getvalue() == ""
+
+
+def test_plan_progress_in_a_log_has_no_carriage_returns(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["plan", "--pop", "8", "--gens", "3", "--no-html", "--no-plots"]
+    assert main([*argv, "--out", str(tmp_path / "log")]) == 0
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    assert [line.split()[:3] for line in err.splitlines()] == [
+        ["nsga2", "gen", f"{g}/3"] for g in (1, 2, 3)
+    ]
+    assert main([*argv, "--out", str(tmp_path / "quiet"), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

@@ -21,7 +21,7 @@ from adept_traj.analysis import (
     objective_bounds,
 )
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
-from adept_traj.cli.progress import progress_reporter
+from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
 from adept_traj.optimise import plan
 from adept_traj.results import PlanningResult
@@ -160,16 +160,17 @@ def run(args: argparse.Namespace) -> int:
     results = {}
     try:
         for name, pop in (("nsga2", args.pop_nsga2), ("mode", args.pop_mode)):
-            results[name] = plan(
-                problem,
-                name,
-                seed=args.seed,
-                pop_size=pop,
-                n_gen=args.gens,
-                weights=args.weights,
-                progress=progress_reporter(name, args.quiet),
-                rate_hz=args.rate,
-            )
+            with ProgressReporter(name, quiet=args.quiet) as progress:
+                results[name] = plan(
+                    problem,
+                    name,
+                    seed=args.seed,
+                    pop_size=pop,
+                    n_gen=args.gens,
+                    weights=args.weights,
+                    progress=progress,
+                    rate_hz=args.rate,
+                )
             results[name].save(args.out / name)
             print(summary(results[name], args.out / name))
     finally:

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
-from adept_traj.cli.progress import progress_reporter
+from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import ALGORITHMS, PlanningInterrupted, plan
@@ -84,20 +84,21 @@ def run(args: argparse.Namespace) -> int:
     if not resume:
         _save_arguments(args, folder)
     try:
-        result = plan(
-            problem,
-            args.algorithm,
-            seed=args.seed,
-            pop_size=args.pop,
-            n_gen=args.gens,
-            weights=args.weights,
-            checkpoint=folder / "checkpoint",
-            resume=resume,
-            progress=progress_reporter(args.algorithm, args.quiet),
-            rate_hz=args.rate,
-        )
+        with ProgressReporter(args.algorithm, quiet=args.quiet) as progress:
+            result = plan(
+                problem,
+                args.algorithm,
+                seed=args.seed,
+                pop_size=args.pop,
+                n_gen=args.gens,
+                weights=args.weights,
+                checkpoint=folder / "checkpoint",
+                resume=resume,
+                progress=progress,
+                rate_hz=args.rate,
+            )
     except PlanningInterrupted as exc:
-        sys.stderr.write(f"\n{exc}: adept-traj plan --resume {folder}\n")
+        sys.stderr.write(f"{exc}: adept-traj plan --resume {folder}\n")
         return 130
     finally:
         problem.close()
