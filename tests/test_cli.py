@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 import os
 import re
 import select
@@ -269,3 +270,77 @@ def test_plan_progress_in_a_log_has_no_carriage_returns(
     ]
     assert main([*argv, "--out", str(tmp_path / "quiet"), "--quiet"]) == 0
     assert capsys.readouterr().err == ""
+
+
+# ------------------------------------------------------------------------------ --ros
+_BLOCKED_SCENE = """
+name = "blocked"
+[robot]
+xyz = [1.45, 0.39, -0.25]
+rpy = [0.0, 0.0, 3.141592653589793]
+[task]
+start = [0.1682, 1.3849, 0.08, -0.7555]
+goal = [-0.7610, 0.2450, 0.20, 1.0095]
+[[obstacle]]  # the whole reach of the arm between start and goal: no move is collision-free
+name = "wall"
+shape = "box"
+min = [0.0, -1.0, -1.0]
+max = [1.2, 2.0, 1.0]
+"""
+_TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quiet"]
+
+
+def test_plan_exports_an_uncertified_trajectory_only_when_allowed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "blocked.toml"
+    scene.write_text(_BLOCKED_SCENE)
+    ros = tmp_path / "ros" / "best.json"
+    out = tmp_path / "refused"
+    assert main([*_TINY, "--scene", str(scene), "--out", str(out), "--ros", str(ros)]) == 1
+    captured = capsys.readouterr()
+    assert not ros.exists()
+    assert not PlanningResult.load(out).feasible  # the folder is still written
+    assert not (out / "run.json").exists()
+    assert not (out / "checkpoint").exists()
+    assert "NOT FEASIBLE" in captured.out
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].startswith("adept-traj: error: the best trade-off is not verified feasible")
+    assert str(ros) in err[0]
+    assert "--allow-infeasible" in err[0]
+    argv = [*_TINY, "--scene", str(scene), "--out", str(tmp_path / "allowed")]
+    assert main([*argv, "--ros", str(ros), "--allow-infeasible"]) == 0
+    assert "ROS JointTrajectory written" in capsys.readouterr().out
+    message = json.loads(ros.read_text())
+    assert message["joint_names"] == ["joint1", "joint2", "joint3", "joint4"]
+
+
+def test_plan_exports_a_certified_trajectory(tmp_path: Path) -> None:
+    ros = tmp_path / "best.json"
+    assert main([*_TINY, "--out", str(tmp_path / "run"), "--ros", str(ros)]) == 0
+    assert PlanningResult.load(tmp_path / "run").feasible
+    assert len(json.loads(ros.read_text())["points"]) > 1000  # 1 kHz over T > 1 s
+
+
+@pytest.mark.parametrize(
+    ("ros", "message"),
+    [
+        ("folder", "is a folder"),
+        ("file.txt/best.json", "is not a folder"),
+        ("bad\0name.json", "not a valid path"),
+        ("run/result.json", "a file of the result folder"),
+        ("run/run.json", "a file of the result folder"),
+    ],
+)
+def test_plan_refuses_a_bad_ros_path_before_the_run(
+    ros: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "file.txt").write_text("")
+    out = tmp_path / "run"
+    assert main([*_TINY, "--out", str(out), "--ros", str(tmp_path / ros)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert message in err
+    assert not out.exists()  # refused before the run started

@@ -3,12 +3,19 @@
 While running, ``DIR/checkpoint/`` holds the last finished generation and ``DIR/run.json``
 the arguments; Ctrl-C stops the run (exit 130) and ``--resume DIR`` continues it. Both are
 removed when the run completes.
+
+``--ros FILE`` exports the best trade-off for a robot controller only when its dense
+certificate is feasible; otherwise the result folder is still written, nothing is
+exported and the exit status is 1 (``--allow-infeasible`` exports it anyway). A ``FILE``
+that cannot be written (a folder, a path through a file, a file of the result folder) is
+refused before the run starts.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -16,18 +23,32 @@ from pathlib import Path
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
-from adept_traj.errors import ConfigurationError
+from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import ALGORITHMS, PlanningInterrupted, plan
+from adept_traj.results import (
+    FRONT_FILE,
+    RESULT_FILE,
+    TRAJECTORY_FILE,
+    PlanningResult,
+    save_ros_joint_trajectory,
+)
 
-__all__ = ["RUN_FILE", "add_parser", "run"]
+__all__ = ["EXIT_NOT_EXPORTED", "RUN_FILE", "add_parser", "run"]
 
 #: The arguments of a run in progress, in its result folder (removed when it completes).
 RUN_FILE = "run.json"
 
+#: Exit status when the run finished but ``--ros`` refused its uncertified best trade-off.
+EXIT_NOT_EXPORTED = 1
+
+#: The files of the result folder that ``--ros`` must not overwrite.
+_RESULT_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, "playback.html", RUN_FILE)
+_CHECKPOINT = "checkpoint"
+
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
-    "workers", "no_html", "no_plots", "ros",
+    "workers", "no_html", "no_plots", "ros", "allow_infeasible",
 )  # fmt: skip
 
 
@@ -46,7 +67,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--no-html", action="store_true", help="do not write playback.html (static meshcat)"
     )
     p.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
-    p.add_argument("--ros", type=Path, help="also export the best trajectory as ROS JSON")
+    p.add_argument("--ros", type=Path, help="also export the certified best trajectory as ROS JSON")
+    p.add_argument(
+        "--allow-infeasible",
+        action="store_true",
+        help="with --ros: export the best trajectory even if its certificate failed",
+    )
     return p
 
 
@@ -58,9 +84,29 @@ def _restore(args: argparse.Namespace) -> Path:
     if not run_file.is_file():
         raise ConfigurationError(f"{args.resume}: no interrupted run here ({RUN_FILE})")
     saved = json.loads(run_file.read_text())
+    allow_infeasible = args.allow_infeasible  # may be given again when resuming
     for key, value in saved.items():
         setattr(args, key, Path(value) if key == "ros" and value is not None else value)
+    args.allow_infeasible = bool(args.allow_infeasible) or allow_infeasible
     return args.resume
+
+
+def _check_ros_path(path: Path, folder: Path) -> None:
+    """Refuse a ``--ros`` file that cannot be written, before the run starts."""
+    if "\0" in str(path):
+        raise InvalidInputError(f"--ros {str(path)!r} is not a valid path (NUL character)")
+    if path.is_dir():
+        raise InvalidInputError(f"--ros {path} is a folder; give a file, e.g. {path}/best.json")
+    parent = path.parent
+    while not parent.exists():  # the export creates missing folders
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InvalidInputError(f"--ros {path}: {parent} is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InvalidInputError(f"--ros {path}: cannot write in {parent}")
+    target, root = path.resolve(), folder.resolve()
+    if target in {root / name for name in _RESULT_FILES} or root / _CHECKPOINT in target.parents:
+        raise InvalidInputError(f"--ros {path} is a file of the result folder {folder}")
 
 
 def _save_arguments(args: argparse.Namespace, folder: Path) -> None:
@@ -79,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError("give --out DIR (or --resume DIR)")
     else:
         folder = args.out
+    if args.ros is not None:
+        _check_ros_path(args.ros, folder)
     problem = problem_from_arguments(args)
     folder.mkdir(parents=True, exist_ok=True)
     if not resume:
@@ -92,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
                 pop_size=args.pop,
                 n_gen=args.gens,
                 weights=args.weights,
-                checkpoint=folder / "checkpoint",
+                checkpoint=folder / _CHECKPOINT,
                 resume=resume,
                 progress=progress,
                 rate_hz=args.rate,
@@ -109,12 +157,24 @@ def run(args: argparse.Namespace) -> int:
         meshcat_view.static_html(result, folder / "playback.html")
     if not args.no_plots:
         save_figures({args.algorithm: result}, folder / "figures")
-    if args.ros is not None:
-        from adept_traj.results import save_ros_joint_trajectory
-
-        save_ros_joint_trajectory(result, args.ros, allow_infeasible=not result.feasible)
-        print(f"ROS JointTrajectory written to {args.ros}")
-    shutil.rmtree(folder / "checkpoint", ignore_errors=True)
+    shutil.rmtree(folder / _CHECKPOINT, ignore_errors=True)
     (folder / RUN_FILE).unlink(missing_ok=True)
     print(summary(result, folder))
+    if args.ros is not None:
+        return _export_ros(result, args.ros, args.allow_infeasible)
+    return 0
+
+
+def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool) -> int:
+    """Write the ROS file unless the best trade-off is uncertified and not allowed."""
+    if not (result.feasible or allow_infeasible):
+        print(
+            f"adept-traj: error: the best trade-off is not verified feasible; {path} was not "
+            "written (it is meant for a robot controller; --allow-infeasible exports it "
+            "anyway)",
+            file=sys.stderr,
+        )
+        return EXIT_NOT_EXPORTED
+    save_ros_joint_trajectory(result, path, allow_infeasible=allow_infeasible)
+    print(f"ROS JointTrajectory written to {path}")
     return 0
