@@ -16,10 +16,15 @@ import pytest
 
 from adept_traj.cli import main
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.optimise import GenerationInfo
+from adept_traj.optimise import GenerationInfo, plan
+from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
+#: An obstacle out of every test robot's reach.
+FAR_BOX = {"name": "box", "shape": "box", "min": [2.0, 2.0, 2.0], "max": [2.1, 2.1, 2.1]}
 
 
 def test_robot_demo_prints_torque_ratios(capsys: pytest.CaptureFixture[str]) -> None:
@@ -344,3 +349,67 @@ def test_plan_refuses_a_bad_ros_path_before_the_run(
     assert len(err.strip().splitlines()) == 1
     assert message in err
     assert not out.exists()  # refused before the run started
+
+
+# ------------------------------------------------------------------------------ verify
+def _limit_lines(out: str) -> dict[str, str]:
+    """The limit lines of ``verify``'s output, by kind."""
+    kinds = ("position", "velocity", "acceleration", "jerk", "torque")
+    rows = [line.split(maxsplit=1) for line in out.splitlines() if line.startswith("  ")]
+    return {row[0]: row[1] for row in rows if row[0] in kinds}
+
+
+_WORST = r"worst -?\d+\.\d{4} \(bound [01]\)"
+
+
+def _planar_verify(tmp_path: Path, joints: str, capsys: pytest.CaptureFixture[str]):
+    """Plan a tiny run of the planar 2-link arm (parameter file: task rows, ``joints``),
+    verify it with the command; the run's saved certificate and the limit lines."""
+    params = tmp_path / "planar.toml"
+    params.write_text(f'tool_frame = "hand"\ntask_rows = ["vx", "vz"]\n{joints}')
+    robot = Robot.from_urdf(ROOT / "tests" / "data" / "planar_2link.urdf", params)
+    assert np.isinf(robot.limits.jerk).all()
+    scene = Scene.from_dict({"name": "far", "obstacle": [FAR_BOX]})
+    problem = TrajectoryProblem(robot, scene, [0.0, 0.0], [1.0, 1.0])
+    try:
+        plan(problem, "nsga2", seed=1, pop_size=8, n_gen=2).save(tmp_path / "run")
+    finally:
+        problem.close()
+    capsys.readouterr()
+    main(["verify", str(tmp_path / "run")])
+    lines = _limit_lines(capsys.readouterr().out)
+    assert list(lines) == ["position", "velocity", "acceleration", "jerk", "torque"]
+    for kind in ("position", "velocity", "torque"):
+        assert re.fullmatch(_WORST, lines[kind]), lines
+    return PlanningResult.load(tmp_path / "run").certificate, lines
+
+
+def test_verify_says_no_limit_for_a_robot_without_acceleration_and_jerk_limits(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, lines = _planar_verify(tmp_path, "", capsys)
+    assert lines["acceleration"] == "no limit"
+    assert lines["jerk"] == "no limit"
+
+
+def test_verify_names_the_joints_without_a_limit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    joints = '[[joint]]\nname = "shoulder"\nacceleration = 20.0\n'  # the elbow has none
+    saved, lines = _planar_verify(tmp_path, joints, capsys)
+    assert re.fullmatch(_WORST + "; no limit: elbow", lines["acceleration"]), lines
+    worst = float(lines["acceleration"].split()[1].rstrip(";"))  # the shoulder's alone
+    assert worst == pytest.approx(saved.acceleration.worst[0], abs=5e-5)
+    assert lines["jerk"] == "no limit"
+
+
+def test_verify_prints_every_limit_of_the_shipped_robot(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main([*_TINY, "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(tmp_path)]) == 0  # this run's best is feasible
+    lines = _limit_lines(capsys.readouterr().out)
+    assert list(lines) == ["position", "velocity", "acceleration", "jerk", "torque"]
+    for text in lines.values():
+        assert re.fullmatch(_WORST, text), lines

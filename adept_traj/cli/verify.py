@@ -3,6 +3,11 @@
 This is the one command that rebuilds the full problem (``result.problem()``, with its
 collision checker): re-certification needs it. Exit status 0 if the best trade-off is
 feasible, 1 if not.
+
+One line per limit kind gives the worst ratio over the joints that have the limit and its
+bound (position: fraction of the range beyond the nearer limit, bound 0; the others:
+ratio to the limit, bound 1); joints without the limit (an infinite one, e.g. no
+acceleration or jerk limit in the robot's files) are listed as ``no limit``.
 """
 
 from __future__ import annotations
@@ -13,11 +18,20 @@ from pathlib import Path
 
 import numpy as np
 
-from adept_traj.analysis import certify
+from adept_traj.analysis import LimitCheck, certify
 from adept_traj.cli.arguments import check_rate
 from adept_traj.results import PlanningResult
+from adept_traj.robot import JointLimits
 
 __all__ = ["add_parser", "run"]
+
+#: The :class:`~adept_traj.robot.JointLimits` field of each rate-limit kind.
+_LIMIT_FIELD = {
+    "velocity": "velocity",
+    "acceleration": "acceleration",
+    "jerk": "jerk",
+    "torque": "effort",
+}
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -26,6 +40,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("folder", type=Path, help="result folder (with result.json)")
     p.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
     return p
+
+
+def _limit_line(check: LimitCheck, limits: JointLimits) -> str:
+    """``worst W (bound B)`` over the joints with a finite limit; ``no limit`` for the rest."""
+    if check.kind == "position":
+        limited = np.ones(len(limits.names), dtype=bool)  # position limits are finite
+    else:
+        limited = np.isfinite(getattr(limits, _LIMIT_FIELD[check.kind]))
+    free = [name for name, has in zip(limits.names, limited) if not has]
+    if not limited.any():
+        return "no limit"
+    text = f"worst {np.max(check.worst[limited]):.4f} (bound {check.bound:g})"
+    return f"{text}; no limit: {', '.join(free)}" if free else text
 
 
 def run(args: argparse.Namespace) -> int:
@@ -37,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
         t0 = time.perf_counter()
         cert = certify(problem, result.best_x, rate_hz=rate)
         elapsed = time.perf_counter() - t0
+        limits = problem.robot.limits
     finally:
         problem.close()
     print(
@@ -45,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         f"; min distance {cert.min_distance:.4f} m (margin {cert.margin} m)"
     )
     for check in cert.checks:
-        print(f"  {check.kind:<13} worst {np.max(check.worst):.4f} (bound {check.bound:g})")
+        print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
         print(f"  violation: {violation}")
     if cert.feasible != result.certificate.feasible:
