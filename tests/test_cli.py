@@ -413,3 +413,57 @@ def test_verify_prints_every_limit_of_the_shipped_robot(
     assert list(lines) == ["position", "velocity", "acceleration", "jerk", "torque"]
     for text in lines.values():
         assert re.fullmatch(_WORST, text), lines
+
+
+# ------------------------------------------------------------------------------ show
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_text()
+        except OSError:  # the process ended while we looked
+            continue
+        if int(text.rsplit(")", 1)[1].split()[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    """``pid`` exists and is not a zombie (Linux /proc)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_show_stops_its_server_on_sigterm(tmp_path: Path) -> None:
+    import signal
+
+    out = tmp_path / "run"
+    assert main([*_TINY, "--out", str(out)]) == 0
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "adept_traj.cli", "show", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    servers: list[int] = []
+    try:
+        line = proc.stdout.readline()
+        assert "http://127.0.0.1:" in line, line + proc.stderr.read()
+        servers = _children(proc.pid)
+        assert len(servers) == 1  # the meshcat server
+        assert _alive(servers[0])
+        proc.send_signal(signal.SIGTERM)
+        status = proc.wait(timeout=30)
+        assert not _alive(servers[0])
+        assert status == 143
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for pid in servers:  # a server left behind by a failing run of this test
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
