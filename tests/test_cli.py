@@ -467,3 +467,20 @@ def test_show_stops_its_server_on_sigterm(tmp_path: Path) -> None:
         for pid in servers:  # a server left behind by a failing run of this test
             if _alive(pid):
                 os.kill(pid, signal.SIGKILL)
+
+
+def test_compare_interrupted_exits_130(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import adept_traj.cli.compare as compare_command
+
+    class StopAtOnce(compare_command.ProgressReporter):
+        def __call__(self, info):
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(compare_command, "ProgressReporter", StopAtOnce)
+    argv = ["compare", "--gens", "2", "--pop-nsga2", "8", "--pop-mode", "8", "--no-plots"]
+    assert main([*argv, "--out", str(tmp_path)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted after generation 1" in err
+    assert "error" not in err

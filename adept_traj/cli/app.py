@@ -26,7 +26,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 
-from adept_traj.cli import build_urdf, compare, plan, robot, show, verify
+from adept_traj.cli import build_urdf, compare, plan, robot, show, status, verify
 from adept_traj.errors import AdeptTrajError
 
 __all__ = ["main"]
@@ -63,8 +63,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Returns
     -------
-    The exit status: 0 success, 2 bad input (one line on standard error), and the
-    command's own codes (``docs/cli.md``).
+    The exit status (:mod:`adept_traj.cli.status`): 0 success, 2 bad input (one line on
+    standard error), and the command's own statuses.
     """
     parser, runs = _parser()
     args = parser.parse_args(argv)
@@ -72,4 +72,4 @@ def main(argv: Sequence[str] | None = None) -> int:
         return runs[args.command](args)
     except (AdeptTrajError, OSError, json.JSONDecodeError) as exc:
         print(f"adept-traj: error: {exc}", file=sys.stderr)
-        return 2
+        return status.BAD_INPUT

@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from adept_traj.cli import status
 from adept_traj.robot import build_urdf
 
 __all__ = ["add_parser", "run"]
@@ -27,4 +28,4 @@ def run(args: argparse.Namespace) -> int:
     else:
         args.output.write_text(text)
         print(f"wrote {args.output}")
-    return 0
+    return status.OK

@@ -8,6 +8,7 @@ and both best trade-offs.
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -20,10 +21,11 @@ from adept_traj.analysis import (
     normalised_hypervolume,
     objective_bounds,
 )
+from adept_traj.cli import status
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
-from adept_traj.optimise import plan
+from adept_traj.optimise import PlanningInterrupted, plan
 from adept_traj.results import PlanningResult
 
 __all__ = ["add_parser", "comparison_markdown", "run"]
@@ -155,7 +157,7 @@ def comparison_markdown(results: dict[str, PlanningResult], weights: Sequence[fl
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``compare``; return the exit status (0)."""
+    """Run ``compare``; return the exit status (0, or 130 when interrupted)."""
     problem = problem_from_arguments(args)
     results = {}
     try:
@@ -173,6 +175,9 @@ def run(args: argparse.Namespace) -> int:
                 )
             results[name].save(args.out / name)
             print(summary(results[name], args.out / name))
+    except PlanningInterrupted as exc:  # no checkpoint: the finished runs are saved
+        print(f"{exc}", file=sys.stderr)
+        return status.INTERRUPTED
     finally:
         problem.close()
     if not args.no_plots:
@@ -181,4 +186,4 @@ def run(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "comparison.md").write_text(text)
     print(text)
-    return 0
+    return status.OK

@@ -20,6 +20,7 @@ import shutil
 import sys
 from pathlib import Path
 
+from adept_traj.cli import status
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
@@ -33,13 +34,10 @@ from adept_traj.results import (
     save_ros_joint_trajectory,
 )
 
-__all__ = ["EXIT_NOT_EXPORTED", "RUN_FILE", "add_parser", "run"]
+__all__ = ["RUN_FILE", "add_parser", "run"]
 
 #: The arguments of a run in progress, in its result folder (removed when it completes).
 RUN_FILE = "run.json"
-
-#: Exit status when the run finished but ``--ros`` refused its uncertified best trade-off.
-EXIT_NOT_EXPORTED = 1
 
 #: The files of the result folder that ``--ros`` must not overwrite.
 _RESULT_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, "playback.html", RUN_FILE)
@@ -117,7 +115,8 @@ def _save_arguments(args: argparse.Namespace, folder: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``plan``; return the exit status (0 done, 130 interrupted)."""
+    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done, 1 the
+    ``--ros`` export refused, 130 interrupted)."""
     resume = args.resume is not None
     if resume:
         folder = _restore(args)
@@ -147,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
             )
     except PlanningInterrupted as exc:
         sys.stderr.write(f"{exc}: adept-traj plan --resume {folder}\n")
-        return 130
+        return status.INTERRUPTED
     finally:
         problem.close()
     result.save(folder)
@@ -162,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
     print(summary(result, folder))
     if args.ros is not None:
         return _export_ros(result, args.ros, args.allow_infeasible)
-    return 0
+    return status.OK
 
 
 def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool) -> int:
@@ -174,7 +173,7 @@ def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool) -> i
             "anyway)",
             file=sys.stderr,
         )
-        return EXIT_NOT_EXPORTED
+        return status.NOT_CERTIFIED
     save_ros_joint_trajectory(result, path, allow_infeasible=allow_infeasible)
     print(f"ROS JointTrajectory written to {path}")
-    return 0
+    return status.OK

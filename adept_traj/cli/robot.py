@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
 from adept_traj.errors import InvalidInputError
 from adept_traj.robot import Robot
@@ -78,4 +79,4 @@ def run(args: argparse.Namespace) -> int:
     if robot.task_rows is not None:
         w = robot.manipulability(q)
         print(f"  manipulability (paper z4): min {w.min():.5f}, max {w.max():.5f} [m²]")
-    return 0
+    return status.OK

@@ -17,12 +17,10 @@ from pathlib import Path
 from types import FrameType
 from typing import NoReturn
 
+from adept_traj.cli import status
 from adept_traj.results import PlanningResult
 
-__all__ = ["EXIT_TERMINATED", "add_parser", "run"]
-
-#: Exit status of ``show`` stopped by SIGTERM (Ctrl-C: 0).
-EXIT_TERMINATED = 128 + signal.SIGTERM
+__all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -49,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         _play(args)
     except KeyboardInterrupt:
-        return EXIT_TERMINATED if terminated else 0
+        return status.TERMINATED if terminated else status.OK
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

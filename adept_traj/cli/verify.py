@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from adept_traj.analysis import LimitCheck, certify
+from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate
 from adept_traj.results import PlanningResult
 from adept_traj.robot import JointLimits
@@ -78,4 +79,4 @@ def run(args: argparse.Namespace) -> int:
         print(f"  violation: {violation}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")
-    return 0 if cert.feasible else 1
+    return status.OK if cert.feasible else status.NOT_CERTIFIED
