@@ -63,7 +63,6 @@ def test_viz_package_is_lazy() -> None:
         "assert v.__all__ == ['meshcat_scene', 'playback', 'plots', 'server']\n"
         "v.plots, v.playback\n"
         "assert 'meshcat' in sys.modules and 'matplotlib' not in sys.modules\n"
-        "assert v.meshcat_view.static_html is v.meshcat_scene.static_html\n"
         "try:\n    v.nothing\nexcept AttributeError:\n    pass\nelse:\n    raise SystemExit(1)\n"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

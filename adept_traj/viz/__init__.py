@@ -15,7 +15,6 @@ imports neither meshcat nor matplotlib::
     viz.meshcat_scene.static_html(result, "out/playback.html")  # imports meshcat here
     viz.plots.save_all(result, "out/figures")  # imports matplotlib here
 
-``viz.meshcat_view`` (the former single module) still re-exports the meshcat names.
 """
 
 from __future__ import annotations
@@ -26,15 +25,12 @@ from typing import TYPE_CHECKING
 
 __all__ = ["meshcat_scene", "playback", "plots", "server"]
 
-#: Lazily imported as well: the former name of the meshcat modules.
-_FORMER = ("meshcat_view",)
-
 if TYPE_CHECKING:  # pragma: no cover - for type checkers only
     from adept_traj.viz import meshcat_scene, playback, plots, server
 
 
 def __getattr__(name: str) -> ModuleType:
-    if name in __all__ or name in _FORMER:
+    if name in __all__:
         module = importlib.import_module(f".{name}", __name__)
         globals()[name] = module
         return module
@@ -42,4 +38,4 @@ def __getattr__(name: str) -> ModuleType:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__) | set(_FORMER))
+    return sorted(set(globals()) | set(__all__))

@@ -1,0 +1,7 @@
+"""``python -m adept_traj.cli``: the ``adept-traj`` command."""
+
+import sys
+
+from adept_traj.cli.app import main
+
+sys.exit(main())

@@ -1,0 +1,75 @@
+"""The ``adept-traj`` command: its argument parser, :func:`main` and error handling.
+
+Sub-commands, one module each:
+
+- ``adept-traj plan --out DIR`` (:mod:`adept_traj.cli.plan`) — plan on a scene (default:
+  the paper's), verify the best trade-off densely and save the result folder; Ctrl-C
+  checkpoints, ``--resume DIR`` continues.
+- ``adept-traj compare --out DIR`` (:mod:`adept_traj.cli.compare`) — NSGA-II and MODE on
+  the same problem, with the paper's Tables 3–5 beside ours (``DIR/comparison.md``).
+- ``adept-traj verify DIR`` (:mod:`adept_traj.cli.verify`) — re-run the dense
+  verification of a saved result.
+- ``adept-traj show DIR`` (:mod:`adept_traj.cli.show`) — play a saved result in the
+  browser (meshcat, 127.0.0.1).
+- ``adept-traj robot`` (:mod:`adept_traj.cli.robot`) — the robot-model demo (torques and
+  manipulability along a move).
+- ``adept-traj build-urdf PARAMS --output URDF`` (:mod:`adept_traj.cli.build_urdf`) —
+  regenerate a URDF from a parameter file.
+
+Bad input never prints a traceback: the command exits with status 2 and a one-line reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+
+from adept_traj.cli import build_urdf, compare, plan, robot, show, status, verify
+from adept_traj.errors import AdeptTrajError
+
+__all__ = ["main"]
+
+_DESCRIPTION = "Multi-objective, collision-free trajectory planning of industrial robots."
+
+#: Each command's module: ``add_parser(sub)`` declares it, ``run(args)`` runs it.
+_COMMANDS = {
+    "plan": plan,
+    "compare": compare,
+    "show": show,
+    "verify": verify,
+    "robot": robot,
+    "build-urdf": build_urdf,
+}
+
+
+def _parser() -> tuple[argparse.ArgumentParser, dict[str, Callable[[argparse.Namespace], int]]]:
+    parser = argparse.ArgumentParser(prog="adept-traj", description=_DESCRIPTION)
+    sub = parser.add_subparsers(dest="command", required=True)
+    runs = {}
+    for name, module in _COMMANDS.items():
+        module.add_parser(sub)
+        runs[name] = module.run
+    return parser, runs
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``adept-traj``.
+
+    Parameters
+    ----------
+    argv: the arguments after the program name (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    The exit status (:mod:`adept_traj.cli.status`): 0 success, 2 bad input (one line on
+    standard error), and the command's own statuses.
+    """
+    parser, runs = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return runs[args.command](args)
+    except (AdeptTrajError, OSError, json.JSONDecodeError) as exc:
+        print(f"adept-traj: error: {exc}", file=sys.stderr)
+        return status.BAD_INPUT

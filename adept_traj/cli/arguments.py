@@ -1,0 +1,95 @@
+"""Options shared by the planning commands (``plan``, ``compare``) and the problem they
+describe.
+
+:func:`add_problem_arguments` declares the options; :func:`problem_from_arguments` checks
+them and builds the :class:`~adept_traj.problem.TrajectoryProblem` on the shipped AdeptOne
+XL; :func:`check_rate` checks a verification rate [Hz].
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
+from adept_traj.validation import as_scalar
+
+__all__ = [
+    "MIN_RATE_HZ",
+    "add_problem_arguments",
+    "check_rate",
+    "floats",
+    "problem_from_arguments",
+]
+
+#: Lowest dense-verification rate the commands accept [Hz].
+MIN_RATE_HZ = 100.0
+
+
+def floats(text: str) -> list[float]:
+    """``argparse`` type of a comma-separated list of numbers, e.g. ``"0.1,1.2,0.08,0"``."""
+    try:
+        return [float(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated numbers, got {text!r}"
+        ) from None
+
+
+def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
+    workers and ``--quiet``."""
+    parser.add_argument("--scene", default="paper", help="'paper' or a scene TOML file")
+    parser.add_argument("--start", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
+    parser.add_argument("--goal", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
+    parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
+    parser.add_argument(
+        "--weights", type=floats, default=list(PAPER_WEIGHTS), help="w1,...,w6 for f_c"
+    )
+    parser.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.add_argument(
+        "--workers", type=int, default=1, help="processes evaluating in parallel (default 1)"
+    )
+
+
+def check_rate(rate: float) -> float:
+    """``rate`` [Hz] if it is a finite number ≥ :data:`MIN_RATE_HZ`, else
+    :class:`~adept_traj.errors.InvalidInputError`."""
+    return as_scalar(rate, "--rate", "[Hz]", minimum=MIN_RATE_HZ)
+
+
+def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
+    """The problem the options describe, on the shipped AdeptOne XL.
+
+    ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights`` must be six
+    finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
+
+    Raises
+    ------
+    ConfigurationError
+        The scene has no start/goal and none was given.
+    InvalidInputError
+        Bad weights or rate, or a start/goal outside the joint limits.
+    """
+    scene = Scene.paper() if args.scene == "paper" else Scene.from_file(args.scene)
+    start = args.start if args.start is not None else scene.start
+    goal = args.goal if args.goal is not None else scene.goal
+    if start is None or goal is None:
+        raise ConfigurationError(
+            f"scene '{scene.name}' has no [task] start/goal: give --start and --goal"
+        )
+    weights = np.asarray(args.weights, dtype=float)
+    if weights.shape != (6,) or not np.all(np.isfinite(weights)) or (weights < 0).any():
+        raise InvalidInputError(
+            f"--weights must be 6 finite numbers ≥ 0; got {','.join(map(str, args.weights))}"
+        )
+    if weights.sum() <= 0:
+        raise InvalidInputError("--weights must not all be 0")
+    check_rate(args.rate)
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal, workers=args.workers)

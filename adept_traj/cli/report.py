@@ -1,0 +1,51 @@
+"""What the planning commands print and draw after a run: the summary and the figures."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from adept_traj.results import PlanningResult, Replay
+
+__all__ = ["save_figures", "summary"]
+
+
+def summary(result: PlanningResult, folder: Path) -> str:
+    """A few lines on a finished run: evaluations and time, the best trade-off's objectives
+    z1 [s] … z6 and its gap to the kinematic lower bound, its dense certificate (violations
+    listed), the result's warning and where it was saved."""
+    z = result.best_objectives
+    cert = result.certificate
+    lines = [
+        f"{result.algorithm}: {result.timing.n_evaluations} evaluations in "
+        f"{result.timing.total_s:.1f} s ({result.timing.evaluation_s:.1f} s evaluating); "
+        f"front of {len(result.front)}",
+        f"best trade-off: T = {z[0]:.3f} s (lower bound {result.lower_bound.T_min:.3f} s, "
+        f"gap {result.gap:.2f}x), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, z4 = {z[3]:.4g} m², "
+        f"z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
+        f"verified at {cert.rate_hz:g} Hz: {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
+        f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m)",
+    ]
+    lines += [f"  violation: {v}" for v in cert.violations]
+    if result.warning:
+        lines.append(f"warning: {result.warning}")
+    lines.append(f"saved to {folder}/result.json")
+    return "\n".join(lines)
+
+
+def save_figures(
+    results: dict[str, PlanningResult],
+    folder: Path,
+    replays: dict[str, Replay] | None = None,
+) -> None:
+    """The paper's figures of ``results`` (by algorithm name) as PNGs in ``folder``
+    (matplotlib, the ``plot`` extra; a note on standard error when it is missing);
+    ``replays`` (same keys) reuse the run's robot and scene."""
+    try:
+        from adept_traj.viz import plots
+
+        paths = plots.save_all(results, folder, replays=replays)
+    except ImportError as exc:
+        print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
+        return
+    print(f"{len(paths)} figures in {folder}")

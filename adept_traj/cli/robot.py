@@ -1,0 +1,82 @@
+"""``adept-traj robot``: the robot-model demo.
+
+Peak joint speeds, accelerations and torques, the torques' ratio to their limits (the
+paper's UC), the integral of the squared torques (z2) and the manipulability range (z4)
+along a rest-to-rest quintic move of the paper's task or of the one given.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from adept_traj.cli import status
+from adept_traj.cli.arguments import floats
+from adept_traj.errors import InvalidInputError
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``robot`` and its options."""
+    p = sub.add_parser("robot", help="robot-model demo: torques and manipulability")
+    p.add_argument("--urdf", type=Path, help="URDF file (default: the AdeptOne XL)")
+    p.add_argument("--params", type=Path, help="parameter file for --urdf")
+    p.add_argument("--start", type=floats, help="q1,...,qn [rad|m] (default: paper's)")
+    p.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: paper's)")
+    p.add_argument("--duration", type=float, default=1.1, help="move time T [s]")
+    p.add_argument("--samples", type=int, default=1001, help="samples along the move")
+    return p
+
+
+def _quintic_move(
+    start: np.ndarray, goal: np.ndarray, duration: float, n: int
+) -> tuple[np.ndarray, ...]:
+    """Rest-to-rest quintic move: t (n,), q, v, a (n, nq)."""
+    tau = np.linspace(0.0, 1.0, n)
+    s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
+    sd = (30 * tau**2 - 60 * tau**3 + 30 * tau**4) / duration
+    sdd = (60 * tau - 180 * tau**2 + 120 * tau**3) / duration**2
+    delta = goal - start
+    return tau * duration, start + s[:, None] * delta, sd[:, None] * delta, sdd[:, None] * delta
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``robot``; return the exit status (0)."""
+    robot = Robot.adept_one_xl() if args.urdf is None else Robot.from_urdf(args.urdf, args.params)
+    paper = Scene.paper()  # its [task]: the paper's start and goal (docs/paper-scenario.md)
+    start = robot.limits.check_position(
+        paper.start if args.start is None else args.start, "--start"
+    )
+    goal = robot.limits.check_position(paper.goal if args.goal is None else args.goal, "--goal")
+    if not (np.isfinite(args.duration) and args.duration > 0):
+        raise InvalidInputError(f"--duration must be a positive number [s]; got {args.duration}")
+    if args.samples < 2:
+        raise InvalidInputError(f"--samples must be at least 2; got {args.samples}")
+    t, q, v, a = _quintic_move(start, goal, args.duration, args.samples)
+    u = robot.inverse_dynamics(q, v, a)
+    lim = robot.limits
+    print(f"{robot.name}: quintic rest-to-rest move in T = {args.duration:g} s")
+    print(f"  start {np.array2string(start, precision=4)}")
+    print(f"  goal  {np.array2string(goal, precision=4)}")
+    print(f"  {'joint':<8}{'peak |q̇|':>16}{'peak |q̈|':>17}{'peak |u|':>14}{'UC':>6}{'|u|/UC':>8}")
+    for k, name in enumerate(robot.joint_names):
+        unit = lim.units[k]
+        force = "N" if unit == "m" else "N·m"
+        peak_u = np.abs(u[:, k]).max()
+        print(
+            f"  {name:<8}{np.abs(v[:, k]).max():>9.3f} {unit + '/s':<6}"
+            f"{np.abs(a[:, k]).max():>9.3f} {unit + '/s²':<7}{peak_u:>9.2f} {force:<4}"
+            f"{lim.torque[k]:>6.0f}{peak_u / lim.torque[k]:>8.3f}"
+        )
+    dt = np.diff(t)
+    energy = np.sum(0.5 * ((u[1:] ** 2).sum(1) + (u[:-1] ** 2).sum(1)) * dt)
+    print(f"  ∫ Σ u² dt (paper z2) = {energy:.2f} [N²·m²·s]")
+    if robot.task_rows is not None:
+        w = robot.manipulability(q)
+        print(f"  manipulability (paper z4): min {w.min():.5f}, max {w.max():.5f} [m²]")
+    return status.OK

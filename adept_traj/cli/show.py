@@ -1,0 +1,69 @@
+"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1).
+
+Loops until stopped. Ctrl-C (SIGINT) stops the meshcat server and exits with status 0;
+SIGTERM (``kill``, a supervisor, a CI timeout) does the same and exits with status 143
+(128 + 15, the shell's code for a process ended by SIGTERM), so that the caller still
+sees that the command was terminated. The server is a process of its own: without this
+it would outlive a terminated command.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import threading
+import time
+from pathlib import Path
+from types import FrameType
+from typing import NoReturn
+
+from adept_traj.cli import status
+from adept_traj.results import PlanningResult
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``show`` and its options."""
+    p = sub.add_parser("show", help="play a saved result in the browser (meshcat)")
+    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
+    p.add_argument("--closest", action="store_true", help="draw the closest-point segment")
+    p.add_argument("--open", action="store_true", help="open the page in a web browser")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``show`` until Ctrl-C (exit status 0) or SIGTERM (exit status 143)."""
+    terminated: list[int] = []
+
+    def on_sigterm(signum: int, frame: FrameType | None) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)  # one is enough: let close() finish
+        terminated.append(signum)
+        raise KeyboardInterrupt
+
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, on_sigterm) if in_main_thread else None
+    try:
+        _play(args)
+    except KeyboardInterrupt:
+        return status.TERMINATED if terminated else status.OK
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _play(args: argparse.Namespace) -> NoReturn:
+    """Start the server and play until interrupted; the server is closed on the way out."""
+    from adept_traj.viz import server
+
+    result = PlanningResult.load(args.folder)
+    vis = server.show(  # closes its own server if interrupted while starting
+        result, speed=args.speed, show_closest=args.closest, open_browser=args.open
+    )
+    try:  # the URL is printed inside: a Ctrl-C right after it must still stop cleanly
+        print(f"playing {args.folder} at {vis.url()} (Ctrl-C to stop)", flush=True)
+        while True:
+            time.sleep(1.0)
+    finally:
+        vis.close()

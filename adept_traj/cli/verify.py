@@ -1,0 +1,74 @@
+"""``adept-traj verify DIR``: re-run the dense verification of a saved result.
+
+This is the one command that rebuilds the full problem (``result.problem()``, with its
+collision checker): re-certification needs it. Exit status 0 if the best trade-off is
+feasible, 1 if not.
+
+One line per limit kind gives the worst ratio over the joints that have the limit and its
+bound (position: fraction of the range beyond the nearer limit, bound 0; the others:
+ratio to the limit, bound 1); joints without the limit (an infinite one, e.g. no
+acceleration or jerk limit in the robot's files) are listed as ``no limit``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from adept_traj.analysis import LimitCheck, certify
+from adept_traj.cli import status
+from adept_traj.cli.arguments import check_rate
+from adept_traj.results import PlanningResult
+from adept_traj.robot import JointLimits
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``verify`` and its options."""
+    p = sub.add_parser("verify", help="re-run the dense verification of a saved result")
+    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    p.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
+    return p
+
+
+def _limit_line(check: LimitCheck, limits: JointLimits) -> str:
+    """``worst W (bound B)`` over the joints with a finite limit; ``no limit`` for the rest."""
+    if check.kind == "position":
+        limited = np.ones(len(limits.names), dtype=bool)  # position limits are finite
+    else:
+        limited = np.isfinite(limits.bound(check.kind))
+    free = [name for name, has in zip(limits.names, limited) if not has]
+    if not limited.any():
+        return "no limit"
+    text = f"worst {np.max(check.worst[limited]):.4f} (bound {check.bound:g})"
+    return f"{text}; no limit: {', '.join(free)}" if free else text
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``verify``; return the exit status (0 feasible, 1 not)."""
+    rate = check_rate(args.rate)
+    result = PlanningResult.load(args.folder)
+    problem = result.problem()
+    try:
+        t0 = time.perf_counter()
+        cert = certify(problem, result.best_x, rate_hz=rate)
+        elapsed = time.perf_counter() - t0
+        limits = problem.robot.limits
+    finally:
+        problem.close()
+    print(
+        f"{args.folder}: re-verified at {rate:g} Hz ({cert.n_samples} samples, "
+        f"{elapsed:.2f} s): {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
+        f"; min distance {cert.min_distance:.4f} m (margin {cert.margin} m)"
+    )
+    for check in cert.checks:
+        print(f"  {check.kind:<13} {_limit_line(check, limits)}")
+    for violation in cert.violations:
+        print(f"  violation: {violation}")
+    if cert.feasible != result.certificate.feasible:
+        print("  note: the saved certificate said otherwise")
+    return status.OK if cert.feasible else status.NOT_CERTIFIED
