@@ -51,8 +51,9 @@ from pymoo.core.problem import Problem
 
 from adept_traj.collision.checker import CollisionChecker, point_signed_distance
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
-from adept_traj.problem.bspline import BSplineTrajectory, kinematic_lower_bound
+from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.objectives import paper_penalty
+from adept_traj.problem.time_bound import kinematic_lower_bound
 from adept_traj.robot.parameter_file import TASK_ROWS
 from adept_traj.robot.robot import Robot, coulomb_sign, manipulability_measure
 from adept_traj.scene.scene import Scene

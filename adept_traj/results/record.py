@@ -36,10 +36,10 @@ import numpy as np
 from adept_traj.analysis.certificate import LIMIT_KINDS, Certificate, DenseTrajectory, LimitCheck
 from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError, ResultFormatError
 from adept_traj.files import write_text_atomic
-from adept_traj.problem.bspline import KinematicBound
-from adept_traj.problem.trajectory_problem import (
+from adept_traj.problem import (
     OBJECTIVE_NAMES,
     Evaluation,
+    KinematicBound,
     ProblemSettings,
     TrajectoryProblem,
 )
