@@ -6,12 +6,12 @@ equation, sense); :data:`OBJECTIVE_NAMES` and :data:`MAXIMISED` are its columns.
 ====  ========================================  =======  =====  =========
 name  quantity                                  unit     paper  sense
 ====  ========================================  =======  =====  =========
-z1    travel time :math:`T`                     s        (1)    minimised
-z2    :math:`\int_0^T \sum_i u_i^2\,dt`         N²·m²·s  (2)    minimised
-z3    clearance penalty                         \-       (3)    minimised
-z4    :math:`\min_t |\det J(q(t))|`             m²       (4)    maximised
-z5    :math:`\sum_i \int_0^T \dddot q_i^2\,dt`  rad²/s⁵  (5)    minimised
-z6    :math:`\sum_i \int_0^T \ddot q_i^2\,dt`   rad²/s³  (6)    minimised
+z1    travel time :math:`T`                     s        eq. 1  minimised
+z2    :math:`\int_0^T \sum_i u_i^2\,dt`         N²·m²·s  eq. 2  minimised
+z3    clearance penalty                         \-       eq. 3  minimised
+z4    :math:`\min_t |\det J(q(t))|`             m²       eq. 4  maximised
+z5    :math:`\sum_i \int_0^T \dddot q_i^2\,dt`  rad²/s⁵  eq. 5  minimised
+z6    :math:`\sum_i \int_0^T \ddot q_i^2\,dt`   rad²/s³  eq. 6  minimised
 ====  ========================================  =======  =====  =========
 
 (z5, z6: m²/s⁵, m²/s³ for a prismatic joint; z3 is dimensionless by default, m⁻² with
@@ -93,10 +93,10 @@ OBJECTIVES: tuple[Objective, ...] = (
     Objective("z6", "∫Σq̈²", "rad²/s³", 6),
 )
 
-#: Names of the objectives, in order: ``("z1", …, "z6")``.
+#: Names of the objectives in order, ``("z1", …, "z6")``.
 OBJECTIVE_NAMES: tuple[str, ...] = tuple(o.name for o in OBJECTIVES)
 
-#: Sense of each objective, in order: only z4 (manipulability) is maximised.
+#: Sense of each objective in order, True where maximised (only z4, the manipulability).
 MAXIMISED: tuple[bool, ...] = tuple(o.maximised for o in OBJECTIVES)
 
 #: Columns that pymoo sees negated (σ = −1 of the sign convention).
