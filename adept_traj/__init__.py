@@ -29,9 +29,15 @@ from adept_traj.errors import (
 )
 from adept_traj.optimise.algorithms import ALGORITHMS, make_algorithm
 from adept_traj.optimise.planner import plan
-from adept_traj.problem.bspline import BSplineTrajectory, KinematicBound, kinematic_lower_bound
-from adept_traj.problem.objectives import paper_penalty
-from adept_traj.problem.trajectory_problem import Evaluation, ProblemSettings, TrajectoryProblem
+from adept_traj.problem import (
+    BSplineTrajectory,
+    Evaluation,
+    KinematicBound,
+    ProblemSettings,
+    TrajectoryProblem,
+    kinematic_lower_bound,
+    paper_penalty,
+)
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot.limits import JointLimits
 from adept_traj.robot.parameter_file import RobotParameters

@@ -1,12 +1,70 @@
-"""Tests of the paper's collision penalty z3 (eqs. 13–16) against hand-computed values."""
+"""Tests of the objective table and pymoo's sign convention (written out by hand), and of the
+paper's collision penalty z3 (eqs. 13–16) against hand-computed values."""
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 import pytest
 
 from adept_traj.errors import InputShapeError, InvalidInputError
-from adept_traj.problem import paper_penalty
+from adept_traj.problem import (
+    MAXIMISED,
+    OBJECTIVE_NAMES,
+    OBJECTIVES,
+    from_pymoo,
+    objectives,
+    paper_penalty,
+    to_pymoo,
+)
+
+
+def test_objective_table() -> None:
+    assert OBJECTIVE_NAMES == ("z1", "z2", "z3", "z4", "z5", "z6")
+    assert MAXIMISED == (False, False, False, True, False, False)  # only z4 (manipulability)
+    assert [o.equation for o in OBJECTIVES] == [1, 2, 3, 4, 5, 6]
+    assert [o.unit for o in OBJECTIVES] == ["s", "N²·m²·s", "-", "m²", "rad²/s⁵", "rad²/s³"]
+    assert OBJECTIVES[0].label == "z1 time [s]"
+    assert OBJECTIVES[3].label == "z4 min|det J| [m²] (max)"
+
+
+def test_module_docstring_table_matches_the_objectives() -> None:
+    """The table in objectives.py's docstring (the API page) says what OBJECTIVES holds."""
+    rows = re.findall(r"^(z\d)\s.*?\s(\S+)\s+eq\. (\d)\s+(minimised|maximised)$",
+                      objectives.__doc__, flags=re.M)  # fmt: skip
+    assert [(r[0], r[1].replace("\\-", "-"), int(r[2]), r[3] == "maximised") for r in rows] == [
+        (o.name, o.unit, o.equation, o.maximised) for o in OBJECTIVES
+    ]
+
+
+def test_pymoo_sign_convention() -> None:
+    rng = np.random.default_rng(3)
+    z = rng.normal(size=(4, 6))
+    z[0, 3] = 0.0
+    expected = np.column_stack([z[:, 0], z[:, 1], z[:, 2], -z[:, 3], z[:, 4], z[:, 5]])
+    before = z.copy()
+    F = to_pymoo(z)
+    np.testing.assert_array_equal(F, expected)
+    assert np.signbit(F[0, 3])  # -0.0: a true negation, as pymoo's F had it before
+    np.testing.assert_array_equal(z, before)  # the caller's array is not changed
+    back = from_pymoo(F)
+    assert back.tobytes() == z.tobytes()  # bit for bit
+    assert to_pymoo(z[0]).shape == (6,)
+    assert to_pymoo(np.ones((2, 3, 6))).shape == (2, 3, 6)
+    np.testing.assert_array_equal(to_pymoo(np.ones((2, 3, 6)))[..., 3], -1.0)
+
+
+def test_pymoo_sign_convention_bad_input() -> None:
+    with pytest.raises(
+        InputShapeError, match=r"objectives must have shape \(\.\.\., 6\).*\(4, 5\)"
+    ):
+        to_pymoo(np.zeros((4, 5)))
+    with pytest.raises(InputShapeError, match=r"F must have shape \(\.\.\., 6\).*\(\)"):
+        from_pymoo(1.0)
+    with pytest.raises(InvalidInputError, match="F must be a numeric array"):
+        from_pymoo([["a"] * 6])
+
 
 SPHERE_AXES = np.array([[0.5, 0.5, 0.5]])
 

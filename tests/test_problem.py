@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import gc
+import multiprocessing
+import os
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -13,7 +19,7 @@ from adept_traj.errors import (
     JointLimitError,
     RobotModelError,
 )
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import Evaluation, ParallelEvaluator, TrajectoryProblem
 from adept_traj.testing.paper_moves import lift_then_lower
 
 
@@ -163,5 +169,94 @@ def test_parallel_workers_equal_serial(robot: Robot, scene: Scene, problem) -> N
         assert both.n_narrow == serial.n_narrow
     finally:
         parallel.close()
-    with pytest.raises(ConfigurationError, match="workers must be an integer ≥ 1"):
+    with pytest.raises(ConfigurationError, match=r"workers must be an integer in \[1, ∞\]; got 0"):
         TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=0)
+
+
+def _new_children(before: set) -> list:
+    return [p for p in multiprocessing.active_children() if p not in before]
+
+
+def _running(pid: int) -> bool:
+    """The process exists and has not exited (a zombie has exited), read from /proc: the
+    pool's own thread may reap a worker while the test waits, so Process.is_alive can race."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] not in ("Z", "X")
+
+
+def _stopped(children: list, timeout: float = 30.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while any(_running(p.pid) for p in children):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
+
+
+def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem) -> None:
+    """close(), a with block and garbage collection each stop the workers; after close()
+    a new pool starts and still gives the serial results."""
+    rng = np.random.default_rng(31)
+    x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(20, problem.n_var))
+    serial = problem.evaluate_batch(x)
+    before = set(multiprocessing.active_children())
+    with TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2) as parallel:
+        parallel.evaluate_batch(x)
+        first = _new_children(before)
+        assert len(first) == 2
+        parallel.close()
+        assert _stopped(first)
+        again = parallel.evaluate_batch(x)  # a new pool
+        np.testing.assert_array_equal(again.objectives, serial.objectives)
+        second = _new_children(before)
+        assert len(second) == 2
+    assert _stopped(second)  # the with block closed it
+
+    collected = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2)
+    collected.evaluate_batch(x)
+    third = _new_children(before)
+    assert len(third) == 2
+    del collected
+    gc.collect()
+    assert _stopped(third)  # garbage collection stopped the pool: nothing kept the problem
+
+
+def _pid_rows(x: np.ndarray) -> Evaluation:
+    """Objectives (k, 2): the row's first variable and the evaluating process id."""
+    k = len(x)
+    return Evaluation(
+        objectives=np.column_stack([x[:, 0], np.full(k, float(os.getpid()))]),
+        constraints=np.zeros((k, 1)),
+        min_distance=np.zeros((k, 0)),
+        n_narrow=k,
+    )
+
+
+def test_parallel_evaluator_hands_the_function_to_forked_workers() -> None:
+    """The function reaches the workers once, when they are forked: a closure (which pickle
+    refuses) works; rows come back in order, each chunk computed in a worker process."""
+    offset = 10.0
+    evaluate = lambda x: _pid_rows(x + offset)  # noqa: E731 (a closure cannot be pickled)
+    x = np.arange(30.0).reshape(10, 3)
+    with ParallelEvaluator(evaluate, workers=2, n_var=3) as evaluator:
+        ev = evaluator.evaluate(x)
+        assert evaluator.running
+    assert not evaluator.running
+    np.testing.assert_array_equal(ev.objectives[:, 0], x[:, 0] + offset)
+    pids = ev.objectives[:, 1]
+    assert len(set(pids[:5])) == 1
+    assert len(set(pids[5:])) == 1
+    assert os.getpid() not in pids  # computed in the workers
+    assert ev.n_narrow == 10
+    with pytest.raises(ConfigurationError, match="closed"):
+        evaluator.evaluate(x)
+    with pytest.raises(ConfigurationError, match=r"workers must be an integer in \[2, ∞\]"):
+        ParallelEvaluator(evaluate, workers=1, n_var=3)
+    with ParallelEvaluator(evaluate, workers=2, n_var=3) as evaluator:
+        with pytest.raises(InputShapeError, match=r"pop ≥ workers = 2; got \(1, 3\)"):
+            evaluator.evaluate(x[:1])
+        with pytest.raises(InputShapeError, match=r"\(\.\.\., 3\)"):
+            evaluator.evaluate(x[:, :2])

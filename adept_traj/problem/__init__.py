@@ -1,37 +1,50 @@
 """The trajectory problem.
 
-B-spline trajectory, kinematic time bound, objectives, :class:`TrajectoryProblem`."""
+The B-spline trajectory (``bspline``; its per-segment arithmetic in ``spline_segments``),
+the kinematic lower bound of the travel time (``time_bound``), the objective table, pymoo's
+sign convention and the paper's penalty (``objectives``), :class:`TrajectoryProblem`
+(``trajectory_problem``) with its :class:`Evaluation` (``evaluation``), its parallel
+evaluator (``evaluator``) and its plain-loop reference (``reference``).
+"""
 
 from __future__ import annotations
 
-from adept_traj.problem.bspline import (
-    BSplineTrajectory,
-    KinematicBound,
+from adept_traj.problem.bspline import BSplineTrajectory
+from adept_traj.problem.evaluation import Evaluation
+from adept_traj.problem.evaluator import ParallelEvaluator
+from adept_traj.problem.objectives import (
+    MAXIMISED,
+    OBJECTIVE_NAMES,
+    OBJECTIVES,
+    Objective,
+    from_pymoo,
+    paper_penalty,
+    to_pymoo,
+)
+from adept_traj.problem.spline_segments import (
     TrajectoryBounds,
     TrajectoryIntegrals,
     TrajectorySamples,
-    kinematic_lower_bound,
 )
-from adept_traj.problem.objectives import (
-    paper_penalty,
-)
-from adept_traj.problem.trajectory_problem import (
-    OBJECTIVE_NAMES,
-    Evaluation,
-    ProblemSettings,
-    TrajectoryProblem,
-)
+from adept_traj.problem.time_bound import KinematicBound, kinematic_lower_bound
+from adept_traj.problem.trajectory_problem import ProblemSettings, TrajectoryProblem
 
 __all__ = [
+    "MAXIMISED",
+    "OBJECTIVES",
     "OBJECTIVE_NAMES",
     "BSplineTrajectory",
     "Evaluation",
     "KinematicBound",
+    "Objective",
+    "ParallelEvaluator",
     "ProblemSettings",
     "TrajectoryBounds",
     "TrajectoryIntegrals",
     "TrajectoryProblem",
     "TrajectorySamples",
+    "from_pymoo",
     "kinematic_lower_bound",
     "paper_penalty",
+    "to_pymoo",
 ]

@@ -32,18 +32,15 @@ i.e. ``T`` first, then the free control points joint-major (joint 0's ``n_free``
 then joint 1's, …). Control points have the units of their joint ([rad] or [m]).
 
 Every method accepts ``x`` of shape ``(n_var,)`` or ``(..., n_var)`` and keeps the leading
-(population) axes. Bounds of :math:`q, \dot q, \ddot q, \dddot q` over :math:`[0, T]` and
-the integrals :math:`\int \ddot q^2 \mathrm{d}t`, :math:`\int \dddot q^2 \mathrm{d}t` are
-computed exactly from the per-segment polynomials, not from samples.
-
-:func:`kinematic_lower_bound` gives the exact minimum rest-to-rest time under velocity,
-acceleration and jerk limits (the time-optimal "double S" profile), a bound no trajectory of
-this class can beat.
+(population) axes. The methods check and normalise their input; the arithmetic on the
+per-segment polynomials (samples, exact bounds of :math:`q, \dot q, \ddot q, \dddot q` and
+exact integrals of :math:`\ddot q^2, \dddot q^2`) is in
+:mod:`adept_traj.problem.spline_segments`. The kinematic lower bound of ``T``:
+:mod:`adept_traj.problem.time_bound`.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -56,178 +53,31 @@ from adept_traj.errors import (
     InvalidInputError,
     JointLimitError,
 )
+from adept_traj.problem.spline_segments import (
+    TrajectoryBounds,
+    TrajectoryIntegrals,
+    TrajectorySamples,
+    _basis,
+    _exact_bounds,
+    _exact_integrals,
+    _gauss_legendre,
+    _sample,
+)
 from adept_traj.validation import (
     as_batch,
     as_finite_array,
+    as_integer,
     as_vector,
     describe_bad_values,
     readonly_copy,
 )
 
-__all__ = [
-    "BSplineTrajectory",
-    "KinematicBound",
-    "TrajectoryBounds",
-    "TrajectoryIntegrals",
-    "TrajectorySamples",
-    "kinematic_lower_bound",
-]
-
-#: Uniform cubic B-spline basis matrix (rows: coefficients of u³, u², u, 1).
-_M = (
-    np.array(
-        [
-            [-1.0, 3.0, -3.0, 1.0],
-            [3.0, -6.0, 3.0, 0.0],
-            [-3.0, 0.0, 3.0, 0.0],
-            [1.0, 4.0, 1.0, 0.0],
-        ]
-    )
-    / 6.0
-)
-_M.flags.writeable = False
+__all__ = ["BSplineTrajectory"]
 
 #: Number of control points fixed at each end of every joint (rest-to-rest conditions).
 _N_FIXED_END = 3
 
 _ALL_ORDERS = (0, 1, 2, 3)
-
-
-# --------------------------------------------------------------------------------------------
-# Result containers
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class TrajectorySamples:
-    """Joint trajectories sampled at shared normalised times.
-
-    Attributes:
-        t: sample times [s], shape ``(..., n_s)`` (``t = T·s``, one row per individual).
-        q: positions [rad] or [m], shape ``(..., n_s, nq)``.
-        qd: velocities [rad/s] or [m/s], shape ``(..., n_s, nq)``.
-        qdd: accelerations [rad/s²] or [m/s²], shape ``(..., n_s, nq)``.
-        qddd: jerks [rad/s³] or [m/s³], shape ``(..., n_s, nq)``.
-
-    A derivative that was not requested (``orders`` of :meth:`BSplineTrajectory.sample`) is
-    ``None``.
-    """
-
-    t: np.ndarray
-    q: np.ndarray | None
-    qd: np.ndarray | None
-    qdd: np.ndarray | None
-    qddd: np.ndarray | None
-
-
-@dataclass(frozen=True, eq=False)
-class TrajectoryBounds:
-    r"""Exact per-joint extrema over :math:`t \in [0, T]`, each of shape ``(..., nq)``.
-
-    Attributes:
-        q_min, q_max: position extrema [rad] or [m].
-        qd_min, qd_max: velocity extrema [rad/s] or [m/s].
-        qdd_min, qdd_max: acceleration extrema [rad/s²] or [m/s²].
-        qddd_min, qddd_max: jerk extrema [rad/s³] or [m/s³] (the jerk is piecewise
-            constant; its value on every segment counts, including the first and last).
-    """
-
-    q_min: np.ndarray
-    q_max: np.ndarray
-    qd_min: np.ndarray
-    qd_max: np.ndarray
-    qdd_min: np.ndarray
-    qdd_max: np.ndarray
-    qddd_min: np.ndarray
-    qddd_max: np.ndarray
-
-    @property
-    def q_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |q_i(t)|` [rad] or [m], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.q_min), np.abs(self.q_max))
-
-    @property
-    def qd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\dot q_i(t)|` [rad/s] or [m/s], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qd_min), np.abs(self.qd_max))
-
-    @property
-    def qdd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\ddot q_i(t)|` [rad/s²] or [m/s²], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qdd_min), np.abs(self.qdd_max))
-
-    @property
-    def qddd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\dddot q_i(t)|` [rad/s³] or [m/s³], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qddd_min), np.abs(self.qddd_max))
-
-
-@dataclass(frozen=True, eq=False)
-class TrajectoryIntegrals:
-    r"""Exact per-joint integrals of squared acceleration and jerk over :math:`[0, T]`.
-
-    Attributes:
-        acc_sq: :math:`\int_0^T \ddot q_i^2 \, \mathrm{d}t` [rad²/s³] or [m²/s³],
-            shape ``(..., nq)``.
-        jerk_sq: :math:`\int_0^T \dddot q_i^2 \, \mathrm{d}t` [rad²/s⁵] or [m²/s⁵],
-            shape ``(..., nq)``.
-    """
-
-    acc_sq: np.ndarray
-    jerk_sq: np.ndarray
-
-    @property
-    def z6(self) -> np.ndarray:
-        r"""Paper objective :math:`z_6 = \sum_i \int_0^T \ddot q_i^2 dt`, shape ``(...)``."""
-        return self.acc_sq.sum(axis=-1)
-
-    @property
-    def z5(self) -> np.ndarray:
-        r"""Paper objective :math:`z_5 = \sum_i \int_0^T \dddot q_i^2 dt`, shape ``(...)``."""
-        return self.jerk_sq.sum(axis=-1)
-
-
-@dataclass(frozen=True, eq=False)
-class KinematicBound:
-    r"""Minimum rest-to-rest travel times under velocity, acceleration and jerk limits.
-
-    Attributes:
-        times: per-joint minimum time [s], shape ``(nq,)``.
-        delta: per-joint distance :math:`|q_\text{goal} - q_\text{start}|` [rad] or [m],
-            shape ``(nq,)``.
-        cases: per-joint profile type, one of ``"rest"`` (Δ = 0), ``"instant"`` (all limits
-            infinite), ``"jerk"`` (neither a nor v reached), ``"acc"`` (a reached, v not),
-            ``"vel"`` (v reached, a not), ``"acc+vel"`` (both reached).
-        T_min: :math:`\max_i` ``times[i]`` [s]: no trajectory respecting the limits can be
-            faster.
-        limiting_joint: index of the joint that attains ``T_min`` (0 if all times are 0).
-    """
-
-    times: np.ndarray
-    delta: np.ndarray
-    cases: tuple[str, ...]
-    T_min: float
-    limiting_joint: int
-
-
-# --------------------------------------------------------------------------------------------
-# Private helpers
-# --------------------------------------------------------------------------------------------
-
-
-def _monomial_derivative_rows(u: np.ndarray, order: int) -> np.ndarray:
-    r"""Rows :math:`\frac{d^r}{du^r}[u^3, u^2, u, 1]`, shape ``(n, 4)``."""
-    one = np.ones_like(u)
-    zero = np.zeros_like(u)
-    if order == 0:
-        cols = (u**3, u**2, u, one)
-    elif order == 1:
-        cols = (3.0 * u**2, 2.0 * u, one, zero)
-    elif order == 2:
-        cols = (6.0 * u, 2.0 * one, zero, zero)
-    else:
-        cols = (6.0 * one, zero, zero, zero)
-    return np.stack(cols, axis=-1)
 
 
 def _check_orders(orders: Sequence[int]) -> tuple[int, ...]:
@@ -251,77 +101,6 @@ def _check_positive_times(T: np.ndarray, name: str) -> None:
     if bad.any():
         where = describe_bad_values(T, bad) if T.ndim else repr(float(T))
         raise InvalidInputError(f"{name} (travel time T [s]) must be > 0; bad entries: {where}")
-
-
-def _clip_candidates(u: np.ndarray) -> np.ndarray:
-    """Map candidate parameters to [0, 1]; NaN/inf (no root) become 0 (an endpoint)."""
-    u = np.where(np.isfinite(u), u, 0.0)
-    return np.clip(u, 0.0, 1.0)
-
-
-def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Real roots of :math:`a u^2 + b u + c` by the cancellation-free formula.
-
-    Complex pairs, and roots of a degenerate polynomial, come out as NaN or inf (the
-    caller replaces them by an endpoint). A linear polynomial (``a = 0``) yields its
-    root in the second output.
-    """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        disc = b * b - 4.0 * a * c
-        sq = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
-        qq = -0.5 * (b + np.where(b >= 0.0, sq, -sq))
-        r1 = qq / a
-        r2 = c / qq
-    return r1, r2
-
-
-def _double_s_time(h: float, v: float, a: float, j: float) -> tuple[float, str]:
-    """Minimum rest-to-rest time [s] for distance ``h`` ≥ 0 under limits v, a, j (> 0, may be inf).
-
-    Biagiotti & Melchiorri, *Trajectory Planning for Automatic Machines and Robots* (2008),
-    Sec. 3.4, with zero boundary velocities and accelerations and symmetric limits.
-    """
-    if h == 0.0:
-        return 0.0, "rest"
-    if math.isinf(j):
-        # Jerk unlimited: trapezoidal (or triangular) velocity profile.
-        if math.isinf(a):
-            return (0.0, "instant") if math.isinf(v) else (h / v, "vel")
-        if math.isinf(v) or v * v / a >= h:
-            return 2.0 * math.sqrt(h / a), "acc"
-        return h / v + v / a, "acc+vel"
-    # Jerk limited. 1) Is v reached? Time Ta to accelerate from 0 to v:
-    if not math.isinf(v):
-        a_reached = (not math.isinf(a)) and v * j >= a * a
-        t_acc = a / j + v / a if a_reached else 2.0 * math.sqrt(v / j)
-        if h >= v * t_acc:  # distance covered by accelerating to v and back to 0
-            return h / v + t_acc, ("acc+vel" if a_reached else "vel")
-    # 2) v not reached: is a reached?
-    if not math.isinf(a) and h >= 2.0 * a**3 / j**2:
-        return a / j + math.sqrt((a / j) ** 2 + 4.0 * h / a), "acc"
-    return 4.0 * (h / (2.0 * j)) ** (1.0 / 3.0), "jerk"
-
-
-def _as_limit(value: Any, name: str, nq: int) -> np.ndarray:
-    """Return a positive limit (inf allowed) broadcast to shape ``(nq,)``."""
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be numeric; got {value!r} ({exc})") from None
-    if arr.ndim > 1 or (arr.ndim == 1 and arr.shape[0] != nq):
-        raise InputShapeError(f"{name} must be a scalar or have shape ({nq},); got {arr.shape}")
-    arr = np.broadcast_to(arr, (nq,)).copy()
-    bad = ~(arr > 0.0)  # NaN, zero and negative values
-    if bad.any():
-        raise InvalidInputError(
-            f"{name} must be > 0 (inf allowed); bad entries: {describe_bad_values(arr, bad)}"
-        )
-    return arr
-
-
-# --------------------------------------------------------------------------------------------
-# The trajectory class
-# --------------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True, eq=False)
@@ -356,14 +135,10 @@ class BSplineTrajectory:
         if start.ndim != 1 or start.shape[0] == 0:
             raise InputShapeError(f"start must have shape (nq,) with nq >= 1; got {start.shape}")
         goal = as_vector(self.goal, "goal", start.shape[0])
-        n_knots = self.n_knots
-        if isinstance(n_knots, bool) or not isinstance(n_knots, (int, np.integer)):
-            raise ConfigurationError(f"n_knots must be an integer >= 4; got {n_knots!r}")
-        if n_knots < 4:
-            raise ConfigurationError(f"n_knots must be >= 4; got {n_knots}")
+        n_knots = as_integer(self.n_knots, "n_knots", minimum=4, error=ConfigurationError)
         object.__setattr__(self, "start", readonly_copy(start))
         object.__setattr__(self, "goal", readonly_copy(goal))
-        object.__setattr__(self, "n_knots", int(n_knots))
+        object.__setattr__(self, "n_knots", n_knots)
         object.__setattr__(
             self, "_fixed_head", readonly_copy(np.broadcast_to(start, (_N_FIXED_END, start.size)))
         )
@@ -534,17 +309,7 @@ class BSplineTrajectory:
             ``B`` of shape ``(n_s, n_control)`` (dimensionless, scaled by :math:`S^r`).
         """
         (order,) = _check_orders([order])
-        return self._basis(self._check_s(s), order)
-
-    def _basis(self, s: np.ndarray, order: int) -> np.ndarray:
-        S = self.n_segments
-        seg = np.minimum(np.floor(s * S).astype(np.intp), S - 1)
-        u = s * S - seg
-        rows = _monomial_derivative_rows(u, order) @ _M * float(S) ** order  # (n_s, 4)
-        B = np.zeros((s.shape[0], self.n_control))
-        cols = seg[:, None] + np.arange(4)
-        np.put_along_axis(B, cols, rows, axis=1)
-        return B
+        return _basis(self._check_s(s), order, self.n_segments)
 
     def sample(self, x: Any, s: Any, orders: Sequence[int] = _ALL_ORDERS) -> TrajectorySamples:
         r"""Evaluate positions and derivatives at normalised times shared by the population.
@@ -567,21 +332,9 @@ class BSplineTrajectory:
         """
         wanted = _check_orders(orders)
         T, P = self._decode_clean(self._check_x(x))
-        s_arr = self._check_s(s)
-        out: list[np.ndarray | None] = [None, None, None, None]
-        for r in wanted:
-            P_r = P if r == 0 else P * (T[..., None, None] ** (-r))  # small: scale before
-            out[r] = self._basis(s_arr, r) @ P_r
-        t = T[..., None] * s_arr
-        return TrajectorySamples(t=t, q=out[0], qd=out[1], qdd=out[2], qddd=out[3])
+        return _sample(T, P, self._check_s(s), wanted)
 
     # ---- exact per-segment analysis ----------------------------------------------------
-
-    def _segment_coefficients(self, P: np.ndarray) -> np.ndarray:
-        """Monomial coefficients in ``u`` per segment, shape ``(..., S, 4, nq)`` (u³, u², u, 1)."""
-        idx = np.arange(self.n_segments)[:, None] + np.arange(4)
-        windows = P[..., idx, :]  # (..., S, 4, nq)
-        return np.einsum("ab,...sbj->...saj", _M, windows)
 
     def bounds(self, x: Any) -> TrajectoryBounds:
         r"""Exact per-joint minima and maxima of :math:`q, \dot q, \ddot q, \dddot q` over [0, T].
@@ -600,43 +353,7 @@ class BSplineTrajectory:
         Returns:
             :class:`TrajectoryBounds`, every field of shape ``(..., nq)`` in SI units.
         """
-        T, P = self._decode_clean(self._check_x(x))
-        c = self._segment_coefficients(P)
-        c3, c2, c1, c0 = c[..., 0, :], c[..., 1, :], c[..., 2, :], c[..., 3, :]  # (..., S, nq)
-        rate = self.n_segments / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
-
-        r1, r2 = _quadratic_roots(3.0 * c3, 2.0 * c2, c1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            vertex = -c2 / (3.0 * c3)
-        zeros = np.zeros_like(c3)
-        ones = np.ones_like(c3)
-        u_q = np.stack([zeros, ones, _clip_candidates(r1), _clip_candidates(r2)], axis=-3)
-        u_qd = np.stack([zeros, ones, _clip_candidates(vertex)], axis=-3)
-        u_qdd = np.stack([zeros, ones], axis=-3)
-        cc3, cc2, cc1, cc0 = (ci[..., None, :, :] for ci in (c3, c2, c1, c0))
-
-        q_val = ((cc3 * u_q + cc2) * u_q + cc1) * u_q + cc0  # (..., k, S, nq)
-        qd_val = ((3.0 * cc3 * u_qd + 2.0 * cc2) * u_qd + cc1) * rate[..., None, :, :]
-        qdd_val = (6.0 * cc3 * u_qdd + 2.0 * cc2) * rate[..., None, :, :] ** 2
-        qddd_val = 6.0 * c3 * rate**3  # (..., S, nq)
-
-        def ext(v: np.ndarray, axes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
-            return v.min(axis=axes), v.max(axis=axes)
-
-        q_min, q_max = ext(q_val, (-3, -2))
-        qd_min, qd_max = ext(qd_val, (-3, -2))
-        qdd_min, qdd_max = ext(qdd_val, (-3, -2))
-        qddd_min, qddd_max = ext(qddd_val, (-2,))
-        return TrajectoryBounds(
-            q_min=q_min,
-            q_max=q_max,
-            qd_min=qd_min,
-            qd_max=qd_max,
-            qdd_min=qdd_min,
-            qdd_max=qdd_max,
-            qddd_min=qddd_min,
-            qddd_max=qddd_max,
-        )
+        return _exact_bounds(*self._decode_clean(self._check_x(x)))
 
     def integrals(self, x: Any) -> TrajectoryIntegrals:
         r"""Exact per-joint integrals of squared acceleration and squared jerk over [0, T].
@@ -658,14 +375,7 @@ class BSplineTrajectory:
             :class:`TrajectoryIntegrals` with ``acc_sq`` and ``jerk_sq`` of shape ``(..., nq)``;
             ``.z6`` and ``.z5`` give the paper's sums over joints, shape ``(...)``.
         """
-        T, P = self._decode_clean(self._check_x(x))
-        c = self._segment_coefficients(P)
-        A = 6.0 * c[..., 0, :]
-        B = 2.0 * c[..., 1, :]
-        rate = self.n_segments / T[..., None]
-        acc = (A * A / 3.0 + A * B + B * B).sum(axis=-2) * rate**3
-        jerk = (A * A).sum(axis=-2) * rate**5
-        return TrajectoryIntegrals(acc_sq=acc, jerk_sq=jerk)
+        return _exact_integrals(*self._decode_clean(self._check_x(x)))
 
     def quadrature(self, n_per_segment: int) -> tuple[np.ndarray, np.ndarray]:
         r"""Composite Gauss–Legendre rule on the spline segments, in normalised time.
@@ -683,17 +393,8 @@ class BSplineTrajectory:
             ``(s, w)``: increasing normalised nodes in (0, 1) and weights (sum 1), both of shape
             ``(n_segments·n_per_segment,)``.
         """
-        if (
-            isinstance(n_per_segment, bool)
-            or not isinstance(n_per_segment, (int, np.integer))
-            or n_per_segment < 1
-        ):
-            raise InvalidInputError(f"n_per_segment must be an integer >= 1; got {n_per_segment!r}")
-        S = self.n_segments
-        xg, wg = np.polynomial.legendre.leggauss(int(n_per_segment))
-        s = (np.arange(S)[:, None] + 0.5 * (xg + 1.0)) / S
-        w = np.broadcast_to(wg / (2.0 * S), s.shape)
-        return s.ravel(), w.ravel().copy()
+        n = as_integer(n_per_segment, "n_per_segment", minimum=1)
+        return _gauss_legendre(self.n_segments, n)
 
     # ---- box bounds for optimisers -----------------------------------------------------
 
@@ -710,7 +411,8 @@ class BSplineTrajectory:
         Args:
             q_lower: lower joint limits [rad] or [m], shape ``(nq,)``.
             q_upper: upper joint limits [rad] or [m], shape ``(nq,)``, ``> q_lower``.
-            T_min: smallest travel time [s], ``> 0`` (e.g. :func:`kinematic_lower_bound`).
+            T_min: smallest travel time [s], ``> 0`` (e.g. from
+                :func:`~adept_traj.problem.time_bound.kinematic_lower_bound`).
             T_max: largest travel time [s], ``> T_min``.
 
         Returns:
@@ -728,85 +430,19 @@ class BSplineTrajectory:
             raise InvalidInputError(f"T_min must be > 0 s; got {t_lo!r}")
         if not t_lo < t_hi:
             raise InvalidInputError(f"T_min must be < T_max; got T_min={t_lo!r}, T_max={t_hi!r}")
-        for i in range(self.nq):
-            if not lo[i] < hi[i]:
-                raise InvalidInputError(
-                    f"joint {i}: q_lower must be < q_upper; "
-                    f"got {float(lo[i])!r} >= {float(hi[i])!r}"
-                )
+        if not (lo < hi).all():
+            i = int(np.argmin(lo < hi))
+            raise InvalidInputError(
+                f"joint {i}: q_lower must be < q_upper; got {float(lo[i])!r} >= {float(hi[i])!r}"
+            )
         for name, q in (("start", self.start), ("goal", self.goal)):
-            for i in range(self.nq):
-                if not lo[i] <= q[i] <= hi[i]:
-                    raise JointLimitError(
-                        f"{name}[{i}] = {float(q[i])!r} (joint {i}) lies outside the joint range "
-                        f"[{float(lo[i])!r}, {float(hi[i])!r}]"
-                    )
+            inside = (lo <= q) & (q <= hi)
+            if not inside.all():
+                i = int(np.argmin(inside))
+                raise JointLimitError(
+                    f"{name}[{i}] = {float(q[i])!r} (joint {i}) lies outside the joint range "
+                    f"[{float(lo[i])!r}, {float(hi[i])!r}]"
+                )
         xl = np.concatenate([[t_lo], np.repeat(lo, self.n_free)])
         xu = np.concatenate([[t_hi], np.repeat(hi, self.n_free)])
         return xl, xu
-
-
-# --------------------------------------------------------------------------------------------
-# Kinematic lower bound
-# --------------------------------------------------------------------------------------------
-
-
-def kinematic_lower_bound(
-    start: Any, goal: Any, v_max: Any, a_max: Any, j_max: Any
-) -> KinematicBound:
-    r"""Exact minimum time of a rest-to-rest move under per-joint v, a, j limits.
-
-    For each joint, :math:`h = |q_\text{goal} - q_\text{start}|` and limits
-    :math:`|\dot q| \le v`, :math:`|\ddot q| \le a`, :math:`|\dddot q| \le j`, the
-    time-optimal profile is the jerk-limited "double S" (bang-bang jerk; Biagiotti &
-    Melchiorri 2008, Sec. 3.4). With :math:`T_a` the time to accelerate from 0 to v,
-
-    .. math::
-
-        T_a = \begin{cases} a/j + v/a & v j \ge a^2 \\ 2\sqrt{v/j} & v j < a^2
-              \end{cases}, \qquad
-        T = \begin{cases}
-            h/v + T_a & h \ge v T_a \quad\text{(v reached)} \\
-            a/j + \sqrt{(a/j)^2 + 4h/a} & h < v T_a,\ h \ge 2a^3/j^2
-                \quad\text{(a reached)} \\
-            4\,(h/(2j))^{1/3} & \text{otherwise.}
-        \end{cases}
-
-    Infinite limits are allowed (``j = inf`` gives the trapezoidal-velocity times;
-    all three infinite give 0). ``h = 0`` gives 0.
-
-    Args:
-        start: start configuration [rad] or [m], shape ``(nq,)``.
-        goal: goal configuration [rad] or [m], shape ``(nq,)``.
-        v_max: velocity limits [rad/s] or [m/s], scalar or ``(nq,)``, > 0 (inf allowed).
-        a_max: acceleration limits [rad/s²] or [m/s²], scalar or ``(nq,)``, > 0.
-        j_max: jerk limits [rad/s³] or [m/s³], scalar or ``(nq,)``, > 0.
-
-    Returns:
-        :class:`KinematicBound` (per-joint times [s], ``T_min`` [s], ``limiting_joint``).
-
-    Example:
-        >>> kinematic_lower_bound([0.0], [0.929], np.inf, 9.5, 50.0).T_min  # doctest: +ELLIPSIS
-        0.843...
-    """
-    q0 = as_finite_array(start, "start")
-    if q0.ndim != 1 or q0.shape[0] == 0:
-        raise InputShapeError(f"start must have shape (nq,) with nq >= 1; got {q0.shape}")
-    nq = q0.shape[0]
-    q1 = as_vector(goal, "goal", nq)
-    v = _as_limit(v_max, "v_max", nq)
-    a = _as_limit(a_max, "a_max", nq)
-    j = _as_limit(j_max, "j_max", nq)
-    delta = np.abs(q1 - q0)
-    results = [
-        _double_s_time(float(delta[i]), float(v[i]), float(a[i]), float(j[i])) for i in range(nq)
-    ]
-    times = np.array([r[0] for r in results])
-    limiting = int(np.argmax(times))
-    return KinematicBound(
-        times=times,
-        delta=delta,
-        cases=tuple(r[1] for r in results),
-        T_min=float(times[limiting]),
-        limiting_joint=limiting,
-    )

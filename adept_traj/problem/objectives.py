@@ -1,11 +1,40 @@
-"""The six objectives of the paper (eqs. 5–16): here the paper's collision penalty z3.
+r"""The six objectives of the paper (eqs. 1–6): their table, pymoo's sign convention, z3.
 
-The penalty is an objective of the trajectory problem, not a distance query: it replaces each
-obstacle by a circumscribing sphere or ellipsoid and scores how deep the tool goes into it.
+:data:`OBJECTIVES` is the one table of the objectives z1…z6 (name, quantity, unit, paper
+equation, sense); :data:`OBJECTIVE_NAMES` and :data:`MAXIMISED` are its columns.
+
+====  ========================================  =======  =====  =========
+name  quantity                                  unit     paper  sense
+====  ========================================  =======  =====  =========
+z1    travel time :math:`T`                     s        eq. 1  minimised
+z2    :math:`\int_0^T \sum_i u_i^2\,dt`         N²·m²·s  eq. 2  minimised
+z3    clearance penalty                         \-       eq. 3  minimised
+z4    :math:`\min_t |\det J(q(t))|`             m²       eq. 4  maximised
+z5    :math:`\sum_i \int_0^T \dddot q_i^2\,dt`  rad²/s⁵  eq. 5  minimised
+z6    :math:`\sum_i \int_0^T \ddot q_i^2\,dt`   rad²/s³  eq. 6  minimised
+====  ========================================  =======  =====  =========
+
+(z5, z6: m²/s⁵, m²/s³ for a prismatic joint; z3 is dimensionless by default, m⁻² with
+``z3="paper-sphere"``.)
+
+**Sign convention.** Objectives are reported as the quantities above, z4 positive
+(:class:`~adept_traj.problem.Evaluation`, results, front files). pymoo minimises every
+column, so the problem hands it :func:`to_pymoo` of them, where each maximised column is
+negated; :func:`from_pymoo` turns pymoo's ``F`` back:
+
+.. math::
+    F_{:,k} = \sigma_k z_{:,k}, \qquad
+    \sigma_k = \begin{cases} -1 & \text{objective } k \text{ maximised (z4)} \\
+                             +1 & \text{otherwise.} \end{cases}
+
+:func:`paper_penalty` is the paper's own collision penalty (eqs. 13–16), a variant of z3: it
+replaces each obstacle by a circumscribing sphere or ellipsoid and scores how deep the tool
+goes into it.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,7 +42,115 @@ import numpy as np
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.validation import as_finite_array
 
-__all__ = ["paper_penalty"]
+__all__ = [
+    "MAXIMISED",
+    "OBJECTIVES",
+    "OBJECTIVE_NAMES",
+    "Objective",
+    "from_pymoo",
+    "paper_penalty",
+    "to_pymoo",
+]
+
+
+@dataclass(frozen=True)
+class Objective:
+    """One objective of the trajectory problem (a row of :data:`OBJECTIVES`).
+
+    Attributes
+    ----------
+    name:
+        ``"z1"`` … ``"z6"``: the key in results, front files and plots.
+    quantity:
+        What it measures, short (``"time"``, ``"min|det J|"``, …).
+    unit:
+        SI unit of the reported value, ``"-"`` when dimensionless.
+    equation:
+        The paper's equation number.
+    maximised:
+        True when larger is better (z4); pymoo sees it negated (:func:`to_pymoo`).
+    """
+
+    name: str
+    quantity: str
+    unit: str
+    equation: int
+    maximised: bool = False
+
+    @property
+    def label(self) -> str:
+        """Axis label with the unit, e.g. ``"z1 time [s]"``, ``"z4 min|det J| [m²] (max)"``."""
+        return f"{self.name} {self.quantity} [{self.unit}]" + (" (max)" if self.maximised else "")
+
+
+#: The objectives z1…z6, in the order of every objective array ``(..., 6)``.
+OBJECTIVES: tuple[Objective, ...] = (
+    Objective("z1", "time", "s", 1),
+    Objective("z2", "∫Σu²", "N²·m²·s", 2),
+    Objective("z3", "clearance penalty", "-", 3),
+    Objective("z4", "min|det J|", "m²", 4, maximised=True),
+    Objective("z5", "∫Σq⃛²", "rad²/s⁵", 5),
+    Objective("z6", "∫Σq̈²", "rad²/s³", 6),
+)
+
+#: Names of the objectives in order, ``("z1", …, "z6")``.
+OBJECTIVE_NAMES: tuple[str, ...] = tuple(o.name for o in OBJECTIVES)
+
+#: Sense of each objective in order, True where maximised (only z4, the manipulability).
+MAXIMISED: tuple[bool, ...] = tuple(o.maximised for o in OBJECTIVES)
+
+#: Columns that pymoo sees negated (σ = −1 of the sign convention).
+_NEGATED = np.flatnonzero(MAXIMISED)
+
+
+def to_pymoo(objectives: Any) -> np.ndarray:
+    """pymoo's ``F`` (every column minimised) of reported objectives: maximised columns
+    negated.
+
+    Parameters
+    ----------
+    objectives:
+        (..., 6) z1…z6 as reported (z4 positive), units as in :data:`OBJECTIVES`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (..., 6) new array: z4 negated, the other columns unchanged (bit for bit).
+    """
+    return _flip_maximised(objectives, "objectives")
+
+
+def from_pymoo(F: Any) -> np.ndarray:
+    """Reported objectives (z4 positive) of pymoo's ``F``: the inverse of :func:`to_pymoo`.
+
+    Parameters
+    ----------
+    F:
+        (..., 6) objectives as pymoo sees them (z4 negated).
+
+    Returns
+    -------
+    numpy.ndarray
+        (..., 6) new array: z4 positive again, the other columns unchanged (bit for bit).
+    """
+    return _flip_maximised(F, "F")
+
+
+def _flip_maximised(values: Any, name: str) -> np.ndarray:
+    """``values`` (..., 6) with the maximised columns negated (the map is its own inverse)."""
+    try:
+        arr = np.array(values, dtype=np.float64)  # a copy: the caller's array is not changed
+    except (TypeError, ValueError):
+        raise InvalidInputError(
+            f"{name} must be a numeric array (..., 6); got {values!r}"
+        ) from None
+    if arr.ndim == 0 or arr.shape[-1] != len(OBJECTIVES):
+        raise InputShapeError(
+            f"{name} must have shape (..., {len(OBJECTIVES)}) (objectives "
+            f"{', '.join(OBJECTIVE_NAMES)}); got {arr.shape}"
+        )
+    arr[..., _NEGATED] = -arr[..., _NEGATED]
+    return arr
 
 
 def paper_penalty(

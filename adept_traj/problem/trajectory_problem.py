@@ -1,20 +1,22 @@
 r"""The paper's trajectory problem: six objectives and 21 constraints, batched (pymoo).
 
 :class:`TrajectoryProblem` is a :class:`pymoo.core.problem.Problem` over the decision vector
-of :class:`~adept_traj.trajectory.BSplineTrajectory` (``[T, free control points]``).
-For a population ``x`` (pop, n_var) it returns (pymoo minimises):
+of :class:`~adept_traj.problem.BSplineTrajectory` (``[T, free control points]``). For a
+population ``x`` (pop, n_var) it computes the objectives z1…z6 of
+:data:`~adept_traj.problem.objectives.OBJECTIVES` (names, units, paper equations, which is
+maximised) as follows:
 
-============  =======================================================================  ===========
-objective     definition                                                               paper
-============  =======================================================================  ===========
-z1            travel time :math:`T` [s]                                                (1)
-z2            :math:`\int_0^T \sum_i u_i^2\,dt` [N²·m²·s], Gauss–Legendre per segment  (2)
-z3            clearance penalty :math:`\sum_o \max(0, 1 - d_o/\delta)^2` [-]           (3), 13–16
-z4            :math:`\min_t |\det J(q(t))|` [m²] (entered negated: maximised)          (4)
-z5            :math:`\sum_i \int_0^T \dddot q_i^2\,dt` exact [rad²/s⁵ …]               (5)
-z6            :math:`\sum_i \int_0^T \ddot q_i^2\,dt` exact [rad²/s³ …]                (6)
-============  =======================================================================  ===========
+- z1: the travel time :math:`T = x_0`;
+- z2: :math:`\int_0^T \sum_i u_i^2\,dt` by Gauss–Legendre quadrature on each segment, the
+  torques :math:`u` from :meth:`~adept_traj.robot.Robot.inverse_dynamics`;
+- z3: the clearance penalty :math:`\sum_o \max(0, 1 - d_o/\delta)^2` (default), or the
+  paper's eqs. 14/16 on the tool points (:func:`~adept_traj.problem.objectives.paper_penalty`);
+- z4: :math:`\min_t |\det J(q(t))|` at the samples;
+- z5, z6: :math:`\sum_i \int_0^T \dddot q_i^2\,dt` and :math:`\sum_i \int_0^T \ddot q_i^2\,dt`,
+  exact per spline segment.
 
+:meth:`TrajectoryProblem.evaluate_batch` reports them as they are (z4 positive); pymoo, which
+minimises, receives :func:`~adept_traj.problem.objectives.to_pymoo` of them (z4 negated).
 where :math:`d_o` is the exact smallest signed distance between any robot solid and obstacle
 ``o`` over the motion (moving obstacles at their pose at each instant) and :math:`\delta` the
 ``influence`` distance. Constraints :math:`g \le 0`, normalised, in this order (5 × nq + 1):
@@ -30,39 +32,38 @@ where :math:`d_o` is the exact smallest signed distance between any robot solid 
 (paper eqs. 7–12; the extrema of q … q⃛ are exact per spline segment, the torque maximum is
 taken at the samples, the distance constraint uses the safety margin ``m``).
 :meth:`TrajectoryProblem.evaluate_reference` computes the same numbers with plain
-per-sample loops (Pinocchio and coal called once per sample and pair): the oracle for tests
-and the baseline for benchmarks.
+per-sample loops (:mod:`~adept_traj.problem.reference`): the oracle for tests and the
+baseline for benchmarks. With ``workers > 1`` populations are evaluated by a
+:class:`~adept_traj.problem.evaluator.ParallelEvaluator` that the problem owns.
 """
 
 from __future__ import annotations
 
+import copy
 import multiprocessing
-import signal
 import time
-import weakref
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
-import coal
 import numpy as np
-import pinocchio as pin
 from pymoo.core.problem import Problem
 
-from adept_traj.collision.checker import CollisionChecker, point_signed_distance
+from adept_traj.collision.checker import CollisionChecker
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
-from adept_traj.problem.bspline import BSplineTrajectory, kinematic_lower_bound
-from adept_traj.problem.objectives import paper_penalty
-from adept_traj.robot.parameter_file import TASK_ROWS
-from adept_traj.robot.robot import Robot, coulomb_sign, manipulability_measure
+from adept_traj.problem.bspline import BSplineTrajectory
+from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
+from adept_traj.problem.evaluator import ParallelEvaluator
+from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
+from adept_traj.problem.reference import _evaluate_reference
+from adept_traj.problem.time_bound import kinematic_lower_bound
+from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
-from adept_traj.scene.shapes import Box, Sphere
-from adept_traj.validation import as_batch
+from adept_traj.scene.shapes import Box
+from adept_traj.validation import as_batch, as_integer
 
-__all__ = ["OBJECTIVE_NAMES", "Evaluation", "ProblemSettings", "TrajectoryProblem"]
+__all__ = ["ProblemSettings", "TrajectoryProblem"]
 
-#: Names of the objectives, in order.
-OBJECTIVE_NAMES = ("z1", "z2", "z3", "z4", "z5", "z6")
+#: Constraint kinds, in order (each once per joint), before the distance constraint.
 _KINDS = ("q", "qd", "qdd", "qddd", "u")
 
 
@@ -89,11 +90,12 @@ class ProblemSettings:
         ``"paper-ellipsoid"`` (eqs. 13–16 on the tool point).
     workers:
         Processes evaluating a population in parallel (default 1: in this process).
-        With ``workers > 1`` the population is split into contiguous chunks evaluated by
-        forked worker processes (Linux); results are identical to the serial evaluation.
-        The workers are forked when first needed and hold a snapshot of the problem (later
-        edits of ``robot.model`` are not seen by them); :meth:`TrajectoryProblem.close`
-        stops them.
+        With ``workers > 1`` a population of at least 16 is split into contiguous chunks
+        evaluated by forked worker processes (Linux) of a
+        :class:`~adept_traj.problem.evaluator.ParallelEvaluator` that the problem owns;
+        results are identical to the serial evaluation. The workers are forked when first
+        needed and hold a snapshot of the problem (later edits of ``robot.model`` are not
+        seen by them); :meth:`TrajectoryProblem.close` stops them.
     """
 
     n_knots: int = 20
@@ -114,13 +116,11 @@ class ProblemSettings:
                 f"need 0 ≤ margin ≤ influence and influence > 0 [m]; got margin={self.margin}, "
                 f"influence={self.influence}"
             )
-        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
-            raise ConfigurationError(f"workers must be an integer ≥ 1; got {self.workers!r}")
+        for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
+            value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
+            object.__setattr__(self, name, value)
         if self.workers > 1 and "fork" not in multiprocessing.get_all_start_methods():
             raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
-        n = self.nodes_per_segment
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise ConfigurationError(f"nodes_per_segment must be an integer ≥ 1; got {n!r}")
         if self.t_bounds is not None:
             try:
                 lo, hi = (float(v) for v in self.t_bounds)
@@ -133,50 +133,13 @@ class ProblemSettings:
             object.__setattr__(self, "t_bounds", (lo, hi))
 
 
-@dataclass(frozen=True)
-class Evaluation:
-    """Objectives, constraints and diagnostics of a population.
-
-    Attributes
-    ----------
-    objectives: (pop, 6) z1…z6 with z4 **positive** (as reported).
-    constraints: (pop, 5·nq + 1) normalised g (feasible where all ≤ 0).
-    min_distance: (pop, n_obstacles) smallest distance to each obstacle [m], clipped at
-        ``influence`` (beyond it only a lower bound is known).
-    n_narrow: coal distance calls made.
-    seconds: wall time of the evaluation [s].
-    """
-
-    objectives: np.ndarray
-    constraints: np.ndarray
-    min_distance: np.ndarray
-    n_narrow: int = 0
-    seconds: float = 0.0
-
-    @property
-    def feasible(self) -> np.ndarray:
-        """(pop,) bool: every constraint satisfied (at the evaluation's resolution)."""
-        return np.all(self.constraints <= 0.0, axis=-1)
-
-
-#: Problems shared with forked evaluation workers (looked up by id in the child). Weak: a
-#: problem that is no longer used is collected, and its workers stop (``weakref.finalize``).
-_REGISTRY: weakref.WeakValueDictionary[int, TrajectoryProblem] = weakref.WeakValueDictionary()
-#: Smallest chunk worth sending to a worker.
+#: Smallest chunk worth sending to a worker: populations smaller than ``2 × _MIN_CHUNK`` are
+#: evaluated in this process.
 _MIN_CHUNK = 8
 #: Samples (individuals × samples per trajectory) evaluated together: the working arrays of
 #: one block stay in the CPU cache (a whole population of 500 × 116 samples would stream
 #: every intermediate array through main memory: ≈ 1.3× slower, measured).
 _BLOCK_SAMPLES = 4096
-
-
-def _worker_init() -> None:
-    """Workers leave Ctrl-C to the parent, which checkpoints and stops the run."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-def _worker_evaluate(key: int, x: np.ndarray) -> Evaluation:
-    return _REGISTRY[key]._evaluate_serial(x)
 
 
 class TrajectoryProblem(Problem):
@@ -236,12 +199,15 @@ class TrajectoryProblem(Problem):
         self.checker = CollisionChecker(robot, scene, influence=settings.influence)
         super().__init__(
             n_var=self.trajectory.n_var,
-            n_obj=6,
+            n_obj=len(OBJECTIVES),
             n_ieq_constr=5 * robot.nq + 1,
             xl=xl,
             xu=xu,
             vtype=float,
+            # copies (the workers' snapshot) and pickles leave the worker pool out
+            exclude_from_serialization=["_evaluator"],
         )
+        self._evaluator: ParallelEvaluator | None = None
 
     # ------------------------------------------------------------------ public
     @property
@@ -253,7 +219,8 @@ class TrajectoryProblem(Problem):
     def evaluate_batch(self, x: Any) -> Evaluation:
         """Evaluate a population ``x`` (pop, n_var), or one vector (n_var,).
 
-        Returns an :class:`Evaluation` (objectives with z4 positive, constraints, diagnostics).
+        Returns an :class:`~adept_traj.problem.Evaluation` (objectives as reported, z4
+        positive; constraints; diagnostics).
         """
         xa = as_batch(x, "x", self.n_var)
         start = time.perf_counter()
@@ -264,26 +231,23 @@ class TrajectoryProblem(Problem):
         """The same as :meth:`evaluate_batch` with plain per-individual, per-sample loops."""
         xa = as_batch(x, "x", self.n_var)
         start = time.perf_counter()
-        ev = self._evaluate_reference(np.atleast_2d(xa))
+        ev = _evaluate_reference(self, np.atleast_2d(xa))
         return _finish(ev, start, single=xa.ndim == 1)
 
     # ------------------------------------------------------------------ pymoo hook
     def _evaluate(self, x: np.ndarray, out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
         ev = self._evaluate_batch(np.asarray(x, dtype=float))
-        f = ev.objectives.copy()
-        f[:, 3] = -f[:, 3]  # pymoo minimises; z4 is maximised
-        out["F"] = f
+        out["F"] = to_pymoo(ev.objectives)  # pymoo minimises: maximised objectives negated
         out["G"] = ev.constraints
 
     def close(self) -> None:
-        """Stop the evaluation worker processes of ``workers > 1`` (if started); they start
-        again when needed. Also done when the problem is garbage-collected, or on leaving a
-        ``with TrajectoryProblem(...) as problem:`` block."""
-        pool = self.__dict__.pop("_pool", None)
-        if pool is not None:
-            self.__dict__.pop("_pool_finalizer").detach()
-            pool.shutdown(wait=True, cancel_futures=True)
-        _REGISTRY.pop(id(self), None)
+        """Stop the evaluation worker processes of ``workers > 1`` (if started) and wait for
+        them; they start again, from a new snapshot, when needed. Also done on leaving a
+        ``with TrajectoryProblem(...) as problem:`` block, and (without waiting) when the
+        problem is garbage-collected."""
+        evaluator, self._evaluator = self._evaluator, None
+        if evaluator is not None:
+            evaluator.close()
 
     def __enter__(self) -> TrajectoryProblem:
         return self
@@ -293,33 +257,20 @@ class TrajectoryProblem(Problem):
 
     # ------------------------------------------------------------------ batched
     def _evaluate_batch(self, x: np.ndarray) -> Evaluation:
-        workers = self.settings.workers
-        if workers > 1 and len(x) >= 2 * _MIN_CHUNK:
-            return self._evaluate_parallel(x, workers)
+        if self.settings.workers > 1 and len(x) >= 2 * _MIN_CHUNK:
+            return self._parallel_evaluator().evaluate(x)
         return self._evaluate_serial(x)
 
-    def _evaluate_parallel(self, x: np.ndarray, workers: int) -> Evaluation:
-        pool = self.__dict__.get("_pool")
-        if pool is None:
-            _REGISTRY[id(self)] = self
-            pool = ProcessPoolExecutor(
-                max_workers=workers,
-                mp_context=multiprocessing.get_context("fork"),
-                initializer=_worker_init,
+    def _parallel_evaluator(self) -> ParallelEvaluator:
+        """The evaluator of ``workers > 1``, made on first use: its workers run
+        :meth:`_evaluate_serial` of a shallow copy of this problem (the same robot, scene,
+        checker, …, without the evaluator), so the pool does not keep the problem alive."""
+        if self._evaluator is None:
+            snapshot = copy.copy(self)  # pymoo's __getstate__ leaves out "_evaluator"
+            self._evaluator = ParallelEvaluator(
+                snapshot._evaluate_serial, self.settings.workers, self.n_var, owner=self
             )
-            self.__dict__["_pool"] = pool
-            self.__dict__["_pool_finalizer"] = weakref.finalize(
-                self, pool.shutdown, wait=False, cancel_futures=True
-            )
-        chunks = np.array_split(x, workers)
-        futures = [pool.submit(_worker_evaluate, id(self), c) for c in chunks if len(c)]
-        try:
-            parts = [f.result() for f in futures]
-        except BaseException:
-            for f in futures:
-                f.cancel()
-            raise
-        return _concatenate(parts)
+        return self._evaluator
 
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
         step = max(1, _BLOCK_SAMPLES // len(self.s))
@@ -395,162 +346,3 @@ class TrajectoryProblem(Problem):
         g_rest = [m / s - 1.0 for m, s in zip(abs_max, scales)]
         g_d = (st.margin - np.minimum(min_dist, st.influence)) / st.influence
         return np.concatenate([g_q, *g_rest, g_d[:, None]], axis=-1)
-
-    # ------------------------------------------------------------------ reference
-    def _evaluate_reference(self, x: np.ndarray) -> Evaluation:
-        """Plain loops: per individual, per segment, per sample, per pair."""
-        robot, model, st = self.robot, self.robot.model, self.settings
-        data = model.createData()
-        gm = robot.collision_model
-        gdata = gm.createData()
-        tool_id = model.getFrameId(robot.tool_frame)
-        rows = [TASK_ROWS.index(r) for r in robot.task_rows]
-        obstacle_geoms = [ob.shape.to_coal() for ob in self.scene.obstacles]
-        solid_shapes = self.checker.solid_shapes
-        req = coal.DistanceRequest()
-        n_obs = len(obstacle_geoms)
-        objectives, constraints, min_distances = [], [], []
-        for xi in x:
-            T, P = self.trajectory.decode(xi)
-            T = float(T)
-            ref = _ReferenceSpline(P, T)
-            z2 = z5 = z6 = 0.0
-            z4 = np.inf
-            u_max = np.zeros(robot.nq)
-            d_obs = np.full(n_obs, np.inf)
-            tool_points, obs_poses = [], []
-            for s, w in zip(self.s, self.weights):
-                q, qd, qdd = ref.evaluate(s)
-                u = pin.rnea(model, data, q, qd, qdd) + model.damping * qd
-                u = u + model.friction * coulomb_sign(qd)
-                z2 += T * w * float(u @ u)
-                u_max = np.maximum(u_max, np.abs(u))
-                jac = pin.computeFrameJacobian(model, data, q, tool_id, pin.LOCAL_WORLD_ALIGNED)
-                z4 = min(z4, float(manipulability_measure(jac[rows])))
-                pin.updateGeometryPlacements(model, data, gm, gdata, q)
-                tool_points.append(data.oMf[tool_id].translation.copy())
-                poses = self.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]
-                obs_poses.append(poses)
-                for o, ob in enumerate(self.scene.obstacles):
-                    tf_o = coal.Transform3s(poses[o, :3, :3], poses[o, :3, 3])
-                    for k, g in enumerate(gm.geometryObjects):
-                        placement = gdata.oMg[k]
-                        if isinstance(ob.shape, Sphere) and solid_shapes[k] is not None:
-                            # Closed form, as documented (coal 3.0.3 misjudges a sphere's
-                            # penetration depth near a cylinder cap).
-                            centre = placement.rotation.T @ (
-                                poses[o, :3, 3] - placement.translation
-                            )
-                            d = (
-                                float(point_signed_distance(solid_shapes[k], centre))
-                                - ob.shape.radius
-                            )
-                        else:
-                            res = coal.DistanceResult()
-                            tf_g = coal.Transform3s(placement.rotation, placement.translation)
-                            d = coal.distance(g.geometry, tf_g, obstacle_geoms[o], tf_o, req, res)
-                        d_obs[o] = min(d_obs[o], d)
-            extrema = ref.extrema()
-            z5, z6 = extrema["jerk_sq"], extrema["acc_sq"]
-            if st.z3 == "clearance":
-                z3 = float(np.sum(np.maximum(0.0, 1.0 - d_obs / st.influence) ** 2))
-            else:
-                poses = np.array(obs_poses).transpose(1, 0, 2, 3)  # (n_obs, n_s, 4, 4)
-                z3 = float(self._paper_penalty(np.array(tool_points), poses))
-            objectives.append([T, z2, z3, z4, z5, z6])
-            g = self._constraints(
-                extrema["q_min"][None],
-                extrema["q_max"][None],
-                [extrema["qd"][None], extrema["qdd"][None], extrema["qddd"][None], u_max[None]],
-                np.array([d_obs.min(initial=np.inf)]),
-            )[0]
-            constraints.append(g)
-            min_distances.append(np.minimum(d_obs, st.influence))
-        return Evaluation(
-            objectives=np.array(objectives),
-            constraints=np.array(constraints),
-            min_distance=np.array(min_distances).reshape(len(x), n_obs),
-        )
-
-
-def _concatenate(parts: list[Evaluation]) -> Evaluation:
-    """One evaluation of the stacked populations of ``parts``."""
-    return Evaluation(
-        objectives=np.concatenate([e.objectives for e in parts]),
-        constraints=np.concatenate([e.constraints for e in parts]),
-        min_distance=np.concatenate([e.min_distance for e in parts]),
-        n_narrow=sum(e.n_narrow for e in parts),
-    )
-
-
-def _finish(ev: Evaluation, start: float, single: bool) -> Evaluation:
-    seconds = time.perf_counter() - start
-    if single:
-        return Evaluation(
-            objectives=ev.objectives[0],
-            constraints=ev.constraints[0],
-            min_distance=ev.min_distance[0],
-            n_narrow=ev.n_narrow,
-            seconds=seconds,
-        )
-    return Evaluation(ev.objectives, ev.constraints, ev.min_distance, ev.n_narrow, seconds)
-
-
-class _ReferenceSpline:
-    """One trajectory evaluated the plain way: per segment, scalar formulas (reference)."""
-
-    _M = np.array([[-1, 3, -3, 1], [3, -6, 3, 0], [-3, 0, 3, 0], [1, 4, 1, 0]]) / 6.0
-
-    def __init__(self, P: np.ndarray, T: float) -> None:
-        self.P, self.T = P, T
-        self.S = P.shape[0] - 3
-        self.rate = self.S / T
-
-    def _coeffs(self, j: int) -> np.ndarray:
-        return self._M @ self.P[j : j + 4]  # (4, nq): u³, u², u, 1
-
-    def evaluate(self, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        j = min(int(s * self.S), self.S - 1)
-        u = s * self.S - j
-        c3, c2, c1, c0 = self._coeffs(j)
-        q = ((c3 * u + c2) * u + c1) * u + c0
-        qd = (3 * c3 * u * u + 2 * c2 * u + c1) * self.rate
-        qdd = (6 * c3 * u + 2 * c2) * self.rate**2
-        return q, qd, qdd
-
-    def extrema(self) -> dict[str, Any]:
-        nq = self.P.shape[1]
-        q_min, q_max = np.full(nq, np.inf), np.full(nq, -np.inf)
-        qd, qdd, qddd = np.zeros(nq), np.zeros(nq), np.zeros(nq)
-        acc_sq = jerk_sq = 0.0
-        r = self.rate
-        for j in range(self.S):
-            c3, c2, c1, c0 = self._coeffs(j)
-            for i in range(nq):
-                cands = [0.0, 1.0]
-                poly = [3 * c3[i], 2 * c2[i], c1[i]]
-                roots = np.roots(poly) if any(poly) else []
-                cands += [z.real for z in roots if abs(z.imag) < 1e-12 and 0 < z.real < 1]
-                for u in cands:
-                    value = ((c3[i] * u + c2[i]) * u + c1[i]) * u + c0[i]
-                    q_min[i], q_max[i] = min(q_min[i], value), max(q_max[i], value)
-                vcands = [0.0, 1.0]
-                if c3[i] != 0 and 0.0 < -c2[i] / (3 * c3[i]) < 1.0:
-                    vcands.append(-c2[i] / (3 * c3[i]))
-                for u in vcands:
-                    qd[i] = max(qd[i], abs((3 * c3[i] * u * u + 2 * c2[i] * u + c1[i]) * r))
-                for u in (0.0, 1.0):
-                    qdd[i] = max(qdd[i], abs((6 * c3[i] * u + 2 * c2[i]) * r**2))
-                qddd[i] = max(qddd[i], abs(6 * c3[i] * r**3))
-                a, b = 6 * c3[i], 2 * c2[i]
-                acc_sq += (a * a / 3 + a * b + b * b) * r**3
-                jerk_sq += a * a * r**5
-        return {
-            "q_min": q_min,
-            "q_max": q_max,
-            "qd": qd,
-            "qdd": qdd,
-            "qddd": qddd,
-            "acc_sq": acc_sq,
-            "jerk_sq": jerk_sq,
-        }

@@ -28,7 +28,7 @@ import numpy as np
 
 from adept_traj.errors import ResultFormatError
 from adept_traj.files import write_text_atomic
-from adept_traj.problem.trajectory_problem import OBJECTIVE_NAMES
+from adept_traj.problem import OBJECTIVE_NAMES
 from adept_traj.results.reader import _read_text
 from adept_traj.results.record import PlanningResult
 

@@ -27,8 +27,7 @@ import numpy as np
 from adept_traj.analysis.certificate import LIMIT_KINDS, Certificate, DenseTrajectory, LimitCheck
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
-from adept_traj.problem.bspline import KinematicBound
-from adept_traj.problem.trajectory_problem import OBJECTIVE_NAMES, ProblemSettings
+from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
 from adept_traj.results.parts import (
     METRIC_NAMES,
     BestSolution,

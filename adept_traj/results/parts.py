@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
-from adept_traj.problem.trajectory_problem import OBJECTIVE_NAMES, Evaluation
+from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
 from adept_traj.robot.robot import Robot, shipped_file
 from adept_traj.validation import (
     as_finite_array,

@@ -30,9 +30,9 @@ import numpy as np
 
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory
 from adept_traj.errors import InputShapeError, InvalidInputError
-from adept_traj.problem.bspline import KinematicBound
-from adept_traj.problem.trajectory_problem import (
+from adept_traj.problem import (
     OBJECTIVE_NAMES,
+    KinematicBound,
     ProblemSettings,
     TrajectoryProblem,
 )

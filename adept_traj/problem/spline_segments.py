@@ -1,0 +1,261 @@
+r"""Exact analysis of the spline's per-segment cubic polynomials: bounds and integrals.
+
+On segment :math:`j` of a uniform cubic B-spline (:class:`~adept_traj.problem.BSplineTrajectory`)
+each joint is the cubic :math:`q(u) = c_3 u^3 + c_2 u^2 + c_1 u + c_0` of the local parameter
+:math:`u \in [0, 1]`, with :math:`(c_3, c_2, c_1, c_0)^\top = M\,[P_j, P_{j+1}, P_{j+2},
+P_{j+3}]^\top` and :math:`\mathrm{d}/\mathrm{d}t = (S/T)\,\mathrm{d}/\mathrm{d}u`. The extrema
+of :math:`q, \dot q, \ddot q, \dddot q` (constraints 7–10 of the paper) and the integrals of
+:math:`\ddot q^2, \dddot q^2` (objectives z6, z5) follow exactly from these coefficients,
+batched over the population, the segments and the joints.
+
+:meth:`BSplineTrajectory.bounds <adept_traj.problem.BSplineTrajectory.bounds>` and
+:meth:`~adept_traj.problem.BSplineTrajectory.integrals` check their input and call the
+hooks here; the results are :class:`TrajectoryBounds` and :class:`TrajectoryIntegrals`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["TrajectoryBounds", "TrajectoryIntegrals", "TrajectorySamples"]
+
+#: Uniform cubic B-spline basis matrix (rows: coefficients of u³, u², u, 1).
+_M = (
+    np.array(
+        [
+            [-1.0, 3.0, -3.0, 1.0],
+            [3.0, -6.0, 3.0, 0.0],
+            [-3.0, 0.0, 3.0, 0.0],
+            [1.0, 4.0, 1.0, 0.0],
+        ]
+    )
+    / 6.0
+)
+_M.flags.writeable = False
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectorySamples:
+    """Joint trajectories sampled at shared normalised times.
+
+    Attributes:
+        t: sample times [s], shape ``(..., n_s)`` (``t = T·s``, one row per individual).
+        q: positions [rad] or [m], shape ``(..., n_s, nq)``.
+        qd: velocities [rad/s] or [m/s], shape ``(..., n_s, nq)``.
+        qdd: accelerations [rad/s²] or [m/s²], shape ``(..., n_s, nq)``.
+        qddd: jerks [rad/s³] or [m/s³], shape ``(..., n_s, nq)``.
+
+    A derivative that was not requested (``orders`` of :meth:`BSplineTrajectory.sample`) is
+    ``None``.
+    """
+
+    t: np.ndarray
+    q: np.ndarray | None
+    qd: np.ndarray | None
+    qdd: np.ndarray | None
+    qddd: np.ndarray | None
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryBounds:
+    r"""Exact per-joint extrema over :math:`t \in [0, T]`, each of shape ``(..., nq)``.
+
+    Attributes:
+        q_min, q_max: position extrema [rad] or [m].
+        qd_min, qd_max: velocity extrema [rad/s] or [m/s].
+        qdd_min, qdd_max: acceleration extrema [rad/s²] or [m/s²].
+        qddd_min, qddd_max: jerk extrema [rad/s³] or [m/s³] (the jerk is piecewise
+            constant; its value on every segment counts, including the first and last).
+    """
+
+    q_min: np.ndarray
+    q_max: np.ndarray
+    qd_min: np.ndarray
+    qd_max: np.ndarray
+    qdd_min: np.ndarray
+    qdd_max: np.ndarray
+    qddd_min: np.ndarray
+    qddd_max: np.ndarray
+
+    @property
+    def q_abs_max(self) -> np.ndarray:
+        r""":math:`\max_t |q_i(t)|` [rad] or [m], shape ``(..., nq)``."""
+        return np.maximum(np.abs(self.q_min), np.abs(self.q_max))
+
+    @property
+    def qd_abs_max(self) -> np.ndarray:
+        r""":math:`\max_t |\dot q_i(t)|` [rad/s] or [m/s], shape ``(..., nq)``."""
+        return np.maximum(np.abs(self.qd_min), np.abs(self.qd_max))
+
+    @property
+    def qdd_abs_max(self) -> np.ndarray:
+        r""":math:`\max_t |\ddot q_i(t)|` [rad/s²] or [m/s²], shape ``(..., nq)``."""
+        return np.maximum(np.abs(self.qdd_min), np.abs(self.qdd_max))
+
+    @property
+    def qddd_abs_max(self) -> np.ndarray:
+        r""":math:`\max_t |\dddot q_i(t)|` [rad/s³] or [m/s³], shape ``(..., nq)``."""
+        return np.maximum(np.abs(self.qddd_min), np.abs(self.qddd_max))
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryIntegrals:
+    r"""Exact per-joint integrals of squared acceleration and jerk over :math:`[0, T]`.
+
+    Attributes:
+        acc_sq: :math:`\int_0^T \ddot q_i^2 \, \mathrm{d}t` [rad²/s³] or [m²/s³],
+            shape ``(..., nq)``.
+        jerk_sq: :math:`\int_0^T \dddot q_i^2 \, \mathrm{d}t` [rad²/s⁵] or [m²/s⁵],
+            shape ``(..., nq)``.
+    """
+
+    acc_sq: np.ndarray
+    jerk_sq: np.ndarray
+
+    @property
+    def z6(self) -> np.ndarray:
+        r"""Paper objective :math:`z_6 = \sum_i \int_0^T \ddot q_i^2 dt`, shape ``(...)``."""
+        return self.acc_sq.sum(axis=-1)
+
+    @property
+    def z5(self) -> np.ndarray:
+        r"""Paper objective :math:`z_5 = \sum_i \int_0^T \dddot q_i^2 dt`, shape ``(...)``."""
+        return self.jerk_sq.sum(axis=-1)
+
+
+def _monomial_derivative_rows(u: np.ndarray, order: int) -> np.ndarray:
+    r"""Rows :math:`\frac{d^r}{du^r}[u^3, u^2, u, 1]`, shape ``(n, 4)``."""
+    one = np.ones_like(u)
+    zero = np.zeros_like(u)
+    if order == 0:
+        cols = (u**3, u**2, u, one)
+    elif order == 1:
+        cols = (3.0 * u**2, 2.0 * u, one, zero)
+    elif order == 2:
+        cols = (6.0 * u, 2.0 * one, zero, zero)
+    else:
+        cols = (6.0 * one, zero, zero, zero)
+    return np.stack(cols, axis=-1)
+
+
+def _basis(s: np.ndarray, order: int, n_segments: int) -> np.ndarray:
+    """Basis (derivative ``order`` in normalised time) at normalised times ``s`` (n_s,) in
+    [0, 1]: shape ``(n_s, n_segments + 3)`` (the math: :meth:`BSplineTrajectory.basis_matrix`)."""
+    S = n_segments
+    seg = np.minimum(np.floor(s * S).astype(np.intp), S - 1)
+    u = s * S - seg
+    rows = _monomial_derivative_rows(u, order) @ _M * float(S) ** order  # (n_s, 4)
+    B = np.zeros((s.shape[0], S + 3))
+    cols = seg[:, None] + np.arange(4)
+    np.put_along_axis(B, cols, rows, axis=1)
+    return B
+
+
+def _sample(
+    T: np.ndarray, P: np.ndarray, s: np.ndarray, orders: tuple[int, ...]
+) -> TrajectorySamples:
+    """Samples at normalised times ``s`` (n_s,) of travel times ``T`` (...) [s] and control
+    points ``P`` (..., S + 3, nq), derivatives ``orders`` (the math:
+    :meth:`BSplineTrajectory.sample`)."""
+    out: list[np.ndarray | None] = [None, None, None, None]
+    for r in orders:
+        P_r = P if r == 0 else P * (T[..., None, None] ** (-r))  # small: scale before
+        out[r] = _basis(s, r, P.shape[-2] - 3) @ P_r
+    t = T[..., None] * s
+    return TrajectorySamples(t=t, q=out[0], qd=out[1], qdd=out[2], qddd=out[3])
+
+
+def _gauss_legendre(n_segments: int, n_per_segment: int) -> tuple[np.ndarray, np.ndarray]:
+    """Composite Gauss–Legendre nodes and weights, each (n_segments·n_per_segment,), in
+    normalised time (the math: :meth:`BSplineTrajectory.quadrature`)."""
+    S = n_segments
+    xg, wg = np.polynomial.legendre.leggauss(n_per_segment)
+    s = (np.arange(S)[:, None] + 0.5 * (xg + 1.0)) / S
+    w = np.broadcast_to(wg / (2.0 * S), s.shape)
+    return s.ravel(), w.ravel().copy()
+
+
+def _clip_candidates(u: np.ndarray) -> np.ndarray:
+    """Map candidate parameters to [0, 1]; NaN/inf (no root) become 0 (an endpoint)."""
+    u = np.where(np.isfinite(u), u, 0.0)
+    return np.clip(u, 0.0, 1.0)
+
+
+def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Real roots of :math:`a u^2 + b u + c` by the cancellation-free formula.
+
+    Complex pairs, and roots of a degenerate polynomial, come out as NaN or inf (the
+    caller replaces them by an endpoint). A linear polynomial (``a = 0``) yields its
+    root in the second output.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        disc = b * b - 4.0 * a * c
+        sq = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
+        qq = -0.5 * (b + np.where(b >= 0.0, sq, -sq))
+        r1 = qq / a
+        r2 = c / qq
+    return r1, r2
+
+
+def _segment_coefficients(P: np.ndarray) -> np.ndarray:
+    """Monomial coefficients in ``u`` per segment, shape ``(..., S, 4, nq)`` (u³, u², u, 1),
+    of control points ``P`` of shape ``(..., S + 3, nq)``."""
+    n_segments = P.shape[-2] - 3
+    idx = np.arange(n_segments)[:, None] + np.arange(4)
+    windows = P[..., idx, :]  # (..., S, 4, nq)
+    return np.einsum("ab,...sbj->...saj", _M, windows)
+
+
+def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
+    """Extrema over [0, T] of travel times ``T`` (...) [s] and control points ``P``
+    (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.bounds`)."""
+    c = _segment_coefficients(P)
+    c3, c2, c1, c0 = c[..., 0, :], c[..., 1, :], c[..., 2, :], c[..., 3, :]  # (..., S, nq)
+    rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
+
+    r1, r2 = _quadratic_roots(3.0 * c3, 2.0 * c2, c1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = -c2 / (3.0 * c3)
+    zeros = np.zeros_like(c3)
+    ones = np.ones_like(c3)
+    u_q = np.stack([zeros, ones, _clip_candidates(r1), _clip_candidates(r2)], axis=-3)
+    u_qd = np.stack([zeros, ones, _clip_candidates(vertex)], axis=-3)
+    u_qdd = np.stack([zeros, ones], axis=-3)
+    cc3, cc2, cc1, cc0 = (ci[..., None, :, :] for ci in (c3, c2, c1, c0))
+
+    q_val = ((cc3 * u_q + cc2) * u_q + cc1) * u_q + cc0  # (..., k, S, nq)
+    qd_val = ((3.0 * cc3 * u_qd + 2.0 * cc2) * u_qd + cc1) * rate[..., None, :, :]
+    qdd_val = (6.0 * cc3 * u_qdd + 2.0 * cc2) * rate[..., None, :, :] ** 2
+    qddd_val = 6.0 * c3 * rate**3  # (..., S, nq)
+
+    def ext(v: np.ndarray, axes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        return v.min(axis=axes), v.max(axis=axes)
+
+    q_min, q_max = ext(q_val, (-3, -2))
+    qd_min, qd_max = ext(qd_val, (-3, -2))
+    qdd_min, qdd_max = ext(qdd_val, (-3, -2))
+    qddd_min, qddd_max = ext(qddd_val, (-2,))
+    return TrajectoryBounds(
+        q_min=q_min,
+        q_max=q_max,
+        qd_min=qd_min,
+        qd_max=qd_max,
+        qdd_min=qdd_min,
+        qdd_max=qdd_max,
+        qddd_min=qddd_min,
+        qddd_max=qddd_max,
+    )
+
+
+def _exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
+    """Integrals over [0, T] of squared acceleration and jerk of travel times ``T`` (...) [s]
+    and control points ``P`` (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.integrals`)."""
+    c = _segment_coefficients(P)
+    A = 6.0 * c[..., 0, :]
+    B = 2.0 * c[..., 1, :]
+    rate = c.shape[-3] / T[..., None]  # d/dt = rate·d/du
+    acc = (A * A / 3.0 + A * B + B * B).sum(axis=-2) * rate**3
+    jerk = (A * A).sum(axis=-2) * rate**5
+    return TrajectoryIntegrals(acc_sq=acc, jerk_sq=jerk)
