@@ -1,4 +1,4 @@
-"""Analysis of moves and fronts: certificate, decision making, indicators."""
+"""Analysis of moves and fronts: certificate, decision making, indicators, the paper's measures."""
 
 from __future__ import annotations
 
@@ -24,16 +24,18 @@ from adept_traj.analysis.decision import (
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     MAXIMISED,
-    algorithm_effort,
     hypervolume,
     igd,
     non_dominated,
     normalised_hypervolume,
     objective_bounds,
+    to_unit_minimisation,
+)
+from adept_traj.analysis.paper_measures import (
+    algorithm_effort,
     optimizer_overhead,
     ratio_non_dominated,
     spread,
-    to_unit_minimisation,
 )
 
 __all__ = [

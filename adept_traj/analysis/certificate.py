@@ -6,7 +6,7 @@ included (:math:`n = \lceil T \cdot \text{rate} \rceil + 1` samples), independen
 optimiser's coarse Gauss–Legendre samples:
 
 - positions, velocities, accelerations and jerks from the spline at every sample, **and** the
-  exact per-segment extrema of :meth:`~adept_traj.trajectory.BSplineTrajectory.bounds`
+  exact per-segment extrema of :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
   (the reported worst value is the larger of the two, so nothing between samples is missed);
 - joint torques/forces :math:`u = ` :meth:`~adept_traj.robot.Robot.inverse_dynamics` at every
   sample (the torque is not a polynomial: dense samples only);

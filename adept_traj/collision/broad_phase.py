@@ -1,7 +1,7 @@
 """The broad phase: conservative lower bounds of solid–obstacle signed distances, batched.
 
 :class:`BroadPhase` turns joint frames (njoints, 3, 4, N) (component-major, from
-:meth:`~adept_traj.kinematics.BatchKinematics.joint_frames`) and obstacle poses into an
+:meth:`~adept_traj.robot.kinematics.BatchKinematics.joint_frames`) and obstacle poses into an
 (N, n_solids, n_obstacles) array of **lower bounds** of the signed distance [m] (negative =
 penetration depth), valid in every case, exact where it says so. The narrow phase
 (:class:`~adept_traj.collision.CollisionChecker`, coal) only needs the pairs whose bound is
@@ -13,7 +13,7 @@ Levels, each on the rows the previous one left within ``influence``:
    the distance never changes; it is computed once (coal, or the closed form below) and
    is exact everywhere. A solid moved by **one joint only** (its parent joint hangs from
    the base: the SCARA's inner arm) and a fixed obstacle: a
-   :class:`~adept_traj.distance_table.DistanceTable` of exact distances over that joint's
+   :class:`~adept_traj.collision.DistanceTable` of exact distances over that joint's
    range bounds the distance to within about 0.6 mm (when the configurations ``q`` are
    given); level 1 is then skipped for the pair, except at samples outside the table's
    grid. (Not for joints with an infinite or very long range, nor for sphere shapes.)
@@ -211,7 +211,7 @@ def coal_kind(geometry: coal.CollisionGeometry) -> tuple[str, np.ndarray] | None
 
 
 def shape_of(kind: tuple[str, np.ndarray] | None) -> object | None:
-    """The :mod:`adept_traj.shapes` shape of a coal primitive (for point distances)."""
+    """The :mod:`adept_traj.scene.shapes` shape of a coal primitive (for point distances)."""
     if kind is None:
         return None
     name, dims = kind

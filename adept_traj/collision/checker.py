@@ -4,7 +4,7 @@
 (..., n_t) [s], the signed distance [m] between **every** robot solid and **every** obstacle
 (moving obstacles at their pose at that time; negative = penetration depth), using coal.
 
-The broad phase (:mod:`adept_traj.broad_phase`, numpy, batched) gives a lower bound of
+The broad phase (:mod:`adept_traj.collision.broad_phase`, numpy, batched) gives a lower bound of
 every distance, exact for sphere obstacles (closed form) and static pairs. Only pairs whose
 bound is ≤ ``influence`` go to coal (narrow phase, one call per close pair: the only Python
 loop, over close pairs, never over all samples). The other entries hold a lower bound
@@ -123,7 +123,8 @@ class CollisionChecker:
 
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:
-        """The robot solids as :mod:`adept_traj.shapes` objects (``None`` if not a primitive)."""
+        """The robot solids as :mod:`adept_traj.scene.shapes` objects (``None``: not a
+        primitive)."""
         return tuple(self._broad.solid_shape)
 
     @property
