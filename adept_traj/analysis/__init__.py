@@ -2,16 +2,7 @@
 
 from __future__ import annotations
 
-from adept_traj.analysis.certificate import (
-    DEFAULT_RATE_HZ,
-    DEFAULT_TOLERANCE,
-    LIMIT_KINDS,
-    Certificate,
-    DenseTrajectory,
-    LimitCheck,
-    certify,
-    dense_samples,
-)
+from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -21,6 +12,7 @@ from adept_traj.analysis.decision import (
     normalise,
     objective_weights,
 )
+from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     MAXIMISED,
@@ -31,6 +23,7 @@ from adept_traj.analysis.indicators import (
     objective_bounds,
     to_unit_minimisation,
 )
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, LIMIT_KINDS, LimitCheck
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
     optimizer_overhead,
