@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-from adept_traj.collision.broad_phase import (
-    Bounds,
-    BroadPhase,
-    point_signed_distance,
-)
+from adept_traj.collision.broad_phase import Bounds, BroadPhase
 from adept_traj.collision.checker import (
     CollisionChecker,
     MinDistances,
     PairDistances,
 )
-from adept_traj.collision.distance_table import (
-    DistanceTable,
-)
+from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.point_distance import point_signed_distance
 
 __all__ = [
     "Bounds",

@@ -23,7 +23,8 @@ from typing import Any
 import coal
 import numpy as np
 
-from adept_traj.collision.broad_phase import BroadPhase, point_signed_distance
+from adept_traj.collision.broad_phase import BroadPhase
+from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
