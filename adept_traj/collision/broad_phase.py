@@ -63,6 +63,7 @@ from adept_traj.collision.point_distance import (
 from adept_traj.collision.primitives import (
     coal_kind,
     covering_spheres,
+    distance_request,
     enclosing_ball,
     half_extent,
     shape_of,
@@ -192,7 +193,7 @@ class BroadPhase:
         """Exact signed distance [m] of one solid–obstacle pair (closed form or coal)."""
         if self.closed_form[k, o]:
             return float(self.closed_form_distance(solid_pose[None], obstacle_pose, k, o)[0])
-        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        request, result = distance_request(), coal.DistanceResult()
         return float(
             coal.distance(
                 geometry,
@@ -258,7 +259,7 @@ class BroadPhase:
         poses = self.solid_poses(frames, np.arange(count), k)
         pose_o = scene.base_from_world @ scene.obstacles[o].pose(0.0)
         functor = coal.ComputeDistance(geometry, self.obstacle_geometry[o])
-        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        request, result = distance_request(), coal.DistanceResult()
         tf_o = coal.Transform3s(pose_o[:3, :3], pose_o[:3, 3])
         tf_s = coal.Transform3s()
         values = np.empty(count)

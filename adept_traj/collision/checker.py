@@ -25,6 +25,7 @@ import numpy as np
 
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.point_distance import point_signed_distance
+from adept_traj.collision.primitives import distance_request
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
@@ -118,7 +119,7 @@ class CollisionChecker:
             [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
             for g in self._robot_geoms
         ]
-        self._request = coal.DistanceRequest()
+        self._request = distance_request()
         self._result = coal.DistanceResult()
         self._tf = (coal.Transform3s(), coal.Transform3s())
 

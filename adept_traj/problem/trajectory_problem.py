@@ -50,6 +50,7 @@ import pinocchio as pin
 from pymoo.core.problem import Problem
 
 from adept_traj.collision.checker import CollisionChecker, point_signed_distance
+from adept_traj.collision.primitives import distance_request
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory, kinematic_lower_bound
 from adept_traj.problem.objectives import paper_penalty
@@ -407,7 +408,7 @@ class TrajectoryProblem(Problem):
         rows = [TASK_ROWS.index(r) for r in robot.task_rows]
         obstacle_geoms = [ob.shape.to_coal() for ob in self.scene.obstacles]
         solid_shapes = self.checker.solid_shapes
-        req = coal.DistanceRequest()
+        req = distance_request()  # the checker's coal settings (GJK tolerance)
         n_obs = len(obstacle_geoms)
         objectives, constraints, min_distances = [], [], []
         for xi in x:
