@@ -49,8 +49,8 @@ import numpy as np
 import pinocchio as pin
 from pymoo.core.problem import Problem
 
+from adept_traj.collision import distance_request
 from adept_traj.collision.checker import CollisionChecker, point_signed_distance
-from adept_traj.collision.primitives import distance_request
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory, kinematic_lower_bound
 from adept_traj.problem.objectives import paper_penalty
