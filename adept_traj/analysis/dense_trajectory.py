@@ -1,9 +1,9 @@
-"""A trajectory sampled on a dense uniform time grid: the samples a certificate checks.
+r"""A trajectory sampled on a dense uniform time grid: the samples a certificate checks.
 
-:func:`dense_samples` gives the number of samples :math:`n = \\lceil T \\cdot \text{rate}
-\rceil + 1` of the grid over :math:`[0, T]` (both ends included) and
-:class:`DenseTrajectory` holds the states, torques and smallest distances at those samples
-(built by :func:`~adept_traj.analysis.certificate.certify`).
+:func:`dense_samples` gives the number of samples
+:math:`n = \lceil T \cdot \text{rate} \rceil + 1` of the grid over :math:`[0, T]` (both
+ends included) and :class:`DenseTrajectory` holds the states, torques and smallest
+distances at those samples (built by :func:`~adept_traj.analysis.certificate.certify`).
 """
 
 from __future__ import annotations

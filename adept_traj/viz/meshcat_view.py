@@ -53,6 +53,7 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     from meshcat.path import Path as MeshcatPath
     from meshcat.visualizer import ViewerWindow
 
+from adept_traj.collision import distance_request
 from adept_traj.errors import InvalidInputError, MeshcatServerError
 from adept_traj.results.record import PlanningResult
 from adept_traj.scene.scene import Obstacle
@@ -427,7 +428,7 @@ def _closest_points(
     and their signed distance (n,) [m]."""
     n = solid_poses.shape[0]
     obstacle_geoms = [ob.shape.to_coal() for ob in obstacles]
-    request, res = coal.DistanceRequest(), coal.DistanceResult()
+    request, res = distance_request(), coal.DistanceResult()  # the checker's settings
     tf_a, tf_b = coal.Transform3s(), coal.Transform3s()
     points = np.empty((n, 2, 3))
     distance = np.full(n, np.inf)
