@@ -51,6 +51,11 @@ def test_feasible_move_is_certified(problem: TrajectoryProblem, feasible: Certif
 
 def test_straight_move_hits_cube1(problem: TrajectoryProblem) -> None:
     cert = certify(problem, problem.trajectory.straight_line(1.5))
+    # Independently, at the reported instant: coal pair by pair finds the same penetration.
+    k = int(np.flatnonzero(cert.dense.t == cert.t_min_distance)[0])
+    best, pairs = coal_min_distances(problem, cert.dense.q[k : k + 1], cert.dense.t[k : k + 1])
+    assert best[0] == pytest.approx(cert.min_distance, abs=1e-9)
+    assert pairs[0] == cert.closest_pair
     assert not cert.feasible
     assert cert.limits_ok
     assert not cert.distance_ok
@@ -127,30 +132,49 @@ def test_dense_torques_and_ratios(problem: TrajectoryProblem, feasible: Certific
         np.testing.assert_array_equal(getattr(dense, name), getattr(samples, name))
 
 
-def test_min_distance_equals_independent_loop(
-    problem: TrajectoryProblem, feasible: Certificate
-) -> None:
-    """Per sample: Pinocchio placements and one coal.distance per (solid, obstacle) pair,
-    obstacles (the pendulum moves) at their pose at that instant."""
-    robot, scene, dense = problem.robot, problem.scene, feasible.dense
+def coal_min_distances(
+    problem: TrajectoryProblem, q: np.ndarray, t: np.ndarray
+) -> tuple[np.ndarray, list[tuple[str, str]]]:
+    """Independent dense check: per sample, Pinocchio placements and one coal.distance per
+    (solid, obstacle) pair (GJK tolerance 1e-9, as documented for the checker), obstacles
+    (the pendulum moves) at their pose at that instant. Returns the smallest distance
+    (n,) [m] and the closest (solid, obstacle) names per sample."""
+    robot, scene = problem.robot, problem.scene
     model, gm = robot.model, robot.collision_model
     data, gdata = model.createData(), gm.createData()
     obstacles = [ob.shape.to_coal() for ob in scene.obstacles]
-    k_min = int(np.argmin(dense.min_distance))
-    for k in (0, 500, 1000, k_min, dense.n_samples - 1):
-        pin.updateGeometryPlacements(model, data, gm, gdata, dense.q[k])
-        poses = scene.obstacle_poses(np.array([dense.t[k]]), in_base_frame=True)[:, 0]
-        best = np.inf
+    poses = scene.obstacle_poses(t, in_base_frame=True)  # (n_obstacles, n, 4, 4)
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    request.gjk_tolerance = 1e-9
+    best, pairs = np.full(len(t), np.inf), []
+    for k in range(len(t)):
+        pin.updateGeometryPlacements(model, data, gm, gdata, q[k])
+        pair = ("", "")
         for o, geom in enumerate(obstacles):
-            tf_o = coal.Transform3s(poses[o, :3, :3], poses[o, :3, 3])
+            tf_o = coal.Transform3s(poses[o, k, :3, :3], poses[o, k, :3, 3])
             for g, obj in enumerate(gm.geometryObjects):
                 placement = gdata.oMg[g]
                 tf_g = coal.Transform3s(placement.rotation, placement.translation)
-                d = coal.distance(
-                    obj.geometry, tf_g, geom, tf_o, coal.DistanceRequest(), coal.DistanceResult()
-                )
-                best = min(best, d)
-        assert dense.min_distance[k] == pytest.approx(best, abs=1e-6), k
+                result.clear()
+                d = coal.distance(obj.geometry, tf_g, geom, tf_o, request, result)
+                if d < best[k]:
+                    best[k], pair = d, (obj.name, scene.obstacles[o].name)
+        pairs.append(pair)
+    return best, pairs
+
+
+def test_min_distance_equals_independent_loop(
+    problem: TrajectoryProblem, feasible: Certificate
+) -> None:
+    """Every one of the 2 101 dense samples against coal called pair by pair."""
+    dense = feasible.dense
+    best, pairs = coal_min_distances(problem, dense.q, dense.t)
+    np.testing.assert_allclose(dense.min_distance, best, rtol=0, atol=1e-9)
+    k = int(np.argmin(best))
+    assert feasible.min_distance == pytest.approx(best[k], abs=1e-9)
+    assert feasible.t_min_distance == dense.t[k]
+    assert feasible.closest_pair == pairs[k]
+    assert best.min() >= problem.settings.margin  # the verdict, independently
 
 
 def test_rate_and_inputs(problem: TrajectoryProblem, feasible_x: np.ndarray) -> None:

@@ -1,17 +1,8 @@
-"""Analysis of moves and fronts: certificate, decision making, indicators."""
+"""Analysis of moves and fronts: certificate, decision making, indicators, the paper's measures."""
 
 from __future__ import annotations
 
-from adept_traj.analysis.certificate import (
-    DEFAULT_RATE_HZ,
-    DEFAULT_TOLERANCE,
-    LIMIT_KINDS,
-    Certificate,
-    DenseTrajectory,
-    LimitCheck,
-    certify,
-    dense_samples,
-)
+from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -21,20 +12,25 @@ from adept_traj.analysis.decision import (
     normalise,
     objective_weights,
 )
+from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     MAXIMISED,
-    algorithm_effort,
     hypervolume,
     igd,
     non_dominated,
     normalised_hypervolume,
     objective_bounds,
+    to_unit_minimisation,
+)
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, LimitCheck
+from adept_traj.analysis.paper_measures import (
+    algorithm_effort,
     optimizer_overhead,
     ratio_non_dominated,
     spread,
-    to_unit_minimisation,
 )
+from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
     "DEFAULT_HV_REFERENCE",

@@ -6,7 +6,7 @@ included (:math:`n = \lceil T \cdot \text{rate} \rceil + 1` samples), independen
 optimiser's coarse Gauss–Legendre samples:
 
 - positions, velocities, accelerations and jerks from the spline at every sample, **and** the
-  exact per-segment extrema of :meth:`~adept_traj.trajectory.BSplineTrajectory.bounds`
+  exact per-segment extrema of :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
   (the reported worst value is the larger of the two, so nothing between samples is missed);
 - joint torques/forces :math:`u = ` :meth:`~adept_traj.robot.Robot.inverse_dynamics` at every
   sample (the torque is not a polynomial: dense samples only);
@@ -42,178 +42,24 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
+from adept_traj.analysis.limit_check import (
+    DEFAULT_TOLERANCE,
+    LimitCheck,
+    _check,
+    _limit_messages,
+    _limits,
+    _ratio_check,
+)
+from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
-from adept_traj.validation import as_finite_array, as_vector, readonly_copy
+from adept_traj.robot.limits import LIMIT_KINDS
+from adept_traj.validation import as_finite_array, as_scalar, as_vector, deep_equal, readonly_copy
 
-__all__ = [
-    "DEFAULT_RATE_HZ",
-    "DEFAULT_TOLERANCE",
-    "LIMIT_KINDS",
-    "Certificate",
-    "DenseTrajectory",
-    "LimitCheck",
-    "certify",
-    "dense_samples",
-]
+__all__ = ["DEFAULT_RATE_HZ", "Certificate", "certify"]
 
 #: Default sampling rate of the dense check [Hz].
 DEFAULT_RATE_HZ = 1000.0
-#: Default tolerance on the limit values (dimensionless ratios).
-DEFAULT_TOLERANCE = 1e-9
-#: The limit kinds, in the order of the problem's constraints.
-LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk", "torque")
-#: The paper's name of each limit (Table 2).
-_LIMIT_SYMBOL = {
-    "position": "QC",
-    "velocity": "VC",
-    "acceleration": "WC",
-    "jerk": "JC",
-    "torque": "UC",
-}
-
-
-@dataclass(frozen=True, eq=False)
-class DenseTrajectory:
-    """A trajectory sampled on a uniform grid (both ends included).
-
-    Attributes
-    ----------
-    t: (n,) sample times [s], ``t[0] = 0``, ``t[-1] = T``.
-    q: (n, nq) positions [rad | m].
-    qd: (n, nq) velocities [rad/s | m/s].
-    qdd: (n, nq) accelerations [rad/s² | m/s²].
-    qddd: (n, nq) jerks [rad/s³ | m/s³].
-    tau: (n, nq) joint torques/forces [N·m | N] (inverse dynamics with friction).
-    min_distance: (n,) smallest signed distance over every (solid, obstacle) pair [m]
-        (negative: penetration depth; ``inf`` when the scene has no obstacle).
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    qddd: np.ndarray
-    tau: np.ndarray
-    min_distance: np.ndarray
-
-    def __post_init__(self) -> None:
-        t = readonly_copy(as_finite_array(self.t, "t"))
-        if t.ndim != 1 or t.size < 2:
-            raise InvalidInputError(f"t must have shape (n,) with n ≥ 2; got {t.shape}")
-        object.__setattr__(self, "t", t)
-        nq = None
-        for name in ("q", "qd", "qdd", "qddd", "tau"):
-            arr = readonly_copy(as_finite_array(getattr(self, name), name))
-            if arr.ndim != 2 or arr.shape[0] != t.size or (nq is not None and arr.shape[1] != nq):
-                raise InvalidInputError(
-                    f"{name} must have shape ({t.size}, nq) like the others; got {arr.shape}"
-                )
-            nq = arr.shape[1]
-            object.__setattr__(self, name, arr)
-        d = np.array(self.min_distance, dtype=np.float64)
-        if d.shape != t.shape or np.isnan(d).any() or (d == -np.inf).any():
-            raise InvalidInputError(
-                f"min_distance must have shape {t.shape} with no NaN or -inf; got {d.shape}"
-            )
-        object.__setattr__(self, "min_distance", readonly_copy(d))
-
-    @property
-    def n_samples(self) -> int:
-        """Number of samples n."""
-        return int(self.t.size)
-
-    @property
-    def nq(self) -> int:
-        """Number of joints."""
-        return int(self.q.shape[1])
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return all(
-            _arrays_equal(getattr(self, k), getattr(other, k))
-            for k in ("t", "q", "qd", "qdd", "qddd", "tau", "min_distance")
-        )
-
-    __hash__ = None  # type: ignore[assignment]
-
-
-@dataclass(frozen=True, eq=False)
-class LimitCheck:
-    """The worst use of one kind of limit over the trajectory, per joint.
-
-    Attributes
-    ----------
-    kind: one of :data:`LIMIT_KINDS`.
-    dense: (nq,) worst value over the dense samples (see the module table; position:
-        fraction of the joint range beyond the nearer limit, ≤ 0 inside; the others: ratio
-        to the limit, ≤ 1 within).
-    exact: (nq,) the same from the exact spline extrema, or ``None`` (torque: samples only).
-    t_worst: (nq,) time [s] of the worst dense sample.
-    tolerance: slack allowed beyond :attr:`bound` (dimensionless).
-    """
-
-    kind: str
-    dense: np.ndarray
-    exact: np.ndarray | None
-    t_worst: np.ndarray
-    tolerance: float = DEFAULT_TOLERANCE
-
-    def __post_init__(self) -> None:
-        if self.kind not in LIMIT_KINDS:
-            raise InvalidInputError(f"kind must be one of {LIMIT_KINDS}; got {self.kind!r}")
-        dense = readonly_copy(as_finite_array(self.dense, f"{self.kind}.dense"))
-        if dense.ndim != 1:
-            raise InvalidInputError(f"{self.kind}.dense must have shape (nq,); got {dense.shape}")
-        object.__setattr__(self, "dense", dense)
-        if self.exact is not None:
-            exact = readonly_copy(as_vector(self.exact, f"{self.kind}.exact", dense.size))
-            object.__setattr__(self, "exact", exact)
-        t_worst = readonly_copy(as_vector(self.t_worst, f"{self.kind}.t_worst", dense.size))
-        object.__setattr__(self, "t_worst", t_worst)
-        tol = float(self.tolerance)
-        if not (math.isfinite(tol) and tol >= 0.0):
-            raise InvalidInputError(f"tolerance must be finite and ≥ 0; got {self.tolerance!r}")
-        object.__setattr__(self, "tolerance", tol)
-
-    @property
-    def bound(self) -> float:
-        """The largest feasible value: 0 for position, 1 for the ratios."""
-        return 0.0 if self.kind == "position" else 1.0
-
-    @property
-    def symbol(self) -> str:
-        """The paper's name of the limit: QC, VC, WC, JC or UC."""
-        return _LIMIT_SYMBOL[self.kind]
-
-    @property
-    def worst(self) -> np.ndarray:
-        """(nq,) the larger of :attr:`dense` and :attr:`exact` (dense alone for torque)."""
-        return self.dense if self.exact is None else np.maximum(self.dense, self.exact)
-
-    @property
-    def within(self) -> np.ndarray:
-        """(nq,) bool: ``worst ≤ bound + tolerance``."""
-        return self.worst <= self.bound + self.tolerance
-
-    @property
-    def ok(self) -> bool:
-        """Every joint within the limit."""
-        return bool(self.within.all())
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return (
-            self.kind == other.kind
-            and self.tolerance == other.tolerance
-            and _arrays_equal(self.dense, other.dense)
-            and _arrays_equal(self.exact, other.exact)
-            and _arrays_equal(self.t_worst, other.t_worst)
-        )
-
-    __hash__ = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,11 +100,9 @@ class Certificate:
         if x.ndim != 1 or x.size < 1 or not x[0] > 0:
             raise InvalidInputError(f"x must have shape (n_var,) with T = x[0] > 0; got {x!r}")
         object.__setattr__(self, "x", x)
-        object.__setattr__(self, "rate_hz", _positive(self.rate_hz, "rate_hz"))
-        margin = float(self.margin)
-        if not (math.isfinite(margin) and margin >= 0.0):
-            raise InvalidInputError(f"margin must be finite and ≥ 0 [m]; got {self.margin!r}")
-        object.__setattr__(self, "margin", margin)
+        rate = as_scalar(self.rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+        object.__setattr__(self, "rate_hz", rate)
+        object.__setattr__(self, "margin", as_scalar(self.margin, "margin", "[m]", minimum=0.0))
         for kind in LIMIT_KINDS:
             check = getattr(self, kind)
             if not isinstance(check, LimitCheck) or check.kind != kind:
@@ -314,24 +158,9 @@ class Certificate:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return (
-            _arrays_equal(self.x, other.x)
-            and (self.rate_hz, self.margin, self.min_distance, self.t_min_distance)
-            == (other.rate_hz, other.margin, other.min_distance, other.t_min_distance)
-            and self.closest_pair == other.closest_pair
-            and self.violations == other.violations
-            and self.checks == other.checks
-            and self.dense == other.dense
-        )
+        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
-
-
-def dense_samples(T: float, rate_hz: float) -> int:
-    """Number of uniform samples over [0, T] [s] with spacing at most 1/``rate_hz`` [Hz],
-    both ends included: ``ceil(T·rate) + 1`` (at least 2). The 1e-9 keeps
-    T·rate = 2100.0000000000005 at 2100."""
-    return max(2, math.ceil(T * rate_hz - 1e-9) + 1)
 
 
 def certify(
@@ -365,17 +194,15 @@ def certify(
     InputShapeError, InvalidInputError
         ``x`` not of shape (n_var,), not finite, ``T ≤ 0``; ``rate_hz`` not > 0.
     ConfigurationError
-        A robot limit that is not > 0 (the velocity, acceleration, jerk and effort limits may
+        A robot limit that is not > 0 (the velocity, acceleration, jerk and torque limits may
         be infinite; the position limits must be finite with lower < upper).
     """
     xa = as_vector(x, "x", problem.n_var)
     T = float(xa[0])
     if not T > 0.0:
         raise InvalidInputError(f"x[0] (travel time T [s]) must be > 0; got {T!r}")
-    rate = _positive(rate_hz, "rate_hz")
-    tol = float(tolerance)
-    if not (math.isfinite(tol) and tol >= 0.0):
-        raise InvalidInputError(f"tolerance must be finite and ≥ 0; got {tolerance!r}")
+    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    tol = as_scalar(tolerance, "tolerance", minimum=0.0)
     robot, lim = problem.robot, problem.robot.limits
     span = _limits(lim)
 
@@ -435,85 +262,3 @@ def certify(
         dense=dense,
         **checks,
     )
-
-
-# ---------------------------------------------------------------------------- helpers
-
-
-def _arrays_equal(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    if a is None or b is None:
-        return a is None and b is None
-    return a.shape == b.shape and bool(np.array_equal(a, b))
-
-
-def _positive(value: Any, name: str) -> float:
-    try:
-        out = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"{name} must be a number > 0; got {value!r}") from None
-    if not (math.isfinite(out) and out > 0.0):
-        raise InvalidInputError(f"{name} must be finite and > 0; got {value!r}")
-    return out
-
-
-def _limits(lim: Any) -> np.ndarray:
-    """Check the robot's limits; return the position ranges (nq,)."""
-    span = np.asarray(lim.upper - lim.lower, dtype=float)
-    if not (np.all(np.isfinite(lim.lower)) and np.all(np.isfinite(lim.upper)) and np.all(span > 0)):
-        raise ConfigurationError(
-            f"position limits must be finite with lower < upper; got lower={lim.lower.tolist()}, "
-            f"upper={lim.upper.tolist()}"
-        )
-    for name in ("velocity", "acceleration", "jerk", "torque"):
-        value = np.asarray(getattr(lim, name), dtype=float)
-        if not np.all(value > 0):  # NaN, 0 and negative values; inf is allowed
-            raise ConfigurationError(
-                f"{name} limits must be > 0 (inf allowed); got {value.tolist()}"
-            )
-    return span
-
-
-def _check(
-    kind: str, values: np.ndarray, exact: np.ndarray | None, t: np.ndarray, tol: float
-) -> LimitCheck:
-    """LimitCheck from per-sample values (n, nq) (already normalised)."""
-    worst = np.argmax(values, axis=0)
-    dense = values[worst, np.arange(values.shape[1])]
-    return LimitCheck(kind=kind, dense=dense, exact=exact, t_worst=t[worst], tolerance=tol)
-
-
-def _ratio_check(
-    kind: str,
-    values: np.ndarray,
-    exact_abs_max: np.ndarray | None,
-    limit: np.ndarray,
-    t: np.ndarray,
-    tol: float,
-) -> LimitCheck:
-    """LimitCheck of max |value| / limit (an infinite limit gives 0)."""
-    ratio = np.abs(values) / limit
-    exact = None if exact_abs_max is None else exact_abs_max / limit
-    return _check(kind, ratio, exact, t, tol)
-
-
-def _limit_messages(
-    check: LimitCheck,
-    names: tuple[str, ...],
-    lower: np.ndarray,
-    upper: np.ndarray,
-) -> list[str]:
-    """One message per joint whose limit of this kind is violated."""
-    out = []
-    for i in np.flatnonzero(~check.within):
-        worst, dense = float(check.worst[i]), float(check.dense[i])
-        at = f"at t = {check.t_worst[i]:.3f} s"
-        if check.exact is not None and dense <= check.bound + check.tolerance:
-            at = f"between samples (exact spline bound; dense worst {dense:.4g} {at})"
-        if check.kind == "position":
-            out.append(
-                f"position {names[i]}: {worst:.4g} of the range beyond its limits "
-                f"[{lower[i]:.6g}, {upper[i]:.6g}] {at}"
-            )
-        else:
-            out.append(f"{check.kind} {names[i]}: {worst:.4g} × {check.symbol} {at}")
-    return out

@@ -83,7 +83,7 @@ def normalise(
         column minimum / maximum of ``F``. To compare several fronts on one scale, as the
         paper's Table 3 does (its Z_max/Z_min rows are the extremes over the fronts being
         compared), pass the extremes of their union
-        (:func:`adept_traj.metrics.objective_bounds`).
+        (:func:`~adept_traj.analysis.indicators.objective_bounds`).
     maximised: sense of each objective (bool or (m,) bools); default :data:`MAXIMISED`
         (only z4 maximised).
 

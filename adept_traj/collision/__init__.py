@@ -1,27 +1,36 @@
-"""Exact robot-obstacle distances over time: checker, conservative broad phase, distance tables."""
+"""Robot-obstacle distances over time.
+
+The checker, the conservative broad phase, distance tables, closed-form point distances and
+the coal primitives (``distance_request``: the settings every distance uses).
+"""
 
 from __future__ import annotations
 
-from adept_traj.collision.broad_phase import (
-    Bounds,
-    BroadPhase,
-    point_signed_distance,
-)
+from adept_traj.collision.broad_phase import Bounds, BroadPhase
 from adept_traj.collision.checker import (
     CollisionChecker,
     MinDistances,
     PairDistances,
 )
-from adept_traj.collision.distance_table import (
-    DistanceTable,
+from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.point_distance import point_signed_distance
+from adept_traj.collision.primitives import (
+    DISTANCE_TOLERANCE,
+    coal_kind,
+    distance_request,
+    shape_of,
 )
 
 __all__ = [
+    "DISTANCE_TOLERANCE",
     "Bounds",
     "BroadPhase",
     "CollisionChecker",
     "DistanceTable",
     "MinDistances",
     "PairDistances",
+    "coal_kind",
+    "distance_request",
     "point_signed_distance",
+    "shape_of",
 ]

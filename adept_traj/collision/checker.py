@@ -4,7 +4,7 @@
 (..., n_t) [s], the signed distance [m] between **every** robot solid and **every** obstacle
 (moving obstacles at their pose at that time; negative = penetration depth), using coal.
 
-The broad phase (:mod:`adept_traj.broad_phase`, numpy, batched) gives a lower bound of
+The broad phase (:mod:`adept_traj.collision.broad_phase`, numpy, batched) gives a lower bound of
 every distance, exact for sphere obstacles (closed form) and static pairs. Only pairs whose
 bound is ≤ ``influence`` go to coal (narrow phase, one call per close pair: the only Python
 loop, over close pairs, never over all samples). The other entries hold a lower bound
@@ -23,7 +23,9 @@ from typing import Any
 import coal
 import numpy as np
 
-from adept_traj.collision.broad_phase import BroadPhase, point_signed_distance
+from adept_traj.collision.broad_phase import BroadPhase
+from adept_traj.collision.point_distance import point_signed_distance
+from adept_traj.collision.primitives import distance_request
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
@@ -117,13 +119,14 @@ class CollisionChecker:
             [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
             for g in self._robot_geoms
         ]
-        self._request = coal.DistanceRequest()
+        self._request = distance_request()
         self._result = coal.DistanceResult()
         self._tf = (coal.Transform3s(), coal.Transform3s())
 
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:
-        """The robot solids as :mod:`adept_traj.shapes` objects (``None`` if not a primitive)."""
+        """The robot solids as :mod:`adept_traj.scene.shapes` objects (``None``: not a
+        primitive)."""
         return tuple(self._broad.solid_shape)
 
     @property

@@ -12,8 +12,9 @@ and bounded between grid points by its Lipschitz constant:
 
 with :math:`L = \rho + R` for a revolute joint (ρ the distance of the solid's enclosing-ball
 centre from the joint axis, R the ball's radius: no point of the solid moves faster than
-:math:`L\,|\dot q|`) and :math:`L = 1` for a prismatic one, and ε = 1e-6 m for the
-tolerance of coal's distances. A signed distance changes by at most the largest
+:math:`L\,|\dot q|`) and :math:`L = 1` for a prismatic one, and ε = 5e-6 m for the
+accuracy of coal's distances (they understate a penetration depth by up to 3.4 µm, see
+:mod:`adept_traj.collision.primitives`). A signed distance changes by at most the largest
 displacement of the moving convex solid (for separation and for penetration depth alike),
 so the bound is valid everywhere; with h = 1 mrad it is at most :math:`L h` below the
 exact distance (≈ 0.6 mm for the AdeptOne's inner arm; about :math:`L h / 2` typically).
@@ -29,9 +30,10 @@ import numpy as np
 
 __all__ = ["DistanceTable"]
 
-#: Subtracted from every bound: coal's distances between primitives are exact to well
-#: below this (GJK/EPA tolerances), so a tabulated value never exceeds the true distance.
-_SLACK = 1e-6
+#: Subtracted from every bound [m]: coal's distances between primitives exceed the true
+#: distance by at most 3.4 µm (penetration; 2 nm beyond 1 mm of separation, measured in
+#: collision.primitives), so a tabulated value minus this never exceeds the true distance.
+_SLACK = 5e-6
 
 
 @dataclass(frozen=True)

@@ -33,10 +33,12 @@ from adept_traj.analysis.certificate import Certificate, certify
 from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
-    algorithm_effort,
     non_dominated,
     normalised_hypervolume,
     objective_bounds,
+)
+from adept_traj.analysis.paper_measures import (
+    algorithm_effort,
     optimizer_overhead,
     ratio_non_dominated,
     spread,

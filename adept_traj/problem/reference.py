@@ -17,7 +17,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from adept_traj.collision.checker import point_signed_distance
+from adept_traj.collision import distance_request, point_signed_distance
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.robot.parameter_file import TASK_ROWS
 from adept_traj.robot.robot import coulomb_sign, manipulability_measure
@@ -37,7 +37,7 @@ def _evaluate_reference(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation
     rows = [TASK_ROWS.index(r) for r in robot.task_rows]
     obstacle_geoms = [ob.shape.to_coal() for ob in problem.scene.obstacles]
     solid_shapes = problem.checker.solid_shapes
-    req = coal.DistanceRequest()
+    req = distance_request()  # the checker's coal settings (GJK tolerance)
     n_obs = len(obstacle_geoms)
     objectives, constraints, min_distances = [], [], []
     for xi in x:

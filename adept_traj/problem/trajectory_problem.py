@@ -56,15 +56,13 @@ from adept_traj.problem.evaluator import ParallelEvaluator
 from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
 from adept_traj.problem.reference import _evaluate_reference
 from adept_traj.problem.time_bound import kinematic_lower_bound
+from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Box
 from adept_traj.validation import as_batch, as_integer
 
 __all__ = ["ProblemSettings", "TrajectoryProblem"]
-
-#: Constraint kinds, in order (each once per joint), before the distance constraint.
-_KINDS = ("q", "qd", "qdd", "qddd", "u")
 
 
 @dataclass(frozen=True)
@@ -212,9 +210,11 @@ class TrajectoryProblem(Problem):
     # ------------------------------------------------------------------ public
     @property
     def constraint_names(self) -> tuple[str, ...]:
-        """Names of the constraints, e.g. ``"qd[joint2]"``, then ``"distance"``."""
+        """Names of the constraints: one per limit kind and joint, named by the kind's
+        symbol (``"q[joint1]"`` … ``"tau[joint4]"``, :data:`~adept_traj.robot.LIMITS`),
+        then ``"distance"``."""
         names = self.robot.joint_names
-        return (*(f"{k}[{n}]" for k in _KINDS for n in names), "distance")
+        return (*(f"{k.symbol}[{n}]" for k in LIMITS for n in names), "distance")
 
     def evaluate_batch(self, x: Any) -> Evaluation:
         """Evaluate a population ``x`` (pop, n_var), or one vector (n_var,).
@@ -342,7 +342,7 @@ class TrajectoryProblem(Problem):
         lim, st = self.robot.limits, self.settings
         span = lim.upper - lim.lower
         g_q = np.maximum(q_max - lim.upper, lim.lower - q_min) / span
-        scales = [lim.velocity, lim.acceleration, lim.jerk, lim.torque]
+        scales = [lim.bound(kind.name) for kind in LIMITS[1:]]
         g_rest = [m / s - 1.0 for m, s in zip(abs_max, scales)]
         g_d = (st.margin - np.minimum(min_dist, st.influence)) / st.influence
         return np.concatenate([g_q, *g_rest, g_d[:, None]], axis=-1)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import LIMIT_KINDS, Certificate, DenseTrajectory, LimitCheck
+from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
@@ -39,7 +39,7 @@ from adept_traj.results.parts import (
 )
 from adept_traj.results.reader import _Reader
 from adept_traj.results.record import FORMAT, VERSION, PlanningResult, _jsonable
-from adept_traj.robot.limits import LIMITS, JointLimits
+from adept_traj.robot.limits import LIMIT_KINDS, LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import deep_equal
 

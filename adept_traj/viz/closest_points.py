@@ -22,8 +22,7 @@ from __future__ import annotations
 import coal
 import numpy as np
 
-from adept_traj.collision import point_signed_distance
-from adept_traj.collision.broad_phase import coal_kind, shape_of
+from adept_traj.collision import coal_kind, distance_request, point_signed_distance, shape_of
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene, Shape, Sphere
 
@@ -99,7 +98,7 @@ def _coal_pair(
     poses ``solid`` (n, 4, 4) and the obstacle at ``obstacle_poses`` (n, 4, 4)."""
     n = solid.shape[0]
     distance, points = np.empty(n), np.empty((n, 2, 3))
-    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    request, result = distance_request(), coal.DistanceResult()  # the checker's settings
     tf_solid, tf_obstacle = coal.Transform3s(), coal.Transform3s()
     for k in range(n):
         tf_solid.setRotation(solid[k, :3, :3])

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.collision.broad_phase import coal_kind, shape_of
+from adept_traj.collision import coal_kind, shape_of
 from adept_traj.scene import Box, Capsule, Cylinder, Sphere
 
 __all__ = ["shape_wireframe", "solid_wireframe", "wireframe"]

@@ -1,0 +1,91 @@
+r"""A trajectory sampled on a dense uniform time grid: the samples a certificate checks.
+
+:func:`dense_samples` gives the number of samples
+:math:`n = \lceil T \cdot \text{rate} \rceil + 1` of the grid over :math:`[0, T]` (both
+ends included) and :class:`DenseTrajectory` holds the states, torques and smallest
+distances at those samples (built by :func:`~adept_traj.analysis.certificate.certify`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from adept_traj.errors import InvalidInputError
+from adept_traj.validation import as_finite_array, as_scalar, deep_equal, readonly_copy
+
+__all__ = ["DenseTrajectory", "dense_samples"]
+
+
+@dataclass(frozen=True, eq=False)
+class DenseTrajectory:
+    """A trajectory sampled on a uniform grid (both ends included).
+
+    Attributes
+    ----------
+    t: (n,) sample times [s], ``t[0] = 0``, ``t[-1] = T``.
+    q: (n, nq) positions [rad | m].
+    qd: (n, nq) velocities [rad/s | m/s].
+    qdd: (n, nq) accelerations [rad/s² | m/s²].
+    qddd: (n, nq) jerks [rad/s³ | m/s³].
+    tau: (n, nq) joint torques/forces [N·m | N] (inverse dynamics with friction).
+    min_distance: (n,) smallest signed distance over every (solid, obstacle) pair [m]
+        (negative: penetration depth; ``inf`` when the scene has no obstacle).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    qddd: np.ndarray
+    tau: np.ndarray
+    min_distance: np.ndarray
+
+    def __post_init__(self) -> None:
+        t = readonly_copy(as_finite_array(self.t, "t"))
+        if t.ndim != 1 or t.size < 2:
+            raise InvalidInputError(f"t must have shape (n,) with n ≥ 2; got {t.shape}")
+        object.__setattr__(self, "t", t)
+        nq = None
+        for name in ("q", "qd", "qdd", "qddd", "tau"):
+            arr = readonly_copy(as_finite_array(getattr(self, name), name))
+            if arr.ndim != 2 or arr.shape[0] != t.size or (nq is not None and arr.shape[1] != nq):
+                raise InvalidInputError(
+                    f"{name} must have shape ({t.size}, nq) like the others; got {arr.shape}"
+                )
+            nq = arr.shape[1]
+            object.__setattr__(self, name, arr)
+        d = np.array(self.min_distance, dtype=np.float64)
+        if d.shape != t.shape or np.isnan(d).any() or (d == -np.inf).any():
+            raise InvalidInputError(
+                f"min_distance must have shape {t.shape} with no NaN or -inf; got {d.shape}"
+            )
+        object.__setattr__(self, "min_distance", readonly_copy(d))
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples n."""
+        return int(self.t.size)
+
+    @property
+    def nq(self) -> int:
+        """Number of joints."""
+        return int(self.q.shape[1])
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return deep_equal(self, other)
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def dense_samples(T: float, rate_hz: float) -> int:
+    """Number of uniform samples over [0, T] [s] with spacing at most 1/``rate_hz`` [Hz],
+    both ends included: ``ceil(T·rate) + 1`` (at least 2). The 1e-9 keeps
+    T·rate = 2100.0000000000005 at 2100."""
+    T = as_scalar(T, "T", "[s]", minimum=0.0)
+    rate_hz = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    return max(2, math.ceil(T * rate_hz - 1e-9) + 1)

@@ -1,0 +1,158 @@
+r"""The worst use of each kind of joint limit over a trajectory, per joint.
+
+A :class:`LimitCheck` summarises one of the :data:`LIMIT_KINDS` (position, velocity,
+acceleration, jerk, torque; the paper's QC, VC, WC, JC, UC of Table 2) as a dimensionless
+value per joint, from dense samples and, where they exist, the exact spline extrema (see
+:mod:`adept_traj.analysis.certificate` for the table of values and bounds). The private
+helpers build the checks and their messages for
+:func:`~adept_traj.analysis.certificate.certify`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.robot.limits import LIMIT_KINDS, LIMITS
+from adept_traj.validation import as_finite_array, as_scalar, as_vector, deep_equal, readonly_copy
+
+__all__ = ["DEFAULT_TOLERANCE", "LimitCheck"]
+
+#: Default tolerance on the limit values (dimensionless ratios).
+DEFAULT_TOLERANCE = 1e-9
+#: The paper's name of each limit kind (Table 2), from the one vocabulary in robot.limits.
+_LIMIT_SYMBOL = {kind.name: kind.paper for kind in LIMITS}
+
+
+@dataclass(frozen=True, eq=False)
+class LimitCheck:
+    """The worst use of one kind of limit over the trajectory, per joint.
+
+    Attributes
+    ----------
+    kind: one of :data:`LIMIT_KINDS`.
+    dense: (nq,) worst value over the dense samples (see the module table; position:
+        fraction of the joint range beyond the nearer limit, ≤ 0 inside; the others: ratio
+        to the limit, ≤ 1 within).
+    exact: (nq,) the same from the exact spline extrema, or ``None`` (torque: samples only).
+    t_worst: (nq,) time [s] of the worst dense sample.
+    tolerance: slack allowed beyond :attr:`bound` (dimensionless).
+    """
+
+    kind: str
+    dense: np.ndarray
+    exact: np.ndarray | None
+    t_worst: np.ndarray
+    tolerance: float = DEFAULT_TOLERANCE
+
+    def __post_init__(self) -> None:
+        if self.kind not in LIMIT_KINDS:
+            raise InvalidInputError(f"kind must be one of {LIMIT_KINDS}; got {self.kind!r}")
+        dense = readonly_copy(as_finite_array(self.dense, f"{self.kind}.dense"))
+        if dense.ndim != 1:
+            raise InvalidInputError(f"{self.kind}.dense must have shape (nq,); got {dense.shape}")
+        object.__setattr__(self, "dense", dense)
+        if self.exact is not None:
+            exact = readonly_copy(as_vector(self.exact, f"{self.kind}.exact", dense.size))
+            object.__setattr__(self, "exact", exact)
+        t_worst = readonly_copy(as_vector(self.t_worst, f"{self.kind}.t_worst", dense.size))
+        object.__setattr__(self, "t_worst", t_worst)
+        object.__setattr__(self, "tolerance", as_scalar(self.tolerance, "tolerance", minimum=0.0))
+
+    @property
+    def bound(self) -> float:
+        """The largest feasible value: 0 for position, 1 for the ratios."""
+        return 0.0 if self.kind == "position" else 1.0
+
+    @property
+    def symbol(self) -> str:
+        """The paper's name of the limit: QC, VC, WC, JC or UC."""
+        return _LIMIT_SYMBOL[self.kind]
+
+    @property
+    def worst(self) -> np.ndarray:
+        """(nq,) the larger of :attr:`dense` and :attr:`exact` (dense alone for torque)."""
+        return self.dense if self.exact is None else np.maximum(self.dense, self.exact)
+
+    @property
+    def within(self) -> np.ndarray:
+        """(nq,) bool: ``worst ≤ bound + tolerance``."""
+        return self.worst <= self.bound + self.tolerance
+
+    @property
+    def ok(self) -> bool:
+        """Every joint within the limit."""
+        return bool(self.within.all())
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return deep_equal(self, other)
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def _limits(lim: Any) -> np.ndarray:
+    """Check the robot's limits; return the position ranges (nq,)."""
+    span = np.asarray(lim.upper - lim.lower, dtype=float)
+    if not (np.all(np.isfinite(lim.lower)) and np.all(np.isfinite(lim.upper)) and np.all(span > 0)):
+        raise ConfigurationError(
+            f"position limits must be finite with lower < upper; got lower={lim.lower.tolist()}, "
+            f"upper={lim.upper.tolist()}"
+        )
+    for name in LIMIT_KINDS[1:]:
+        value = np.asarray(lim.bound(name), dtype=float)
+        if not np.all(value > 0):  # NaN, 0 and negative values; inf is allowed
+            raise ConfigurationError(
+                f"{name} limits must be > 0 (inf allowed); got {value.tolist()}"
+            )
+    return span
+
+
+def _check(
+    kind: str, values: np.ndarray, exact: np.ndarray | None, t: np.ndarray, tol: float
+) -> LimitCheck:
+    """LimitCheck from per-sample values (n, nq) (already normalised)."""
+    worst = np.argmax(values, axis=0)
+    dense = values[worst, np.arange(values.shape[1])]
+    return LimitCheck(kind=kind, dense=dense, exact=exact, t_worst=t[worst], tolerance=tol)
+
+
+def _ratio_check(
+    kind: str,
+    values: np.ndarray,
+    exact_abs_max: np.ndarray | None,
+    limit: np.ndarray,
+    t: np.ndarray,
+    tol: float,
+) -> LimitCheck:
+    """LimitCheck of max |value| / limit (an infinite limit gives 0)."""
+    ratio = np.abs(values) / limit
+    exact = None if exact_abs_max is None else exact_abs_max / limit
+    return _check(kind, ratio, exact, t, tol)
+
+
+def _limit_messages(
+    check: LimitCheck,
+    names: tuple[str, ...],
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> list[str]:
+    """One message per joint whose limit of this kind is violated."""
+    out = []
+    for i in np.flatnonzero(~check.within):
+        worst, dense = float(check.worst[i]), float(check.dense[i])
+        at = f"at t = {check.t_worst[i]:.3f} s"
+        if check.exact is not None and dense <= check.bound + check.tolerance:
+            at = f"between samples (exact spline bound; dense worst {dense:.4g} {at})"
+        if check.kind == "position":
+            out.append(
+                f"position {names[i]}: {worst:.4g} of the range beyond its limits "
+                f"[{lower[i]:.6g}, {upper[i]:.6g}] {at}"
+            )
+        else:
+            out.append(f"{check.kind} {names[i]}: {worst:.4g} × {check.symbol} {at}")
+    return out
