@@ -28,12 +28,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from adept_traj.analysis.indicators import MAXIMISED, _as_objectives, _as_sense, _fraction_towards
+from adept_traj.analysis.indicators import _as_objectives, _as_sense, _fraction_towards
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.problem.objectives import MAXIMISED
 from adept_traj.validation import as_finite_array, as_vector, readonly_copy
 
 __all__ = [
-    "MAXIMISED",
     "PAPER_WEIGHTS",
     "BestTradeoff",
     "average_fitness",

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike
 from pymoo.indicators.igd import IGD
 
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.problem.objectives import MAXIMISED  # the objective table's sense
 from adept_traj.validation import as_finite_array, as_vector
 
 __all__ = [
@@ -55,8 +56,6 @@ __all__ = [
     "to_unit_minimisation",
 ]
 
-MAXIMISED: tuple[bool, ...] = (False, False, False, True, False, False)
-"""Sense of the paper's objectives ``[z1..z6]``: only z4 (manipulability) is maximised."""
 
 #: Default reference point of :func:`normalised_hypervolume`, in the unit space where 0 is
 #: the best bound and 1 the worst bound of every objective.

@@ -11,7 +11,7 @@ gives the formulas with references and explains every choice):
 * :func:`algorithm_effort` — AE, run time per evaluation [s].
 
 Objective arrays ``F`` have shape ``(n, m)`` and the sense of each objective is given by
-``maximised`` (default :data:`~adept_traj.analysis.indicators.MAXIMISED`), as in
+``maximised`` (default :data:`~adept_traj.problem.MAXIMISED`), as in
 :mod:`adept_traj.analysis.indicators`, which holds the standard indicators (hypervolume,
 IGD) and the dominance test. Inputs are never modified.
 """

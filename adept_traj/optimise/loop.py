@@ -47,8 +47,9 @@ class GenerationInfo:
 class RunState:
     """Final population and bookkeeping of a run.
 
-    ``X`` (pop, n_var), ``F`` (pop, n_obj) as pymoo sees them (z4 negated), ``G``
-    (pop, n_constr), ``CV`` (pop,) total constraint violation; ``total_s`` and
+    ``X`` (pop, n_var), ``F`` (pop, n_obj) as pymoo sees them (maximised columns negated:
+    :func:`~adept_traj.problem.to_pymoo`), ``G`` (pop, n_constr), ``CV`` (pop,) total
+    constraint violation; ``total_s`` and
     ``evaluation_s`` [s] the wall time of the run and the part spent evaluating (earlier
     sessions of a resumed run included); ``history`` one dict per generation.
     """

@@ -46,7 +46,7 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.problem.trajectory_problem import TrajectoryProblem
+from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
     NO_FEASIBLE_WARNING,
     BestSolution,
@@ -89,13 +89,6 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
 _HV_GENERATIONS = 25
 
 
-def _z4_positive(F: np.ndarray) -> np.ndarray:
-    """pymoo's objectives (z4 negated) as reported (z4 positive)."""
-    out = np.array(F, dtype=float)
-    out[:, 3] = -out[:, 3]
-    return out
-
-
 def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecord]:
     """Generation records with the hypervolume of each generation's feasible front, on the
     bounds of the final front and of every generation's front (reference point 1.1), for
@@ -107,14 +100,14 @@ def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecor
     if final_front is not None and len(state.fronts):
         k = len(state.fronts)
         chosen = {int(i) for i in np.linspace(0, k - 1, min(k, _HV_GENERATIONS)).round()}
-        positive = [_z4_positive(F) for F in state.fronts if len(F)]
+        positive = [from_pymoo(F) for F in state.fronts if len(F)]
         lo, hi = objective_bounds(final_front, *positive)  # a one-point front would collapse
     records = []
     for i, h in enumerate(state.history):
         hv = None
         j = i - offset
         if j in chosen and len(state.fronts[j]):
-            hv = normalised_hypervolume(_z4_positive(state.fronts[j]), lo, hi)
+            hv = normalised_hypervolume(from_pymoo(state.fronts[j]), lo, hi)
         records.append(
             GenerationRecord(
                 generation=h["generation"],
@@ -203,7 +196,7 @@ def plan(
         progress=progress,
     )
     # The final population's values as the run computed them (z4 back to positive).
-    objectives = _z4_positive(state.F)
+    objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)
     feasible = np.all(constraints <= 0.0, axis=1)
     if feasible.any():

@@ -7,7 +7,7 @@ equation, sense); :data:`OBJECTIVE_NAMES` and :data:`MAXIMISED` are its columns.
 name  quantity                                  unit     paper  sense
 ====  ========================================  =======  =====  =========
 z1    travel time :math:`T`                     s        eq. 1  minimised
-z2    :math:`\int_0^T \sum_i u_i^2\,dt`         N²·m²·s  eq. 2  minimised
+z2    :math:`\int_0^T \sum_i \tau_i^2\,dt`      N²·m²·s  eq. 2  minimised
 z3    clearance penalty                         \-       eq. 3  minimised
 z4    :math:`\min_t |\det J(q(t))|`             m²       eq. 4  maximised
 z5    :math:`\sum_i \int_0^T \dddot q_i^2\,dt`  rad²/s⁵  eq. 5  minimised
@@ -86,7 +86,7 @@ class Objective:
 #: The objectives z1…z6, in the order of every objective array ``(..., 6)``.
 OBJECTIVES: tuple[Objective, ...] = (
     Objective("z1", "time", "s", 1),
-    Objective("z2", "∫Σu²", "N²·m²·s", 2),
+    Objective("z2", "∫Στ²", "N²·m²·s", 2),
     Objective("z3", "clearance penalty", "-", 3),
     Objective("z4", "min|det J|", "m²", 4, maximised=True),
     Objective("z5", "∫Σq⃛²", "rad²/s⁵", 5),
