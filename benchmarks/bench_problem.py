@@ -12,9 +12,9 @@ nodes on each of the 19 spline segments plus both ends: 116 samples per trajecto
   close to the obstacles: the hardest case for the distance computation).
 
 Prints evaluations per second of :meth:`TrajectoryProblem.evaluate_batch` and of the plain
-per-sample :meth:`TrajectoryProblem.evaluate_reference` (on a few individuals), their ratio
-measured in the same run, the coal calls per evaluation and the peak memory of one batched
-evaluation of the population (tracemalloc: numpy allocations).
+per-sample :func:`adept_traj.testing.reference.evaluate_reference` (on a few individuals),
+their ratio measured in the same run, the coal calls per evaluation and the peak memory of
+one batched evaluation of the population (tracemalloc: numpy allocations).
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from _timing import best_of  # benchmarks/_timing.py
 from adept_traj import Robot, Scene
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.testing.paper_moves import lift_then_lower  # a hand-made collision-free move
+from adept_traj.testing.reference import evaluate_reference
 
 
 def main() -> None:
@@ -64,7 +65,7 @@ def main() -> None:
         ev = problem.evaluate_batch(pop)
         batched = args.pop / best_of(lambda pop=pop: problem.evaluate_batch(pop), args.repeat)
         few = pop[: args.reference]
-        reference = len(few) / best_of(lambda few=few: problem.evaluate_reference(few), 1)
+        reference = len(few) / best_of(lambda few=few: evaluate_reference(problem, few), 1)
         print(
             f"{name:<15}{batched:>13.0f}{reference:>16.1f}{batched / reference:>7.0f}×"
             f"{ev.n_narrow / args.pop:>15.1f}{int(ev.feasible.sum()):>10}"

@@ -21,6 +21,7 @@ from adept_traj.errors import (
 )
 from adept_traj.problem import Evaluation, ParallelEvaluator, TrajectoryProblem
 from adept_traj.testing.paper_moves import lift_then_lower
+from adept_traj.testing.reference import evaluate_reference
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +69,7 @@ def test_batched_equals_reference(problem: TrajectoryProblem) -> None:
     x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(3, problem.n_var))
     x = np.vstack([x, problem.trajectory.straight_line(1.3), lift_then_lower(problem)])
     batched = problem.evaluate_batch(x)
-    reference = problem.evaluate_reference(x)
+    reference = evaluate_reference(problem, x)
     np.testing.assert_allclose(batched.objectives, reference.objectives, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(batched.constraints, reference.constraints, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(batched.min_distance, reference.min_distance, rtol=0, atol=1e-9)
@@ -81,7 +82,7 @@ def test_paper_penalty_variant_equals_reference(robot: Robot, scene: Scene, vari
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, z3=variant)
     x = np.vstack([problem.trajectory.straight_line(1.4), lift_then_lower(problem)])
     batched = problem.evaluate_batch(x)
-    reference = problem.evaluate_reference(x)
+    reference = evaluate_reference(problem, x)
     np.testing.assert_allclose(batched.objectives, reference.objectives, rtol=1e-9, atol=1e-12)
     assert batched.objectives[0, 2] > 0  # the straight move enters cube 1's sphere
 

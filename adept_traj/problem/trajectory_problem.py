@@ -31,8 +31,8 @@ where :math:`d_o` is the exact smallest signed distance between any robot solid 
 
 (paper eqs. 7–12; the extrema of q … q⃛ are exact per spline segment, the torque maximum is
 taken at the samples, the distance constraint uses the safety margin ``m``).
-:meth:`TrajectoryProblem.evaluate_reference` computes the same numbers with plain
-per-sample loops (:mod:`~adept_traj.problem.reference`): the oracle for tests and the
+:func:`adept_traj.testing.reference.evaluate_reference` computes the same numbers with
+plain per-sample loops and no code shared with this module: the oracle for tests and the
 baseline for benchmarks. With ``workers > 1`` populations are evaluated by a
 :class:`~adept_traj.problem.evaluator.ParallelEvaluator` that the problem owns.
 """
@@ -54,7 +54,6 @@ from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
 from adept_traj.problem.evaluator import ParallelEvaluator
 from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
-from adept_traj.problem.reference import _evaluate_reference
 from adept_traj.problem.time_bound import kinematic_lower_bound
 from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
@@ -225,13 +224,6 @@ class TrajectoryProblem(Problem):
         xa = as_batch(x, "x", self.n_var)
         start = time.perf_counter()
         ev = self._evaluate_batch(np.atleast_2d(xa))
-        return _finish(ev, start, single=xa.ndim == 1)
-
-    def evaluate_reference(self, x: Any) -> Evaluation:
-        """The same as :meth:`evaluate_batch` with plain per-individual, per-sample loops."""
-        xa = as_batch(x, "x", self.n_var)
-        start = time.perf_counter()
-        ev = _evaluate_reference(self, np.atleast_2d(xa))
         return _finish(ev, start, single=xa.ndim == 1)
 
     # ------------------------------------------------------------------ pymoo hook

@@ -1,33 +1,85 @@
 """The plain-loop reference evaluation of the trajectory problem (the tests' oracle).
 
-:meth:`~adept_traj.problem.TrajectoryProblem.evaluate_reference` computes the same
-objectives and constraints as the batched evaluation with plain per-individual, per-segment,
-per-sample loops: Pinocchio (RNEA, frame Jacobians) and coal are called once per sample and
-per (solid, obstacle) pair, with no broad phase, and the spline is evaluated segment by
-segment with scalar formulas (``_ReferenceSpline``), not with
-:mod:`~adept_traj.problem.spline_segments`. It is the oracle of the tests and the baseline
-of the benchmarks, not meant to be fast.
+:func:`evaluate_reference` computes the same objectives and constraints as
+:meth:`~adept_traj.problem.TrajectoryProblem.evaluate_batch` with plain per-individual,
+per-segment, per-sample loops: Pinocchio (RNEA, frame Jacobians) and coal are called once per
+sample and per (solid, obstacle) pair, with no broad phase; the spline is evaluated segment
+by segment with scalar formulas (``_ReferenceSpline``), not with
+:mod:`~adept_traj.problem.spline_segments`; the constraints (paper (7)–(12)) and the
+circumscribing volumes of the paper's penalty (eqs. 13, 15) are written out here again. It
+shares no evaluation code with the batched problem, which makes it the oracle of the tests
+and the baseline of the benchmarks; it is not meant to be fast.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+import time
+from typing import Any
 
 import coal
 import numpy as np
 import pinocchio as pin
 
 from adept_traj.collision import distance_request, point_signed_distance
-from adept_traj.problem.evaluation import Evaluation
-from adept_traj.robot.parameter_file import TASK_ROWS
-from adept_traj.robot.robot import coulomb_sign, manipulability_measure
-from adept_traj.scene.shapes import Sphere
+from adept_traj.problem import Evaluation, TrajectoryProblem, paper_penalty
+from adept_traj.robot import LIMITS, TASK_ROWS, coulomb_sign, manipulability_measure
+from adept_traj.scene import Box, Sphere
+from adept_traj.validation import as_batch, check_type
 
-if TYPE_CHECKING:
-    from adept_traj.problem.trajectory_problem import TrajectoryProblem
+__all__ = ["evaluate_reference"]
 
 
-def _evaluate_reference(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
+def evaluate_reference(problem: TrajectoryProblem, x: Any) -> Evaluation:
+    """Objectives and constraints of ``x`` by plain loops (see the module docstring).
+
+    Parameters
+    ----------
+    problem: the trajectory problem (its robot, scene, settings, trajectory and samples).
+    x: (pop, n_var) decision vectors, or one (n_var,).
+
+    Returns
+    -------
+    :class:`~adept_traj.problem.Evaluation` like ``problem.evaluate_batch(x)`` (rows for a
+    population; no population axis for a single vector), with its wall time.
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    xa = as_batch(x, "x", problem.n_var)
+    start = time.perf_counter()
+    ev = _evaluate(problem, np.atleast_2d(xa))
+    seconds = time.perf_counter() - start
+    if xa.ndim == 1:
+        return Evaluation(ev.objectives[0], ev.constraints[0], ev.min_distance[0], 0, seconds)
+    return Evaluation(ev.objectives, ev.constraints, ev.min_distance, 0, seconds)
+
+
+def _semi_axes(problem: TrajectoryProblem) -> np.ndarray:
+    """Semi-axes (n_obs, 3) [m] of the paper's circumscribing volumes: a sphere of the
+    shape's bounding radius (eq. 13), or for a box with ``"paper-ellipsoid"`` the smallest
+    ellipsoid with the box's axes, √3 × the half sides (eq. 15)."""
+    axes = []
+    for ob in problem.scene.obstacles:
+        if problem.settings.z3 == "paper-ellipsoid" and isinstance(ob.shape, Box):
+            axes.append(np.sqrt(3.0) * 0.5 * np.asarray(ob.shape.size))
+        else:
+            axes.append(np.full(3, ob.shape.bounding_radius))
+    return np.array(axes).reshape(-1, 3)
+
+
+def _constraints(
+    problem: TrajectoryProblem, extrema: dict[str, Any], tau_max: np.ndarray, d_min: float
+) -> np.ndarray:
+    """The 5·nq + 1 normalised constraints g ≤ 0 (paper (7)–(12)), written out."""
+    lim, st = problem.robot.limits, problem.settings
+    span = lim.upper - lim.lower
+    g = [np.maximum(extrema["q_max"] - lim.upper, lim.lower - extrema["q_min"]) / span]
+    peaks = {"qd": extrema["qd"], "qdd": extrema["qdd"], "qddd": extrema["qddd"], "tau": tau_max}
+    for kind in LIMITS[1:]:
+        g.append(peaks[kind.symbol] / lim.bound(kind.name) - 1.0)
+    g.append(np.array([(st.margin - min(d_min, st.influence)) / st.influence]))
+    return np.concatenate(g)
+
+
+def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
     """Plain loops: per individual, per segment, per sample, per pair (``x`` (pop, n_var))."""
     robot, model, st = problem.robot, problem.robot.model, problem.settings
     data = model.createData()
@@ -81,15 +133,18 @@ def _evaluate_reference(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation
             z3 = float(np.sum(np.maximum(0.0, 1.0 - d_obs / st.influence) ** 2))
         else:
             poses = np.array(obs_poses).transpose(1, 0, 2, 3)  # (n_obs, n_s, 4, 4)
-            z3 = float(problem._paper_penalty(np.array(tool_points), poses))
+            rotations = None if st.z3 == "paper-sphere" else poses[..., :3, :3]
+            z3 = float(
+                paper_penalty(
+                    np.array(tool_points),
+                    poses[..., :3, 3],
+                    _semi_axes(problem),
+                    rotations=rotations,
+                    equation=14 if st.z3 == "paper-sphere" else 16,
+                )
+            )
         objectives.append([T, z2, z3, z4, z5, z6])
-        g = problem._constraints(
-            extrema["q_min"][None],
-            extrema["q_max"][None],
-            [extrema["qd"][None], extrema["qdd"][None], extrema["qddd"][None], u_max[None]],
-            np.array([d_obs.min(initial=np.inf)]),
-        )[0]
-        constraints.append(g)
+        constraints.append(_constraints(problem, extrema, u_max, d_obs.min(initial=np.inf)))
         min_distances.append(np.minimum(d_obs, st.influence))
     return Evaluation(
         objectives=np.array(objectives),
