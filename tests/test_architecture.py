@@ -113,3 +113,19 @@ def test_every_exception_class_is_in_errors_py():
             ):
                 elsewhere.append(f"{path.relative_to(PACKAGE)}:{node.lineno} {node.name}")
     assert not elsewhere, elsewhere
+
+
+def test_every_subpackage_ships_in_the_wheel():
+    """pyproject.toml lists every package folder (a missing one is left out of the wheel:
+    `pip install .` then fails where an editable install works)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+
+    pyproject = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    listed = set(pyproject["tool"]["setuptools"]["packages"])
+    folders = {
+        ".".join(p.parent.relative_to(PACKAGE.parent).parts) for p in PACKAGE.rglob("__init__.py")
+    }
+    assert folders <= listed, sorted(folders - listed)

@@ -46,6 +46,8 @@ def save_figures(
 
         paths = plots.save_all(results, folder, replays=replays)
     except ImportError as exc:
+        if (exc.name or "").split(".")[0] != "matplotlib":
+            raise  # a broken install of adept_traj itself is an error, not a missing extra
         print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
         return
     print(f"{len(paths)} figures in {folder}")
