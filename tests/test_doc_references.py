@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PAGES = sorted((ROOT / "docs").glob("*.md")) + [ROOT / "README.md"]
+PAGES = [*sorted((ROOT / "docs").glob("*.md")), ROOT / "README.md"]
 
 #: ``adept_traj.a.b.c`` (dotted) and ``adept_traj/a/b.py`` (paths) in prose and code.
 DOTTED = re.compile(r"(?<![\"'])\badept_traj(?:\.[A-Za-z_][A-Za-z0-9_]*)+")  # not in "strings"

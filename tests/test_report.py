@@ -26,5 +26,5 @@ def test_missing_matplotlib_is_a_note(monkeypatch, tmp_path: Path, capsys):
 
 def test_missing_part_of_adept_traj_is_an_error(monkeypatch, tmp_path: Path):
     monkeypatch.setattr(plots, "save_all", _raise("adept_traj.viz.plots.fronts"))
-    with pytest.raises(ImportError, match="adept_traj.viz.plots.fronts"):
+    with pytest.raises(ImportError, match=r"adept_traj\.viz\.plots\.fronts"):
         save_figures({}, tmp_path)
