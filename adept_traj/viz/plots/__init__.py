@@ -11,7 +11,7 @@ function                     module                            figure
                                                                the fronts (Figs. 5–6)
 :func:`best_tradeoffs`       :mod:`.tradeoffs`                 the best trade-offs side by
                                                                side, scored bars (Fig. 7)
-:func:`joint_motion`         :mod:`.motion`                    q, q̇, q̈, q⃛ and u of every
+:func:`joint_motion`         :mod:`.motion`                    q, q̇, q̈, q⃛ and τ of every
                                                                joint against time (Figs. 8–9)
 :func:`tool_path_3d`         :mod:`.tool_path`                 tool path, obstacles and
                                                                pendulum in the world (Fig. 4)
