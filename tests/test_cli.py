@@ -377,12 +377,14 @@ def _planar_verify(tmp_path: Path, joints: str, capsys: pytest.CaptureFixture[st
     finally:
         problem.close()
     capsys.readouterr()
-    main(["verify", str(tmp_path / "run")])
+    saved = PlanningResult.load(tmp_path / "run").certificate
+    assert saved.feasible  # nothing in reach, limits far: the tiny run's best passes
+    assert main(["verify", str(tmp_path / "run")]) == 0
     lines = _limit_lines(capsys.readouterr().out)
     assert list(lines) == ["position", "velocity", "acceleration", "jerk", "torque"]
     for kind in ("position", "velocity", "torque"):
         assert re.fullmatch(_WORST, lines[kind]), lines
-    return PlanningResult.load(tmp_path / "run").certificate, lines
+    return saved, lines
 
 
 def test_verify_says_no_limit_for_a_robot_without_acceleration_and_jerk_limits(

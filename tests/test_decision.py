@@ -29,6 +29,23 @@ TABLE4_F_C = {"NSGA-II": 0.497040, "MODE": 0.467136}
 ROWS = np.stack([NSGA2, MODE])
 
 
+def scores_by_hand(F: np.ndarray, z_min: np.ndarray, z_max: np.ndarray, maximised) -> np.ndarray:
+    """Min–max scores in [0, 1], 1 = best, written out per element with plain loops (no
+    library code): (Z_max − z)/(Z_max − Z_min) for a minimised objective, (z − Z_min)/(…) for
+    a maximised one, 1 where Z_max = Z_min."""
+    out = np.empty(np.shape(F))
+    for i, row in enumerate(F):
+        for k, z in enumerate(row):
+            span = z_max[k] - z_min[k]
+            if span == 0.0:
+                out[i, k] = 1.0
+            elif maximised[k]:
+                out[i, k] = (z - z_min[k]) / span
+            else:
+                out[i, k] = (z_max[k] - z) / span
+    return out
+
+
 # ---------------------------------------------------------------- F_avg, paper Table 3
 def test_average_fitness_reproduces_table3() -> None:
     f_avg = average_fitness(ROWS, Z_MIN, Z_MAX)
@@ -145,10 +162,16 @@ def test_combined_objective_weights_are_rescaled() -> None:
     np.testing.assert_allclose(objective_weights([2.0, 2.0, 4.0], 3), [0.25, 0.25, 0.5])
 
 
-def test_combined_objective_equal_weights_is_one_minus_f_avg() -> None:
+def test_combined_objective_and_f_avg_by_hand() -> None:
+    """On random rows (default bounds: the column extremes): f_c = Σ w_i (1 − n_i) with the
+    weights summing to 1, F_avg = mean n_i; equal weights give f_c = 1 − F_avg."""
     rng = np.random.default_rng(4)
     F = rng.random((15, 6))
-    np.testing.assert_allclose(combined_objective(F, np.ones(6)), 1.0 - average_fitness(F))
+    n = scores_by_hand(F, F.min(axis=0), F.max(axis=0), MAXIMISED)
+    w = np.array(PAPER_WEIGHTS) / sum(PAPER_WEIGHTS)
+    np.testing.assert_allclose(combined_objective(F, PAPER_WEIGHTS), (1.0 - n) @ w, rtol=1e-13)
+    np.testing.assert_allclose(average_fitness(F), n.mean(axis=1), rtol=1e-13)
+    np.testing.assert_allclose(combined_objective(F, np.ones(6)), 1.0 - n.mean(axis=1))
 
 
 @pytest.mark.parametrize(
@@ -169,7 +192,7 @@ def _candidate_f_c_definitions() -> dict[str, np.ndarray]:
     """Natural readings of "normalized weighting objective functions" on Table 3's rows."""
     w = np.array(PAPER_WEIGHTS)
     maxi = np.array(MAXIMISED)
-    n = normalise(ROWS, Z_MIN, Z_MAX)
+    n = scores_by_hand(ROWS, Z_MIN, Z_MAX, MAXIMISED)
     ratio = ROWS / Z_MAX  # z_i / Z_max,i
     return {
         "sum w (1 - n)  [ours]": (1.0 - n) @ w,
@@ -200,7 +223,7 @@ def test_table4_mode_f_c_exceeds_any_bounded_weighted_badness() -> None:
     """Structural reason: on Table 3's bounds the MODE row is at its best value in every
     objective except z2, so any f_c = Σ w_i b_i with a badness b_i ∈ [0, 1] that is 0 at the
     best value is at most w_2 = 0.25 — below Table 4's 0.467136."""
-    n = normalise(ROWS, Z_MIN, Z_MAX)
+    n = scores_by_hand(ROWS, Z_MIN, Z_MAX, MAXIMISED)
     np.testing.assert_array_equal(np.delete(n[1], 1), np.ones(5))
     assert n[1, 1] < 1.0
     assert PAPER_WEIGHTS[1] == 0.25 < TABLE4_F_C["MODE"]
@@ -229,12 +252,13 @@ def test_best_tradeoff_uses_both_scores() -> None:
     )
     w = [0.8, 0.1, 0.1]
     r = best_tradeoff(F, weights=w, maximised=False)
-    f_c = combined_objective(F, w, maximised=False)
-    f_avg = average_fitness(F, maximised=False)
+    # every column spans [0, 1]: the badness 1 − n is F itself, the score n is 1 − F
+    f_c = [0.1 + 0.1, 0.8, 0.8 * 0.2 + 0.1 * 0.5 + 0.1 * 0.4, 0.8 * 0.3 + 0.1 * 0.45 + 0.1 * 0.4]
+    f_avg = [1.0 / 3.0, 2.0 / 3.0, (0.8 + 0.5 + 0.6) / 3.0, (0.7 + 0.55 + 0.6) / 3.0]
     assert int(np.argmin(f_c)) == 0
     assert int(np.argmax(f_avg)) == 1
-    np.testing.assert_allclose(r.f_c, f_c)
-    np.testing.assert_allclose(r.F_avg, f_avg)
+    np.testing.assert_allclose(r.f_c, f_c, rtol=1e-14)
+    np.testing.assert_allclose(r.F_avg, f_avg, rtol=1e-14)
     np.testing.assert_array_equal(r.rank_f_c, [1, 4, 2, 3])
     np.testing.assert_array_equal(r.rank_F_avg, [4, 1, 2, 3])
     assert r.index == 2

@@ -112,6 +112,21 @@ def test_paper_penalty_sums_over_obstacles() -> None:
     assert float(paper_penalty(pts, centres, axes)) == pytest.approx(expected, rel=1e-12)
 
 
+def penalty_by_hand(points: np.ndarray, centres: np.ndarray, axes: np.ndarray) -> float:
+    """Eqs. 15–16 of one motion with plain loops: per obstacle o the smallest
+    r_e = Σ_i ((p_i − c_i) / a_i)² over the samples (points (n_t, 3), centres (n_obs, n_t, 3)),
+    adding 1 / r_e² when r_e ≤ 1."""
+    total = 0.0
+    for o in range(len(axes)):
+        r_e = min(
+            sum(((p[i] - c[i]) / axes[o][i]) ** 2 for i in range(3))
+            for p, c in zip(points, centres[o])
+        )
+        if r_e <= 1.0:
+            total += 1.0 / r_e**2
+    return total
+
+
 def test_paper_penalty_batched() -> None:
     rng = np.random.default_rng(41)
     n_obs, n_t = 2, 5
@@ -120,19 +135,19 @@ def test_paper_penalty_batched() -> None:
     axes = np.array([[0.6, 0.5, 0.7], [0.8, 0.8, 0.8]])
     out = paper_penalty(pts, centres, axes)
     assert out.shape == (3, 4)
+    expected = [
+        [penalty_by_hand(pts[i, j], centres[:, i, j], axes) for j in range(4)] for i in range(3)
+    ]
+    np.testing.assert_allclose(out, expected, rtol=1e-12)
     assert (out > 0).any()
     assert (out == 0).any()
-    for i in range(3):
-        for j in range(4):
-            one = paper_penalty(pts[i, j], centres[:, i, j], axes)
-            assert float(out[i, j]) == pytest.approx(float(one), rel=1e-12)
     # centres shared by every motion, given with singleton batch axes
     shared = centres[:, :1, :1]
     out = paper_penalty(pts, shared, axes)
-    for i in range(3):
-        for j in range(4):
-            one = paper_penalty(pts[i, j], shared[:, 0, 0], axes)
-            assert float(out[i, j]) == pytest.approx(float(one), rel=1e-12)
+    expected = [
+        [penalty_by_hand(pts[i, j], shared[:, 0, 0], axes) for j in range(4)] for i in range(3)
+    ]
+    np.testing.assert_allclose(out, expected, rtol=1e-12)
 
 
 def test_paper_penalty_centres_broadcast_over_motions() -> None:
@@ -140,8 +155,9 @@ def test_paper_penalty_centres_broadcast_over_motions() -> None:
     centres = np.array([[[0.0, 0.0, 0.0]], [[10.0, 10.0, 10.0]]])  # 2 obstacles, 1 time
     axes = np.full((2, 3), 0.5)
     out = paper_penalty(pts, centres, axes)
-    expected = [float(paper_penalty(p, centres, axes)) for p in pts]  # [1e24, 625]
-    np.testing.assert_allclose(out, expected, rtol=1e-12)
+    # motion 0 sits on obstacle 0's centre: r_e = 0, which the library floors at 1e-12: 1 / 1e-24;
+    # motion 1 at 0.1 from it: r_e = (0.1 / 0.5)² = 0.04, 1 / 0.04² = 625; obstacle 1 is far
+    np.testing.assert_allclose(out, [1e24, 625.0], rtol=1e-12)
 
 
 @pytest.mark.parametrize(

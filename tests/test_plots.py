@@ -8,10 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import matplotlib  # the [test] extra: a missing matplotlib fails here, it is not skipped
 import numpy as np
 import pytest
-
-pytest.importorskip("matplotlib")
 
 import adept_traj as at
 from adept_traj.errors import InvalidInputError
@@ -79,15 +78,17 @@ FIGURES = [
 def figures(
     results: dict[str, PlanningResult], tmp_path_factory: pytest.TempPathFactory
 ) -> dict[str, Path]:
-    """Every figure, drawn once by save_all; the backend is checked around the call."""
-    import matplotlib
+    """Every figure, drawn once by save_all; the backend and pyplot's figure list are
+    checked around the call (pyplot is imported first, so a figure made through it would
+    register)."""
+    import matplotlib.pyplot as plt
 
     backend = matplotlib.get_backend()
+    before = plt.get_fignums()
     folder = tmp_path_factory.mktemp("figures") / "figs"
     written = plots.save_all(results, folder)
     assert matplotlib.get_backend() == backend  # the caller's backend is left alone
-    if "matplotlib.pyplot" in sys.modules:
-        assert sys.modules["matplotlib.pyplot"].get_fignums() == []  # no pyplot figure
+    assert plt.get_fignums() == before  # no pyplot figure made or left open
     assert all(p.parent == folder for p in written)
     return {p.name: p for p in written}
 

@@ -12,6 +12,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scipy import interpolate, optimize
 
 from adept_traj.errors import (
     AdeptTrajError,
@@ -133,6 +134,9 @@ def test_minimal_knots() -> None:
     np.testing.assert_array_equal(x, [2.0])
     smp = traj.sample(x, [0.0, 1.0])
     np.testing.assert_allclose(smp.q, [START, GOAL], atol=1e-14)
+    # Three segments of width h = 1/3 with P0..P2 = start and P3..P5 = goal: the constant jerk
+    # of the first and last segment is (P3 - 3 P2 + 3 P1 - P0) / (h³ T³) = 27 (goal - start) / T³.
+    np.testing.assert_allclose(smp.qddd, [27.0 * (GOAL - START) / 8.0] * 2, rtol=1e-12)
 
 
 # --------------------------------------------------------------------------------------------
@@ -151,8 +155,8 @@ def test_boundary_conditions(n_knots: int) -> None:
     np.testing.assert_allclose(smp.qd, 0.0, atol=1e-11)
     np.testing.assert_allclose(smp.qdd, 0.0, atol=1e-9)
     np.testing.assert_allclose(smp.t[:, 1], x[:, 0])
-    if n_knots > 4:  # the jerk is not zero at the ends (documented)
-        assert np.all(np.abs(smp.qddd).max(axis=(1, 2)) > 1e-3)
+    # the jerk is not zero at the ends (documented)
+    assert np.all(np.abs(smp.qddd).max(axis=(1, 2)) > 1e-3)
 
 
 @pytest.mark.parametrize("n_knots", [4, 7, 20])
@@ -171,7 +175,6 @@ def test_position_vs_cox_de_boor(n_knots: int) -> None:
 
 
 def test_all_derivatives_vs_scipy_bspline(traj: BSplineTrajectory) -> None:
-    interpolate = pytest.importorskip("scipy.interpolate")
     rng = np.random.default_rng(4)
     x = random_x(traj, rng, (4,))
     s = rng.uniform(0.0, 1.0, 300)
@@ -223,6 +226,10 @@ def test_sample_orders_and_basis(traj: BSplineTrajectory) -> None:
     np.testing.assert_allclose(traj.basis_matrix(s, 0).sum(axis=1), 1.0, atol=1e-14)
     for r in (1, 2, 3):
         np.testing.assert_allclose(traj.basis_matrix(s, r).sum(axis=1), 0.0, atol=1e-9)
+    # Column c is the basis function N_c: Cox–de Boor with the unit coefficient vector e_c.
+    knots, unit = uniform_knots(traj.n_segments), np.eye(traj.n_control)
+    reference = np.column_stack([cox_de_boor(knots, e, s) for e in unit])
+    np.testing.assert_allclose(traj.basis_matrix(s, 0), reference, rtol=0, atol=1e-14)
     _, P = traj.decode(x)
     np.testing.assert_allclose(
         full.qd, traj.basis_matrix(s, 1) @ P / x[:, 0, None, None], rtol=1e-12, atol=1e-12
@@ -311,11 +318,12 @@ def test_bounds_degenerate_polynomials() -> None:
     _check_bounds_vs_dense(traj, x)
 
 
-def test_integrals_vs_simpson(traj: BSplineTrajectory) -> None:
-    rng = np.random.default_rng(8)
-    x = random_x(traj, rng, (10,))
-    # Composite Simpson with an even number of panels per segment: exact for the piecewise
-    # quadratic q̈² and the piecewise constant q⃛² (up to rounding).
+def simpson_integrals(traj: BSplineTrajectory, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """∫₀ᵀ q̈² dt and ∫₀ᵀ q⃛² dt per joint, (..., nq), by composite Simpson on the samples.
+
+    An even number of panels per segment: exact for the piecewise quadratic q̈² and the
+    piecewise constant q⃛² (up to rounding).
+    """
     per_seg = 40
     n = traj.n_segments * per_seg
     s = np.linspace(0.0, 1.0, n + 1)
@@ -326,9 +334,16 @@ def test_integrals_vs_simpson(traj: BSplineTrajectory) -> None:
     # At knots the jerk jumps: use one-sided values (left/right limits) from each side.
     smp_left = traj.sample(x, np.clip(s - 1e-13, 0.0, 1.0))
     smp_right = traj.sample(x, np.clip(s + 1e-13, 0.0, 1.0))
-    T = x[:, 0, None]
-    ref_acc = T * np.einsum("k,pkj->pj", w, 0.5 * (smp_left.qdd**2 + smp_right.qdd**2))
-    ref_jerk = T * np.einsum("k,pkj->pj", w, 0.5 * (smp_left.qddd**2 + smp_right.qddd**2))
+    T = x[..., 0, None]
+    ref_acc = T * np.einsum("k,...kj->...j", w, 0.5 * (smp_left.qdd**2 + smp_right.qdd**2))
+    ref_jerk = T * np.einsum("k,...kj->...j", w, 0.5 * (smp_left.qddd**2 + smp_right.qddd**2))
+    return ref_acc, ref_jerk
+
+
+def test_integrals_vs_simpson(traj: BSplineTrajectory) -> None:
+    rng = np.random.default_rng(8)
+    x = random_x(traj, rng, (10,))
+    ref_acc, ref_jerk = simpson_integrals(traj, x)
     got = traj.integrals(x)
     np.testing.assert_allclose(got.acc_sq, ref_acc, rtol=1e-9)
     np.testing.assert_allclose(got.jerk_sq, ref_jerk, rtol=1e-9)
@@ -360,12 +375,27 @@ def test_quadrature_exactness(traj: BSplineTrajectory, n: int) -> None:
         np.testing.assert_allclose(w @ u**p, 1.0 / (p + 1), rtol=1e-13)
     # One degree more is no longer exact (the claimed degree is sharp).
     assert abs(w @ u ** (2 * n) - 1.0 / (2 * n + 1)) > 1e-8
-    # ∫₀ᵀ q̈² dt with n ≥ 2 (degree 2 per segment) matches the exact integral.
-    if n >= 2:
-        x = random_x(traj, np.random.default_rng(9), (3,))
-        qdd = traj.sample(x, s, orders=(2,)).qdd
-        approx = x[:, 0, None] * np.einsum("k,pkj->pj", w, qdd**2)
-        np.testing.assert_allclose(approx, traj.integrals(x).acc_sq, rtol=1e-12)
+
+
+@pytest.mark.parametrize("n", [2, 3, 5])
+def test_quadrature_integrates_acceleration_squared(traj: BSplineTrajectory, n: int) -> None:
+    """∫₀ᵀ q̈² dt with n ≥ 2 points per segment (q̈² is of degree 2 per segment) equals
+    composite Simpson's value."""
+    s, w = traj.quadrature(n)
+    x = random_x(traj, np.random.default_rng(9), (3,))
+    qdd = traj.sample(x, s, orders=(2,)).qdd
+    approx = x[:, 0, None] * np.einsum("k,pkj->pj", w, qdd**2)
+    np.testing.assert_allclose(approx, simpson_integrals(traj, x)[0], rtol=1e-9)
+
+
+def test_one_point_quadrature_misses_acceleration_squared(traj: BSplineTrajectory) -> None:
+    """One midpoint per segment integrates degree 1 only: q̈² (degree 2) is missed."""
+    s, w = traj.quadrature(1)
+    x = random_x(traj, np.random.default_rng(9), (3,))
+    qdd = traj.sample(x, s, orders=(2,)).qdd
+    approx = x[:, 0, None] * np.einsum("k,pkj->pj", w, qdd**2)
+    exact = simpson_integrals(traj, x)[0]
+    assert np.all(np.abs(approx - exact) > 1e-6 * exact)
 
 
 # --------------------------------------------------------------------------------------------
@@ -502,7 +532,6 @@ def test_kinematic_bound_continuous_across_cases(v: float, cases: set[str]) -> N
 
 def _lp_max_distance(T: float, v: float, a: float, j: float, n: int = 240) -> float:
     """Largest rest-to-rest distance with piecewise-constant jerk on n steps (LP)."""
-    optimize = pytest.importorskip("scipy.optimize")
     dt = T / n
     L = np.tril(np.ones((n + 1, n)), -1)  # row k sums steps i < k
     acc = dt * L  # a_k

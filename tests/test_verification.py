@@ -31,6 +31,7 @@ def test_feasible_move_is_certified(problem: TrajectoryProblem, feasible: Certif
     assert feasible.violations == ()
     assert feasible.min_distance >= problem.settings.margin
     assert feasible.margin == problem.settings.margin
+    assert [check.kind for check in feasible.checks] == list(LIMIT_KINDS)
     for check in feasible.checks:
         assert np.all(check.worst <= check.bound), check.kind
         assert check.within.all()

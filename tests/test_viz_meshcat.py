@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 import umsgpack
 
-from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult, Replay, RobotInfo
@@ -103,9 +102,8 @@ def test_frames_and_poses(result: PlanningResult, problem: TrajectoryProblem) ->
     # tool path from start to goal, world frame
     tool = scene.robot_base @ robot.tool_pose(np.vstack([problem.start, problem.goal]))
     np.testing.assert_allclose(pb.tool_path[[0, -1]], tool[:, :3, 3], atol=1e-12)
-    # closest points: exact distances, the segment joins the two witness points
-    checker = CollisionChecker(robot, scene)
-    exact = checker.distances(pb.q, pb.times, exact=True).min_distance
+    # closest points: coal's distances pair by pair, the segment joins the two witness points
+    exact, _ = coal_nearest(problem, pb.q, pb.times)
     np.testing.assert_allclose(pb.closest_distance, exact, atol=1e-9)
     gap = np.linalg.norm(pb.closest_points[:, 1] - pb.closest_points[:, 0], axis=-1)
     np.testing.assert_allclose(gap, np.abs(pb.closest_distance), atol=1e-9)
@@ -358,7 +356,7 @@ def listening_addresses(pid: int) -> list[tuple[str, str, int]]:
     return found
 
 
-def test_show_serves_on_localhost_only(
+def test_show_serves_on_localhost(
     result: PlanningResult, capsys: pytest.CaptureFixture[str]
 ) -> None:
     vis = server.show(result, speed=2.0, show_closest=True)
@@ -371,11 +369,25 @@ def test_show_serves_on_localhost_only(
         with urllib.request.urlopen(url, timeout=10) as reply:
             assert reply.status == 200
             assert b"meshcat" in reply.read().lower()
-        if Path("/proc/net/tcp").is_file():
-            sockets = listening_addresses(window.server_proc.pid)
-            ports = {int(url.rsplit(":", 1)[1].split("/")[0]), int(window.zmq_url.rsplit(":")[-1])}
-            assert {p for _, _, p in sockets} == ports
-            assert all(f == "tcp" and a == "0100007F" for f, a, _ in sockets), sockets
+    finally:
+        vis.close()
+    assert window.closed
+    assert window.server_proc.poll() is not None
+    vis.close()  # idempotent
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").is_file(), reason="needs Linux /proc/net/tcp")
+def test_show_listens_on_the_loopback_address_only(result: PlanningResult) -> None:
+    """The server's only listening sockets (read from /proc) are its two ports on
+    127.0.0.1, IPv4."""
+    vis = server.show(result)
+    window = vis.window
+    try:
+        url = vis.url()
+        sockets = listening_addresses(window.server_proc.pid)
+        ports = {int(url.rsplit(":", 1)[1].split("/")[0]), int(window.zmq_url.rsplit(":")[-1])}
+        assert {p for _, _, p in sockets} == ports
+        assert all(f == "tcp" and a == "0100007F" for f, a, _ in sockets), sockets
     finally:
         vis.close()
     assert window.closed
