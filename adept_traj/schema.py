@@ -305,7 +305,10 @@ class Node:
         done, v = self._settled(default, null, expected)
         if done:
             return v
-        return float(self._numbers((), unit, minimum, strict, _ABSENT))
+        usual = type(v) in (int, float) and math.isfinite(v)  # the common case, without numpy
+        if usual and (v > minimum or (v == minimum and not strict)):
+            return float(v)
+        return float(self._numbers((), unit, minimum, strict, _ABSENT))  # raises
 
     def array(
         self,
