@@ -205,7 +205,8 @@ class Node:
         return node
 
     def build(self, make: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
-        """``make(*args, **kwargs)``, its input errors raised as this node's errors."""
+        """``make(*args, **kwargs)``; the errors it raises on bad input (AdeptTrajError,
+        ValueError, TypeError: e.g. a string compared with a number) as this node's error."""
         try:
             return make(*args, **kwargs)
         except (AdeptTrajError, ValueError, TypeError) as exc:
@@ -236,6 +237,7 @@ class Node:
         expected = "a non-empty string" if nonempty else "a string"
         if choices is not None:
             expected = " or ".join(map(repr, choices)) if len(choices) < 3 else f"one of {names}"
+        expected += "" if null is _ABSENT else " or null"
         done, v = self._settled(default, null, expected)
         if done:
             return v
@@ -272,6 +274,7 @@ class Node:
         lo = "-∞" if minimum is None else minimum
         hi = "∞" if maximum is None else maximum
         expected = "an integer" if minimum is maximum is None else f"an integer in [{lo}, {hi}]"
+        expected += "" if null is _ABSENT else " or null"
         done, v = self._settled(default, null, expected)
         if done:
             return v

@@ -114,6 +114,12 @@ def test_integer_and_boolean() -> None:
     assert type(top["i"].integer()) is int
     assert top["i"].integer(minimum=3, maximum=3) == 3
     assert top["n"].integer(null=None) is None
+    assert field_of(lambda: top["f"].integer(null=None))[1].endswith(
+        "field 'f': must be an integer or null; got 3.0"
+    )
+    assert field_of(lambda: top["i"].string(null=None))[1].endswith(
+        "field 'i': must be a string or null; got 3"
+    )
     assert top["b"].boolean() is True
     for key, got in (("f", "3.0"), ("b", "true"), ("n", "null")):
         assert field_of(lambda key=key: top[key].integer())[1].endswith(
