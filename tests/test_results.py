@@ -314,6 +314,7 @@ def test_json_with_nan(saved: Path) -> None:
         (lambda d: d["certificate"].update(feasible=False), "certificate.feasible"),
         (lambda d: d["problem_settings"].update(colour="red"), "problem_settings.colour"),
         (lambda d: d["problem_settings"].update(margin=-1.0), "problem_settings"),
+        (lambda d: d["problem_settings"].update(margin="abc"), "problem_settings"),  # TypeError
         (lambda d: d["scene"].update(obstacle="nope"), "scene"),
         (lambda d: d["limits"]["q_upper"].__setitem__(0, "high"), "limits.q_upper[0]"),
         (lambda d: d["best"].update(index=9), "best.index"),

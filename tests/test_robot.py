@@ -387,9 +387,24 @@ def test_bad_parameter_files(tmp_path: Path) -> None:
     urdf = DATA / "planar_2link.urdf"
     cases = {
         '[[joint]]\nname = "wrist"\njerk = 1.0\n': r"joint\(s\) \['wrist'\] are not in",
-        '[[joint]]\nname = "elbow"\njerk = -1.0\n': r"'elbow': field 'jerk' must be a positive",
-        '[[joint]]\nname = "elbow"\nstiffness = 1.0\n': r"unknown field\(s\) \['stiffness'\]",
-        'task_rows = ["vx", "spin"]\n': "task_rows",
+        '[[joint]]\nname = "elbow"\njerk = -1.0\n': (
+            r"p1\.toml: field 'joint\[0\]\.jerk': must be a finite number > 0 "
+            r"\[rad/s³ \| m/s³\]; got -1\.0 \(in joint 'elbow'\)$"
+        ),
+        '[[joint]]\nname = "elbow"\nstiffness = 1.0\n': (
+            r"p2\.toml: field 'joint\[0\]\.stiffness': unknown field; allowed fields: 'name', "
+            r".*'viscous' \(in joint 'elbow'\)$"
+        ),
+        'task_rows = ["vx", "spin"]\n': (
+            r"p3\.toml: field 'task_rows\[1\]': must be one of 'vx', .*'wz'; got the string 'spin'"
+        ),
+        'task_rows = ["vx", "vx"]\n': r"field 'task_rows': must hold distinct strings; got 'vx'",
+        '[[joint]]\nname = "elbow"\nlower = 1.0\nupper = 0.5\n': (
+            r"field 'joint\[0\]\.upper': must be above 'lower' \(1\.0\); got 0\.5"
+        ),
+        '[[joint]]\nname = "elbow"\n[[joint]]\nname = "elbow"\n': (
+            r"field 'joint': names must be distinct; got 'elbow' more than once"
+        ),
         "tool_frame = [": "invalid TOML",
         'tool_frame = "paw"\n': "no frame 'paw'",
     }

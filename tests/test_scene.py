@@ -595,23 +595,68 @@ def test_good_template_loads(tmp_path: Path) -> None:
     assert scene.obstacle("pend.bob").motion.g == 9.81  # type: ignore[attr-defined]
 
 
+IN_CUBE = "(in obstacle 'cube1')"
+IN_PEND = "(in pendulum 'pend')"
+SIZE_1 = "field 'obstacle[0].size[1]': must be a finite number > 0 [m]; got"
+
+
 @pytest.mark.parametrize(
     ("old", "new", "fragments"),
     [
-        ("size = [0.4, 0.2, 0.3]", "size = [0.4, -0.2, 0.3]", ["'cube1'", "'size'", "positive"]),
-        ("size = [0.4, 0.2, 0.3]", "size = [0.4, 0.2]", ["'cube1'", "'size'", "3 positive"]),
-        ("size = [0.4, 0.2, 0.3]", 'size = [0.4, "a", 0.3]', ["'cube1'", "'size'", "'a'"]),
-        ("size = [0.4, 0.2, 0.3]", "size = [0.4, true, 0.3]", ["'cube1'", "'size'"]),
-        ("size = [0.4, 0.2, 0.3]", "size = [0.4, nan, 0.3]", ["'cube1'", "'size'"]),
-        ("size = [0.4, 0.2, 0.3]\n", "", ["'cube1'", "missing field 'size'"]),
-        ('shape = "box"', 'shape = "cone"', ["'cube1'", "'shape'", "'cone'", "'sphere'"]),
-        ('shape = "box"\n', "", ["'cube1'", "missing field 'shape'"]),
-        ('name = "cube1"\n', "", ["obstacle #1", "missing field 'name'"]),
-        ("xyz = [0.9, 0.7, 0.15]", "xyz = [0.9, 0.7, 0.15]\ncolour = 1", ["'cube1'", "'colour'"]),
-        ("xyz = [0.9, 0.7, 0.15]", "xyz = [0.9, 0.7, 0.15]\nradius = 1.0", ["'cube1'", "'radius'"]),
-        ('name = "t"', 'name = "t"\nunits = "mm"', ["unknown field 'units'"]),
-        ("[robot]", "[robot]\nz = 1.0", ["[robot]", "unknown field 'z'"]),
-        ("xyz = [0.0, 0.0, 0.0]", 'xyz = "origin"', ["[robot]", "'xyz'", "'origin'"]),
+        ("size = [0.4, 0.2, 0.3]", "size = [0.4, -0.2, 0.3]", [f"{SIZE_1} -0.2 {IN_CUBE}"]),
+        (
+            "size = [0.4, 0.2, 0.3]",
+            "size = [0.4, 0.2]",
+            [
+                "field 'obstacle[0].size': must be a list of 3 finite numbers > 0 [m]; "
+                f"got a list of 2: [0.4, 0.2] {IN_CUBE}"
+            ],
+        ),
+        ("size = [0.4, 0.2, 0.3]", 'size = [0.4, "a", 0.3]', [f"{SIZE_1} the string 'a'"]),
+        ("size = [0.4, 0.2, 0.3]", "size = [0.4, true, 0.3]", [f"{SIZE_1} true {IN_CUBE}"]),
+        ("size = [0.4, 0.2, 0.3]", "size = [0.4, nan, 0.3]", [f"{SIZE_1} nan {IN_CUBE}"]),
+        (
+            "size = [0.4, 0.2, 0.3]\n",
+            "",
+            [
+                "field 'obstacle[0].size': missing; must be a list of 3 finite numbers > 0 [m] "
+                + IN_CUBE
+            ],
+        ),
+        (
+            'shape = "box"',
+            'shape = "cone"',
+            [
+                "field 'obstacle[0].shape': must be one of 'box', 'sphere', 'cylinder', "
+                f"'capsule'; got the string 'cone' {IN_CUBE}"
+            ],
+        ),
+        ('shape = "box"\n', "", ["field 'obstacle[0].shape': missing; must be one of 'box'"]),
+        ('name = "cube1"\n', "", ["field 'obstacle[0].name': missing; must be a non-empty string"]),
+        (
+            "xyz = [0.9, 0.7, 0.15]",
+            "xyz = [0.9, 0.7, 0.15]\ncolour = 1",
+            [
+                "field 'obstacle[0].colour': unknown field; allowed fields: 'name', 'shape'",
+                IN_CUBE,
+            ],
+        ),
+        (
+            "xyz = [0.9, 0.7, 0.15]",
+            "xyz = [0.9, 0.7, 0.15]\nradius = 1.0",
+            ["field 'obstacle[0].radius': unknown field", "'size', 'min', 'max' " + IN_CUBE],
+        ),
+        (
+            'name = "t"',
+            'name = "t"\nunits = "mm"',
+            ["field 'units': unknown field; allowed fields: 'name', 'robot', 'task', 'obstacle'"],
+        ),
+        ("[robot]", "[robot]\nz = 1.0", ["field 'robot.z': unknown field; allowed fields: 'xyz'"]),
+        (
+            "xyz = [0.0, 0.0, 0.0]",
+            'xyz = "origin"',
+            ["field 'robot.xyz': must be a list of 3 finite numbers [m]; got the string 'origin'"],
+        ),
         (
             "[[pendulum]]",
             '[[obstacle]]\nname = "cube1"\nshape = "sphere"\nradius = 0.1\nxyz = [0, 0, 0]\n'
@@ -624,37 +669,63 @@ def test_good_template_loads(tmp_path: Path) -> None:
             "[[pendulum]]",
             ["'pend.bob'", "'name'", "unique"],
         ),
-        ("v0 = 2.0", "v0 = 7.0", ["pendulum 'pend'", "v0"]),
-        ("v0 = 2.0", 'v0 = "fast"', ["pendulum 'pend'", "'v0'", "'fast'"]),
-        ("length = 1.0", "length = -1.0", ["pendulum 'pend'", "'length'"]),
-        ("bob_radius = 0.08\n", "", ["pendulum 'pend'", "missing field 'bob_radius'"]),
+        ("v0 = 2.0", "v0 = 7.0", ["field 'pendulum[0]': ", "v0", IN_PEND]),
+        (
+            "v0 = 2.0",
+            'v0 = "fast"',
+            [
+                "field 'pendulum[0].v0': must be a finite number ≥ 0 [m/s]; "
+                f"got the string 'fast' {IN_PEND}"
+            ],
+        ),
+        (
+            "length = 1.0",
+            "length = -1.0",
+            [f"field 'pendulum[0].length': must be a finite number > 0 [m]; got -1.0 {IN_PEND}"],
+        ),
+        (
+            "bob_radius = 0.08\n",
+            "",
+            [f"field 'pendulum[0].bob_radius': missing; must be a finite number > 0 [m] {IN_PEND}"],
+        ),
         (
             "bob_radius = 0.08",
             "bob_radius = 0.08\nswing_axis = [0, 0, 1]",
-            ["'pend'", "swing_axis"],
+            ["field 'pendulum[0]': ", "swing_axis", IN_PEND],
         ),
-        ("bob_radius = 0.08", "bob_radius = 0.08\nmass = 1.0", ["'pend'", "unknown field 'mass'"]),
+        (
+            "bob_radius = 0.08",
+            "bob_radius = 0.08\nmass = 1.0",
+            ["field 'pendulum[0].mass': unknown field; allowed fields: 'name', 'pivot'", IN_PEND],
+        ),
         (
             "size = [0.4, 0.2, 0.3]\nxyz = [0.9, 0.7, 0.15]",
             "min = [0.7, 0.6, 0.0]\nmax = [1.1, 0.6, 0.3]",
-            ["'cube1'", "'max'", "greater"],
+            [
+                "field 'obstacle[0].max': must be greater than 'min' = [0.7, 0.6, 0.0] in every "
+                f"axis [m]; got [1.1, 0.6, 0.3] {IN_CUBE}"
+            ],
         ),
         (
             "size = [0.4, 0.2, 0.3]\nxyz = [0.9, 0.7, 0.15]",
             "min = [0.7, 0.6, 0.0]\nmax = [1.1, 0.8, 0.3]\nxyz = [0.0, 0.0, 0.0]",
-            ["'cube1'", "'xyz'", "min"],
+            ["field 'obstacle[0].xyz': cannot be combined with 'min'/'max'", IN_CUBE],
         ),
         (
             "size = [0.4, 0.2, 0.3]\nxyz = [0.9, 0.7, 0.15]",
             "min = [0.7, 0.6, 0.0]",
-            ["'cube1'", "missing field 'max'"],
+            ["field 'obstacle[0].max': missing; must be a list of 3 finite numbers [m]", IN_CUBE],
         ),
         (
             'name = "t"',
             'name = "t"\n[task]\nstart = [0.0, 1.0]\ngoal = [1.0]',
-            ["[task]", "length"],
+            ["field 'task': 'start' and 'goal' must have the same length; got 2 and 1"],
         ),
-        ("[[obstacle]]", "[obstacle]", ["'obstacle'", "[[obstacle]]"]),
+        (
+            "[[obstacle]]",
+            "[obstacle]",
+            ["field 'obstacle': must be an array of tables ([[obstacle]]); got a table"],
+        ),
     ],
 )
 def test_bad_scene_files(tmp_path: Path, old: str, new: str, fragments: list[str]) -> None:
@@ -683,12 +754,16 @@ def test_missing_file(tmp_path: Path) -> None:
 
 
 def test_from_dict_names_its_source() -> None:
-    with pytest.raises(SceneError, match=r"^my-source: obstacle 'x': field 'radius'"):
+    with pytest.raises(
+        SceneError,
+        match=r"^my-source: field 'obstacle\[0\]\.radius': must be a finite number > 0 \[m\]; "
+        r"got 0 \(in obstacle 'x'\)$",
+    ):
         Scene.from_dict(
             {"obstacle": [{"name": "x", "shape": "sphere", "radius": 0, "xyz": [0, 0, 0]}]},
             source="my-source",
         )
-    with pytest.raises(SceneError, match=r"^<dict>: scene data must be a table"):
+    with pytest.raises(SceneError, match=r"^<dict>: must be a table; got a list of 2: \[1, 2\]$"):
         Scene.from_dict([1, 2])  # type: ignore[arg-type]
 
 

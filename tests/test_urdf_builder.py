@@ -115,16 +115,33 @@ def test_inertia_rejects_bad_values() -> None:
 
 def test_builder_errors_name_the_item(tmp_path: Path) -> None:
     text = TOML.read_text()
-    cases = {
-        "effort = 400.0": ("", r"joint 'joint1': building a URDF needs \['effort'\]"),
-        'parent = "link1"\nchild = "link2"': (
+    cases = [
+        ("effort = 400.0", "", r"joint 'joint1': building a URDF needs \['effort'\]"),
+        (
+            'parent = "link1"\nchild = "link2"',
             'parent = "link1"\nchild = "link9"',
             "unknown link 'link9'",
         ),
-        'shape = "cylinder"\nradius = 0.14': ('shape = "cylinder"', "'radius' is required"),
-        "mass = 1.5": ("mass = 0.0", r"solid 'gripper': field 'mass' must be a positive"),
-    }
-    for k, (old, (new, pattern)) in enumerate(cases.items()):
+        (
+            'shape = "cylinder"\nradius = 0.14',
+            'shape = "cylinder"',
+            r"case2\.toml: field 'link\[0\]\.solid\[0\]\.radius': missing; must be a finite "
+            r"number > 0 \[m\] \(in link 'base_link', solid 'column'\)$",
+        ),
+        (
+            "mass = 1.5",
+            "mass = 0.0",
+            r"case3\.toml: field 'link\[4\]\.solid\[\d\]\.mass': must be a finite number > 0 "
+            r"\[kg\]; got 0\.0 \(in link 'link4', solid 'gripper'\)$",
+        ),
+        (
+            'shape = "cylinder"\nradius = 0.14',
+            'shape = "box"\nradius = 0.14',
+            r"case4\.toml: field 'link\[0\]\.solid\[0\]\.radius': unknown field; allowed "
+            r"fields: 'name', 'shape', 'xyz', 'rpy', 'mass', 'rgba', 'size' \(in link 'base_link'",
+        ),
+    ]
+    for k, (old, new, pattern) in enumerate(cases):
         assert old in text
         path = tmp_path / f"case{k}.toml"
         path.write_text(text.replace(old, new, 1))

@@ -6,10 +6,10 @@ form, so every value reads back exactly. JSON has no NaN or infinity: NaN is ref
 infinite value is written as ``null`` (``-inf`` in ``limits.q_lower``, ``+inf`` everywhere
 else it may occur: infinite joint limits, the distance of a scene without obstacles).
 
-Decoding goes through the one schema reader, ``_Reader``
-(:mod:`~adept_traj.results.reader`): a node of the parsed JSON (its value and its dotted
-path such as ``front[3].x``) with typed accessors; any missing or malformed field or value
-raises :class:`~adept_traj.errors.ResultFormatError` naming the file and the field.
+Decoding goes through the package's one schema reader, :class:`~adept_traj.schema.Node`:
+a node of the parsed JSON (its value and its dotted path such as ``front[3].x``) with typed
+accessors; any missing or malformed field or value raises
+:class:`~adept_traj.errors.ResultFormatError` naming the file and the field.
 :meth:`PlanningResult.save <adept_traj.results.PlanningResult.save>` and
 :meth:`~adept_traj.results.PlanningResult.load` are the public entry points.
 """
@@ -37,10 +37,11 @@ from adept_traj.results.parts import (
     RobotInfo,
     Timing,
 )
-from adept_traj.results.reader import _Reader
+from adept_traj.results.reader import _open_json
 from adept_traj.results.record import FORMAT, VERSION, PlanningResult, _jsonable
 from adept_traj.robot.limits import LIMIT_KINDS, LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
+from adept_traj.schema import Node
 from adept_traj.validation import deep_equal
 
 __all__: list[str] = []
@@ -57,7 +58,7 @@ def _write_json(r: PlanningResult, path: Path) -> Path:
 
 def _read_json(path: Path) -> PlanningResult:
     """The result stored in the ``result.json`` at ``path``."""
-    return _decode(_Reader.open(path))
+    return _decode(_open_json(path))
 
 
 # ============================================================================ encoding
@@ -180,32 +181,26 @@ def _scalar(value: Any) -> str:
 
 
 # ============================================================================ decoding
-def _decode(top: _Reader) -> PlanningResult:
-    top.obj()
-    fmt = top["format"].value
-    if fmt != FORMAT:
-        raise top.error(f"expected {FORMAT!r}; got {fmt!r}", "format")
-    version = top["version"].value
-    if isinstance(version, bool) or version != VERSION:
-        raise top.error(f"unsupported version {version!r} (this adept_traj reads 1)", "version")
+def _decode(top: Node) -> PlanningResult:
+    top.table()
+    top["format"].string(choices=(FORMAT,))
+    version = top["version"].integer()
+    if version != VERSION:
+        raise top["version"].error(f"unsupported version {version} (this adept_traj reads 1)")
     rob = top["robot"]
     robot = rob.build(
         RobotInfo,
         name=rob["name"].string(),
         joint_names=rob["joint_names"].strings(),
         urdf=rob["urdf"].string(),
-        params=rob.child("params", optional=True).string(nullable=True),
-        tool_frame=rob.child("tool_frame", optional=True).string(nullable=True),
+        params=rob["params"].string(null=None, default=None),
+        tool_frame=rob["tool_frame"].string(null=None, default=None),
     )
     nq = len(robot.joint_names)
-    ps = top["problem_settings"]
-    known = {f.name for f in dataclasses.fields(ProblemSettings)}
-    for key in ps.obj():
-        if key not in known:
-            raise ps.error(f"unknown setting (known: {sorted(known)})", f"{ps.where}.{key}")
-    settings = {k: tuple(v) if isinstance(v, list) else v for k, v in ps.value.items()}
+    ps = top["problem_settings"].check_keys([f.name for f in dataclasses.fields(ProblemSettings)])
+    settings = {k: tuple(v) if isinstance(v, list) else v for k, v in ps.table().items()}
     scene = top["scene"]
-    scene.build(Scene.from_dict, scene.obj(), source=f"{top.file} (scene)")
+    scene.build(Scene.from_dict, scene.table(), source=f"{top.file} (scene)")
     lim = top["limits"]
 
     def limit(key: str, null: float = math.inf) -> np.ndarray:
@@ -233,20 +228,21 @@ def _decode(top: _Reader) -> PlanningResult:
     best = bd.build(
         BestSolution,
         index=bd["index"].integer(),
-        f_c=bd["f_c"].optional_number(),
-        f_avg=bd["F_avg"].optional_number(),
+        f_c=bd["f_c"].number(null=None),
+        f_avg=bd["F_avg"].number(null=None),
     )
     if best.index >= len(front):
-        raise bd.error(f"{best.index} is not a row of the front ({len(front)} rows)", "best.index")
+        raise bd["index"].error(f"{best.index} is not a row of the front ({len(front)} rows)")
     certificate = _decode_certificate(top["certificate"], _decode_dense(top["best_trajectory"], nq))
     if not deep_equal(certificate.x, front.x[best.index]):
-        raise top.error(f"differs from front[{best.index}].x (the best solution)", "certificate.x")
+        raise top["certificate"]["x"].error(
+            f"differs from front[{best.index}].x (the best solution)"
+        )
     md, td, vd = top["metrics"], top["timing"], top["versions"]
-    ref = md["HV_reference_point"]
     metrics = md.build(
         Metrics,
-        **{name: md[key].optional_number() for name, key in _JSON_METRICS.items()},
-        hv_reference_point=None if ref.value is None else ref.array((len(OBJECTIVE_NAMES),)),
+        **{name: md[key].number(null=None) for name, key in _JSON_METRICS.items()},
+        hv_reference_point=md["HV_reference_point"].array((len(OBJECTIVE_NAMES),), nullable=True),
     )
     timing = td.build(
         Timing,
@@ -266,16 +262,16 @@ def _decode(top: _Reader) -> PlanningResult:
         limits=limits,
         lower_bound=lower_bound,
         algorithm=alg["name"].string(),
-        algorithm_settings=alg["settings"].obj(),
-        seed=top["seed"].integer(nullable=True),
+        algorithm_settings=alg["settings"].table(),
+        seed=top["seed"].integer(null=None),
         front=front,
         best=best,
         certificate=certificate,
         timing=timing,
         metrics=metrics,
-        history=_decode_history(top.child("history", optional=True)),
-        warning=top.child("warning", optional=True).string(nullable=True),
-        versions={k: vd[k].string() for k in vd.obj()},
+        history=_decode_history(top["history"]),
+        warning=top["warning"].string(null=None, default=None),
+        versions={k: vd[k].string() for k in vd.table()},
     )
     stored = top["certificate"]["feasible"]
     if stored.boolean() != certificate.feasible:
@@ -283,12 +279,10 @@ def _decode(top: _Reader) -> PlanningResult:
     return result
 
 
-def _decode_front(node: _Reader) -> Front:
-    if not isinstance(node.value, list) or not node.value:
-        raise node.error(f"expected a non-empty list of solutions; got {node.kind()}")
+def _decode_front(node: Node) -> Front:
     xs, objs, cons, feas = [], [], [], []
     n_var = n_con = None
-    for item in node.items():
+    for item in node.items(min_items=1):
         xs.append(item["x"].array((n_var,)))
         objs.append(item["objectives"].array((len(OBJECTIVE_NAMES),)))
         cons.append(item["constraints"].array((n_con,)))
@@ -303,23 +297,22 @@ def _decode_front(node: _Reader) -> Front:
     )
 
 
-def _decode_dense(node: _Reader, nq: int) -> DenseTrajectory:
+def _decode_dense(node: Node, nq: int) -> DenseTrajectory:
     t = node["t"].array((None,))
     arrays = {name: node[name].array((t.size, nq)) for name in _DENSE_FIELDS[1:-1]}
     distance = node["min_distance"].array((t.size,), null=math.inf)
     return node.build(DenseTrajectory, t=t, **arrays, min_distance=distance)
 
 
-def _decode_certificate(node: _Reader, dense: DenseTrajectory) -> Certificate:
+def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
     nq, checks = dense.nq, {}
     for kind in LIMIT_KINDS:
         cd = node[kind]
-        exact = cd["exact"]
         checks[kind] = cd.build(
             LimitCheck,
             kind=kind,
             dense=cd["dense"].array((nq,)),
-            exact=None if exact.value is None else exact.array((nq,)),
+            exact=cd["exact"].array((nq,), nullable=True),
             t_worst=cd["t_worst"].array((nq,)),
             tolerance=cd["tolerance"].number(),
         )
@@ -330,7 +323,7 @@ def _decode_certificate(node: _Reader, dense: DenseTrajectory) -> Certificate:
         rate_hz=node["rate_hz"].number(),
         margin=node["margin"].number(),
         min_distance=node["min_distance"].number(null=math.inf),
-        t_min_distance=node["t_min_distance"].optional_number(),
+        t_min_distance=node["t_min_distance"].number(null=None),
         closest_pair=None if pair.value is None else pair.strings(),
         violations=node["violations"].strings(),
         dense=dense,
@@ -338,8 +331,8 @@ def _decode_certificate(node: _Reader, dense: DenseTrajectory) -> Certificate:
     )
 
 
-def _decode_history(node: _Reader) -> tuple[GenerationRecord, ...] | None:
-    if node.value is None:
+def _decode_history(node: Node) -> tuple[GenerationRecord, ...] | None:
+    if not node.present or node.value is None:
         return None
     return tuple(
         item.build(
@@ -347,7 +340,7 @@ def _decode_history(node: _Reader) -> tuple[GenerationRecord, ...] | None:
             generation=item["generation"].integer(),
             n_evaluations=item["n_evaluations"].integer(),
             n_feasible=item["n_feasible"].integer(),
-            hypervolume=item["hypervolume"].optional_number(),
+            hypervolume=item["hypervolume"].number(null=None),
         )
-        for item in node.items("a list or null")
+        for item in node.items()
     )

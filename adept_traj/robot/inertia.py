@@ -30,10 +30,6 @@ class MassProperties:
     inertia: np.ndarray
 
 
-def _positive(value: float, name: str) -> float:
-    return as_scalar(value, name, "[kg]" if name == "mass" else "[m]", minimum=0.0, strict=True)
-
-
 def box_inertia(mass: float, size: Sequence[float] | np.ndarray) -> np.ndarray:
     r"""Inertia (3, 3) [kg·m²] of a uniform box of mass ``mass`` [kg] and full side lengths
     ``size`` (3,) [m] about its centre, in its own axes (``pin.Inertia.FromBox``).
@@ -42,9 +38,12 @@ def box_inertia(mass: float, size: Sequence[float] | np.ndarray) -> np.ndarray:
         I = \tfrac{m}{12}\operatorname{diag}\left(s_y^2 + s_z^2,\ s_x^2 + s_z^2,\
             s_x^2 + s_y^2\right)
     """
-    m = _positive(mass, "mass")
+    m = as_scalar(mass, "mass", "[kg]", minimum=0.0, strict=True)
     sides = as_vector(size, "size", 3, "[m]")
-    sx, sy, sz = (_positive(s, f"size_{axis}") for s, axis in zip(sides, "xyz"))
+    sx, sy, sz = (
+        as_scalar(s, f"size_{axis}", "[m]", minimum=0.0, strict=True)
+        for s, axis in zip(sides, "xyz")
+    )
     return pin.Inertia.FromBox(m, sx, sy, sz).inertia.copy()
 
 
@@ -55,7 +54,9 @@ def cylinder_inertia(mass: float, radius: float, length: float) -> np.ndarray:
 
     .. math:: I_{zz} = \tfrac{m r^2}{2}, \quad I_{xx} = I_{yy} = \tfrac{m}{12}(3 r^2 + l^2)
     """
-    m, r, length = _positive(mass, "mass"), _positive(radius, "radius"), _positive(length, "length")
+    m = as_scalar(mass, "mass", "[kg]", minimum=0.0, strict=True)
+    r = as_scalar(radius, "radius", "[m]", minimum=0.0, strict=True)
+    length = as_scalar(length, "length", "[m]", minimum=0.0, strict=True)
     return pin.Inertia.FromCylinder(m, r, length).inertia.copy()
 
 
@@ -65,7 +66,8 @@ def sphere_inertia(mass: float, radius: float) -> np.ndarray:
 
     .. math:: I = \tfrac{2}{5} m r^2 \mathbf{1}
     """
-    m, r = _positive(mass, "mass"), _positive(radius, "radius")
+    m = as_scalar(mass, "mass", "[kg]", minimum=0.0, strict=True)
+    r = as_scalar(radius, "radius", "[m]", minimum=0.0, strict=True)
     return pin.Inertia.FromSphere(m, r).inertia.copy()
 
 

@@ -21,6 +21,7 @@ from typing import Any
 
 from adept_traj.errors import RobotModelError
 from adept_traj.files import read_toml
+from adept_traj.schema import Node, error_factory
 
 __all__ = [
     "TASK_ROWS",
@@ -36,64 +37,27 @@ TASK_ROWS: tuple[str, ...] = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 _SHAPES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",)}
 
+#: Errors of a parameter file: RobotModelError naming the file and the field path.
+_ERROR = error_factory(RobotModelError)
 
-class _Reader:
-    """Reads fields of one TOML table, naming the file, the item and the field on error."""
-
-    def __init__(self, data: Any, where: str) -> None:
-        if not isinstance(data, Mapping):
-            raise RobotModelError(f"{where}: must be a table; got {data!r}")
-        self.data, self.where, self.used = data, where, set()
-
-    def fail(self, key: str, expected: str) -> RobotModelError:
-        return RobotModelError(
-            f"{self.where}: field '{key}' must be {expected}; got {self.data.get(key)!r}"
-        )
-
-    def get(self, key: str, default: Any = None) -> Any:
-        self.used.add(key)
-        return self.data.get(key, default)
-
-    def string(self, key: str, required: bool = True) -> str | None:
-        value = self.get(key)
-        if value is None and not required:
-            return None
-        if not isinstance(value, str) or not value:
-            raise self.fail(key, "a non-empty string")
-        return value
-
-    def number(self, key: str, *, positive: bool = False, nonneg: bool = False) -> float | None:
-        value = self.get(key)
-        if value is None:
-            return None
-        ok = isinstance(value, int | float) and not isinstance(value, bool)
-        ok = ok and math.isfinite(value)
-        if ok and positive:
-            ok = value > 0
-        if ok and nonneg:
-            ok = value >= 0
-        if not ok:
-            kind = "positive" if positive else "non-negative" if nonneg else "finite"
-            raise self.fail(key, f"a {kind} number")
-        return float(value)
-
-    def vector(self, key: str, size: int, default: tuple[float, ...] | None = None):
-        value = self.get(key)
-        if value is None:
-            return default
-        ok = isinstance(value, list) and len(value) == size
-        ok = ok and all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-            for v in value
-        )
-        if not ok:
-            raise self.fail(key, f"a list of {size} finite numbers")
-        return tuple(float(v) for v in value)
-
-    def finish(self) -> None:
-        unknown = sorted(set(self.data) - self.used)
-        if unknown:
-            raise RobotModelError(f"{self.where}: unknown field(s) {unknown}")
+_TOP_KEYS = ("name", "base_link", "tool_frame", "task_rows", "joint", "link", "frame")
+_SOLID_KEYS = ("name", "shape", "xyz", "rpy", "mass", "rgba")
+_FRAME_KEYS = ("name", "parent", "xyz", "rpy")
+#: The numbers of a [[joint]] table: key -> (unit, minimum, strictly above the minimum).
+_JOINT_NUMBERS: dict[str, tuple[str, float, bool]] = {
+    "lower": ("[rad | m]", -math.inf, False),
+    "upper": ("[rad | m]", -math.inf, False),
+    "velocity": ("[rad/s | m/s]", 0.0, True),
+    "acceleration": ("[rad/s² | m/s²]", 0.0, True),
+    "jerk": ("[rad/s³ | m/s³]", 0.0, True),
+    "effort": ("[N·m | N]", 0.0, True),
+    "gear_ratio": ("[-]", 0.0, True),
+    "rotor_inertia": ("[kg·m²]", 0.0, False),
+    "coulomb": ("[N·m | N]", 0.0, False),
+    "viscous": ("[N·m·s/rad | N·s/m]", 0.0, False),
+}
+_JOINT_VECTORS = {"xyz": "[m]", "rpy": "[rad]", "axis": "[-]"}
+_JOINT_KEYS = ("name", "type", "parent", "child", *_JOINT_VECTORS, *_JOINT_NUMBERS)
 
 
 @dataclass(frozen=True)
@@ -188,37 +152,21 @@ class RobotParameters:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> RobotParameters:
         """Validate a parsed parameter mapping (same schema as the TOML file)."""
-        top = _Reader(data, source)
-        rows = top.get("task_rows")
-        if rows is not None and (
-            not isinstance(rows, list)
-            or not rows
-            or any(r not in TASK_ROWS for r in rows)
-            or len(set(rows)) != len(rows)
-        ):
-            raise top.fail("task_rows", f"a list of distinct names from {list(TASK_ROWS)}")
+        top = Node(data, source, _ERROR).check_keys(_TOP_KEYS)
         params = cls(
             source=source,
-            name=top.string("name", required=False),
-            base_link=top.string("base_link", required=False),
-            tool_frame=top.string("tool_frame", required=False),
-            task_rows=tuple(rows) if rows is not None else None,
-            joints=tuple(
-                _joint(item, f"{source}: joint {i}") for i, item in enumerate(_items(top, "joint"))
+            name=top["name"].string(nonempty=True, default=None),
+            base_link=top["base_link"].string(nonempty=True, default=None),
+            tool_frame=top["tool_frame"].string(nonempty=True, default=None),
+            task_rows=top["task_rows"].strings(
+                choices=TASK_ROWS, distinct=True, min_items=1, default=None
             ),
-            links=tuple(
-                _link(item, f"{source}: link {i}") for i, item in enumerate(_items(top, "link"))
-            ),
-            frames=tuple(
-                _frame(item, f"{source}: frame {i}") for i, item in enumerate(_items(top, "frame"))
-            ),
+            joints=tuple(_joint(name, node) for name, node in top["joint"].named_tables()),
+            links=tuple(_link(name, node) for name, node in top["link"].named_tables()),
+            frames=tuple(_frame(name, node) for name, node in top["frame"].named_tables()),
         )
-        top.finish()
-        for kind in ("joints", "links", "frames"):
-            names = [x.name for x in getattr(params, kind)]
-            dup = {n for n in names if names.count(n) > 1}
-            if dup:
-                raise RobotModelError(f"{source}: duplicate {kind[:-1]} name(s) {sorted(dup)}")
+        for key in ("joint", "link", "frame"):
+            _check_distinct(top[key], [x.name for x in getattr(params, f"{key}s")])
         return params
 
     def joint(self, name: str) -> JointParameters | None:
@@ -226,92 +174,71 @@ class RobotParameters:
         return next((j for j in self.joints if j.name == name), None)
 
 
-def _items(top: _Reader, key: str) -> list[Any]:
-    items = top.get(key, [])
-    if not isinstance(items, list):
-        raise top.fail(key, f"an array of tables ([[{key}]])")
-    return items
+def _check_distinct(node: Node, names: list[str]) -> None:
+    """Refuse an array of tables that gives a name twice."""
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise node.error(f"names must be distinct; got {twice[0]!r} more than once")
 
 
-def _joint(data: Any, where: str) -> JointParameters:
-    name = _Reader(data, where).string("name")
-    r = _Reader(data, f"{where.rsplit(':', 1)[0]}: joint '{name}'")
-    r.get("name")
-    jtype = r.string("type", required=False)
-    if jtype is not None and jtype not in ("revolute", "prismatic"):
-        raise r.fail("type", "'revolute' or 'prismatic'")
-    values: dict[str, Any] = {"name": name, "type": jtype}
-    for key in ("parent", "child"):
-        values[key] = r.string(key, required=False)
-    for key in ("xyz", "rpy", "axis"):
-        values[key] = r.vector(key, 3)
-    for key in ("lower", "upper"):
-        values[key] = r.number(key)
-    for key in ("velocity", "acceleration", "jerk", "effort", "gear_ratio"):
-        values[key] = r.number(key, positive=True)
-    for key in ("rotor_inertia", "coulomb", "viscous"):
-        values[key] = r.number(key, nonneg=True)
-    r.finish()
+def _floats(node: Node, size: int, unit: str, default: Any = None, **bounds: Any) -> Any:
+    """``size`` numbers as a tuple of floats (``default`` when absent); ``bounds``: the
+    ``minimum``/``strict`` of :meth:`Node.array <adept_traj.schema.Node.array>`."""
+    arr = node.array((size,), unit, default=None, **bounds)
+    return default if arr is None else tuple(arr.tolist())
+
+
+def _joint(name: str, node: Node) -> JointParameters:
+    node.check_keys(_JOINT_KEYS)
+    values: dict[str, Any] = {
+        "name": name,
+        "type": node["type"].string(choices=("revolute", "prismatic"), default=None),
+        "parent": node["parent"].string(nonempty=True, default=None),
+        "child": node["child"].string(nonempty=True, default=None),
+    }
+    for key, unit in _JOINT_VECTORS.items():
+        values[key] = _floats(node[key], 3, unit)
+    for key, (unit, minimum, strict) in _JOINT_NUMBERS.items():
+        values[key] = node[key].number(unit, minimum=minimum, strict=strict, default=None)
     lower, upper = values["lower"], values["upper"]
     if lower is not None and upper is not None and not lower < upper:
-        raise RobotModelError(f"{r.where}: 'lower' ({lower}) must be below 'upper' ({upper})")
+        raise node["upper"].error(f"must be above 'lower' ({lower}); got {upper}")
     return JointParameters(**values)
 
 
-def _solid(data: Any, where: str) -> SolidParameters:
-    name = _Reader(data, where).string("name")
-    r = _Reader(data, f"{where}: solid '{name}'")
-    r.get("name")
-    shape = r.string("shape")
-    if shape not in _SHAPES:
-        raise r.fail("shape", f"one of {sorted(_SHAPES)}")
-    size = r.vector("size", 3)
-    radius = r.number("radius", positive=True)
-    length = r.number("length", positive=True)
-    given = {"size": size, "radius": radius, "length": length}
-    for key, value in given.items():
-        if (key in _SHAPES[shape]) != (value is not None):
-            need = "required" if key in _SHAPES[shape] else "not allowed"
-            raise RobotModelError(f"{r.where}: field '{key}' is {need} for a {shape}")
-    if size is not None and min(size) <= 0:
-        raise r.fail("size", "3 positive numbers [m]")
-    mass = r.number("mass", positive=True)
-    if mass is None:
-        raise r.fail("mass", "a positive number [kg]")
-    rgba = r.vector("rgba", 4, default=(0.7, 0.7, 0.7, 1.0))
-    solid = SolidParameters(
+def _solid(name: str, node: Node) -> SolidParameters:
+    shape = node["shape"].string(choices=sorted(_SHAPES))
+    node.check_keys(_SOLID_KEYS + _SHAPES[shape])
+    dims: dict[str, Any] = {"size": None, "radius": None, "length": None}
+    for key in _SHAPES[shape]:  # required for this shape (and refused for the others)
+        field, positive = node[key], {"minimum": 0.0, "strict": True}
+        dims[key] = (
+            tuple(field.array((3,), "[m]", **positive).tolist())
+            if key == "size"
+            else field.number("[m]", **positive)
+        )
+    return SolidParameters(
         name=name,
         shape=shape,
-        size=size,
-        radius=radius,
-        length=length,
-        xyz=r.vector("xyz", 3, default=(0.0, 0.0, 0.0)),
-        rpy=r.vector("rpy", 3, default=(0.0, 0.0, 0.0)),
-        mass=mass,
-        rgba=rgba,
+        **dims,
+        xyz=_floats(node["xyz"], 3, "[m]", (0.0, 0.0, 0.0)),
+        rpy=_floats(node["rpy"], 3, "[rad]", (0.0, 0.0, 0.0)),
+        mass=node["mass"].number("[kg]", minimum=0.0, strict=True),
+        rgba=_floats(node["rgba"], 4, "[-]", (0.7, 0.7, 0.7, 1.0)),
     )
-    r.finish()
-    return solid
 
 
-def _link(data: Any, where: str) -> LinkParameters:
-    name = _Reader(data, where).string("name")
-    r = _Reader(data, f"{where.rsplit(':', 1)[0]}: link '{name}'")
-    r.get("name")
-    solids = tuple(_solid(s, r.where) for s in _items(r, "solid"))
-    r.finish()
+def _link(name: str, node: Node) -> LinkParameters:
+    node.check_keys(("name", "solid"))
+    solids = tuple(_solid(sname, snode) for sname, snode in node["solid"].named_tables())
     return LinkParameters(name=name, solids=solids)
 
 
-def _frame(data: Any, where: str) -> FrameParameters:
-    name = _Reader(data, where).string("name")
-    r = _Reader(data, f"{where.rsplit(':', 1)[0]}: frame '{name}'")
-    r.get("name")
-    frame = FrameParameters(
+def _frame(name: str, node: Node) -> FrameParameters:
+    node.check_keys(_FRAME_KEYS)
+    return FrameParameters(
         name=name,
-        parent=r.string("parent"),
-        xyz=r.vector("xyz", 3, default=(0.0, 0.0, 0.0)),
-        rpy=r.vector("rpy", 3, default=(0.0, 0.0, 0.0)),
+        parent=node["parent"].string(nonempty=True),
+        xyz=_floats(node["xyz"], 3, "[m]", (0.0, 0.0, 0.0)),
+        rpy=_floats(node["rpy"], 3, "[rad]", (0.0, 0.0, 0.0)),
     )
-    r.finish()
-    return frame

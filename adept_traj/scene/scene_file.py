@@ -21,20 +21,10 @@ import tomli_w
 
 from adept_traj.errors import SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
-from adept_traj.scene._toml_fields import (
-    _array_of_tables,
-    _build,
-    _check_keys,
-    _entry_where,
-    _number,
-    _numbers,
-    _string,
-    _table,
-    _Where,
-)
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.scene import _BOB_SUFFIX, _ROD_SUFFIX, Obstacle, Scene, pendulum_obstacles
 from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
+from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
 
 __all__ = [
@@ -214,6 +204,8 @@ def _pendulum_dict(
 
 # ====================================================================== reading
 
+#: Errors of a scene file: SceneError naming the source (file) and the field path.
+_ERROR = error_factory(SceneError)
 _TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum")
 _ROBOT_KEYS = ("xyz", "rpy")
 _TASK_KEYS = ("start", "goal")
@@ -229,102 +221,89 @@ _PENDULUM_KEYS = (
 )  # fmt: skip
 
 
-def _parse_obstacle(entry: Mapping[str, Any], w: _Where) -> Obstacle:
-    name = _string(entry, "name", w)
-    kinds = f"one of {', '.join(map(repr, _SHAPE_KEYS))}"
-    kind = _string(entry, "shape", w, expected=kinds)
-    if kind not in _SHAPE_KEYS:
-        raise w.field_error("shape", kinds, kind)
-    _check_keys(entry, _OBSTACLE_COMMON + _SHAPE_KEYS[kind], w)
+def _parse_obstacle(name: str, node: Node) -> Obstacle:
+    kind = node["shape"].string(choices=tuple(_SHAPE_KEYS))
+    node.check_keys(_OBSTACLE_COMMON + _SHAPE_KEYS[kind])
+    positive = {"minimum": 0.0, "strict": True}
     shape: Shape
-    if kind == "box" and ("min" in entry or "max" in entry):
+    if kind == "box" and (node["min"].present or node["max"].present):
         for other in ("size", "xyz", "rpy"):
-            if other in entry:
-                raise w.error(
-                    f"field {other!r} cannot be combined with 'min'/'max' (a box given by its "
-                    "corners is axis-aligned, centred at (min + max) / 2)"
+            if node[other].present:
+                raise node[other].error(
+                    "cannot be combined with 'min'/'max' (a box given by its corners is "
+                    "axis-aligned, centred at (min + max) / 2)"
                 )
-        lo = _numbers(entry, "min", w, 3, "[m] (the lower corner)")
-        hi = _numbers(entry, "max", w, 3, "[m] (the upper corner)")
-        if not all(h > low for h, low in zip(hi, lo, strict=True)):
-            raise w.field_error("max", f"greater than 'min' = {lo} in every axis [m]", hi)
-        size = [h - low for h, low in zip(hi, lo, strict=True)]
-        xyz = [0.5 * (h + low) for h, low in zip(hi, lo, strict=True)]
-        rpy = [0.0, 0.0, 0.0]
-        shape = _build(w, Box, size)
+        lo = node["min"].array((3,), "[m] (the lower corner)")
+        hi = node["max"].array((3,), "[m] (the upper corner)")
+        if not (hi > lo).all():
+            raise node["max"].error(
+                f"must be greater than 'min' = {lo.tolist()} in every axis [m]; got {hi.tolist()}"
+            )
+        xyz, rpy = 0.5 * (hi + lo), np.zeros(3)
+        shape = node.build(Box, hi - lo)
     else:
         if kind == "box":
-            shape = _build(w, Box, _numbers(entry, "size", w, 3, "[m]", positive=True))
+            shape = node.build(Box, node["size"].array((3,), "[m]", **positive))
         elif kind == "sphere":
-            shape = _build(w, Sphere, _number(entry, "radius", w, "[m]"))
+            shape = node.build(Sphere, node["radius"].number("[m]", **positive))
         else:
             cls = Cylinder if kind == "cylinder" else Capsule
-            radius = _number(entry, "radius", w, "[m]")
-            length = _number(entry, "length", w, "[m]")
-            shape = _build(w, cls, radius, length)
-        xyz = _numbers(entry, "xyz", w, 3, "[m] (the centre)")
-        rpy = _numbers(entry, "rpy", w, 3, "[rad]", default=[0.0, 0.0, 0.0])
-    motion = _build(w, FixedPose, transform_from_xyz_rpy(xyz, rpy))
-    return _build(w, Obstacle, name, shape, motion)
+            radius = node["radius"].number("[m]", **positive)
+            shape = node.build(cls, radius, node["length"].number("[m]", **positive))
+        xyz = node["xyz"].array((3,), "[m] (the centre)")
+        rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
+    motion = node.build(FixedPose, transform_from_xyz_rpy(xyz, rpy))
+    return node.build(Obstacle, name, shape, motion)
 
 
-def _parse_pendulum(entry: Mapping[str, Any], w: _Where) -> tuple[Obstacle, Obstacle]:
-    _check_keys(entry, _PENDULUM_KEYS, w)
-    name = _string(entry, "name", w)
-    motion = _build(
-        w,
+def _parse_pendulum(name: str, node: Node) -> tuple[Obstacle, Obstacle]:
+    node.check_keys(_PENDULUM_KEYS)
+    positive = {"minimum": 0.0, "strict": True}
+    motion = node.build(
         PendulumMotion,
-        pivot=_numbers(entry, "pivot", w, 3, "[m]"),
-        length=_number(entry, "length", w, "[m]"),
-        v0=_number(entry, "v0", w, "[m/s]", sign="non-negative"),
-        omega=_number(entry, "omega", w, "[rad/s]"),
-        g=_number(entry, "g", w, "[m/s²]", default=9.81),
-        swing_axis=_numbers(entry, "swing_axis", w, 3, "(horizontal)", default=[1.0, 0.0, 0.0]),
+        pivot=node["pivot"].array((3,), "[m]"),
+        length=node["length"].number("[m]", **positive),
+        v0=node["v0"].number("[m/s]", minimum=0.0),
+        omega=node["omega"].number("[rad/s]", **positive),
+        g=node["g"].number("[m/s²]", **positive, default=9.81),
+        swing_axis=node["swing_axis"].array((3,), "[-] (horizontal)", default=np.eye(3)[0]),
     )
-    return _build(
-        w,
+    return node.build(
         pendulum_obstacles,
         name,
         motion,
-        bob_radius=_number(entry, "bob_radius", w, "[m]"),
-        rod_radius=_number(entry, "rod_radius", w, "[m]", default=0.01),
+        bob_radius=node["bob_radius"].number("[m]", **positive),
+        rod_radius=node["rod_radius"].number("[m]", **positive, default=0.01),
     )
 
 
 def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
-    top = _Where(source)
-    if not isinstance(data, Mapping):
-        raise top.error(f"scene data must be a table (mapping); got {type(data).__name__}")
-    _check_keys(data, _TOP_KEYS, top)
-    name = _string(data, "name", top, default=default_name)
+    top = Node(data, source, _ERROR).check_keys(_TOP_KEYS)
+    name = top["name"].string(nonempty=True, default=default_name)
 
-    robot = _Where(source, "[robot]")
     base = np.eye(4)
-    if "robot" in data:
-        table = _table(data["robot"], "robot", top)
-        _check_keys(table, _ROBOT_KEYS, robot)
-        xyz = _numbers(table, "xyz", robot, 3, "[m]", default=[0.0, 0.0, 0.0])
-        rpy = _numbers(table, "rpy", robot, 3, "[rad]", default=[0.0, 0.0, 0.0])
-        base = transform_from_xyz_rpy(xyz, rpy)
+    robot = top["robot"]
+    if robot.present:
+        robot.check_keys(_ROBOT_KEYS)
+        xyz = robot["xyz"].array((3,), "[m]", default=np.zeros(3))
+        base = transform_from_xyz_rpy(xyz, robot["rpy"].array((3,), "[rad]", default=np.zeros(3)))
 
     start = goal = None
-    if "task" in data:
-        task = _Where(source, "[task]")
-        table = _table(data["task"], "task", top)
-        _check_keys(table, _TASK_KEYS, task)
-        start = _numbers(table, "start", task, None, "[rad | m]")
-        goal = _numbers(table, "goal", task, None, "[rad | m]")
-        if len(start) != len(goal):
+    task = top["task"]
+    if task.present:
+        task.check_keys(_TASK_KEYS)
+        start = task["start"].array((None,), "[rad | m]")
+        goal = task["goal"].array((None,), "[rad | m]")
+        if start.size != goal.size:
             raise task.error(
-                f"fields 'start' and 'goal' must have the same length; "
-                f"got {len(start)} and {len(goal)}"
+                f"'start' and 'goal' must have the same length; got {start.size} and {goal.size}"
             )
 
     obstacles: list[Obstacle] = []
-    for i, entry in enumerate(_array_of_tables(data, "obstacle", top)):
-        obstacles.append(_parse_obstacle(entry, _entry_where(source, "obstacle", i, entry)))
-    for i, entry in enumerate(_array_of_tables(data, "pendulum", top)):
-        obstacles.extend(_parse_pendulum(entry, _entry_where(source, "pendulum", i, entry)))
-    return _build(
-        top, Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
+    for entry_name, node in top["obstacle"].named_tables():
+        obstacles.append(_parse_obstacle(entry_name, node))
+    for entry_name, node in top["pendulum"].named_tables():
+        obstacles.extend(_parse_pendulum(entry_name, node))
+    return top.build(
+        Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
     )
