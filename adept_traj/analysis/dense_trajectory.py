@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_finite_array, as_scalar, deep_equal, readonly_copy
 
 __all__ = ["DenseTrajectory", "dense_samples"]
@@ -49,7 +50,7 @@ class DenseTrajectory:
             raise InvalidInputError(f"t must have shape (n,) with n ≥ 2; got {t.shape}")
         object.__setattr__(self, "t", t)
         nq = None
-        for name in ("q", "qd", "qdd", "qddd", "tau"):
+        for name in (kind.quantity for kind in LIMITS):
             arr = readonly_copy(as_finite_array(getattr(self, name), name))
             if arr.ndim != 2 or arr.shape[0] != t.size or (nq is not None and arr.shape[1] != nq):
                 raise InvalidInputError(

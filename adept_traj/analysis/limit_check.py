@@ -24,7 +24,7 @@ __all__ = ["DEFAULT_TOLERANCE", "LimitCheck"]
 #: Default tolerance on the limit values (dimensionless ratios).
 DEFAULT_TOLERANCE = 1e-9
 #: The paper's name of each limit kind (Table 2), from the one vocabulary in robot.limits.
-_LIMIT_SYMBOL = {kind.name: kind.paper for kind in LIMITS}
+_LIMIT_SYMBOL = {kind.name: kind.symbol for kind in LIMITS}
 
 
 @dataclass(frozen=True, eq=False)

@@ -210,10 +210,10 @@ class TrajectoryProblem(Problem):
     @property
     def constraint_names(self) -> tuple[str, ...]:
         """Names of the constraints: one per limit kind and joint, named by the kind's
-        symbol (``"q[joint1]"`` … ``"tau[joint4]"``, :data:`~adept_traj.robot.LIMITS`),
+        quantity (``"q[joint1]"`` … ``"tau[joint4]"``, :data:`~adept_traj.robot.LIMITS`),
         then ``"distance"``."""
         names = self.robot.joint_names
-        return (*(f"{k.symbol}[{n}]" for k in LIMITS for n in names), "distance")
+        return (*(f"{k.quantity}[{n}]" for k in LIMITS for n in names), "distance")
 
     def evaluate_batch(self, x: Any) -> Evaluation:
         """Evaluate a population ``x`` (pop, n_var), or one vector (n_var,).

@@ -31,11 +31,12 @@ from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES
 from adept_traj.results.reader import _read_text
 from adept_traj.results.record import PlanningResult
+from adept_traj.robot.limits import LIMITS
 
 __all__: list[str] = []
 
 #: Derivative prefixes of the joint columns of ``best_trajectory.csv``, in order.
-_JOINT_PREFIXES = ("q", "qd", "qdd", "qddd", "tau")
+_JOINT_PREFIXES = tuple(kind.quantity for kind in LIMITS)
 
 
 # ============================================================================ front.csv

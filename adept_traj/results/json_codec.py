@@ -48,7 +48,7 @@ __all__: list[str] = []
 
 #: JSON key of each metric of :class:`Metrics`.
 _JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
-_DENSE_FIELDS = ("t", "q", "qd", "qdd", "qddd", "tau", "min_distance")
+_DENSE_FIELDS = ("t", *(kind.quantity for kind in LIMITS), "min_distance")
 
 
 def _write_json(r: PlanningResult, path: Path) -> Path:
@@ -84,8 +84,8 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
             "units": list(lim.units),
             "q_lower": _floats(lim.lower),
             "q_upper": _floats(lim.upper),
-            # the other bounds under their quantity's symbol: qd, qdd, qddd, tau
-            **{kind.symbol: _floats(lim.bound(kind.name)) for kind in LIMITS[1:]},
+            # the other bounds under their quantity's name: qd, qdd, qddd, tau
+            **{kind.quantity: _floats(lim.bound(kind.name)) for kind in LIMITS[1:]},
         },
         "lower_bound": {
             "T_min": _float(lb.T_min),
@@ -212,7 +212,7 @@ def _decode(top: Node) -> PlanningResult:
         units=lim["units"].strings(),
         lower=limit("q_lower", -math.inf),
         upper=limit("q_upper"),
-        **{kind.name: limit(kind.symbol) for kind in LIMITS[1:]},
+        **{kind.name: limit(kind.quantity) for kind in LIMITS[1:]},
     )
     lb = top["lower_bound"]
     lower_bound = lb.build(

@@ -3,9 +3,9 @@ limit kinds used across the package.
 
 A *limit kind* is one of ``position``, ``velocity``, ``acceleration``, ``jerk``, ``torque``
 (:data:`LIMIT_KINDS`). Each kind bounds one quantity along a trajectory, whose values are held
-in arrays named by its symbol — ``q``, ``qd``, ``qdd``, ``qddd``, ``tau`` (the fields of
-sampled trajectories, the CSV columns and result.json) — and is called QC, VC, WC, JC, UC in
-the paper. :data:`LIMITS` is the single table that links the three; no other module spells
+in arrays named by its quantity — ``q``, ``qd``, ``qdd``, ``qddd``, ``tau`` (the fields of
+sampled trajectories, the CSV columns and result.json) — and has the paper's symbol QC, VC,
+WC, JC, UC. :data:`LIMITS` is the single table that links the three; no other module spells
 these lists out. External formats keep their own words at their boundary only: URDF and ROS
 say ``effort`` for the torque limit and the torques.
 """
@@ -32,17 +32,17 @@ class LimitKind:
     name: the kind (``"position"``, ``"velocity"``, ``"acceleration"``, ``"jerk"``,
         ``"torque"``); also the :class:`JointLimits` field holding its bound, except
         ``position``, bounded by ``lower`` and ``upper``.
-    symbol: the name of the bounded quantity's arrays (``"q"``, ``"qd"``, ``"qdd"``,
+    quantity: the name of the bounded quantity's arrays (``"q"``, ``"qd"``, ``"qdd"``,
         ``"qddd"``, ``"tau"``).
     order: the derivative order of q it bounds (0–3), ``None`` for the torque.
-    paper: the paper's label (Table 2): ``"QC"``, ``"VC"``, ``"WC"``, ``"JC"``, ``"UC"``.
+    symbol: the paper's symbol (Table 2): ``"QC"``, ``"VC"``, ``"WC"``, ``"JC"``, ``"UC"``.
     units: the unit of the bound for a revolute and for a prismatic joint.
     """
 
     name: str
-    symbol: str
+    quantity: str
     order: int | None
-    paper: str
+    symbol: str
     units: tuple[str, str]
 
 

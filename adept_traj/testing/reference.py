@@ -74,7 +74,7 @@ def _constraints(
     g = [np.maximum(extrema["q_max"] - lim.upper, lim.lower - extrema["q_min"]) / span]
     peaks = {"qd": extrema["qd"], "qdd": extrema["qdd"], "qddd": extrema["qddd"], "tau": tau_max}
     for kind in LIMITS[1:]:
-        g.append(peaks[kind.symbol] / lim.bound(kind.name) - 1.0)
+        g.append(peaks[kind.quantity] / lim.bound(kind.name) - 1.0)
     g.append(np.array([(st.margin - min(d_min, st.influence)) / st.influence]))
     return np.concatenate(g)
 

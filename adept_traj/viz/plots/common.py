@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult
 from adept_traj.viz.inputs import as_result
 
@@ -39,15 +40,8 @@ __all__ = [
     "violations_line",
 ]
 
-#: Axis labels of z1…z6 with their units (z4 is maximised, the others minimised).
-OBJECTIVE_LABELS = (
-    "z1 time [s]",
-    "z2 ∫Σu² [N²·m²·s]",
-    "z3 clearance penalty [-]",
-    "z4 min|det J| [m²] (max)",
-    "z5 ∫Σq⃛² [rad²/s⁵]",
-    "z6 ∫Σq̈² [rad²/s³]",
-)
+#: Axis labels of z1…z6 with their units, from the objective table (z4 marked "(max)").
+OBJECTIVE_LABELS = tuple(objective.label for objective in OBJECTIVES)
 #: Colour and marker of each result in a figure, in order (at most six results).
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
 MARKERS = ("o", "s", "^", "D", "v", "P")

@@ -64,7 +64,7 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     axes = np.atleast_2d(fig.subplots(len(LIMITS), nq, sharex=True, squeeze=False))
     fig.subplots_adjust(left=0.06, right=0.99, bottom=0.05, top=0.92, wspace=0.32, hspace=0.2)
     for row, kind in enumerate(LIMITS):
-        data = getattr(dense, kind.symbol)
+        data = getattr(dense, kind.quantity)
         title, units = _TITLES.get(kind.name, kind.name), kind.units
         for j in range(nq):
             ax = axes[row, j]
