@@ -18,6 +18,7 @@ __all__ = [
     "JointLimitError",
     "MeshcatServerError",
     "PlanningInterrupted",
+    "ResourceLimitError",
     "ResultFormatError",
     "RobotModelError",
     "SceneError",
@@ -84,3 +85,11 @@ class SceneFileNotFoundError(SceneError, FileNotFoundError):
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):
     """The local meshcat server could not be started or does not answer."""
+
+
+class ResourceLimitError(InvalidInputError):
+    """An option or input would need more memory, or a file is larger or deeper, than a
+    documented limit (or than the machine has available): refused before the work starts.
+
+    The message names the option (or file), its value, the estimate and the limit.
+    """

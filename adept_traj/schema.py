@@ -27,7 +27,6 @@ Used by :mod:`adept_traj.results.json_codec`, :mod:`adept_traj.robot.parameter_f
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from typing import Any
@@ -35,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import AdeptTrajError
+from adept_traj.files import parse_json
 
 __all__ = ["ErrorFactory", "Node", "error_factory"]
 
@@ -96,20 +96,15 @@ class Node:
 
     @classmethod
     def from_json(cls, text: str, file: Any, error: ErrorFactory) -> Node:
-        """The top node of the JSON document ``text`` (NaN and Infinity refused)."""
+        """The top node of the JSON document ``text``, parsed by
+        :func:`adept_traj.files.parse_json` (size and nesting depth bounded; NaN, Infinity
+        and numbers beyond ±1.8e308 refused)."""
+        prefix = f"{file}: "
 
-        def reject(constant: str) -> Any:
-            raise error(str(file), None, f"holds {constant}, which JSON does not allow")
+        def refuse(message: str) -> Exception:
+            return error(str(file), None, message.removeprefix(prefix))
 
-        try:
-            value = json.loads(text, parse_constant=reject)
-        except json.JSONDecodeError as exc:
-            raise error(
-                str(file),
-                None,
-                f"not valid JSON: {exc.msg} (line {exc.lineno}, column {exc.colno})",
-            ) from None
-        return cls(value, file, error, syntax="JSON")
+        return cls(parse_json(text.encode("utf-8"), str(file), refuse), file, error, syntax="JSON")
 
     # ------------------------------------------------------------------ errors
     @property

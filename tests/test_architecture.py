@@ -15,8 +15,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "adept_traj"
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
     "errors": 0, "data": 0, "urdf": 0,
-    "validation": 1, "files": 1, "schema": 1,
-    "transforms": 2,
+    "validation": 1, "files": 1, "memory": 1,
+    "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,
     "collision": 5,

@@ -290,6 +290,18 @@ def test_bad_json(saved: Path) -> None:
     assert "not valid JSON" in str(expect_error(saved, "result.json"))
 
 
+def test_json_number_beyond_float_range_is_refused(saved: Path) -> None:
+    """``1e400`` used to load as +inf and turn a collision into "no obstacle"."""
+    text = (saved / "result.json").read_text(encoding="utf-8")
+    (saved / "result.json").write_text(text.replace('"total_s": 12.5', '"total_s": 1e400'))
+    assert "the number 1e400 is not finite" in str(expect_error(saved, "result.json"))
+
+
+def test_deeply_nested_json_is_refused_without_recursion_error(saved: Path) -> None:
+    (saved / "result.json").write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    assert "nest" in str(expect_error(saved, "result.json"))
+
+
 def test_json_with_nan(saved: Path) -> None:
     text = (saved / "result.json").read_text(encoding="utf-8")
     (saved / "result.json").write_text(text.replace('"total_s": 12.5', '"total_s": NaN'))

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
+from adept_traj.analysis.certificate import (
+    DEFAULT_RATE_HZ,
+    Certificate,
+    certificate_bytes,
+    certify,
+    check_certificate_memory,
+)
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -46,7 +52,9 @@ __all__ = [
     "algorithm_effort",
     "average_fitness",
     "best_tradeoff",
+    "certificate_bytes",
     "certify",
+    "check_certificate_memory",
     "combined_objective",
     "dense_samples",
     "hypervolume",

@@ -52,11 +52,18 @@ from adept_traj.analysis.limit_check import (
     _ratio_check,
 )
 from adept_traj.errors import InvalidInputError
+from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
 from adept_traj.validation import as_finite_array, as_scalar, as_vector, deep_equal, readonly_copy
 
-__all__ = ["DEFAULT_RATE_HZ", "Certificate", "certify"]
+__all__ = [
+    "DEFAULT_RATE_HZ",
+    "Certificate",
+    "certificate_bytes",
+    "certify",
+    "check_certificate_memory",
+]
 
 #: Default sampling rate of the dense check [Hz].
 DEFAULT_RATE_HZ = 1000.0
@@ -163,6 +170,39 @@ class Certificate:
     __hash__ = None  # type: ignore[assignment]
 
 
+def certificate_bytes(problem: TrajectoryProblem, T: float, rate_hz: float) -> int:
+    r"""Estimated peak memory [B] of :func:`certify` over a travel time ``T`` [s] at
+    ``rate_hz`` [Hz]: with :math:`n = \lceil T \cdot \text{rate} \rceil + 1` samples,
+    :math:`n_q` joints, :math:`n_s` robot solids and :math:`n_o` obstacles,
+
+    .. math::
+        M = n \,(700\,n_q + 12\,n_s n_o)\ \text{B} + 1\ \text{MiB}.
+
+    The first term is the states, torques, poses and their temporaries (2 610 B per sample
+    measured for the AdeptOne XL, :math:`n_q = 4`, 7 solids), the second the exact
+    distance of every pair at every sample (10 B per pair and sample measured); the
+    coefficients are :mod:`tracemalloc` peaks at 2–16 kHz with 4 and 24 obstacles, rounded
+    up (``benchmarks/bench_memory.py``).
+    """
+    n = dense_samples(T, rate_hz)
+    nq, checker = problem.trajectory.nq, problem.checker
+    return n * (700 * nq + 12 * checker.n_solids * checker.n_obstacles) + 2**20
+
+
+def check_certificate_memory(
+    problem: TrajectoryProblem, rate_hz: float, T: float | None = None, *, option: str = "rate_hz"
+) -> int:
+    """:func:`certificate_bytes` if it fits the memory budget, else
+    :class:`~adept_traj.errors.ResourceLimitError` naming ``option`` (e.g. ``"--rate"``),
+    the rate, the estimate and the limit. ``T`` [s] defaults to the longest travel time
+    the problem allows (its upper bound of ``x[0]``): the check before a run."""
+    rate = as_scalar(rate_hz, option, "[Hz]", minimum=0.0, strict=True)
+    T = float(problem.xu[0]) if T is None else as_scalar(T, "T", "[s]", minimum=0.0)
+    need = certificate_bytes(problem, T, rate)
+    check_memory(need, option, f"{rate:g} Hz (T = {T:.4g} s)")
+    return need
+
+
 def certify(
     problem: TrajectoryProblem,
     x: Any,
@@ -196,6 +236,9 @@ def certify(
     ConfigurationError
         A robot limit that is not > 0 (the velocity, acceleration, jerk and torque limits may
         be infinite; the position limits must be finite with lower < upper).
+    ResourceLimitError
+        The samples would need more memory than the budget
+        (:func:`check_certificate_memory`); checked before anything is allocated.
     """
     xa = as_vector(x, "x", problem.n_var)
     T = float(xa[0])
@@ -205,6 +248,7 @@ def certify(
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
     robot, lim = problem.robot, problem.robot.limits
     span = _limits(lim)
+    check_certificate_memory(problem, rate, T)
 
     n = dense_samples(T, rate)
     s = np.linspace(0.0, 1.0, n)

@@ -23,6 +23,7 @@ from adept_traj.analysis import (
 )
 from adept_traj.cli import status
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
+from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
 from adept_traj.optimise import PlanningInterrupted, plan
@@ -159,9 +160,12 @@ def comparison_markdown(results: dict[str, PlanningResult], weights: Sequence[fl
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``; return the exit status (0, or 130 when interrupted)."""
     problem = problem_from_arguments(args)
+    runs = (("nsga2", args.pop_nsga2), ("mode", args.pop_mode))
     results = {}
     try:
-        for name, pop in (("nsga2", args.pop_nsga2), ("mode", args.pop_mode)):
+        for name, pop in runs:  # both refused before either starts
+            check_run_options(problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}")
+        for name, pop in runs:
             with ProgressReporter(name, quiet=args.quiet) as progress:
                 results[name] = plan(
                     problem,

@@ -15,10 +15,23 @@ import numpy as np
 from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
 from adept_traj.errors import InvalidInputError
+from adept_traj.memory import check_memory
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "samples_bytes"]
+
+
+def samples_bytes(n_samples: int, nq: int) -> int:
+    r"""Estimated peak memory [B] of the demo with ``n_samples`` samples of ``nq`` joints:
+
+    .. math::
+        M = 300\,n_q\,n + 1\ \text{MiB}
+
+    (the move, the torques, the manipulability and their temporaries: 1 110 B per sample
+    measured with :mod:`tracemalloc` for the AdeptOne XL, :math:`n_q = 4`, at
+    n = 10⁴–8·10⁴, rounded up; ``benchmarks/bench_memory.py``)."""
+    return 300 * nq * n_samples + 2**20
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -57,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError(f"--duration must be a positive number [s]; got {args.duration}")
     if args.samples < 2:
         raise InvalidInputError(f"--samples must be at least 2; got {args.samples}")
+    check_memory(samples_bytes(args.samples, robot.nq), "--samples", args.samples)
     t, q, v, a = _quintic_move(start, goal, args.duration, args.samples)
     u = robot.inverse_dynamics(q, v, a)
     lim = robot.limits

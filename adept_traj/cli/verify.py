@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from adept_traj.analysis import LimitCheck, certify
+from adept_traj.analysis import LimitCheck, certify, check_certificate_memory
 from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate
 from adept_traj.results import PlanningResult
@@ -54,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
     result = PlanningResult.load(args.folder)
     problem = result.problem()
     try:
+        check_certificate_memory(problem, rate, float(result.best_x[0]), option="--rate")
         t0 = time.perf_counter()
         cert = certify(problem, result.best_x, rate_hz=rate)
         elapsed = time.perf_counter() - t0

@@ -34,6 +34,8 @@ from adept_traj.optimise.repair import (
 )
 from adept_traj.optimise.sampling import (
     RampSampling,
+    check_population_memory,
+    population_bytes,
 )
 
 __all__ = [
@@ -46,11 +48,13 @@ __all__ = [
     "PlanningInterrupted",
     "RampSampling",
     "RunState",
+    "check_population_memory",
     "kinematic_time",
     "load_checkpoint",
     "make_algorithm",
     "optimise",
     "plan",
+    "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
 ]

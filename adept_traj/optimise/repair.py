@@ -33,10 +33,28 @@ __all__ = ["KinematicTimeRepair", "kinematic_time"]
 #: Relative slack so that the repaired T satisfies the limits despite rounding.
 _SLACK = 1e-9
 
+#: Candidates whose exact extrema are computed at once: the per-segment arrays of
+#: :meth:`~adept_traj.problem.BSplineTrajectory.bounds` stay a few MB whatever the
+#: population size.
+_BLOCK_ROWS = 1024
+
 
 def kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
     """(pop,) smallest T [s] meeting the velocity, acceleration and jerk limits for the
-    control points of ``x`` (pop, n_var) (their current T is ignored)."""
+    control points of ``x`` (pop, n_var) (their current T is ignored).
+
+    Computed in blocks of :data:`_BLOCK_ROWS` candidates (each row alone: the same numbers
+    as at once), so the peak memory does not grow with the population."""
+    x = np.asarray(x, dtype=float)
+    if len(x) <= _BLOCK_ROWS:
+        return _kinematic_time(problem, x)
+    return np.concatenate(
+        [_kinematic_time(problem, x[i : i + _BLOCK_ROWS]) for i in range(0, len(x), _BLOCK_ROWS)]
+    )
+
+
+def _kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
+    """:func:`kinematic_time` of one block ``x`` (k, n_var)."""
     unit = np.array(x, dtype=float)
     unit[..., 0] = 1.0
     b = problem.trajectory.bounds(unit)

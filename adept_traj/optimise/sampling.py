@@ -33,13 +33,20 @@ import numpy as np
 from pymoo.core.sampling import Sampling
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.memory import check_memory
 from adept_traj.optimise.repair import kinematic_time
-from adept_traj.validation import as_scalar
+from adept_traj.validation import as_integer, as_scalar
 
-__all__ = ["RampSampling"]
+__all__ = ["RampSampling", "check_population_memory", "population_bytes"]
 
 
 _GRID = np.linspace(0.0, 1.0, 2001)
+
+#: S-curves (one per individual and joint) tabulated at once on :data:`_GRID`: a block of
+#: 512 curves holds 512 × 2001 × 8 B ≈ 8 MB per temporary array (about six are alive at a
+#: time), whatever the population size (pop × nq × 2001 × 8 B ≈ 320 MB per array at pop
+#: 5 000 unblocked).
+_BLOCK_CURVES = 512
 
 
 def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -59,6 +66,55 @@ def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
     w = uu * (len(g) - 1) - idx
     take = np.take_along_axis
     return take(pos, idx, axis=-1) * (1 - w) + take(pos, idx + 1, axis=-1) * w
+
+
+def _s_curves_blocked(u: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """:func:`_s_curve` of ``u`` (n, nq, k) and ``r`` (n, nq), computed in blocks of rows of
+    at most :data:`_BLOCK_CURVES` curves: the same numbers, bit for bit (every row is
+    computed alone), with a peak memory independent of n."""
+    rows = max(1, _BLOCK_CURVES // max(1, u.shape[1]))
+    if len(u) <= rows:
+        return _s_curve(u, r)
+    out = np.empty(u.shape)
+    for i in range(0, len(u), rows):
+        out[i : i + rows] = _s_curve(u[i : i + rows], r[i : i + rows])
+    return out
+
+
+def population_bytes(pop_size: int, n_gen: int = 1) -> int:
+    r"""Estimated peak memory [B] of a run with ``pop_size`` individuals over ``n_gen``
+    generations (the whole process, Python and the libraries included):
+
+    .. math::
+        M = 150\,\text{MiB} + 20\,\text{kB} \cdot N + 18\,\text{B} \cdot N^2
+            + 48\,\text{B} \cdot N \cdot G .
+
+    The :math:`N^2` term is pymoo's duplicate elimination (``eliminate_duplicates=True``):
+    it holds an (N, N) distance matrix and the indices of its upper triangle, 17.5 B per
+    pair measured; the sampler, the repair and the evaluation work in blocks and add only
+    the linear term; the :math:`N G` term is the history of the generations' fronts (at
+    most N points of 6 objectives each). Fitted to the peak RSS of ``adept-traj plan
+    --gens 2`` at N = 1 000, 2 000, 4 000 (NSGA-II and MODE: 169–420 MB, ≤ this estimate;
+    ``benchmarks/bench_memory.py``).
+    """
+    n = as_integer(pop_size, "pop_size", minimum=1, error=ConfigurationError)
+    g = as_integer(n_gen, "n_gen", minimum=1, error=ConfigurationError)
+    return 150 * 2**20 + 20_000 * n + 18 * n * n + 48 * n * g
+
+
+def check_population_memory(
+    pop_size: int, n_gen: int = 1, *, options: tuple[str, str] = ("pop_size", "n_gen")
+) -> int:
+    """:func:`population_bytes` if it fits the memory budget
+    (:func:`~adept_traj.memory.memory_budget`), else
+    :class:`~adept_traj.errors.ResourceLimitError` naming ``options[0]`` (the population
+    option, e.g. ``"--pop"``) or ``options[1]`` (the generations) when the population alone
+    fits."""
+    need = population_bytes(pop_size, n_gen)
+    alone = population_bytes(pop_size, 1)
+    check_memory(alone, options[0], pop_size)
+    check_memory(need, options[1], f"{n_gen} with {options[0]} = {pop_size}")
+    return need
 
 
 class RampSampling(Sampling):
@@ -103,6 +159,8 @@ class RampSampling(Sampling):
         self.full_window, self.detour_prob = full_window, detour_prob
 
     def _do(self, problem: Any, n_samples: int, random_state: Any = None, **kwargs: Any):
+        if n_samples > 0:  # the first step of a run: refuse a population beyond the budget
+            check_population_memory(n_samples)
         rng = random_state if random_state is not None else np.random.default_rng()
         x = self.ramps(problem, n_samples, rng)
         if n_samples > 0:
@@ -124,7 +182,7 @@ class RampSampling(Sampling):
         a, b = np.where(full, 0.0, a), np.where(full, 1.0, b)
         r = rng.uniform(0.05, 0.25, size=(n_samples, nq))
         u = (xi[None, None, :] - a[:, :, None]) / (b - a)[:, :, None]  # (n, nq, n_free)
-        ramp = np.swapaxes(_s_curve(u, r), 1, 2)  # (n, n_free, nq)
+        ramp = np.swapaxes(_s_curves_blocked(u, r), 1, 2)  # (n, n_free, nq)
         detour = rng.normal(0.0, self.detour, size=(n_samples, 1, nq)) * span
         detour *= rng.uniform(size=(n_samples, 1, nq)) < self.detour_prob
         free = (

@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from adept_traj.errors import ResultFormatError
+from adept_traj.files import read_bytes_bounded
 from adept_traj.schema import Node
 
 __all__: list[str] = []
@@ -25,12 +26,18 @@ def _open_json(path: Path) -> Node:
 
 
 def _read_text(path: Path) -> str:
-    """The UTF-8 text of a file of the result folder (ResultFormatError if unreadable)."""
+    """The UTF-8 text of a file of the result folder, at most
+    :data:`~adept_traj.files.MAX_FILE_BYTES` (ResultFormatError if missing, unreadable,
+    too large or not UTF-8)."""
+
+    def refuse(message: str) -> ResultFormatError:
+        return ResultFormatError(path, None, message.removeprefix(f"{path}: "))
+
+    def missing(_message: str) -> ResultFormatError:
+        return ResultFormatError(path, None, "missing file")
+
+    raw = read_bytes_bounded(path, refuse, not_found=missing, what="result file")
     try:
-        return path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ResultFormatError(path, None, "missing file") from None
+        return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ResultFormatError(path, None, f"not UTF-8 text ({exc.reason})") from None
-    except OSError as exc:
-        raise ResultFormatError(path, None, f"cannot read: {exc.strerror or exc}") from None

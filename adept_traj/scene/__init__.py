@@ -9,8 +9,10 @@ from adept_traj.scene.motion_laws import (
     PendulumMotion,
 )
 from adept_traj.scene.scene import (
+    MAX_OBSTACLES,
     Obstacle,
     Scene,
+    check_obstacle_count,
     pendulum_obstacles,
 )
 from adept_traj.scene.scene_file import (
@@ -31,6 +33,7 @@ from adept_traj.scene.shapes import (
 )
 
 __all__ = [
+    "MAX_OBSTACLES",
     "Box",
     "Capsule",
     "Cylinder",
@@ -42,6 +45,7 @@ __all__ = [
     "SceneFileNotFoundError",
     "Shape",
     "Sphere",
+    "check_obstacle_count",
     "coal_transform",
     "pendulum_obstacles",
     "read_paper_scene",

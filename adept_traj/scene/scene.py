@@ -17,13 +17,19 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from adept_traj.errors import InputShapeError, InvalidInputError, SceneError
+from adept_traj.errors import InputShapeError, InvalidInputError, ResourceLimitError, SceneError
 from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
 from adept_traj.scene.shapes import Cylinder, Shape, Sphere, _ValueObject
 from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
 from adept_traj.validation import as_finite_array, check_type, readonly_copy
 
-__all__ = ["Obstacle", "Scene", "pendulum_obstacles"]
+__all__ = ["MAX_OBSTACLES", "Obstacle", "Scene", "check_obstacle_count", "pendulum_obstacles"]
+
+#: Most obstacles a scene may hold (a pendulum counts as its two obstacles). Every
+#: evaluation computes robot–obstacle distances for every pair (and the dense certificate
+#: holds (n_samples, n_solids, n_obstacles) distances: 2 GB at 1 kHz over 5 s with 10 000
+#: obstacles and 5 solids); far beyond this a scene file takes minutes to load.
+MAX_OBSTACLES = 10_000
 
 #: Suffixes of the two obstacles a pendulum yields.
 _ROD_SUFFIX = ".rod"
@@ -128,6 +134,29 @@ def pendulum_obstacles(
     return rod, bob
 
 
+def check_obstacle_count(n: int, source: str = "scene") -> int:
+    """Return ``n`` if a scene may hold ``n`` obstacles, else raise
+    :class:`~adept_traj.errors.ResourceLimitError` naming ``source``, ``n`` and
+    :data:`MAX_OBSTACLES`. Readers call it on the number of entries before building any
+    obstacle."""
+    if n > MAX_OBSTACLES:
+        raise ResourceLimitError(
+            f"{source}: {n} obstacles, more than the limit MAX_OBSTACLES = {MAX_OBSTACLES}"
+        )
+    return n
+
+
+def _count_entries(data: Mapping[str, Any]) -> int:
+    """Obstacles a scene-file mapping describes: ``[[obstacle]]`` entries plus two per
+    ``[[pendulum]]`` (non-list values count 0: the reader reports them)."""
+    count = 0
+    for key, per_entry in (("obstacle", 1), ("pendulum", 2)):
+        entries = data.get(key) if isinstance(data, Mapping) else None
+        if isinstance(entries, list):
+            count += per_entry * len(entries)
+    return count
+
+
 def _as_joint_vector(value: Any, name: str) -> np.ndarray:
     arr = as_finite_array(value, name)
     if arr.ndim != 1 or arr.size == 0:
@@ -168,6 +197,7 @@ class Scene(_ValueObject):
                 f"obstacles must be a sequence of Obstacle; got {type(self.obstacles).__name__}"
             )
         obstacles = tuple(self.obstacles)
+        check_obstacle_count(len(obstacles), f"scene {self.name!r}")
         for i, ob in enumerate(obstacles):
             if not isinstance(ob, Obstacle):
                 raise InvalidInputError(
@@ -284,9 +314,15 @@ class Scene(_ValueObject):
         Args:
             data: mapping with the scene-file schema (what ``tomllib`` returns).
             source: name used in error messages (a file name).
+
+        Raises:
+            ResourceLimitError: more than :data:`MAX_OBSTACLES` obstacles (checked before
+                any is built).
+            SceneError: ``data`` does not describe a valid scene.
         """
         from adept_traj.scene.scene_file import scene_from_dict
 
+        check_obstacle_count(_count_entries(data), source)
         return scene_from_dict(data, source)
 
     def to_dict(self) -> dict[str, Any]:

@@ -22,7 +22,15 @@ import tomli_w
 from adept_traj.errors import SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
-from adept_traj.scene.scene import _BOB_SUFFIX, _ROD_SUFFIX, Obstacle, Scene, pendulum_obstacles
+from adept_traj.scene.scene import (
+    _BOB_SUFFIX,
+    _ROD_SUFFIX,
+    Obstacle,
+    Scene,
+    _count_entries,
+    check_obstacle_count,
+    pendulum_obstacles,
+)
 from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
 from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
@@ -71,7 +79,9 @@ def read_paper_scene() -> Scene:
 
 def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
     """A scene from the parsed content of a scene file (what ``tomllib`` returns); ``source``
-    names it in error messages."""
+    names it in error messages. More than :data:`~adept_traj.scene.MAX_OBSTACLES`
+    obstacles are refused before any is built."""
+    check_obstacle_count(_count_entries(data), source)
     return _parse_scene(data, source, "scene")
 
 
