@@ -8,12 +8,14 @@ and the textbook planar 2-link arm.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+import adept_traj as at
 from adept_traj import Robot
 from adept_traj.errors import (
     InputShapeError,
@@ -490,3 +492,22 @@ def test_small_determinants_match_lapack(k: int) -> None:
     singular = a.copy()
     singular[..., -1, :] = singular[..., 0, :]  # two equal rows
     np.testing.assert_allclose(_det(singular), 0.0, atol=1e-12)
+
+
+def test_joint_limits_effort_keyword_is_deprecated_but_works():
+    """``effort=`` (the name before the limit-kind vocabulary) still builds the same limits."""
+    args = (("a",), ("rad",), [-1.0], [1.0], [2.0], [3.0], [4.0])
+    with pytest.warns(DeprecationWarning, match="use torque"):
+        old = at.JointLimits(*args, effort=[5.0])
+    assert old == at.JointLimits(*args, torque=[5.0])
+    shipped = Robot.adept_one_xl().limits  # 4 joints: arrays compared element-wise
+    assert shipped == dataclasses.replace(shipped)
+    assert shipped != dataclasses.replace(shipped, torque=shipped.torque * 2)
+    np.testing.assert_array_equal(old.torque, [5.0])
+    with pytest.warns(DeprecationWarning, match="use JointLimits.torque"):
+        np.testing.assert_array_equal(old.effort, [5.0])
+    assert dataclasses.replace(old, torque=[6.0]).torque[0] == 6.0
+    with pytest.raises(at.InvalidInputError, match="not both"):
+        at.JointLimits(*args, [5.0], effort=[5.0])
+    with pytest.raises(at.InvalidInputError, match="torque limits"):
+        at.JointLimits(*args)

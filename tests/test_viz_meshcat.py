@@ -19,7 +19,7 @@ import pytest
 import umsgpack
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import BSplineTrajectory, TrajectoryProblem
 from adept_traj.results import PlanningResult, Replay, RobotInfo
 from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
 from adept_traj.testing.paper_moves import lift_then_lower, single_result
@@ -214,6 +214,13 @@ def test_replay_of_another_solution(result: PlanningResult, problem: TrajectoryP
         playback.build_animation(result, replay=other)
     with pytest.raises(InvalidInputError, match="replay must be a Replay"):
         playback.build_animation(result, replay=problem)
+    # the same x from another start: another move (the viewer used to check x alone)
+    moved = BSplineTrajectory(
+        result.start + 0.05, result.goal, n_knots=int(result.problem_settings.n_knots)
+    )
+    elsewhere = Replay(problem.robot, problem.scene, moved, result.best_x)
+    with pytest.raises(InvalidInputError, match="start, goal"):
+        playback.build_animation(result, replay=elsewhere)
 
 
 def test_speed_and_fps(result: PlanningResult) -> None:

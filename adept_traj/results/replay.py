@@ -20,7 +20,13 @@ from adept_traj.problem import BSplineTrajectory, TrajectorySamples
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
-from adept_traj.validation import as_finite_array, as_integer, check_type, readonly_copy
+from adept_traj.validation import (
+    as_finite_array,
+    as_integer,
+    check_type,
+    deep_equal,
+    readonly_copy,
+)
 
 __all__ = ["Replay"]
 
@@ -94,6 +100,38 @@ class Replay:
             result.start, result.goal, n_knots=int(result.problem_settings.n_knots)
         )
         return cls(robot, scene, trajectory, result.best_x if x is None else x)
+
+    @classmethod
+    def of_best(cls, result: PlanningResult, replay: Any = None) -> Replay:
+        """The replay of ``result``'s best solution: ``replay`` when the caller has one,
+        checked to show that motion, else :meth:`of` (robot files loaded, scene parsed,
+        once).
+
+        Raises
+        ------
+        InvalidInputError
+            ``replay`` is not a :class:`Replay`, or its joints, start, goal, knots or
+            decision vector differ from the result's (it shows another move).
+        """
+        check_type(result, PlanningResult, "result")
+        if replay is None:
+            return cls.of(result)
+        check_type(replay, Replay, "replay")
+        tr = replay.trajectory
+        if not (
+            tuple(replay.robot.joint_names) == tuple(result.robot.joint_names)
+            and tr.n_knots == int(result.problem_settings.n_knots)
+            and deep_equal(tr.start, result.start)
+            and deep_equal(tr.goal, result.goal)
+            and deep_equal(replay.x, result.best_x)
+        ):
+            raise InvalidInputError(
+                "replay must show the result's best solution, result.best_x "
+                "(Replay.of(result)); its joints, start, goal, n_knots or x differ from the "
+                f"result's (replay T = {replay.duration:.6g} s, best T = "
+                f"{float(result.best_x[0]):.6g} s)"
+            )
+        return replay
 
     @property
     def duration(self) -> float:

@@ -23,7 +23,6 @@ built once or handed in), never the full problem. See ``docs/plots-and-export.md
 from __future__ import annotations
 
 import json
-import math
 import os
 from pathlib import Path
 from typing import Any
@@ -36,7 +35,7 @@ from adept_traj.files import write_text_atomic
 from adept_traj.results.csv_codec import _write_trajectory_csv
 from adept_traj.results.record import PlanningResult
 from adept_traj.results.replay import Replay
-from adept_traj.validation import check_type, deep_equal
+from adept_traj.validation import as_scalar, check_type
 
 __all__ = [
     "MAX_ROS_POINTS",
@@ -51,8 +50,7 @@ _NS_PER_S = 1_000_000_000
 
 
 def _as_result(result: Any) -> PlanningResult:
-    if not isinstance(result, PlanningResult):
-        raise InvalidInputError(f"result must be a PlanningResult; got {type(result).__name__}")
+    check_type(result, PlanningResult, "result")
     return result
 
 
@@ -88,38 +86,13 @@ def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
 
 # ============================================================================ ROS
 def _rate(rate_hz: Any) -> float:
-    if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float, np.integer, np.floating)):
-        raise InvalidInputError(f"rate_hz must be a number [Hz] or None; got {rate_hz!r}")
-    rate = float(rate_hz)
-    if not (math.isfinite(rate) and rate > 0.0):
-        raise InvalidInputError(f"rate_hz must be finite and > 0 [Hz]; got {rate_hz!r}")
-    return rate
+    return as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
 
 
 def _duration(t: float) -> dict[str, int]:
     """ROS 2 ``builtin_interfaces/Duration`` of ``t`` ≥ 0 seconds, rounded to 1 ns."""
     sec, nanosec = divmod(round(t * _NS_PER_S), _NS_PER_S)
     return {"sec": int(sec), "nanosec": int(nanosec)}
-
-
-def _replay_of(r: PlanningResult, replay: Any) -> Replay:
-    """``replay`` checked to be the motion of ``r``'s best solution (default: built)."""
-    if replay is None:
-        return Replay.of(r)
-    check_type(replay, Replay, "replay")
-    tr = replay.trajectory
-    if not (
-        tuple(replay.robot.joint_names) == r.robot.joint_names
-        and tr.n_knots == int(r.problem_settings.n_knots)
-        and deep_equal(tr.start, r.start)
-        and deep_equal(tr.goal, r.goal)
-        and deep_equal(replay.x, r.best_x)
-    ):
-        raise InvalidInputError(
-            "replay must show the result's best solution (Replay.of(result)); its joints, "
-            "start, goal, n_knots or x differ from the result's"
-        )
-    return replay
 
 
 def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, ...]:
@@ -130,7 +103,7 @@ def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, 
             f"rate_hz = {rate:g} Hz gives {n} points over T = {float(r.best_x[0]):.6g} s; at "
             f"most {MAX_ROS_POINTS} are exported"
         )
-    motion = _replay_of(r, replay)
+    motion = Replay.of_best(r, replay)
     smp = motion.sample_uniform(n)
     return smp.t, smp.q, smp.qd, smp.qdd, motion.torques(smp)
 
@@ -225,7 +198,7 @@ def to_ros_joint_trajectory(
         )
     if rate_hz is None:
         if replay is not None:
-            _replay_of(r, replay)
+            Replay.of_best(r, replay)
         d = r.best_trajectory
         t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
     else:

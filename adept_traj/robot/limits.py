@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from adept_traj.errors import InvalidInputError, JointLimitError
-from adept_traj.validation import as_batch, readonly_copy
+from adept_traj.validation import as_batch, deep_equal, readonly_copy
 
 __all__ = ["LIMITS", "LIMIT_KINDS", "JointLimits", "LimitKind"]
 
@@ -58,7 +59,7 @@ LIMITS: tuple[LimitKind, ...] = (
 LIMIT_KINDS: tuple[str, ...] = tuple(kind.name for kind in LIMITS)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False, eq=False)
 class JointLimits:
     """Per-joint limits, each an array of shape ``(nq,)`` in SI units.
 
@@ -70,7 +71,8 @@ class JointLimits:
     velocity: max ``|q̇|`` [rad/s | m/s] (VC).
     acceleration: max ``|q̈|`` [rad/s² | m/s²] (WC); ``inf`` when unknown.
     jerk: max ``|q⃛|`` [rad/s³ | m/s³] (JC); ``inf`` when unknown.
-    torque: max ``|τ|`` [N·m | N] (UC); URDF calls it ``effort``.
+    torque: max ``|τ|`` [N·m | N] (UC); URDF calls it ``effort``. The keyword ``effort=``
+        is still accepted (deprecated, with a :class:`DeprecationWarning`).
     """
 
     names: tuple[str, ...]
@@ -82,9 +84,42 @@ class JointLimits:
     jerk: np.ndarray
     torque: np.ndarray
 
-    def __post_init__(self) -> None:
-        for field in ("lower", "upper", "velocity", "acceleration", "jerk", "torque"):
-            object.__setattr__(self, field, readonly_copy(getattr(self, field)))
+    def __init__(
+        self,
+        names: tuple[str, ...],
+        units: tuple[str, ...],
+        lower: Any,
+        upper: Any,
+        velocity: Any,
+        acceleration: Any,
+        jerk: Any,
+        torque: Any = None,
+        *,
+        effort: Any = None,
+    ) -> None:
+        if effort is not None:
+            if torque is not None:
+                raise InvalidInputError("give torque (or the deprecated effort), not both")
+            warnings.warn(
+                "JointLimits(effort=...) is deprecated; use torque=...",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+            torque = effort
+        if torque is None:
+            raise InvalidInputError("torque limits [N·m | N] are required (one per joint)")
+        object.__setattr__(self, "names", tuple(names))
+        object.__setattr__(self, "units", tuple(units))
+        values = (lower, upper, velocity, acceleration, jerk, torque)
+        for field, value in zip(
+            ("lower", "upper", "velocity", "acceleration", "jerk", "torque"), values
+        ):
+            object.__setattr__(self, field, readonly_copy(value))
+
+    def __eq__(self, other: object) -> bool:
+        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
 
     @property
     def effort(self) -> np.ndarray:
