@@ -118,7 +118,7 @@ def _shown(value: Any) -> str:
     if isinstance(value, bool):
         return "on" if value else "off"
     if isinstance(value, list):
-        return ",".join(f"{x:g}" for x in value)
+        return ",".join(str(x) for x in value)  # every digit: the values differ somewhere
     return str(value)
 
 
