@@ -24,8 +24,9 @@ import pytest
 from adept_traj.cli import main
 from adept_traj.files import write_atomic
 
-#: A tiny run: 3 generations of 8 (about a second); no html/figures unless asked for.
-_RUN = ["plan", "--pop", "8", "--gens", "3", "--seed", "4", "--quiet"]
+#: A tiny run: 3 generations of 8 (about a second) with a feasible front (so a hypervolume
+#: history); no html/figures unless asked for.
+_RUN = ["plan", "--pop", "8", "--gens", "3", "--rate", "1500", "--quiet"]
 _LIGHT = ["--no-html", "--no-plots"]
 
 #: Run ``main(argv)`` in this process, but send ``signal`` to itself when the ``n``-th call
@@ -111,6 +112,8 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The uninterrupted tiny run (no html/figures)."""
     folder = tmp_path_factory.mktemp("reference") / "run"
     assert main([*_RUN, *_LIGHT, "--out", str(folder)]) == 0
+    history = json.loads((folder / "result.json").read_text())["history"]
+    assert [h["hypervolume"] is not None for h in history] == [True, True, True]
     return folder
 
 
@@ -183,11 +186,11 @@ def in_progress(tmp_path: Path) -> Path:
     ("option", "named"),
     [
         (["--pop", "12"], ("--pop 12", "--pop 8")),
-        (["--seed", "1"], ("--seed 1", "--seed 4")),  # 1 is the default: given all the same
+        (["--seed", "4"], ("--seed 4", "--seed 1")),
+        (["--rate", "1000"], ("--rate 1000.0", "--rate 1500.0")),  # the default, given
         (["--algorithm", "mode"], ("--algorithm mode", "--algorithm nsga2")),
         (["--scene", "tests/data/planar_2link.toml"], ("planar_2link.toml", "--scene paper")),
         (["--gens", "5"], ("--gens 5", "--gens 3")),
-        (["--rate", "2000"], ("--rate 2000", "--rate 1000")),
         (
             ["--weights", "1,1,1,1,1,1"],
             ("--weights 1.0,1.0,1.0,1.0,1.0,1.0", "--weights 0.25,0.25,0.1,"),
@@ -213,7 +216,7 @@ def test_resume_refuses_options_that_differ_from_the_run(
 def test_resume_accepts_the_run_s_own_options(in_progress: Path, reference: Path) -> None:
     """Options given again with the run's values (1 is --workers' default: given all the
     same) are accepted; scene paths compare as absolute paths."""
-    argv = ["plan", "--resume", str(in_progress), "--pop", "8", "--seed", "4", "--no-plots"]
+    argv = ["plan", "--resume", str(in_progress), "--pop", "8", "--seed", "1", "--no-plots"]
     assert main([*argv, "--no-html", "--workers", "1", "--scene", "paper", "--quiet"]) == 0
     _assert_same_run(in_progress, reference)
 
@@ -286,7 +289,7 @@ def test_plan_refuses_a_folder_holding_a_result(
 
 
 def test_overwrite_removes_only_the_old_run_s_files(finished: Path, reference: Path) -> None:
-    assert main([*_RUN, *_LIGHT, "--seed", "4", "--out", str(finished), "--overwrite"]) == 0
+    assert main([*_RUN, *_LIGHT, "--out", str(finished), "--overwrite"]) == 0
     assert not (finished / "playback.html").exists()  # the old run's, not rewritten
     assert not (finished / "figures" / "joint_motion_mode.png").exists()
     assert (finished / "figures" / "my_sketch.png").read_bytes() == b"the user's"
