@@ -1,5 +1,6 @@
-"""File input and output shared by the subpackages: atomic writes (no half-written file is
-ever left behind), and bounded reading of TOML and JSON with errors that name the file.
+"""File input and output shared by the subpackages: atomic, durable writes (no half-written
+file is ever left behind, a finished file survives a crash), and bounded reading of TOML and
+JSON with errors that name the file.
 
 Every file the library reads goes through :func:`read_bytes_bounded` (at most
 :data:`MAX_FILE_BYTES`, read in chunks, so ``/dev/zero`` or a 10 GB file is refused at
@@ -34,18 +35,28 @@ __all__ = [
     "parse_toml",
     "read_bytes_bounded",
     "read_toml",
+    "sync_folder",
+    "temp_path",
     "write_atomic",
     "write_text_atomic",
 ]
 
 
 def write_atomic(path: Path, writer: Callable[[Path], None]) -> Path:
-    """Call ``writer`` on a temporary file beside ``path`` (folders created), then rename it
-    to ``path`` in one step; return ``path``."""
+    """Call ``writer`` on a temporary file beside ``path`` (:func:`temp_path`; folders
+    created), flush it to disk, then rename it to ``path`` in one step and flush the folder;
+    return ``path``. If anything fails (Ctrl-C included), the temporary file is removed and
+    ``path`` is left as it was."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    writer(tmp)
-    os.replace(tmp, path)
+    tmp = temp_path(path)
+    try:
+        writer(tmp)
+        _sync_file(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    sync_folder(path.parent)
     return path
 
 
@@ -217,3 +228,31 @@ def parse_json(raw: bytes, source: str, error: type[Exception]) -> Any:
         raise error(
             f"{source}: not valid JSON: {exc.msg} (line {exc.lineno}, column {exc.colno})"
         ) from None
+
+
+# ============================================================================ durable writes
+def temp_path(path: Path) -> Path:
+    """The temporary file :func:`write_atomic` writes before renaming it to ``path``
+    (``.<name>.tmp`` beside it)."""
+    return path.with_name(f".{path.name}.tmp")
+
+
+def _sync_file(path: Path) -> None:
+    """Flush the content of the file at ``path`` to disk (``fsync``)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def sync_folder(folder: Path) -> None:
+    """Flush the entries of ``folder`` (renames, new and removed files) to disk, where the
+    system allows it (POSIX; a no-op on Windows)."""
+    if os.name != "posix":  # pragma: no cover - folders cannot be opened on Windows
+        return
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)

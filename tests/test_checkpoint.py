@@ -179,19 +179,57 @@ def test_files_and_keys(tmp_path: Path) -> None:
     algorithm, problem = set_up()
     generations(algorithm, problem, 2)
     meta = {"fingerprint": {"a": 1}, "total_s": 1.5, "evaluation_s": 1.0, "history": []}
-    save_checkpoint(tmp_path, algorithm, meta)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["checkpoint.json", "checkpoint.npz"]
-    stored = json.loads((tmp_path / "checkpoint.json").read_text())
+    save_checkpoint(tmp_path, algorithm, meta, {"extra": np.arange(3.0)})
+    assert [p.name for p in tmp_path.iterdir()] == ["checkpoint.npz"]  # one file, one rename
+    with np.load(tmp_path / "checkpoint.npz", allow_pickle=False) as data:
+        assert {"X", "F", "G", "CV", "n_iter", "meta", "loop.extra"} <= set(data.files)
+        stored = json.loads(str(data["meta"]))
     assert stored["format"] == "adept_traj.checkpoint"
-    assert stored["version"] == CHECKPOINT_VERSION == 1
+    assert stored["version"] == CHECKPOINT_VERSION == 2
     assert (stored["n_iter"], stored["n_eval"]) == (3, 20)
     loaded, arrays = load_checkpoint(tmp_path)
     assert loaded == stored
     np.testing.assert_array_equal(arrays["X"], algorithm.pop.get("X"))
     np.testing.assert_array_equal(arrays["CV"], algorithm.pop.get("CV"))
+    np.testing.assert_array_equal(arrays["loop.extra"], [0.0, 1.0, 2.0])
     assert int(arrays["n_iter"]) == 3
-    with np.load(tmp_path / "checkpoint.npz", allow_pickle=False) as data:
-        assert {"X", "F", "G", "CV", "n_iter"} <= set(data.files)
+    assert "meta" not in arrays
+
+
+def test_a_version_1_checkpoint_is_replaced_by_one_file(tmp_path: Path) -> None:
+    """Resuming a version-1 checkpoint (two files) writes version 2 and removes the old
+    metadata file, so the folder never holds two generations' files."""
+    shutil.copytree(STORED, tmp_path, dirs_exist_ok=True)
+    meta, _ = load_checkpoint(tmp_path)
+    assert meta["version"] == 1
+    algorithm, problem = set_up()
+    generations(algorithm, problem, 1)
+    save_checkpoint(tmp_path, algorithm, {k: meta[k] for k in ("fingerprint", "history")} | {
+        "total_s": 0.0, "evaluation_s": 0.0})  # fmt: skip
+    assert [p.name for p in tmp_path.iterdir()] == ["checkpoint.npz"]
+    assert load_checkpoint(tmp_path)[0]["version"] == 2
+
+
+def test_an_interrupted_write_keeps_the_previous_checkpoint(tmp_path: Path, monkeypatch) -> None:
+    """Ctrl-C while the checkpoint is written: the previous one stays whole and no
+    temporary file is left behind."""
+    algorithm, problem = set_up()
+    generations(algorithm, problem, 1)
+    meta = {"fingerprint": {}, "total_s": 0.0, "evaluation_s": 0.0, "history": []}
+    save_checkpoint(tmp_path, algorithm, meta)
+    before = (tmp_path / "checkpoint.npz").read_bytes()
+    generations(algorithm, problem, 1)
+
+    def torn(fh, **arrays):
+        fh.write(b"PK half a file")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez", torn)
+    with pytest.raises(KeyboardInterrupt):
+        save_checkpoint(tmp_path, algorithm, meta)
+    assert [p.name for p in tmp_path.iterdir()] == ["checkpoint.npz"]
+    assert (tmp_path / "checkpoint.npz").read_bytes() == before
+    assert load_checkpoint(tmp_path)[0]["n_iter"] == 2
 
 
 def test_restore_continues_exactly(tmp_path: Path) -> None:
@@ -244,6 +282,39 @@ def test_load_refuses_a_foreign_or_torn_checkpoint(tmp_path: Path) -> None:
     (tmp_path / "checkpoint.json").write_text(json.dumps(meta))
     with pytest.raises(ConfigurationError, match=r"incomplete checkpoint, missing \['rng'\]"):
         load_checkpoint(tmp_path)
+    (tmp_path / "checkpoint.json").unlink()
+    with pytest.raises(ConfigurationError, match=r"missing checkpoint\.json"):
+        load_checkpoint(tmp_path)
+    (tmp_path / "checkpoint.npz").write_bytes(b"PK torn")
+    with pytest.raises(ConfigurationError, match="unreadable checkpoint"):
+        load_checkpoint(tmp_path)
+
+
+def test_resume_restores_the_fronts_of_every_generation(tmp_path: Path) -> None:
+    """The per-generation fronts (for the hypervolume history) survive an interruption."""
+    full = optimise(Toy(), NSGA2(pop_size=10), 5, seed=3)
+    with pytest.raises(PlanningInterrupted):
+        optimise(
+            Toy(), NSGA2(pop_size=10), 5, seed=3, checkpoint=tmp_path, progress=_interrupt_at(2)
+        )
+    resumed = optimise(Toy(), NSGA2(pop_size=10), 5, seed=3, checkpoint=tmp_path, resume=True)
+    assert len(resumed.fronts) == len(full.fronts) == 5
+    for a, b in zip(resumed.fronts, full.fronts):
+        np.testing.assert_array_equal(a, b)
+
+
+class StoppedWhileEvaluating(Toy):
+    """Ctrl-C during the first evaluation (the first generation)."""
+
+    def _evaluate(self, x, out, *args, **kwargs) -> None:
+        raise KeyboardInterrupt
+
+
+def test_ctrl_c_in_the_first_generation_names_no_checkpoint(tmp_path: Path) -> None:
+    with pytest.raises(PlanningInterrupted, match="nothing checkpointed") as caught:
+        optimise(StoppedWhileEvaluating(), NSGA2(pop_size=10), 3, seed=1, checkpoint=tmp_path)
+    assert caught.value.checkpoint is None
+    assert list(tmp_path.iterdir()) == []
 
 
 def _interrupt_at(generation: int):

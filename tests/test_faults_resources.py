@@ -92,6 +92,27 @@ def test_plan_refuses_a_huge_population_before_sampling(problem) -> None:
         (["--rate", "1e9"], "--rate = 1e+09 Hz"),
     ],
 )
+def test_plan_refuses_before_running(argv, option, tmp_path, capsys) -> None:
+    """The same limits for plan (--pop for its one population), before run.json is written."""
+    argv = ["--pop" if a.startswith("--pop-") else a for a in argv]
+    option = option.replace("--pop-nsga2", "--pop").replace("--pop-mode", "--pop")
+    out = tmp_path / "run"
+    assert main(["plan", *argv, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert option in err
+    assert "would need about" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["--pop-nsga2", "100000"], "--pop-nsga2 = 100000"),
+        (["--pop-mode", "100000"], "--pop-mode = 100000"),
+        (["--gens", "1000000000000"], "--gens = 1000000000000"),
+        (["--rate", "1e9"], "--rate = 1e+09 Hz"),
+    ],
+)
 def test_compare_refuses_before_running(argv, option, tmp_path, capsys) -> None:
     out = tmp_path / "cmp"
     assert main(["compare", *argv, "--out", str(out), "--quiet"]) == 2

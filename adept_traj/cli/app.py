@@ -17,6 +17,8 @@ Sub-commands, one module each:
   regenerate a URDF from a parameter file.
 
 Bad input never prints a traceback: the command exits with status 2 and a one-line reason.
+Ctrl-C that a command does not handle itself (e.g. while the problem is built) exits with
+status 130 and one line, without a traceback.
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     The exit status (:mod:`adept_traj.cli.status`): 0 success, 2 bad input (one line on
-    standard error), and the command's own statuses.
+    standard error), 130 interrupted, and the command's own statuses.
     """
     parser, runs = _parser()
     args = parser.parse_args(argv)
@@ -73,3 +75,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (AdeptTrajError, OSError, json.JSONDecodeError) as exc:
         print(f"adept-traj: error: {exc}", file=sys.stderr)
         return status.BAD_INPUT
+    except KeyboardInterrupt:
+        print(f"adept-traj: {args.command} interrupted", file=sys.stderr)
+        return status.INTERRUPTED

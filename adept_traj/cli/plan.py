@@ -1,8 +1,14 @@
 """``adept-traj plan``: plan on a scene, verify the best trade-off densely, save the result.
 
 While running, ``DIR/checkpoint/`` holds the last finished generation and ``DIR/run.json``
-the arguments; Ctrl-C stops the run (exit 130) and ``--resume DIR`` continues it. Both are
-removed when the run completes.
+the arguments; Ctrl-C stops the run (exit 130) and ``--resume DIR`` continues it, from the
+last checkpoint, to the same result as an uninterrupted run (also after a kill, at any
+instant: :mod:`adept_traj.cli._run_folder` says how a folder tells its state). Both are
+removed when the run completes; ``--resume`` of a complete run says so and changes nothing.
+
+``--out DIR`` refuses a folder that holds files of an earlier run unless ``--overwrite`` is
+given, which removes those files (only those ``plan`` writes) before the run. Every option
+and output path is checked before anything is written.
 
 ``--ros FILE`` exports the best trade-off for a robot controller only when its dense
 certificate is feasible; otherwise the result folder is still written, nothing is
@@ -14,41 +20,50 @@ refused before the run starts.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 from adept_traj.cli import status
+from adept_traj.cli._run_folder import (
+    CHECKPOINT,
+    HTML_FILE,
+    RUN_FILE,
+    TOP_FILES,
+    as_path,
+    check_folder,
+    commit,
+    is_complete,
+    read_arguments,
+    remove_written,
+    write_arguments,
+)
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
+from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.optimise import ALGORITHMS, PlanningInterrupted, plan
-from adept_traj.results import (
-    FRONT_FILE,
-    RESULT_FILE,
-    TRAJECTORY_FILE,
-    PlanningResult,
-    Replay,
-    save_ros_joint_trajectory,
+from adept_traj.optimise import (
+    ALGORITHMS,
+    PlanningInterrupted,
+    has_checkpoint,
+    make_algorithm,
+    plan,
 )
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
+from adept_traj.validation import as_integer
 
 __all__ = ["RUN_FILE", "add_parser", "run"]
-
-#: The arguments of a run in progress, in its result folder (removed when it completes).
-RUN_FILE = "run.json"
-
-#: The files of the result folder that ``--ros`` must not overwrite.
-_RESULT_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, "playback.html", RUN_FILE)
-_CHECKPOINT = "checkpoint"
 
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
     "workers", "no_html", "no_plots", "ros", "allow_infeasible",
 )  # fmt: skip
+#: Saved options that may be given anew when resuming (they change nothing in the result).
+_FREE_ON_RESUME = ("workers", "allow_infeasible")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -60,40 +75,74 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--pop", type=int, help="population size (default: the paper's)")
     p.add_argument("--gens", type=int, help="generations (default: the paper's, 100)")
-    p.add_argument("--out", type=Path, help="result folder")
-    p.add_argument("--resume", type=Path, help="continue an interrupted run in this folder")
+    p.add_argument("--out", type=str, help="result folder")
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the files of an earlier run in --out (only the files plan writes)",
+    )
+    p.add_argument("--resume", type=str, help="continue an interrupted run in this folder")
     p.add_argument(
         "--no-html", action="store_true", help="do not write playback.html (static meshcat)"
     )
     p.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
-    p.add_argument("--ros", type=Path, help="also export the certified best trajectory as ROS JSON")
+    p.add_argument("--ros", type=str, help="also export the certified best trajectory as ROS JSON")
     p.add_argument(
         "--allow-infeasible",
         action="store_true",
         help="with --ros: export the best trajectory even if its certificate failed",
     )
+    # An option left out is None, so that --resume tells it from one given (even with its
+    # default value); the defaults fill it in for a new run.
+    p.set_defaults(plan_defaults={k: p.get_default(k) for k in _SAVED}, **dict.fromkeys(_SAVED))
     return p
 
 
-def _restore(args: argparse.Namespace) -> Path:
-    """Load the arguments of the interrupted run in ``--resume DIR`` into ``args``."""
-    if args.out is not None and args.out != args.resume:
-        raise ConfigurationError("--resume DIR continues in DIR; do not give another --out")
-    run_file = args.resume / RUN_FILE
-    if not run_file.is_file():
-        raise ConfigurationError(f"{args.resume}: no interrupted run here ({RUN_FILE})")
-    saved = json.loads(run_file.read_text())
-    allow_infeasible = args.allow_infeasible  # may be given again when resuming
-    for key, value in saved.items():
-        setattr(args, key, Path(value) if key == "ros" and value is not None else value)
-    args.allow_infeasible = bool(args.allow_infeasible) or allow_infeasible
-    return args.resume
+def _option(key: str) -> str:
+    return "--" + key.replace("_", "-")
+
+
+def _comparable(key: str, value: Any) -> Any:
+    """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
+    if value is None or (key == "scene" and value == "paper"):
+        return value
+    if key in ("scene", "ros"):
+        return str(Path(value).resolve())
+    if key in ("start", "goal", "weights"):
+        return [float(x) for x in value]
+    return value
+
+
+def _shown(value: Any) -> str:
+    if value is None:
+        return "not given"
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, list):
+        return ",".join(str(x) for x in value)  # every digit: the values differ somewhere
+    return str(value)
+
+
+def _resumed_options(saved: dict[str, Any], given: dict[str, Any], folder: Path) -> dict:
+    """The options of the run in ``folder``; an option given again must equal its saved
+    value (except :data:`_FREE_ON_RESUME`), else :class:`ConfigurationError` naming both."""
+    options = dict(saved)
+    for key, value in given.items():
+        if key in _FREE_ON_RESUME:
+            options[key] = value
+            continue
+        old, new = saved.get(key), _comparable(key, value)
+        if new != _comparable(key, old):
+            raise ConfigurationError(
+                f"{_option(key)} {_shown(new)} conflicts with the run being resumed in "
+                f"{folder} ({_option(key)} {_shown(old)}); leave it out to continue that "
+                "run, or start a new one with --out"
+            )
+    return options
 
 
 def _check_ros_path(path: Path, folder: Path) -> None:
     """Refuse a ``--ros`` file that cannot be written, before the run starts."""
-    if "\0" in str(path):
-        raise InvalidInputError(f"--ros {str(path)!r} is not a valid path (NUL character)")
     if path.is_dir():
         raise InvalidInputError(f"--ros {path} is a folder; give a file, e.g. {path}/best.json")
     parent = path.parent
@@ -104,67 +153,122 @@ def _check_ros_path(path: Path, folder: Path) -> None:
     if not os.access(parent, os.W_OK | os.X_OK):
         raise InvalidInputError(f"--ros {path}: cannot write in {parent}")
     target, root = path.resolve(), folder.resolve()
-    if target in {root / name for name in _RESULT_FILES} or root / _CHECKPOINT in target.parents:
+    if target in {root / name for name in TOP_FILES} or root / CHECKPOINT in target.parents:
         raise InvalidInputError(f"--ros {path} is a file of the result folder {folder}")
 
 
-def _save_arguments(args: argparse.Namespace, folder: Path) -> None:
-    saved = {k: getattr(args, k) for k in _SAVED}
-    saved["scene"] = str(saved["scene"])
-    saved["ros"] = None if saved["ros"] is None else str(saved["ros"])
-    (folder / RUN_FILE).write_text(json.dumps(saved, indent=1))
+def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
+    """(the run's options, its folder, whether it resumes), checked; nothing is written."""
+    given = {k: getattr(args, k) for k in _SAVED if getattr(args, k) is not None}
+    if "ros" in given:
+        given["ros"] = as_path(given["ros"], "--ros")
+    out, resume = as_path(args.out, "--out"), as_path(args.resume, "--resume")
+    if resume is None:
+        if out is None:
+            raise ConfigurationError("give --out DIR (or --resume DIR)")
+        folder, options = out, {**args.plan_defaults, **given}
+        options["scene"] = _comparable("scene", options["scene"])
+        options["ros"] = _comparable("ros", options["ros"])
+    else:
+        folder = resume
+        if out is not None and out != folder:
+            raise ConfigurationError("--resume DIR continues in DIR; do not give another --out")
+        if args.overwrite:
+            raise ConfigurationError("--overwrite starts a new run; it does not go with --resume")
+        options = _resumed_options(read_arguments(folder), given, folder)
+    options = {**args.plan_defaults, **options}
+    opts = argparse.Namespace(**{**vars(args), **options})
+    opts.ros = None if opts.ros is None else Path(opts.ros)
+    return opts, folder, resume is not None
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done, 1 the
-    ``--ros`` export refused, 130 interrupted)."""
-    resume = args.resume is not None
-    if resume:
-        folder = _restore(args)
-    elif args.out is None:
-        raise ConfigurationError("give --out DIR (or --resume DIR)")
-    else:
-        folder = args.out
-    if args.ros is not None:
-        _check_ros_path(args.ros, folder)
-    problem = problem_from_arguments(args)
-    folder.mkdir(parents=True, exist_ok=True)
+    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done (or
+    ``--resume`` of a complete run), 1 the ``--ros`` export refused, 130 interrupted)."""
+    resume = as_path(args.resume, "--resume")
+    if resume is not None and is_complete(resume):
+        print(
+            f"adept-traj: {resume}: the run is already complete ({RESULT_FILE}); nothing to resume",
+            file=sys.stderr,
+        )
+        return status.OK
+    opts, folder, resume = _options(args)
+    if opts.ros is not None:
+        _check_ros_path(opts.ros, folder)
     if not resume:
-        _save_arguments(args, folder)
+        check_folder(
+            folder, overwrite=args.overwrite, html=not opts.no_html, figures=not opts.no_plots
+        )
+    as_integer(opts.seed, "--seed", minimum=0, error=ConfigurationError)
+    make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
+    problem = problem_from_arguments(opts)
     try:
-        with ProgressReporter(args.algorithm, quiet=args.quiet) as progress:
-            result = plan(
-                problem,
-                args.algorithm,
-                seed=args.seed,
-                pop_size=args.pop,
-                n_gen=args.gens,
-                weights=args.weights,
-                checkpoint=folder / _CHECKPOINT,
-                resume=resume,
-                progress=progress,
-                rate_hz=args.rate,
-            )
-    except PlanningInterrupted as exc:
-        sys.stderr.write(f"{exc}: adept-traj plan --resume {folder}\n")
-        return status.INTERRUPTED
+        # memory of the population and of the dense certificate, before anything is written
+        check_run_options(problem, opts.algorithm, opts.pop, opts.gens, opts.rate)
+        if not resume:
+            remove_written(folder)  # only with --overwrite: check_folder refused otherwise
+            folder.mkdir(parents=True, exist_ok=True)
+            saved = {k: getattr(opts, k) for k in _SAVED}
+            write_arguments(folder, {**saved, "ros": _comparable("ros", opts.ros)})
+        return _run(opts, problem, folder, resume)
     finally:
         problem.close()
+
+
+def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, resume: bool) -> int:
+    """Plan, save and mark the run complete; on Ctrl-C say how to resume."""
+    checkpoint = folder / CHECKPOINT
+    try:
+        with ProgressReporter(opts.algorithm, quiet=opts.quiet) as progress:
+            result = plan(
+                problem,
+                opts.algorithm,
+                seed=opts.seed,
+                pop_size=opts.pop,
+                n_gen=opts.gens,
+                weights=opts.weights,
+                checkpoint=checkpoint,
+                # Interrupted before its first checkpoint: the run starts again.
+                resume=resume and has_checkpoint(checkpoint),
+                progress=progress,
+                rate_hz=opts.rate,
+            )
+        return _finish(result, problem, folder, opts)
+    except PlanningInterrupted as exc:
+        if exc.checkpoint is None:
+            sys.stderr.write(
+                f"{exc}; adept-traj plan --resume {folder} starts the run again (same result)\n"
+            )
+        else:
+            sys.stderr.write(f"{exc}: adept-traj plan --resume {folder}\n")
+        return status.INTERRUPTED
+    except KeyboardInterrupt:
+        sys.stderr.write(
+            "interrupted after the last generation (checkpointed), while certifying or "
+            f"saving; finish with: adept-traj plan --resume {folder}\n"
+        )
+        return status.INTERRUPTED
+
+
+def _finish(
+    result: PlanningResult, problem: TrajectoryProblem, folder: Path, opts: argparse.Namespace
+) -> int:
+    """Write every output of the run, then mark it complete (the last step)."""
     result.save(folder)
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
-    if not args.no_html:
+    if not opts.no_html:
         from adept_traj.viz import meshcat_scene
 
-        meshcat_scene.static_html(result, folder / "playback.html", replay=replay)
-    if not args.no_plots:
-        save_figures({args.algorithm: result}, folder / "figures", {args.algorithm: replay})
-    shutil.rmtree(folder / _CHECKPOINT, ignore_errors=True)
-    (folder / RUN_FILE).unlink(missing_ok=True)
+        meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
+    if not opts.no_plots:
+        save_figures({opts.algorithm: result}, folder / "figures", {opts.algorithm: replay})
     print(summary(result, folder))
-    if args.ros is not None:
-        return _export_ros(result, args.ros, args.allow_infeasible, replay)
-    return status.OK
+    code = status.OK
+    if opts.ros is not None:
+        code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)
+    commit(folder)
+    return code
 
 
 def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool, replay: Replay) -> int:

@@ -12,6 +12,7 @@ from adept_traj.optimise.algorithms import (
 )
 from adept_traj.optimise.checkpoint import (
     CHECKPOINT_VERSION,
+    has_checkpoint,
     load_checkpoint,
     restore_algorithm,
     save_checkpoint,
@@ -49,6 +50,7 @@ __all__ = [
     "RampSampling",
     "RunState",
     "check_population_memory",
+    "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
     "make_algorithm",

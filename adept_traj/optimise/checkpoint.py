@@ -1,17 +1,23 @@
 """Checkpoints of a pymoo run without pickle, and the exact restore of the algorithm.
 
-A checkpoint folder holds two files, each written atomically:
+A checkpoint is **one file**, ``checkpoint.npz`` (``np.savez``, read with
+``allow_pickle=False``), replaced atomically and flushed to disk
+(:func:`~adept_traj.files.write_atomic`): a crash at any instant leaves either the previous
+generation's checkpoint or the new one, never a mix. It holds
 
-``checkpoint.npz`` (``np.savez``, read with ``allow_pickle=False``)
-    ``X`` (pop, n_var), ``F`` (pop, n_obj), ``G`` (pop, n_constr), ``CV`` (pop, 1) of the
-    population, ``n_iter`` (0-d, the generation counter, to match the two files), and
-    ``data.<key>`` for every numeric per-individual attribute the algorithm keeps (e.g.
-    ``data.rank`` (pop,), ``data.crowding`` (pop,)), and ``absent.<key>`` (pop,) bool for
-    an attribute that only some members have (the members without it).
-``checkpoint.json``
-    ``format`` = ``"adept_traj.checkpoint"``, ``version`` = 1, ``n_iter``, ``n_eval`` (the
-    evaluation counter), ``rng`` (the state of the algorithm's ``numpy`` generator), and what
-    the loop adds: ``fingerprint``, ``total_s`` [s], ``evaluation_s`` [s], ``history``.
+- ``X`` (pop, n_var), ``F`` (pop, n_obj), ``G`` (pop, n_constr), ``CV`` (pop, 1) of the
+  population and ``n_iter`` (0-d, the generation counter);
+- ``data.<key>`` for every numeric per-individual attribute the algorithm keeps (e.g.
+  ``data.rank`` (pop,), ``data.crowding`` (pop,)), and ``absent.<key>`` (pop,) bool for
+  an attribute that only some members have (the members without it);
+- ``loop.<key>``: arrays the loop adds (the feasible fronts of every generation so far);
+- ``meta`` (0-d text): JSON with ``format`` = ``"adept_traj.checkpoint"``, ``version`` = 2,
+  ``n_iter``, ``n_eval`` (the evaluation counter), ``rng`` (the state of the algorithm's
+  ``numpy`` generator), and what the loop adds: ``fingerprint``, ``total_s`` [s],
+  ``evaluation_s`` [s], ``history``.
+
+Version 1 (the same arrays, the metadata in a second file ``checkpoint.json``) is still
+read, so a run interrupted by an earlier release resumes.
 
 This module is the **only** one that relies on pymoo's internals (tested by
 ``tests/test_checkpoint.py``, so that a pymoo upgrade that changes them fails there with a
@@ -41,10 +47,18 @@ from pymoo.core.population import Population
 from adept_traj.errors import ConfigurationError
 from adept_traj.files import write_atomic
 
-__all__ = ["CHECKPOINT_VERSION", "load_checkpoint", "restore_algorithm", "save_checkpoint"]
+__all__ = [
+    "CHECKPOINT_VERSION",
+    "has_checkpoint",
+    "load_checkpoint",
+    "restore_algorithm",
+    "save_checkpoint",
+]
 
-#: Version of the checkpoint files (``checkpoint.json`` key ``version``).
-CHECKPOINT_VERSION = 1
+#: Version of the checkpoint file (``meta`` key ``version``); version 1 is still read.
+CHECKPOINT_VERSION = 2
+
+_ARRAYS, _META_V1 = "checkpoint.npz", "checkpoint.json"
 
 _FORMAT = "adept_traj.checkpoint"
 #: Keys the loop stores in ``checkpoint.json`` besides the algorithm's counters.
@@ -95,27 +109,35 @@ def _json_state(rng: np.random.Generator) -> dict[str, Any]:
     return json.loads(json.dumps(state, default=int))
 
 
-def save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
+def has_checkpoint(folder: Path) -> bool:
+    """Whether ``folder`` holds a checkpoint (of any version) to resume from."""
+    return (folder / _ARRAYS).is_file()
+
+
+def save_checkpoint(
+    folder: Path,
+    algorithm: Any,
+    meta: dict[str, Any],
+    extra: dict[str, np.ndarray] | None = None,
+) -> None:
     """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``.
 
     Parameters
     ----------
     folder:
-        Created if missing; ``checkpoint.npz`` and ``checkpoint.json`` are replaced atomically.
+        Created if missing; ``checkpoint.npz`` is replaced atomically (one file: a crash
+        leaves the previous checkpoint or this one).
     algorithm:
         A set-up, initialised pymoo algorithm.
     meta:
         JSON-ready values stored with it (the loop's ``fingerprint``, ``total_s`` [s],
         ``evaluation_s`` [s] and ``history``).
+    extra:
+        Further numeric arrays of the caller, stored as ``loop.<key>``.
     """
     folder.mkdir(parents=True, exist_ok=True)
     arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
-
-    def write_npz(path: Path) -> None:
-        with path.open("wb") as fh:
-            np.savez(fh, **arrays)
-
-    write_atomic(folder / "checkpoint.npz", write_npz)
+    arrays.update({f"loop.{key}": np.asarray(value) for key, value in (extra or {}).items()})
     state = {
         "format": _FORMAT,
         "version": CHECKPOINT_VERSION,
@@ -124,42 +146,61 @@ def save_checkpoint(folder: Path, algorithm: Any, meta: dict[str, Any]) -> None:
         "rng": _json_state(algorithm.random_state),
         **meta,
     }
-    write_atomic(folder / "checkpoint.json", lambda p: p.write_text(json.dumps(state, indent=1)))
+    arrays["meta"] = np.array(json.dumps(state))
+
+    def write_npz(path: Path) -> None:
+        with path.open("wb") as fh:
+            np.savez(fh, **arrays)
+
+    write_atomic(folder / _ARRAYS, write_npz)
+    (folder / _META_V1).unlink(missing_ok=True)  # of a version-1 checkpoint resumed here
 
 
 def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """Read a checkpoint folder: (metadata of ``checkpoint.json``, arrays of
-    ``checkpoint.npz``).
+    """Read a checkpoint folder: (metadata, arrays of ``checkpoint.npz`` without ``meta``).
 
     Raises
     ------
     ConfigurationError
         No checkpoint in ``folder``, unreadable or incomplete files, another format or
-        version, or files of two different generations (interrupted between the two writes).
+        version, or (version 1) files of two different generations.
     """
-    meta_path, npz_path = folder / "checkpoint.json", folder / "checkpoint.npz"
-    if not meta_path.is_file() or not npz_path.is_file():
-        raise ConfigurationError(f"{folder}: no checkpoint to resume (checkpoint.json/.npz)")
+    npz_path = folder / _ARRAYS
+    if not npz_path.is_file():
+        raise ConfigurationError(f"{folder}: no checkpoint to resume ({_ARRAYS})")
     try:
-        meta = json.loads(meta_path.read_text())
         with np.load(npz_path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
+        # Version 2 keeps its metadata inside; version 1 beside it in checkpoint.json.
+        version = CHECKPOINT_VERSION if "meta" in arrays else 1
+        text = str(arrays.pop("meta")) if version > 1 else _read_meta_v1(folder)
+        meta = json.loads(text)
     except (OSError, ValueError) as exc:
         raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
-    version = CHECKPOINT_VERSION
-    if meta.get("format") != _FORMAT or meta.get("version") != version:
-        raise ConfigurationError(f"{meta_path}: not an adept_traj checkpoint of version {version}")
+    if not isinstance(meta, dict) or (meta.get("format"), meta.get("version")) != (
+        _FORMAT,
+        version,
+    ):
+        raise ConfigurationError(f"{folder}: not an adept_traj checkpoint of version {version}")
     needed = {"n_iter", "n_eval", "rng"} | _LOOP_KEYS
     missing = sorted(needed - set(meta)) + sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays))
     if missing:
         raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {missing}")
     if int(arrays["n_iter"]) != meta["n_iter"]:
-        # Interrupted between the two atomic renames: the files are from two generations.
+        # Version 1, interrupted between its two renames: the files are of two generations.
         raise ConfigurationError(
             f"{folder}: checkpoint.npz (generation {int(arrays['n_iter']) - 1}) and "
-            f"checkpoint.json (generation {meta['n_iter'] - 1}) disagree; cannot resume exactly"
+            f"its metadata (generation {meta['n_iter'] - 1}) disagree; cannot resume exactly"
         )
     return meta, arrays
+
+
+def _read_meta_v1(folder: Path) -> str:
+    """The text of a version-1 checkpoint's ``checkpoint.json``."""
+    path = folder / _META_V1
+    if not path.is_file():
+        raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {_META_V1}")
+    return path.read_text()
 
 
 def restore_algorithm(algorithm: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:

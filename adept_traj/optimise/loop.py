@@ -5,10 +5,12 @@ pymoo's public ask/tell interface only. After every generation it can write a ch
 folder (:mod:`adept_traj.optimise.checkpoint`: ``checkpoint.json`` + ``checkpoint.npz``, no
 pickle): the population with every per-individual attribute the algorithm keeps (F, G, CV,
 rank, crowding, …), the generation and evaluation counters, the state of the algorithm's
-random generator and the timings so far. :func:`optimise` with ``resume=True`` restores all
-of it, so an interrupted run continues **exactly** as an uninterrupted one with the same
-seed (tested). Ctrl-C (``KeyboardInterrupt``) during a generation leaves the last finished
-generation on disk and raises :class:`PlanningInterrupted`.
+random generator, the feasible front of every generation so far and the timings.
+:func:`optimise` with ``resume=True`` restores all of it, so an interrupted run continues
+**exactly** as an uninterrupted one with the same seed (tested, killed at every
+generation). Ctrl-C (``KeyboardInterrupt``) during a generation leaves the last finished
+generation on disk and raises :class:`PlanningInterrupted` (whose ``checkpoint`` is
+``None`` if no generation was finished yet).
 """
 
 from __future__ import annotations
@@ -63,8 +65,8 @@ class RunState:
     total_s: float
     evaluation_s: float
     history: list[dict[str, Any]] = field(default_factory=list)
-    #: Per generation of this session (not restored on resume): the objectives (pymoo's
-    #: sense) of the population's feasible non-dominated members, for hypervolume history.
+    #: Per generation (restored on resume): the objectives (pymoo's sense) of the
+    #: population's feasible non-dominated members, for the hypervolume history.
     fronts: list[np.ndarray] = field(default_factory=list)
 
 
@@ -112,13 +114,15 @@ def optimise(
     ConfigurationError
         ``resume`` without a usable checkpoint, or a checkpoint of another run.
     PlanningInterrupted
-        On Ctrl-C; the last finished generation is in ``checkpoint`` (if given).
+        On Ctrl-C; the last finished generation is in ``checkpoint`` (if given; its
+        ``checkpoint`` attribute is ``None`` when nothing was checkpointed yet).
     """
     folder = Path(checkpoint) if checkpoint is not None else None
     fingerprint = fingerprint or {}
     algorithm.setup(problem, seed=seed, termination=("n_gen", n_gen), verbose=False)
     spent_total = spent_eval = 0.0
     history: list[dict[str, Any]] = []
+    fronts: list[np.ndarray] = []
     if resume:
         if folder is None:
             raise ConfigurationError("resume needs a checkpoint folder")
@@ -131,9 +135,9 @@ def optimise(
         restore_algorithm(algorithm, meta, arrays)
         spent_total, spent_eval = meta["total_s"], meta["evaluation_s"]
         history = meta["history"]
+        fronts = _restored_fronts(arrays, len(history))
     start = time.perf_counter() - spent_total
     evaluation_s = spent_eval
-    fronts: list[np.ndarray] = []
     try:
         while algorithm.has_next():
             infills = algorithm.ask()
@@ -174,13 +178,18 @@ def optimise(
                     "evaluation_s": evaluation_s,
                     "history": history,
                 }
-                save_checkpoint(folder, algorithm, meta)
+                save_checkpoint(folder, algorithm, meta, _stored_fronts(fronts))
             if progress is not None:
                 progress(info)
     except KeyboardInterrupt:
-        where = f"; resume from {folder}" if folder is not None else " (no checkpoint folder)"
+        if folder is None:
+            where, saved = " (no checkpoint folder)", None
+        elif not history:
+            where, saved = " (no generation finished: nothing checkpointed)", None
+        else:
+            where, saved = f"; resume from {folder}", folder
         raise PlanningInterrupted(
-            f"interrupted after generation {len(history)}{where}", folder
+            f"interrupted after generation {len(history)}{where}", saved
         ) from None
     pop = algorithm.pop
     return RunState(
@@ -195,3 +204,23 @@ def optimise(
         history=history,
         fronts=fronts,
     )
+
+
+def _stored_fronts(fronts: list[np.ndarray]) -> dict[str, np.ndarray]:
+    """The fronts of every generation as two arrays for the checkpoint: ``fronts`` (the rows
+    of all fronts, (k, n_obj)) and ``front_sizes`` (n_gen,)."""
+    return {"fronts": np.concatenate(fronts), "front_sizes": np.array([len(F) for F in fronts])}
+
+
+def _restored_fronts(arrays: dict[str, np.ndarray], n_generations: int) -> list[np.ndarray]:
+    """The per-generation fronts of a checkpoint: of its last generations (all of them, or
+    none for a version-1 checkpoint, or those after a version-1 checkpoint was resumed)."""
+    if "loop.front_sizes" not in arrays:
+        return []
+    sizes = arrays["loop.front_sizes"]
+    if len(sizes) > n_generations or sizes.sum() != len(arrays["loop.fronts"]):
+        raise ConfigurationError(
+            f"checkpoint: {len(sizes)} fronts of {sizes.sum()} rows stored for "
+            f"{n_generations} generations and {len(arrays['loop.fronts'])} rows"
+        )
+    return np.split(arrays["loop.fronts"], np.cumsum(sizes)[:-1])

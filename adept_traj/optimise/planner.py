@@ -46,6 +46,7 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.loop import GenerationInfo, optimise
+from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
     NO_FEASIBLE_WARNING,
@@ -185,6 +186,7 @@ def plan(
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
+    check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
     state = optimise(
         problem,
         alg,

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.files import write_atomic
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult
 from adept_traj.viz.inputs import as_result
@@ -162,6 +163,6 @@ def new_figure(width: float, height: float) -> Figure:
 
 
 def save_figure(fig: Figure, path: Path) -> Path:
-    """Write ``fig`` as a PNG at :data:`DPI`; return ``path``."""
-    fig.savefig(path, dpi=DPI)
-    return path
+    """Write ``fig`` as a PNG at :data:`DPI` atomically (no half-written figure is left by
+    a crash or Ctrl-C); return ``path``."""
+    return write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=DPI, format="png"))
