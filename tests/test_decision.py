@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from adept_traj.analysis import (
-    MAXIMISED,
     PAPER_WEIGHTS,
     BestTradeoff,
     average_fitness,
@@ -18,6 +17,7 @@ from adept_traj.analysis import (
     objective_weights,
 )
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.problem import MAXIMISED
 
 # Paper Table 3 (z1 [s], z2, z3, z4 [m²], z5, z6)
 Z_MAX = np.array([1.0, 9506597.528661, 0.00005, 0.157367, 279.932092, 269.784010])

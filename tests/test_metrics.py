@@ -14,7 +14,6 @@ import pytest
 from indicator_oracles import dominated_mask, first_copies, igd_loop, wfg_hypervolume
 
 from adept_traj.analysis import (
-    MAXIMISED,
     algorithm_effort,
     hypervolume,
     igd,
@@ -27,6 +26,7 @@ from adept_traj.analysis import (
     to_unit_minimisation,
 )
 from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
+from adept_traj.problem import MAXIMISED
 
 SQ2 = np.sqrt(2.0)
 

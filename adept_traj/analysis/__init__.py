@@ -21,7 +21,6 @@ from adept_traj.analysis.decision import (
 from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
-    MAXIMISED,
     hypervolume,
     igd,
     non_dominated,
@@ -43,7 +42,6 @@ __all__ = [
     "DEFAULT_RATE_HZ",
     "DEFAULT_TOLERANCE",
     "LIMIT_KINDS",
-    "MAXIMISED",
     "PAPER_WEIGHTS",
     "BestTradeoff",
     "Certificate",

@@ -47,7 +47,6 @@ from adept_traj.validation import as_finite_array, as_vector
 
 __all__ = [
     "DEFAULT_HV_REFERENCE",
-    "MAXIMISED",
     "hypervolume",
     "igd",
     "non_dominated",

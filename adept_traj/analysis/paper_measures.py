@@ -25,13 +25,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from adept_traj.analysis.indicators import (
-    MAXIMISED,
     _as_objectives,
     _as_sense,
     _minimisation_form,
     non_dominated,
 )
 from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
+from adept_traj.problem.objectives import MAXIMISED
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = [

@@ -24,7 +24,6 @@ import coal
 import numpy as np
 
 from adept_traj.collision.broad_phase import BroadPhase
-from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import distance_request
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
@@ -35,7 +34,6 @@ __all__ = [
     "CollisionChecker",
     "MinDistances",
     "PairDistances",
-    "point_signed_distance",
 ]
 
 

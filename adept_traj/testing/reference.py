@@ -7,12 +7,17 @@ sample and per (solid, obstacle) pair, with no broad phase; the spline is evalua
 by segment with scalar formulas (``_ReferenceSpline``), not with
 :mod:`~adept_traj.problem.spline_segments`; the constraints (paper (7)–(12)) and the
 circumscribing volumes of the paper's penalty (eqs. 13, 15) are written out here again. It
-shares no evaluation code with the batched problem, which makes it the oracle of the tests
-and the baseline of the benchmarks; it is not meant to be fast.
+shares no evaluation code with the batched problem — the Coulomb sign, the manipulability
+measure, the closed-form point distances of sphere obstacles and the paper's penalty are
+written out here too, scalar, one sample at a time — which makes it the oracle of the tests
+and the baseline of the benchmarks; it is not meant to be fast. What it shares with the
+batched path are the libraries (Pinocchio's RNEA and Jacobians, coal's distances), the
+problem's samples and its settings.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -20,10 +25,10 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from adept_traj.collision import distance_request, point_signed_distance
-from adept_traj.problem import Evaluation, TrajectoryProblem, paper_penalty
-from adept_traj.robot import LIMITS, TASK_ROWS, coulomb_sign, manipulability_measure
-from adept_traj.scene import Box, Sphere
+from adept_traj.collision import distance_request
+from adept_traj.problem import Evaluation, TrajectoryProblem
+from adept_traj.robot import LIMITS, TASK_ROWS, VELOCITY_AT_REST
+from adept_traj.scene import Box, Capsule, Cylinder, Sphere
 from adept_traj.validation import as_batch, check_type
 
 __all__ = ["evaluate_reference"]
@@ -65,6 +70,69 @@ def _semi_axes(problem: TrajectoryProblem) -> np.ndarray:
     return np.array(axes).reshape(-1, 3)
 
 
+def _coulomb_sign(v: float) -> float:
+    """sign(v), 0 at rest (|v| ≤ VELOCITY_AT_REST), one joint at a time."""
+    return 0.0 if abs(v) <= VELOCITY_AT_REST else math.copysign(1.0, v)
+
+
+def _manipulability(jt: np.ndarray) -> float:
+    """Yoshikawa's measure of a task Jacobian (m, n) with numpy's LU determinant."""
+    m, n = jt.shape
+    if m == n:
+        return abs(float(np.linalg.det(jt)))
+    gram = jt @ jt.T if m < n else jt.T @ jt
+    return math.sqrt(max(float(np.linalg.det(gram)), 0.0))
+
+
+def _point_to_solid(shape: Any, p: np.ndarray) -> float:
+    """Signed distance [m] of one point p (3,), in the solid's frame, to the solid (box,
+    cylinder or capsule along z, sphere), from the nearest point written case by case."""
+    x, y, z = (float(c) for c in p)
+    if isinstance(shape, Sphere):
+        return math.sqrt(x * x + y * y + z * z) - shape.radius
+    if isinstance(shape, Capsule):
+        half = 0.5 * shape.length
+        zc = min(max(z, -half), half)
+        return math.sqrt(x * x + y * y + (z - zc) ** 2) - shape.radius
+    if isinstance(shape, Cylinder):
+        r, half = math.hypot(x, y), 0.5 * shape.length
+        dr, dz = r - shape.radius, abs(z) - half
+        if dr <= 0.0 and dz <= 0.0:  # inside: to the nearer of the side and the caps
+            return max(dr, dz)
+        return math.hypot(max(dr, 0.0), max(dz, 0.0))
+    if isinstance(shape, Box):
+        half = 0.5 * np.asarray(shape.size, dtype=float)
+        e = np.abs([x, y, z]) - half
+        if (e <= 0.0).all():
+            return float(e.max())
+        return math.sqrt(sum(max(v, 0.0) ** 2 for v in e))
+    raise TypeError(f"no point distance for {type(shape).__name__}")
+
+
+def _paper_penalty(
+    tool: np.ndarray, centres: np.ndarray, axes: np.ndarray, rotations: np.ndarray | None
+) -> float:
+    """The paper's penalty (eqs. 13–16) by plain loops: tool (n_s, 3), centres (n_obs, n_s,
+    3), semi-axes (n_obs, 3), rotations (n_obs, n_s, 3, 3) or None (eq. 14 on spheres)."""
+    total = 0.0
+    for o in range(len(axes)):
+        closest = math.inf
+        for k in range(len(tool)):
+            d = tool[k] - centres[o, k]
+            if rotations is None:
+                r = math.sqrt(float(d @ d))  # eq. 14: r_t = ||x − x0||, inside when r ≤ r0
+                inside = r <= axes[o, 0]
+            else:
+                u = rotations[o, k].T @ d  # eq. 16 in the obstacle's own axes
+                r = max(float(np.sum(u * u / (axes[o] * axes[o]))), 1e-12)
+                inside = r <= 1.0
+            if inside:
+                closest = min(closest, r)
+        if math.isfinite(closest):
+            total += 1.0 / max(closest, 1e-12) ** 2
+    return total
+
+
 def _constraints(
     problem: TrajectoryProblem, extrema: dict[str, Any], tau_max: np.ndarray, d_min: float
 ) -> np.ndarray:
@@ -98,17 +166,17 @@ def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
         ref = _ReferenceSpline(P, T)
         z2 = z5 = z6 = 0.0
         z4 = np.inf
-        u_max = np.zeros(robot.nq)
+        tau_max = np.zeros(robot.nq)
         d_obs = np.full(n_obs, np.inf)
         tool_points, obs_poses = [], []
         for s, w in zip(problem.s, problem.weights):
             q, qd, qdd = ref.evaluate(s)
-            u = pin.rnea(model, data, q, qd, qdd) + model.damping * qd
-            u = u + model.friction * coulomb_sign(qd)
-            z2 += T * w * float(u @ u)
-            u_max = np.maximum(u_max, np.abs(u))
+            tau = pin.rnea(model, data, q, qd, qdd) + model.damping * qd
+            tau = tau + model.friction * np.array([_coulomb_sign(v) for v in qd])
+            z2 += T * w * float(tau @ tau)
+            tau_max = np.maximum(tau_max, np.abs(tau))
             jac = pin.computeFrameJacobian(model, data, q, tool_id, pin.LOCAL_WORLD_ALIGNED)
-            z4 = min(z4, float(manipulability_measure(jac[rows])))
+            z4 = min(z4, _manipulability(jac[rows]))
             pin.updateGeometryPlacements(model, data, gm, gdata, q)
             tool_points.append(data.oMf[tool_id].translation.copy())
             poses = problem.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]
@@ -121,7 +189,7 @@ def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
                         # Closed form, as documented (coal 3.0.3 misjudges a sphere's
                         # penetration depth near a cylinder cap).
                         centre = placement.rotation.T @ (poses[o, :3, 3] - placement.translation)
-                        d = float(point_signed_distance(solid_shapes[k], centre)) - ob.shape.radius
+                        d = _point_to_solid(solid_shapes[k], centre) - ob.shape.radius
                     else:
                         res = coal.DistanceResult()
                         tf_g = coal.Transform3s(placement.rotation, placement.translation)
@@ -134,17 +202,11 @@ def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
         else:
             poses = np.array(obs_poses).transpose(1, 0, 2, 3)  # (n_obs, n_s, 4, 4)
             rotations = None if st.z3 == "paper-sphere" else poses[..., :3, :3]
-            z3 = float(
-                paper_penalty(
-                    np.array(tool_points),
-                    poses[..., :3, 3],
-                    _semi_axes(problem),
-                    rotations=rotations,
-                    equation=14 if st.z3 == "paper-sphere" else 16,
-                )
+            z3 = _paper_penalty(
+                np.array(tool_points), poses[..., :3, 3], _semi_axes(problem), rotations
             )
         objectives.append([T, z2, z3, z4, z5, z6])
-        constraints.append(_constraints(problem, extrema, u_max, d_obs.min(initial=np.inf)))
+        constraints.append(_constraints(problem, extrema, tau_max, d_obs.min(initial=np.inf)))
         min_distances.append(np.minimum(d_obs, st.influence))
     return Evaluation(
         objectives=np.array(objectives),
