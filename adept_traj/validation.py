@@ -135,7 +135,7 @@ def check_type(value: Any, kind: type | tuple[type, ...], name: str) -> None:
     """Raise :class:`~adept_traj.errors.InvalidInputError` unless ``value`` is a ``kind``."""
     if not isinstance(value, kind):
         names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
-        raise InvalidInputError(f"{name} must be a {names}; got {type(value).__name__}")
+        raise InvalidInputError(f"{name} must be of type {names}; got {type(value).__name__}")
 
 
 def deep_equal(a: Any, b: Any) -> bool:

@@ -1,5 +1,5 @@
 """Cost of the front indicators: moocore (C, used by the library) against the hand-written
-numpy code it replaced (now the test oracles in ``tests/indicator_oracles.py``).
+numpy code it replaced (now the test oracles in ``adept_traj.testing.indicator_oracles``).
 
 Run: ``python benchmarks/bench_indicators.py [--repeat 5]``. Fronts of 50–500 mutually
 non-dominated points on the positive unit sphere in 6 objectives (the hardest case for the
@@ -10,16 +10,13 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import moocore
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from indicator_oracles import dominated_mask, wfg_hypervolume
+from adept_traj.testing.indicator_oracles import dominated_mask, wfg_hypervolume
 
 
 def median_of(fn: Callable[[], object], repeat: int) -> float:

@@ -25,7 +25,7 @@ def main() -> None:
         unit = "N" if robot.limits.units[k] == "m" else "N·m"
         peak = np.abs(tau[:, k]).max()
         print(
-            f"  {name}: peak |u| = {peak:7.2f} {unit} ({peak / robot.limits.torque[k]:.0%} of UC)"
+            f"  {name}: peak |τ| = {peak:7.2f} {unit} ({peak / robot.limits.torque[k]:.0%} of UC)"
         )
     print(f"manipulability along the move: {w.min():.4f} … {w.max():.4f} m²")
     bound = at.kinematic_lower_bound(

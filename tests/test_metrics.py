@@ -1,7 +1,7 @@
 """Tests of the indicators against hand values and independent numpy oracles.
 
 The library computes the hypervolume, dominance and IGD with moocore / pymoo; the oracles
-(``tests/indicator_oracles.py``: the WFG hypervolume, the pairwise dominance test, the IGD
+(``adept_traj.testing.indicator_oracles``: the WFG hypervolume, the pairwise dominance test, the IGD
 double loop) share no code with them.
 """
 
@@ -11,7 +11,6 @@ import itertools
 
 import numpy as np
 import pytest
-from indicator_oracles import dominated_mask, first_copies, igd_loop, wfg_hypervolume
 
 from adept_traj.analysis import (
     algorithm_effort,
@@ -27,6 +26,12 @@ from adept_traj.analysis import (
 )
 from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
 from adept_traj.problem import MAXIMISED
+from adept_traj.testing.indicator_oracles import (
+    dominated_mask,
+    first_copies,
+    igd_loop,
+    wfg_hypervolume,
+)
 
 SQ2 = np.sqrt(2.0)
 

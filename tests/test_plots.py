@@ -172,9 +172,9 @@ def test_tool_path_with_a_replay_loads_nothing(
 @pytest.mark.parametrize(
     ("make", "match"),
     [
-        (lambda res: [], "replays must be a Mapping"),
+        (lambda res: [], "replays must be of type Mapping"),
         (lambda res: {"other": None}, "names no result"),
-        (lambda res: {"mode": "replay"}, "replay must be a Replay"),
+        (lambda res: {"mode": "replay"}, "replay must be of type Replay"),
         (lambda res: {"mode": Replay.of(res["nsga2"])}, "best_x"),  # another result's
     ],
     ids=["list", "unknown-name", "not-a-replay", "other-result"],

@@ -42,8 +42,8 @@ def test_as_integer():
 
 
 def test_check_type():
-    check_type(1.0, (int, float), "x")
-    with pytest.raises(InvalidInputError, match="x must be a int or float; got str"):
+    assert check_type(1.0, (int, float), "x") is None
+    with pytest.raises(InvalidInputError, match="x must be of type int or float; got str"):
         check_type("1", (int, float), "x")
 
 

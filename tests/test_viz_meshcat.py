@@ -212,7 +212,7 @@ def test_replay_of_another_solution(result: PlanningResult, problem: TrajectoryP
     other = Replay.of(result, x, robot=problem.robot, scene=problem.scene)
     with pytest.raises(InvalidInputError, match="best_x"):
         playback.build_animation(result, replay=other)
-    with pytest.raises(InvalidInputError, match="replay must be a Replay"):
+    with pytest.raises(InvalidInputError, match="replay must be of type Replay"):
         playback.build_animation(result, replay=problem)
     # the same x from another start: another move (the viewer used to check x alone)
     moved = BSplineTrajectory(

@@ -72,24 +72,24 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError(f"--samples must be at least 2; got {args.samples}")
     check_memory(samples_bytes(args.samples, robot.nq), "--samples", args.samples)
     t, q, v, a = _quintic_move(start, goal, args.duration, args.samples)
-    u = robot.inverse_dynamics(q, v, a)
+    tau = robot.inverse_dynamics(q, v, a)
     lim = robot.limits
     print(f"{robot.name}: quintic rest-to-rest move in T = {args.duration:g} s")
     print(f"  start {np.array2string(start, precision=4)}")
     print(f"  goal  {np.array2string(goal, precision=4)}")
-    print(f"  {'joint':<8}{'peak |q̇|':>16}{'peak |q̈|':>17}{'peak |u|':>14}{'UC':>6}{'|u|/UC':>8}")
+    print(f"  {'joint':<8}{'peak |q̇|':>16}{'peak |q̈|':>17}{'peak |τ|':>14}{'UC':>6}{'|τ|/UC':>8}")
     for k, name in enumerate(robot.joint_names):
         unit = lim.units[k]
         force = "N" if unit == "m" else "N·m"
-        peak_u = np.abs(u[:, k]).max()
+        peak_tau = np.abs(tau[:, k]).max()
         print(
             f"  {name:<8}{np.abs(v[:, k]).max():>9.3f} {unit + '/s':<6}"
-            f"{np.abs(a[:, k]).max():>9.3f} {unit + '/s²':<7}{peak_u:>9.2f} {force:<4}"
-            f"{lim.torque[k]:>6.0f}{peak_u / lim.torque[k]:>8.3f}"
+            f"{np.abs(a[:, k]).max():>9.3f} {unit + '/s²':<7}{peak_tau:>9.2f} {force:<4}"
+            f"{lim.torque[k]:>6.0f}{peak_tau / lim.torque[k]:>8.3f}"
         )
     dt = np.diff(t)
-    energy = np.sum(0.5 * ((u[1:] ** 2).sum(1) + (u[:-1] ** 2).sum(1)) * dt)
-    print(f"  ∫ Σ u² dt (paper z2) = {energy:.2f} [N²·m²·s]")
+    energy = np.sum(0.5 * ((tau[1:] ** 2).sum(1) + (tau[:-1] ** 2).sum(1)) * dt)
+    print(f"  ∫ Σ τ² dt (paper z2) = {energy:.2f} [N²·m²·s]")
     if robot.task_rows is not None:
         w = robot.manipulability(q)
         print(f"  manipulability (paper z4): min {w.min():.5f}, max {w.max():.5f} [m²]")

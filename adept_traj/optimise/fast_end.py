@@ -141,8 +141,9 @@ class FastEndSearch:
         return Population.merge(off[keep], Population.new(X=children))
 
     def _perturb(self, problem: Any, parents: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """Smooth perturbations of the parents' free control points (:func:`_modes` over the
-        Greville abscissae), clipped to the bounds; T is set afterwards."""
+        """Smooth perturbations of the parents' free control points (cos⁴ bumps times
+        ``_envelope`` over the Greville abscissae), clipped to the bounds; T is set
+        afterwards."""
         traj = problem.trajectory
         _, P = traj.decode(parents)
         free = P[:, 3:-3, :]  # (n, n_free, nq)

@@ -110,7 +110,7 @@ class Robot:
     visual_model : pinocchio.GeometryModel
         The visual geometry (same solids for the AdeptOne XL), for display.
     limits : JointLimits
-        Position, velocity, acceleration, jerk and effort limits (``inf`` when unknown).
+        Position, velocity, acceleration, jerk and torque limits (``inf`` when unknown).
     tool_frame : str
         Name of the tool frame used by :meth:`tool_pose` and :meth:`manipulability`.
     task_rows : tuple of str or None
@@ -175,7 +175,7 @@ class Robot:
         ----------
         urdf:
             Path of the URDF. Its ``<inertial>``, ``<limit>`` and ``<dynamics damping
-            friction>`` give masses, position/velocity/effort limits and friction.
+            friction>`` give masses, position/velocity/torque (URDF: effort) limits and friction.
         params:
             Optional parameter file (TOML path or :class:`RobotParameters`): acceleration
             and jerk limits, rotor inertia × gear ratio² (→ ``model.armature``), and
