@@ -27,3 +27,14 @@ def test_result_saved_by_the_flat_layout_reverifies(capsys):
     assert main(["verify", str(OLD)]) == 1  # not feasible, as stored
     out = capsys.readouterr().out
     assert "distance: -0.01492 m < margin 0.01 m at t = 0.684 s (link4/gripper – cube1)" in out
+
+
+def test_result_saved_by_the_flat_layout_is_written_back_unchanged(tmp_path):
+    """Load and save reproduce the three files: the CSVs byte for byte, result.json as the
+    same JSON data (versions included: they record the run, not the reader)."""
+    at.PlanningResult.load(OLD).save(tmp_path)
+    for name in ("front.csv", "best_trajectory.csv"):
+        assert (tmp_path / name).read_bytes() == (OLD / name).read_bytes(), name
+    old = json.loads((OLD / "result.json").read_text(encoding="utf-8"))
+    new = json.loads((tmp_path / "result.json").read_text(encoding="utf-8"))
+    assert new == old
