@@ -201,7 +201,7 @@ class _Auditor:
         finite = np.isfinite(s) & np.isfinite(c)
         mag = np.where(finite, np.maximum(np.abs(s), np.abs(c)), 0.0)
         scale = mag.max(axis=0) if s.ndim == 2 and s.size else (mag.max() if s.size else 0.0)
-        gap = np.where(finite, np.abs(s - c), np.inf)
+        gap = np.abs(np.subtract(s, c, out=np.full(s.shape, np.inf), where=finite))
         bad = (s != c) & (gap > AUDIT_RTOL * scale)
         if rows:
             blocks = [(path.format(i), s[i], c[i], bad[i], gap[i]) for i in range(len(s))]
