@@ -139,7 +139,7 @@ def test_deleted_obstacle_is_named(old, capsys) -> None:
     code, found, _ = _verify(old, capsys)
     assert code == status.MISMATCH
     n = len(raw["scene"]["obstacle"])
-    assert found["scene.obstacle"] == (f"'{n - 1} items'", f"'{n} items'")
+    assert found["scene.obstacle"] == (str(n - 1), str(n))
     # without cube 1 the best no longer collides: the stored certificate disagrees too
     assert "certificate.closest_pair" in found
 
@@ -179,6 +179,26 @@ def test_feasible_run_with_changed_hypervolume_and_robot_file(tmp_path: Path) ->
     params.write_text(params.read_text() + '[[joint]]\nname = "shoulder"\nvelocity = 0.5\n')
     fields = {m.field for m in audit(result).mismatches}
     assert "limits.qd[0]" in fields
+
+
+def test_feasible_member_marked_infeasible_is_named(tmp_path: Path) -> None:
+    result = _planar_run(tmp_path)
+    k = len(result.front) - 1
+    assert np.all(result.front.constraints[k] <= 0.0)
+    flags = result.front.feasible.copy()
+    flags[k] = False
+    f = result.front
+    found = audit(dataclasses.replace(result, front=Front(f.x, f.objectives, f.constraints, flags)))
+    by_field = {m.field: m for m in found.mismatches}
+    assert set(by_field) == {f"front[{k}].feasible", f"front[{k}]"}
+    assert (
+        by_field[f"front[{k}].feasible"].stored,
+        by_field[f"front[{k}].feasible"].recomputed,
+    ) == (
+        False,
+        True,
+    )
+    assert by_field[f"front[{k}]"].stored == "infeasible member"
 
 
 def test_mismatch_line_format(old, tmp_path, capsys) -> None:

@@ -237,7 +237,7 @@ class _Auditor:
         elif isinstance(stored, list) and isinstance(recomputed, list):
             if len(stored) != len(recomputed):
                 self.count(1, 1)
-                self.add(path, f"{len(stored)} items", f"{len(recomputed)} items")
+                self.add(path, len(stored), len(recomputed), "number of items")
                 return
             for i, (a, b) in enumerate(zip(stored, recomputed, strict=True)):
                 self.tree(f"{path}[{i}]", a, b)
@@ -310,13 +310,12 @@ class _Auditor:
             self.value(f"front[{i}].feasible", bool(stored), bool(now))
         if not front.feasible.any():
             return  # the least-infeasible members of a population that is not stored
-        rule = "plan keeps only the feasible non-dominated members"
-        for i in np.flatnonzero(~front.feasible):
-            self.add(f"front[{i}].feasible", False, True, rule)
+        rule = "plan keeps only the feasible non-dominated members when one is feasible"
         kept = non_dominated(front.objectives)
         self.count(len(front), len(front))
-        for i in np.flatnonzero(~kept):
-            self.add(f"front[{i}]", "non-dominated", "dominated by another member", rule)
+        for i in np.flatnonzero(~front.feasible | ~kept):
+            member = "infeasible member" if not front.feasible[i] else "dominated member"
+            self.add(f"front[{i}]", member, "not in the front", rule)
 
     def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
         self.value(f"{path}.feasible", stored.feasible, now.feasible)
