@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import signal
 
-__all__ = ["BAD_INPUT", "INTERRUPTED", "NOT_CERTIFIED", "OK", "TERMINATED"]
+__all__ = ["BAD_INPUT", "INTERRUPTED", "MISMATCH", "NOT_CERTIFIED", "OK", "TERMINATED"]
 
 #: Success (``show``: stopped with Ctrl-C).
 OK = 0
@@ -13,6 +13,10 @@ OK = 0
 NOT_CERTIFIED = 1
 #: Bad input: one line ``adept-traj: error: …`` on standard error.
 BAD_INPUT = 2
+#: ``verify``: a value stored in the result folder differs from its recomputation (the
+#: folder was altered, or the robot's files changed since the run); takes precedence over
+#: :data:`NOT_CERTIFIED`.
+MISMATCH = 3
 #: ``plan``, ``compare``: stopped with Ctrl-C (128 + SIGINT).
 INTERRUPTED = 128 + signal.SIGINT
 #: ``show``: stopped with SIGTERM (128 + SIGTERM); its meshcat server is stopped too.

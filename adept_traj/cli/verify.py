@@ -1,8 +1,13 @@
-"""``adept-traj verify DIR``: re-run the dense verification of a saved result.
+"""``adept-traj verify DIR``: re-run the dense verification of a saved result and audit
+every stored number that can be recomputed.
 
 This is the one command that rebuilds the full problem (``result.problem()``, with its
-collision checker): re-certification needs it. Exit status 0 if the best trade-off is
-feasible, 1 if not.
+collision checker): re-certification needs it. Exit status (:mod:`adept_traj.cli.status`):
+0 if the best trade-off is feasible and the folder holds what its decision vectors give,
+1 (:data:`~adept_traj.cli.status.NOT_CERTIFIED`) if the best trade-off is not feasible,
+3 (:data:`~adept_traj.cli.status.MISMATCH`) if a stored value differs from its
+recomputation (:func:`~adept_traj.results.audit`; one ``mismatch:`` line each), whatever
+the verdict.
 
 One line per limit kind gives the worst ratio over the joints that have the limit and its
 bound (position: fraction of the range beyond the nearer limit, bound 0; the others:
@@ -18,11 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from adept_traj.analysis import LimitCheck, certify, check_certificate_memory
+from adept_traj.analysis import PAPER_WEIGHTS, LimitCheck, certify, check_certificate_memory
 from adept_traj.cli import status
-from adept_traj.cli.arguments import check_rate
-from adept_traj.results import PlanningResult
+from adept_traj.cli.arguments import check_rate, floats
+from adept_traj.results import PlanningResult, audit
 from adept_traj.robot import JointLimits
+from adept_traj.scene import Scene
 
 __all__ = ["add_parser", "run"]
 
@@ -32,6 +38,17 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("verify", help="re-run the dense verification of a saved result")
     p.add_argument("folder", type=Path, help="result folder (with result.json)")
     p.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
+    p.add_argument(
+        "--weights",
+        type=floats,
+        default=list(PAPER_WEIGHTS),
+        help="w1,...,w6 for f_c as given to plan (default: the paper's)",
+    )
+    p.add_argument(
+        "--scene",
+        help="'paper' or the scene TOML file the run was planned on, compared with the stored "
+        "scene (default: the paper scene when the stored scene is named 'paper')",
+    )
     return p
 
 
@@ -49,21 +66,28 @@ def _limit_line(check: LimitCheck, limits: JointLimits) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``verify``; return the exit status (0 feasible, 1 not)."""
+    """Run ``verify``; return the exit status (0 feasible and no mismatch, 1 not feasible,
+    3 a mismatch)."""
     rate = check_rate(args.rate)
     result = PlanningResult.load(args.folder)
+    scene = None
+    if args.scene is not None:
+        scene = Scene.paper() if args.scene == "paper" else Scene.from_file(args.scene)
     problem = result.problem()
     try:
         check_certificate_memory(problem, rate, float(result.best_x[0]), option="--rate")
         t0 = time.perf_counter()
-        cert = certify(problem, result.best_x, rate_hz=rate)
+        found = audit(result, weights=args.weights, scene=scene, problem=problem)
+        cert = found.certificate
+        if rate != cert.rate_hz:
+            cert = certify(problem, result.best_x, rate_hz=rate)
         elapsed = time.perf_counter() - t0
         limits = problem.robot.limits
     finally:
         problem.close()
     print(
-        f"{args.folder}: re-verified at {rate:g} Hz ({cert.n_samples} samples, "
-        f"{elapsed:.2f} s): {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
+        f"{args.folder}: re-verified at {rate:g} Hz ({cert.n_samples} samples): "
+        f"{'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f"; min distance {cert.min_distance:.4f} m (margin {cert.margin} m)"
     )
     for check in cert.checks:
@@ -72,4 +96,21 @@ def run(args: argparse.Namespace) -> int:
         print(f"  violation: {violation}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")
+    for mismatch in found.mismatches:
+        print(f"  mismatch: {mismatch}")
+    for item in found.not_checked:
+        print(f"  not checked: {item}")
+    n = len(found.mismatches)
+    verdict = (
+        "no mismatch"
+        if found.ok
+        else f"{n} mismatch{'es' if n > 1 else ''}: the folder does not hold what its "
+        "decision vectors give"
+    )
+    print(
+        f"  audit: {found.n_values} values in {found.n_fields} fields recomputed and compared "
+        f"({elapsed:.2f} s): {verdict}"
+    )
+    if not found.ok:
+        return status.MISMATCH
     return status.OK if cert.feasible else status.NOT_CERTIFIED

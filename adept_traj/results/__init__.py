@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 from adept_traj.errors import ResultFormatError
+from adept_traj.results.audit import AUDIT_RTOL, Audit, Mismatch, audit
 from adept_traj.results.parts import (
     SHIPPED_ROBOT,
     BestSolution,
@@ -37,6 +38,7 @@ from adept_traj.results.ros_export import (
 )
 
 __all__ = [
+    "AUDIT_RTOL",
     "FORMAT",
     "FRONT_FILE",
     "MAX_ROS_POINTS",
@@ -45,15 +47,18 @@ __all__ = [
     "SHIPPED_ROBOT",
     "TRAJECTORY_FILE",
     "VERSION",
+    "Audit",
     "BestSolution",
     "Front",
     "GenerationRecord",
     "Metrics",
+    "Mismatch",
     "PlanningResult",
     "Replay",
     "ResultFormatError",
     "RobotInfo",
     "Timing",
+    "audit",
     "save_ros_joint_trajectory",
     "software_versions",
     "to_csv",

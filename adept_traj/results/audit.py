@@ -1,0 +1,390 @@
+r"""Audit of a saved result: every stored number that can be recomputed is recomputed and
+compared (``adept-traj verify``; the list is in ``docs/results.md``).
+
+:func:`audit` rebuilds the problem of a :class:`~adept_traj.results.PlanningResult` from
+its robot files and stored scene (:meth:`PlanningResult.problem`) and compares, field by
+field of ``result.json``:
+
+- the robot's name, joints, tool frame and limits, and the kinematic lower bound of the
+  travel time, against the reloaded robot (:func:`~adept_traj.problem.kinematic_lower_bound`);
+- the stored scene against the scene rebuilt from it and against a reference scene (the
+  shipped paper scene when the stored one is named ``"paper"``, or the one given);
+- every front member's objectives and constraints against
+  :meth:`~adept_traj.problem.TrajectoryProblem.evaluate_batch` of its decision vector, its
+  ``feasible`` flag against the recomputed constraints, and, when the front has a feasible
+  member, that every member is feasible and none dominates another (how ``plan`` builds it);
+- the certificate (dense trajectory t, q, qd, qdd, qddd, tau, min_distance; every limit
+  check, the minimum distance, its time and pair, the violations, the verdict) against a
+  fresh :func:`~adept_traj.analysis.certify` at the stored rate and tolerance;
+- ``best.F_avg`` and ``best.f_c`` against :func:`~adept_traj.analysis.best_tradeoff` of the
+  stored front with ``weights`` (not stored: ``plan``'s are the paper's unless changed),
+  and ``best.index`` against ``plan``'s rule (the trade-off order; when the choice is not
+  the first, the members before it must fail certification: they are certified again);
+- the metrics SSM, OO, AE, HV and the HV reference point, recomputed as ``plan`` does from
+  the stored front and timing.
+
+Numbers agree when equal or within a relative tolerance :data:`AUDIT_RTOL` of the field's
+magnitude (per column of a matrix, i.e. per quantity and joint):
+
+.. math::
+
+    |s - r| \le \varepsilon \max_{\text{column}} \max(|s|, |r|), \qquad
+    \varepsilon = 10^{-9}
+
+Evaluation is deterministic, but not bit-identical across batch sizes, numpy builds and
+processors (a result re-evaluated alone differs from its population's values in the last
+bit: 4.5e-13 on an energy of 2 433 J, 7e-15 N·m on torques of 50 N·m); a tampered value
+(q shifted by 0.05 rad, a halved objective, zeroed torques) is many orders above it.
+Infinite values must be equal. RNI (needs the final population) and the per-generation
+hypervolumes (need every generation's front) cannot be recomputed: :attr:`Audit.not_checked`
+names them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from adept_traj.analysis import (
+    DEFAULT_HV_REFERENCE,
+    PAPER_WEIGHTS,
+    Certificate,
+    algorithm_effort,
+    best_tradeoff,
+    certify,
+    non_dominated,
+    normalised_hypervolume,
+    objective_bounds,
+    objective_weights,
+    optimizer_overhead,
+    spread,
+)
+from adept_traj.problem import OBJECTIVE_NAMES, TrajectoryProblem
+from adept_traj.results.record import PlanningResult
+from adept_traj.robot import LIMITS
+from adept_traj.scene import Scene
+from adept_traj.validation import check_type, deep_equal
+
+__all__ = ["AUDIT_RTOL", "Audit", "Mismatch", "audit"]
+
+#: Relative tolerance of the comparison of a stored and a recomputed number (module doc).
+AUDIT_RTOL = 1e-9
+#: What cannot be recomputed from a result folder.
+NOT_RECOMPUTABLE = (
+    "metrics.RNI (needs the final population, which is not stored)",
+    "history[*].hypervolume (needs every generation's front, which is not stored)",
+)
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """A stored value that differs from its recomputation.
+
+    Attributes
+    ----------
+    field: its path in ``result.json``, e.g. ``front[3].objectives[1]``,
+        ``best_trajectory.tau[12][2]`` (for an array: its worst element).
+    stored: the stored value.
+    recomputed: the recomputed value.
+    note: what else the reader should know (how many values of the field differ, …).
+    """
+
+    field: str
+    stored: Any
+    recomputed: Any
+    note: str = ""
+
+    def __str__(self) -> str:
+        text = f"{self.field}: stored {_show(self.stored)}, recomputed {_show(self.recomputed)}"
+        return f"{text} ({self.note})" if self.note else text
+
+
+@dataclass(frozen=True, eq=False)
+class Audit:
+    """What :func:`audit` found.
+
+    Attributes
+    ----------
+    mismatches: every :class:`Mismatch` (empty: the folder holds what its decision vectors
+        give).
+    n_fields: fields compared (an array counts once; one per front member and field).
+    n_values: numbers and other values compared.
+    not_checked: what could not be compared, and why.
+    certificate: the fresh :class:`~adept_traj.analysis.Certificate` of the best solution
+        at the stored rate.
+    """
+
+    mismatches: tuple[Mismatch, ...]
+    n_fields: int
+    n_values: int
+    not_checked: tuple[str, ...]
+    certificate: Certificate
+
+    @property
+    def ok(self) -> bool:
+        """No mismatch."""
+        return not self.mismatches
+
+
+def audit(
+    result: PlanningResult,
+    *,
+    weights: ArrayLike = PAPER_WEIGHTS,
+    scene: Scene | None = None,
+    problem: TrajectoryProblem | None = None,
+) -> Audit:
+    """Recompute every stored number of ``result`` that can be and compare (module doc).
+
+    Parameters
+    ----------
+    result: the loaded result.
+    weights: (6,) the weights of f_c given to ``plan`` (default: the paper's).
+    scene: the scene the run was planned on, to compare the stored one with; default: the
+        shipped paper scene when the stored scene is named ``"paper"``, else none.
+    problem: ``result.problem()`` if the caller has built it (left open); default: built
+        here and closed.
+
+    Returns
+    -------
+    Audit
+        The mismatches, what was compared and the fresh certificate.
+    """
+    check_type(result, PlanningResult, "result")
+    w = objective_weights(weights, len(OBJECTIVE_NAMES))
+    if scene is not None:
+        check_type(scene, Scene, "scene")
+    elif result.scene.get("name") == "paper":
+        scene = Scene.paper()
+    if problem is not None:
+        check_type(problem, TrajectoryProblem, "problem")
+        return _Auditor(result, problem, w, scene).run()
+    with result.problem() as built:
+        return _Auditor(result, built, w, scene).run()
+
+
+def _show(value: Any) -> str:
+    """A value as printed in a mismatch: floats in shortest round-trip form."""
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, (np.integer, np.bool_)):
+        return repr(value.item())
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def _index(idx: tuple[int, ...]) -> str:
+    return "".join(f"[{int(i)}]" for i in idx)
+
+
+class _Auditor:
+    """Collects the comparisons of one audit."""
+
+    def __init__(
+        self, result: PlanningResult, problem: TrajectoryProblem, weights: Any, scene: Any
+    ) -> None:
+        self.r, self.p, self.weights, self.scene = result, problem, weights, scene
+        self.mismatches: list[Mismatch] = []
+        self.not_checked = list(NOT_RECOMPUTABLE)
+        self.n_fields = self.n_values = 0
+
+    # ------------------------------------------------------------------ comparisons
+    def numbers(self, path: str, stored: Any, recomputed: Any, rows: bool = False) -> None:
+        """Compare two arrays of numbers (module doc); ``rows``: one field per row, named
+        ``path.format(row)``."""
+        s, c = np.asarray(stored, dtype=float), np.asarray(recomputed, dtype=float)
+        if s.shape != c.shape:
+            self.count(1, 1)
+            self.add(path.format("*"), f"shape {s.shape}", f"shape {c.shape}")
+            return
+        finite = np.isfinite(s) & np.isfinite(c)
+        mag = np.where(finite, np.maximum(np.abs(s), np.abs(c)), 0.0)
+        scale = mag.max(axis=0) if s.ndim == 2 and s.size else (mag.max() if s.size else 0.0)
+        gap = np.abs(np.subtract(s, c, out=np.full(s.shape, np.inf), where=finite))
+        bad = (s != c) & (gap > AUDIT_RTOL * scale)
+        if rows:
+            blocks = [(path.format(i), s[i], c[i], bad[i], gap[i]) for i in range(len(s))]
+        else:
+            blocks = [(path, s, c, bad, gap)]
+        self.count(len(blocks), s.size)
+        for name, sv, cv, bv, gv in blocks:
+            if bv.any():
+                worst = np.unravel_index(int(np.argmax(np.where(bv, gv, -1.0))), bv.shape)
+                n_bad = int(bv.sum())
+                note = f"{n_bad} of {bv.size} values differ" if n_bad > 1 else ""
+                self.add(name + _index(worst), sv[worst], cv[worst], note)
+
+    def value(self, path: str, stored: Any, recomputed: Any, note: str = "") -> None:
+        """Compare two values of any other kind (exactly, :func:`deep_equal`)."""
+        self.count(1, 1)
+        if not deep_equal(stored, recomputed):
+            self.add(path, stored, recomputed, note)
+
+    def optional(self, path: str, stored: float | None, recomputed: float | None) -> None:
+        """Compare two numbers either of which may be ``None`` (not computed)."""
+        if stored is None or recomputed is None:
+            self.value(path, stored, recomputed)
+        else:
+            self.numbers(path, stored, recomputed)
+
+    def tree(self, path: str, stored: Any, recomputed: Any) -> None:
+        """Compare two parsed documents (dicts, lists, leaves) leaf by leaf."""
+        if isinstance(stored, dict) and isinstance(recomputed, dict):
+            for key in sorted(set(stored) | set(recomputed), key=str):
+                missing = "(absent)"
+                self.tree(f"{path}.{key}", stored.get(key, missing), recomputed.get(key, missing))
+        elif isinstance(stored, list) and isinstance(recomputed, list):
+            if len(stored) != len(recomputed):
+                self.count(1, 1)
+                self.add(path, len(stored), len(recomputed), "number of items")
+                return
+            for i, (a, b) in enumerate(zip(stored, recomputed, strict=True)):
+                self.tree(f"{path}[{i}]", a, b)
+        else:
+            self.value(path, stored, recomputed)
+
+    def count(self, fields: int, values: int) -> None:
+        self.n_fields += fields
+        self.n_values += values
+
+    def add(self, path: str, stored: Any, recomputed: Any, note: str = "") -> None:
+        self.mismatches.append(Mismatch(path, stored, recomputed, note))
+
+    # ------------------------------------------------------------------ the audit
+    def run(self) -> Audit:
+        self.robot()
+        self.scenes()
+        self.front()
+        certificate = certify(
+            self.p,
+            self.r.best_x,
+            rate_hz=self.r.certificate.rate_hz,
+            tolerance=self.r.certificate.position.tolerance,
+        )
+        self.certificate("certificate", self.r.certificate, certificate)
+        self.best(certificate)
+        self.metrics()
+        return Audit(
+            tuple(self.mismatches),
+            self.n_fields,
+            self.n_values,
+            tuple(self.not_checked),
+            certificate,
+        )
+
+    def robot(self) -> None:
+        r, robot = self.r, self.p.robot
+        self.value("robot.name", r.robot.name, robot.name)
+        self.value("robot.joint_names", list(r.robot.joint_names), list(robot.joint_names))
+        self.value("robot.tool_frame", r.robot.tool_frame, robot.tool_frame)
+        stored, now = r.limits, robot.limits
+        self.value("limits.units", list(stored.units), list(now.units))
+        self.numbers("limits.q_lower", stored.lower, now.lower)
+        self.numbers("limits.q_upper", stored.upper, now.upper)
+        for kind in LIMITS[1:]:
+            self.numbers(f"limits.{kind.quantity}", stored.bound(kind.name), now.bound(kind.name))
+        lb, now_lb = r.lower_bound, self.p.lower_bound
+        self.numbers("lower_bound.T_min", lb.T_min, now_lb.T_min)
+        self.numbers("lower_bound.per_joint", lb.times, now_lb.times)
+        self.numbers("lower_bound.delta", lb.delta, now_lb.delta)
+        self.value("lower_bound.limiting_joint", lb.limiting_joint, now_lb.limiting_joint)
+        self.value("lower_bound.cases", list(lb.cases), list(now_lb.cases))
+
+    def scenes(self) -> None:
+        self.tree("scene", self.r.scene, self.p.scene.to_dict())
+        if self.scene is None:
+            self.not_checked.append(
+                f"scene against its file (the stored scene is named "
+                f"{self.r.scene.get('name')!r}; give the file: verify --scene FILE)"
+            )
+        else:
+            self.tree("scene", self.r.scene, self.scene.to_dict())
+
+    def front(self) -> None:
+        front = self.r.front
+        ev = self.p.evaluate_batch(front.x)
+        self.numbers("front[{}].objectives", front.objectives, ev.objectives, rows=True)
+        self.numbers("front[{}].constraints", front.constraints, ev.constraints, rows=True)
+        for i, (stored, now) in enumerate(zip(front.feasible, ev.feasible, strict=True)):
+            self.value(f"front[{i}].feasible", bool(stored), bool(now))
+        if not front.feasible.any():
+            return  # the least-infeasible members of a population that is not stored
+        rule = "plan keeps only the feasible non-dominated members when one is feasible"
+        kept = non_dominated(front.objectives)
+        self.count(len(front), len(front))
+        for i in np.flatnonzero(~front.feasible | ~kept):
+            member = "infeasible member" if not front.feasible[i] else "dominated member"
+            self.add(f"front[{i}]", member, "not in the front", rule)
+
+    def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
+        self.value(f"{path}.feasible", stored.feasible, now.feasible)
+        self.value(f"{path}.n_samples", stored.n_samples, now.n_samples)
+        self.numbers(f"{path}.margin", stored.margin, now.margin)
+        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
+        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
+        self.value(f"{path}.closest_pair", stored.closest_pair, now.closest_pair)
+        self.value(f"{path}.violations", list(stored.violations), list(now.violations))
+        for old, new in zip(stored.checks, now.checks, strict=True):
+            for name in ("dense", "t_worst"):
+                self.numbers(f"{path}.{old.kind}.{name}", getattr(old, name), getattr(new, name))
+            if old.exact is None or new.exact is None:
+                self.value(f"{path}.{old.kind}.exact", old.exact, new.exact)
+            else:
+                self.numbers(f"{path}.{old.kind}.exact", old.exact, new.exact)
+        for name in ("t", *(kind.quantity for kind in LIMITS), "min_distance"):
+            self.numbers(
+                f"best_trajectory.{name}", getattr(stored.dense, name), getattr(now.dense, name)
+            )
+
+    def best(self, certificate: Certificate) -> None:
+        r = self.r
+        choice = best_tradeoff(r.front.objectives, self.weights)
+        i = r.best.index
+        self.optional("best.F_avg", r.best.f_avg, float(choice.F_avg[i]))
+        weights = ",".join(f"{w:g}" for w in self.weights)
+        self.count(1, 1)
+        if r.best.f_c is not None and not _close(r.best.f_c, float(choice.f_c[i])):
+            self.add("best.f_c", r.best.f_c, float(choice.f_c[i]), f"with weights {weights}")
+        expected = self.expected_index(choice.order, certificate)
+        self.value("best.index", i, expected, f"plan's rule with weights {weights}")
+
+    def expected_index(self, order: np.ndarray, certificate: Certificate) -> int:
+        """``plan``'s choice: the first of the trade-off order, or when its certificate
+        fails, the first member after it marked feasible whose certificate passes."""
+        r, first = self.r, int(order[0])
+        if r.best.index == first:
+            return first  # the members after it are not certified again
+        rank = int(np.flatnonzero(order == r.best.index)[0])
+        tried = [first] + [int(k) for k in order[1:rank] if r.front.feasible[k]]
+        rate, tol = r.certificate.rate_hz, r.certificate.position.tolerance
+        for k in tried:
+            if certify(self.p, r.front.x[k], rate_hz=rate, tolerance=tol).feasible:
+                return k
+        ok = certificate.feasible and bool(r.front.feasible[r.best.index])
+        return r.best.index if ok else first
+
+    def metrics(self) -> None:
+        r, m = self.r, self.r.metrics
+        F = r.front.objectives
+        self.optional("metrics.SSM", m.ssm, spread(F) if len(F) > 1 else None)
+        t = r.timing
+        timed = 0.0 <= t.evaluation_s <= t.total_s and t.total_s > 0.0  # else undefined
+        oo = optimizer_overhead(t.total_s, t.evaluation_s) if timed else None
+        self.optional("metrics.OO", m.oo, oo)
+        self.optional(
+            "metrics.AE", m.ae, algorithm_effort(t.total_s, t.n_evaluations) if timed else None
+        )
+        feasible = bool(r.front.feasible.any())
+        hv = normalised_hypervolume(F, *objective_bounds(F)) if feasible else None
+        self.optional("metrics.HV", m.hv, hv)
+        ref = np.full(len(OBJECTIVE_NAMES), DEFAULT_HV_REFERENCE) if feasible else None
+        if m.hv_reference_point is None or ref is None:
+            self.value("metrics.HV_reference_point", m.hv_reference_point, ref)
+        else:
+            self.numbers("metrics.HV_reference_point", m.hv_reference_point, ref)
+
+
+def _close(a: float, b: float) -> bool:
+    """``a`` and ``b`` agree within :data:`AUDIT_RTOL` of the larger magnitude."""
+    return a == b or abs(a - b) <= AUDIT_RTOL * max(abs(a), abs(b))
