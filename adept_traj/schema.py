@@ -112,6 +112,11 @@ class Node:
         """Whether the document has this value (``False`` for an absent key)."""
         return self.value is not _ABSENT
 
+    def error_at(self, path: str, message: str) -> Exception:
+        """The caller's exception for the field at dotted ``path`` below this node."""
+        full = ".".join(p for p in (self.path, path) if p).replace(".[", "[")
+        return self._error(self.file, full or None, message)
+
     def error(self, message: str) -> Exception:
         """The caller's exception for this node: file, path, ``message`` and labels."""
         labels = f" (in {', '.join(self.context)})" if self.context else ""

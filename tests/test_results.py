@@ -302,6 +302,26 @@ def test_deeply_nested_json_is_refused_without_recursion_error(saved: Path) -> N
     assert "nest" in str(expect_error(saved, "result.json"))
 
 
+@pytest.mark.parametrize(
+    ("edit", "field"),
+    [
+        (lambda d: d["best"]["objectives"].__setitem__(0, 9.0), "best.objectives[0]"),
+        (lambda d: d.__setitem__("gap", 1.0), "gap"),
+        (lambda d: d["certificate"].__setitem__("n_samples", 7), "certificate.n_samples"),
+        (lambda d: d["certificate"]["velocity"]["within"].__setitem__(0, False), "within[0]"),
+        (lambda d: d["certificate"]["torque"]["worst"].__setitem__(1, 0.0), "torque.worst[1]"),
+    ],
+)
+def test_derived_fields_must_agree_with_the_file(saved: Path, edit, field) -> None:
+    """Fields the loader derives (not reads) were ignored: tampering went unseen."""
+    doc = json.loads((saved / "result.json").read_text(encoding="utf-8"))
+    edit(doc)
+    (saved / "result.json").write_text(json.dumps(doc), encoding="utf-8")
+    message = str(expect_error(saved, "result.json"))
+    assert field in message
+    assert "the rest of the file gives" in message
+
+
 def test_json_with_nan(saved: Path) -> None:
     text = (saved / "result.json").read_text(encoding="utf-8")
     (saved / "result.json").write_text(text.replace('"total_s": 12.5', '"total_s": NaN'))

@@ -148,9 +148,11 @@ def test_changed_best_index_is_named(old, capsys) -> None:
     raw = json.loads((old / "result.json").read_text(encoding="utf-8"))
     assert raw["best"]["index"] == 5
 
-    def edit(doc):  # keep certificate.x = front[index].x, which the loader checks
+    def edit(doc):  # keep what the loader derives consistent: certificate.x, objectives, gap
         doc["best"]["index"] = 7
         doc["certificate"]["x"] = doc["front"][7]["x"]
+        doc["best"]["objectives"] = doc["front"][7]["objectives"]
+        doc["gap"] = doc["front"][7]["objectives"][0] / doc["lower_bound"]["T_min"]
 
     _edit_json(old, edit)
     code, found, _ = _verify(old, capsys)

@@ -276,7 +276,27 @@ def _decode(top: Node) -> PlanningResult:
     stored = top["certificate"]["feasible"]
     if stored.boolean() != certificate.feasible:
         raise stored.error(f"is {stored.value} but the stored checks say {certificate.feasible}")
+    _check_derived(top, result)
     return result
+
+
+def _check_derived(top: Node, result: PlanningResult) -> None:
+    """Refuse a file whose fields the decoder derives rather than reads (``best.objectives``,
+    ``gap``, ``certificate.n_samples``, each check's ``worst`` and ``within``, …) disagree
+    with what the rest of the file gives: the file re-encoded from the decoded result must be
+    the file read. The walk is iterative (the nesting is already bounded)."""
+    stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(_dumps(_encode(result))), "")]
+    while stack:
+        stored, derived, path = stack.pop()
+        if isinstance(stored, dict) and isinstance(derived, dict):
+            if stored.keys() != derived.keys():
+                extra = sorted(set(stored) ^ set(derived))
+                raise top.error_at(path, f"fields {extra} are not those of a result of version 1")
+            stack.extend((stored[k], derived[k], f"{path}.{k}" if path else k) for k in stored)
+        elif isinstance(stored, list) and isinstance(derived, list) and len(stored) == len(derived):
+            stack.extend((s, d, f"{path}[{i}]") for i, (s, d) in enumerate(zip(stored, derived)))
+        elif stored != derived or type(stored) is not type(derived):
+            raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
 
 
 def _decode_front(node: Node) -> Front:
