@@ -38,6 +38,7 @@ from adept_traj.problem import (
     kinematic_lower_bound,
     paper_penalty,
 )
+from adept_traj.results.audit import audit
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot.limits import JointLimits
 from adept_traj.robot.parameter_file import RobotParameters
@@ -86,6 +87,7 @@ __all__ = [
     "Sphere",
     "TrajectoryProblem",
     "__version__",
+    "audit",
     "average_fitness",
     "best_tradeoff",
     "certify",
