@@ -294,6 +294,36 @@ def test_toml_nesting_ignores_strings_and_comments() -> None:
     assert data["t"]["c"] == '[[[\n"""[['
 
 
+@pytest.mark.parametrize(
+    ("content", "says"),
+    [
+        (b"[" * 100_000 + b"]" * 100_000, "nested 100000 levels deep, more than the limit of 64"),
+        (b'{"pop": NaN}', "NaN is not a JSON number"),
+        (b'{"pop": 1e400}', "the number 1e400 is not finite"),
+        (b"\xff", "not UTF-8 text"),
+    ],
+    ids=["deep", "nan", "overflow", "binary"],
+)
+def test_resume_refuses_a_hostile_run_file_in_one_line(
+    content: bytes, says: str, tmp_path: Path, capsys
+) -> None:
+    (tmp_path / "run.json").write_bytes(content)
+    assert main(["plan", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert f"{tmp_path / 'run.json'}: {says}" in err
+    assert "Traceback" not in err
+
+
+def test_resume_refuses_a_run_file_beyond_the_size_limit(tmp_path: Path, capsys) -> None:
+    with (tmp_path / "run.json").open("wb") as fh:  # sparse: no 64 MiB written
+        fh.truncate(MAX_FILE_BYTES + 1)
+    assert main(["plan", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "run.json: run arguments larger than the limit" in err
+
+
 # ============================================================================ obstacles
 def _sphere_entries(n: int) -> dict:
     return {
