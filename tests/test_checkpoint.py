@@ -303,7 +303,7 @@ def _with_meta(folder: Path, text: str) -> None:
     ("tamper", "match"),
     [
         (lambda t: t.replace('"total_s": 1.5', '"total_s": NaN'), r"NaN is not a JSON number"),
-        (lambda t: t.replace('"total_s": 1.5', '"total_s": 1e400'), r"the number 1e400 is not finite"),
+        (lambda t: t.replace('"total_s": 1.5', '"total_s": 1e400'), r"number 1e400 is not finite"),
         (lambda t: t.replace('"history": []', '"history": ' + "[" * 100_000 + "]" * 100_000),
          r"nested 100001 levels deep, more than the limit of 64"),
     ],
@@ -317,7 +317,7 @@ def test_load_refuses_non_finite_or_deep_metadata(tmp_path: Path, tamper, match:
         text = str(data["meta"])
     assert tamper(text) != text
     _with_meta(tmp_path, tamper(text))
-    with pytest.raises(ConfigurationError, match=r"checkpoint\.npz \(meta\): " + match):
+    with pytest.raises(ConfigurationError, match=r"checkpoint\.npz \(meta\): (the )?" + match):
         load_checkpoint(tmp_path)
 
 
