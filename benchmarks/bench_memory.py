@@ -4,9 +4,10 @@ Run: ``python benchmarks/bench_memory.py [--pops 1000,2000,5000] [--gens 1]``. F
 population, runs ``adept-traj plan --pop N --gens G --quiet --no-plots --no-html`` in a
 subprocess and prints its peak resident memory (``ru_maxrss`` of the child) beside
 :func:`adept_traj.optimise.population_bytes`, the estimate the command checks before the
-run. Measured on the 2-core development machine (NSGA-II, gens 1): pop 5 000 peaked at
-1 659 MB before the sampler and the repair worked in blocks and at 554 MB after; what is
-left above the linear part is pymoo's duplicate elimination, an (N, N) distance matrix.
+run. Measured on the 2-core development machine (NSGA-II, gens 1, median of 3): pop 5 000
+peaked at 1 659 MB before the sampler and the repair worked in blocks, at 555 MB after
+(pymoo's duplicate elimination: an (N, N) distance matrix), and at 187 MB with
+:class:`~adept_traj.optimise.BlockedDuplicateElimination`.
 """
 
 from __future__ import annotations

@@ -290,6 +290,45 @@ def test_load_refuses_a_foreign_or_torn_checkpoint(tmp_path: Path) -> None:
         load_checkpoint(tmp_path)
 
 
+def _with_meta(folder: Path, text: str) -> None:
+    """Replace the metadata inside ``folder``'s checkpoint.npz by ``text``."""
+    with np.load(folder / "checkpoint.npz", allow_pickle=False) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays["meta"] = np.array(text)
+    with (folder / "checkpoint.npz").open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+@pytest.mark.parametrize(
+    ("tamper", "match"),
+    [
+        (lambda t: t.replace('"total_s": 1.5', '"total_s": NaN'), r"NaN is not a JSON number"),
+        (lambda t: t.replace('"total_s": 1.5', '"total_s": 1e400'), r"number 1e400 is not finite"),
+        (lambda t: t.replace('"history": []', '"history": ' + "[" * 100_000 + "]" * 100_000),
+         r"nested 100001 levels deep, more than the limit of 64"),
+    ],
+)  # fmt: skip
+def test_load_refuses_non_finite_or_deep_metadata(tmp_path: Path, tamper, match: str) -> None:
+    algorithm, problem = set_up()
+    generations(algorithm, problem, 2)
+    meta = {"fingerprint": {"a": 1}, "total_s": 1.5, "evaluation_s": 1.0, "history": []}
+    save_checkpoint(tmp_path, algorithm, meta)
+    with np.load(tmp_path / "checkpoint.npz", allow_pickle=False) as data:
+        text = str(data["meta"])
+    assert tamper(text) != text
+    _with_meta(tmp_path, tamper(text))
+    with pytest.raises(ConfigurationError, match=r"checkpoint\.npz \(meta\): (the )?" + match):
+        load_checkpoint(tmp_path)
+
+
+def test_load_refuses_a_version_1_metadata_file_with_nan(tmp_path: Path) -> None:
+    shutil.copytree(STORED, tmp_path, dirs_exist_ok=True)
+    meta = json.loads((tmp_path / "checkpoint.json").read_text())
+    (tmp_path / "checkpoint.json").write_text(json.dumps({**meta, "total_s": float("nan")}))
+    with pytest.raises(ConfigurationError, match=r"checkpoint\.json: NaN is not a JSON number"):
+        load_checkpoint(tmp_path)
+
+
 def test_resume_restores_the_fronts_of_every_generation(tmp_path: Path) -> None:
     """The per-generation fronts (for the hypervolume history) survive an interruption."""
     full = optimise(Toy(), NSGA2(pop_size=10), 5, seed=3)

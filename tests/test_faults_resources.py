@@ -54,9 +54,9 @@ def test_budget_is_the_ceiling_or_the_available_memory(monkeypatch: pytest.Monke
     assert memory.memory_budget() <= memory.MAX_MEMORY_BYTES
     monkeypatch.setattr(memory, "available_memory", lambda: 1 * GiB)
     assert memory.memory_budget() == 1 * GiB
-    pattern = r"--pop = 9000 .*1\.7 GiB.*available on this machine, 1\.0 GiB"
+    pattern = r"--pop = 15000 .*1\.3 GiB.*available on this machine, 1\.0 GiB"
     with pytest.raises(ResourceLimitError, match=pattern):
-        check_population_memory(9000, options=("--pop", "--gens"))  # ≈ 1.6 GiB
+        check_population_memory(15000, options=("--pop", "--gens"))  # ≈ 1.3 GiB
 
 
 def test_check_memory_names_option_value_estimate_and_limit() -> None:
@@ -71,9 +71,9 @@ def test_check_memory_names_option_value_estimate_and_limit() -> None:
 
 # ============================================================================ population
 def test_population_estimate_formula() -> None:
-    # 150 MiB + 20 kB·N + 18 B·N² + 48 B·N·G, written out independently.
-    assert population_bytes(1000, 10) == 157286400 + 20_000_000 + 18_000_000 + 480_000
-    assert population_bytes(100_000) > memory.MAX_MEMORY_BYTES  # 180 GB
+    # 170 MiB + 20 kB·N + 4 B·N² + 300 B·N·G, written out independently.
+    assert population_bytes(1000, 10) == 178257920 + 20_000_000 + 4_000_000 + 3_000_000
+    assert population_bytes(100_000) > memory.MAX_MEMORY_BYTES  # 39 GiB
 
 
 def test_plan_refuses_a_huge_population_before_sampling(problem) -> None:
@@ -292,6 +292,36 @@ def test_toml_nesting_ignores_strings_and_comments() -> None:
     data = parse_toml(text.encode(), "s", SceneError)
     assert data["a"] == [[1], "[[[["]
     assert data["t"]["c"] == '[[[\n"""[['
+
+
+@pytest.mark.parametrize(
+    ("content", "says"),
+    [
+        (b"[" * 100_000 + b"]" * 100_000, "nested 100000 levels deep, more than the limit of 64"),
+        (b'{"pop": NaN}', "NaN is not a JSON number"),
+        (b'{"pop": 1e400}', "the number 1e400 is not finite"),
+        (b"\xff", "not UTF-8 text"),
+    ],
+    ids=["deep", "nan", "overflow", "binary"],
+)
+def test_resume_refuses_a_hostile_run_file_in_one_line(
+    content: bytes, says: str, tmp_path: Path, capsys
+) -> None:
+    (tmp_path / "run.json").write_bytes(content)
+    assert main(["plan", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert f"{tmp_path / 'run.json'}: {says}" in err
+    assert "Traceback" not in err
+
+
+def test_resume_refuses_a_run_file_beyond_the_size_limit(tmp_path: Path, capsys) -> None:
+    with (tmp_path / "run.json").open("wb") as fh:  # sparse: no 64 MiB written
+        fh.truncate(MAX_FILE_BYTES + 1)
+    assert main(["plan", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "run.json: run arguments larger than the limit" in err
 
 
 # ============================================================================ obstacles

@@ -295,6 +295,23 @@ def test_static_html_is_self_contained(page: Path, result: PlanningResult) -> No
     assert keys[-1]["time"] == pytest.approx(30 * float(result.best_x[0]))
 
 
+def test_same_result_same_page_bytes(page: Path, result: PlanningResult, tmp_path: Path) -> None:
+    """meshcat's ids are time-based (uuid1); the page's come from the drawn paths."""
+    again = meshcat_scene.static_html(result, tmp_path / "again.html")
+    assert again.read_bytes() == page.read_bytes()
+    drawn = [
+        c for c in page_commands(page.read_text(encoding="utf-8")) if c["type"] == "set_object"
+    ]
+    ids = [c["object"]["object"]["uuid"] for c in drawn]
+    ids += [g["uuid"] for c in drawn for g in c["object"]["geometries"]]
+    ids += [m["uuid"] for c in drawn for m in c["object"]["materials"]]
+    assert len(ids) == len(set(ids)) == 3 * len(drawn)  # every object, geometry, material
+    for c in drawn:  # each object refers to its own geometry and material
+        (geometry,), (material,) = c["object"]["geometries"], c["object"]["materials"]
+        assert c["object"]["object"]["geometry"] == geometry["uuid"]
+        assert c["object"]["object"]["material"] == material["uuid"]
+
+
 def chromium() -> str:
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
     if exe is None:

@@ -24,7 +24,13 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.files import sync_folder, temp_path, write_text_atomic
+from adept_traj.files import (
+    parse_json,
+    read_bytes_bounded,
+    sync_folder,
+    temp_path,
+    write_text_atomic,
+)
 from adept_traj.results import FRONT_FILE, RESULT_FILE, TRAJECTORY_FILE
 
 __all__ = [
@@ -168,15 +174,15 @@ def read_arguments(folder: Path) -> dict[str, Any]:
     Raises
     ------
     ConfigurationError
-        No run in progress there, or an unreadable :data:`RUN_FILE`.
+        No run in progress there, or an unreadable :data:`RUN_FILE` (among them one larger
+        than :data:`~adept_traj.files.MAX_FILE_BYTES`, nested deeper than
+        :data:`~adept_traj.files.MAX_NESTING`, or holding a non-finite number).
     """
     run_file = folder / RUN_FILE
     if not run_file.is_file():
         raise ConfigurationError(f"{folder}: no interrupted run here ({RUN_FILE})")
-    try:
-        saved = json.loads(run_file.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise ConfigurationError(f"{run_file}: unreadable ({exc})") from None
+    raw = read_bytes_bounded(run_file, ConfigurationError, what="run arguments")
+    saved = parse_json(raw, str(run_file), ConfigurationError)
     if not isinstance(saved, dict):
         raise ConfigurationError(f"{run_file}: not the arguments of a run")
     return saved

@@ -17,6 +17,10 @@ from adept_traj.optimise.checkpoint import (
     restore_algorithm,
     save_checkpoint,
 )
+from adept_traj.optimise.duplicates import (
+    BLOCK_PAIRS,
+    BlockedDuplicateElimination,
+)
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
@@ -41,8 +45,10 @@ from adept_traj.optimise.sampling import (
 
 __all__ = [
     "ALGORITHMS",
+    "BLOCK_PAIRS",
     "CHECKPOINT_VERSION",
     "AlgorithmSettings",
+    "BlockedDuplicateElimination",
     "FastEndSearch",
     "GenerationInfo",
     "KinematicTimeRepair",

@@ -26,7 +26,9 @@ Every algorithm starts from :class:`~adept_traj.optimise.RampSampling` unless an
 :class:`~adept_traj.optimise.KinematicTimeRepair`, makes 30 % of its offspring by
 :class:`~adept_traj.optimise.FastEndSearch` (local search at the fast end of the front;
 same number of evaluations; a third of those are fresh ramps from the sampling, at their
-kinematic minimum time), and eliminates duplicates. Randomness comes only from pymoo's
+kinematic minimum time), and eliminates duplicates
+(:class:`~adept_traj.optimise.BlockedDuplicateElimination`: pymoo's default decisions in
+blocks of bounded memory). Randomness comes only from pymoo's
 per-algorithm generator seeded by ``seed`` (see :mod:`adept_traj.optimise.planner`).
 """
 
@@ -38,6 +40,7 @@ from typing import Any
 from pymoo.core.algorithm import Algorithm
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
@@ -157,6 +160,10 @@ def make_algorithm(
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
     from pymoo.algorithms.moo.nsga2 import NSGA2, RankAndCrowding
 
+    # pymoo's eliminate_duplicates=True (the default of every algorithm here), its
+    # decisions taken in blocks: no (pop, pop) distance matrix.
+    dup = {"eliminate_duplicates": BlockedDuplicateElimination()}
+
     if key == "nsga2":
         from pymoo.operators.crossover.sbx import SBX
         from pymoo.operators.mutation.pm import PM
@@ -166,7 +173,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             sampling=sampling,
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
             mutation=PM(prob=1.0, prob_var=s["mutation_prob_var"], eta=s["mutation_eta"]),
-            eliminate_duplicates=True,
+            **dup,
             repair=repair,
         )
     if key == "mode":
@@ -191,7 +198,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             mating=variant,
             survival=RankAndCrowding(),
             n_offsprings=pop,
-            eliminate_duplicates=True,
+            **dup,
             output=MultiObjectiveOutput(),
             advance_after_initial_infill=True,
             repair=repair,
@@ -204,15 +211,15 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
     if key == "nsga3":
         from pymoo.algorithms.moo.nsga3 import NSGA3
 
-        return NSGA3(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair)
+        return NSGA3(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair, **dup)
     if key == "unsga3":
         from pymoo.algorithms.moo.unsga3 import UNSGA3
 
-        return UNSGA3(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair)
+        return UNSGA3(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair, **dup)
     if key == "smsemoa":
         from pymoo.algorithms.moo.sms import SMSEMOA
 
-        return SMSEMOA(pop_size=pop, sampling=sampling, repair=repair)
+        return SMSEMOA(pop_size=pop, sampling=sampling, repair=repair, **dup)
     from pymoo.algorithms.moo.rvea import RVEA
 
-    return RVEA(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair)
+    return RVEA(ref_dirs=ref_dirs(), pop_size=pop, sampling=sampling, repair=repair, **dup)

@@ -45,7 +45,7 @@ import numpy as np
 from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
-from adept_traj.files import write_atomic
+from adept_traj.files import parse_json, read_bytes_bounded, write_atomic
 
 __all__ = [
     "CHECKPOINT_VERSION",
@@ -171,12 +171,16 @@ def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]
     try:
         with np.load(npz_path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
-        # Version 2 keeps its metadata inside; version 1 beside it in checkpoint.json.
-        version = CHECKPOINT_VERSION if "meta" in arrays else 1
-        text = str(arrays.pop("meta")) if version > 1 else _read_meta_v1(folder)
-        meta = json.loads(text)
     except (OSError, ValueError) as exc:
         raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
+    # Version 2 keeps its metadata inside; version 1 beside it in checkpoint.json. Both are
+    # parsed by the bounded parser (size, nesting, no NaN or infinity: none is ever written).
+    version = CHECKPOINT_VERSION if "meta" in arrays else 1
+    if version > 1:
+        raw = str(arrays.pop("meta")).encode("utf-8")
+        meta = parse_json(raw, f"{npz_path} (meta)", ConfigurationError)
+    else:
+        meta = parse_json(_read_meta_v1(folder), str(folder / _META_V1), ConfigurationError)
     if not isinstance(meta, dict) or (meta.get("format"), meta.get("version")) != (
         _FORMAT,
         version,
@@ -195,12 +199,13 @@ def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]
     return meta, arrays
 
 
-def _read_meta_v1(folder: Path) -> str:
-    """The text of a version-1 checkpoint's ``checkpoint.json``."""
+def _read_meta_v1(folder: Path) -> bytes:
+    """The bytes of a version-1 checkpoint's ``checkpoint.json`` (at most
+    :data:`~adept_traj.files.MAX_FILE_BYTES`)."""
     path = folder / _META_V1
     if not path.is_file():
         raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {_META_V1}")
-    return path.read_text()
+    return read_bytes_bounded(path, ConfigurationError, what="checkpoint metadata")
 
 
 def restore_algorithm(algorithm: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:

@@ -86,20 +86,25 @@ def population_bytes(pop_size: int, n_gen: int = 1) -> int:
     generations (the whole process, Python and the libraries included):
 
     .. math::
-        M = 150\,\text{MiB} + 20\,\text{kB} \cdot N + 18\,\text{B} \cdot N^2
-            + 48\,\text{B} \cdot N \cdot G .
+        M = 170\,\text{MiB} + 20\,\text{kB} \cdot N + 4\,\text{B} \cdot N^2
+            + 300\,\text{B} \cdot N \cdot G .
 
-    The :math:`N^2` term is pymoo's duplicate elimination (``eliminate_duplicates=True``):
-    it holds an (N, N) distance matrix and the indices of its upper triangle, 17.5 B per
-    pair measured; the sampler, the repair and the evaluation work in blocks and add only
-    the linear term; the :math:`N G` term is the history of the generations' fronts (at
-    most N points of 6 objectives each). Fitted to the peak RSS of ``adept-traj plan
-    --gens 2`` at N = 1 000, 2 000, 4 000 (NSGA-II and MODE: 169–420 MB, ≤ this estimate;
-    ``benchmarks/bench_memory.py``).
+    The sampler, the repair, the evaluation and the duplicate elimination
+    (:class:`~adept_traj.optimise.BlockedDuplicateElimination`) work in blocks and add only
+    the linear term. The :math:`N^2` term is the non-dominated sorting of the 2N parents
+    and offspring (pymoo's compiled fast non-dominated sort keeps, for each member, the
+    members it dominates: 4 B per ordered pair, 8 B·N² if every pair were ordered; the term
+    allows for half of them). The :math:`N G` term is the history of the generations' fronts
+    and the allocator's growth over the generations (measured 200–600 B per individual and
+    generation over the first 15 generations, less later). Fitted to the peak RSS of
+    ``adept-traj plan`` (``benchmarks/bench_memory.py``; NSGA-II and MODE): 163 MB at
+    N = 100, 172–197 MB at N = 1 000–4 000 and 274–338 MB at N = 16 000 (2 generations),
+    217–225 MB at N = 4 000 over 15 generations, 187 MB at N = 5 000 (one generation;
+    555 MB with pymoo's (N, N) duplicate elimination) — each at most this estimate.
     """
     n = as_integer(pop_size, "pop_size", minimum=1, error=ConfigurationError)
     g = as_integer(n_gen, "n_gen", minimum=1, error=ConfigurationError)
-    return 150 * 2**20 + 20_000 * n + 18 * n * n + 48 * n * g
+    return 170 * 2**20 + 20_000 * n + 4 * n * n + 300 * n * g
 
 
 def check_population_memory(

@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import html
 import math
+import uuid
 import warnings
 from pathlib import Path
 from typing import Any
@@ -65,14 +66,51 @@ def draw(vis: meshcat.Visualizer, playback: Playback, *, loop: bool = True) -> N
     )
 
 
+#: Namespace of the ids given to drawn objects in a page (:func:`uuid.uuid5` of their path).
+_PAGE_IDS = uuid.UUID("6f0b1c52-3a5e-4c1b-9d8e-2b7f4e1a9c30")
+
+
+def _stable_ids(data: dict[str, Any]) -> dict[str, Any]:
+    """A lowered meshcat command whose ids are derived from its path instead of meshcat's
+    time-based ``uuid1`` (a copy; ``data`` is unchanged): the k-th distinct id met in the
+    command (every ``"uuid"`` value: object, geometry, material, texture, ...) becomes
+    ``uuid5(_PAGE_IDS, f"{path}#{k}")``, and every reference to it follows. The same drawing
+    gives the same bytes, and distinct paths keep distinct ids."""
+    found: dict[str, str] = {}
+
+    def collect(node: Any) -> None:
+        if isinstance(node, dict):
+            for key, value in node.items():
+                if key == "uuid" and isinstance(value, str) and value not in found:
+                    found[value] = str(uuid.uuid5(_PAGE_IDS, f"{data.get('path')}#{len(found)}"))
+                collect(value)
+        elif isinstance(node, list):
+            for item in node:
+                collect(item)
+
+    def rename(node: Any) -> Any:
+        if isinstance(node, dict):
+            return {key: rename(value) for key, value in node.items()}
+        if isinstance(node, list):
+            return [rename(item) for item in node]
+        if isinstance(node, str):
+            return found.get(node, node)
+        return node
+
+    collect(data)
+    return rename(data) if found else data
+
+
 class _RecordingWindow:
-    """Stands in for a meshcat window: keeps every command as the viewer's msgpack bytes."""
+    """Stands in for a meshcat window: keeps every command as the viewer's msgpack bytes,
+    with ids derived from the drawn paths (:func:`_stable_ids`), so that the same playback
+    always gives the same bytes."""
 
     def __init__(self) -> None:
         self.commands: list[bytes] = []
 
     def send(self, command: Any) -> None:
-        self.commands.append(umsgpack.packb(command.lower()))
+        self.commands.append(umsgpack.packb(_stable_ids(command.lower())))
 
     def close(self) -> None:
         pass
