@@ -83,15 +83,16 @@ def test_plan_refuses_a_huge_population_before_sampling(problem) -> None:
     assert time.perf_counter() - t0 < 5.0
 
 
-@pytest.mark.parametrize(
-    ("argv", "option"),
-    [
-        (["--pop-nsga2", "100000"], "--pop-nsga2 = 100000"),
-        (["--pop-mode", "100000"], "--pop-mode = 100000"),
-        (["--gens", "1000000000000"], "--gens = 1000000000000"),
-        (["--rate", "1e9"], "--rate = 1e+09 Hz"),
-    ],
-)
+#: Oversized options of compare and what the refusal names (plan has one --pop).
+OVERSIZED = [
+    (["--pop-nsga2", "100000"], "--pop-nsga2 = 100000"),
+    (["--pop-mode", "100000"], "--pop-mode = 100000"),
+    (["--gens", "1000000000000"], "--gens = 1000000000000"),
+    (["--rate", "1e9"], "--rate = 1e+09 Hz"),
+]
+
+
+@pytest.mark.parametrize(("argv", "option"), OVERSIZED)
 def test_plan_refuses_before_running(argv, option, tmp_path, capsys) -> None:
     """The same limits for plan (--pop for its one population), before run.json is written."""
     argv = ["--pop" if a.startswith("--pop-") else a for a in argv]
@@ -104,15 +105,7 @@ def test_plan_refuses_before_running(argv, option, tmp_path, capsys) -> None:
     assert not out.exists()
 
 
-@pytest.mark.parametrize(
-    ("argv", "option"),
-    [
-        (["--pop-nsga2", "100000"], "--pop-nsga2 = 100000"),
-        (["--pop-mode", "100000"], "--pop-mode = 100000"),
-        (["--gens", "1000000000000"], "--gens = 1000000000000"),
-        (["--rate", "1e9"], "--rate = 1e+09 Hz"),
-    ],
-)
+@pytest.mark.parametrize(("argv", "option"), OVERSIZED)
 def test_compare_refuses_before_running(argv, option, tmp_path, capsys) -> None:
     out = tmp_path / "cmp"
     assert main(["compare", *argv, "--out", str(out), "--quiet"]) == 2
