@@ -131,6 +131,10 @@ def _encode_certificate(c: Certificate) -> dict[str, Any]:
         "violations": list(c.violations),
         "x": _floats(c.x),
     }
+    if c.guarantee is not None:  # optional keys (absent in files of older versions)
+        out["guarantee"] = c.guarantee
+    if c.distance_bound is not None:
+        out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
     for check in c.checks:
         out[check.kind] = {
             "limit": check.symbol,
@@ -347,6 +351,10 @@ def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
         closest_pair=None if pair.value is None else pair.strings(),
         violations=node["violations"].strings(),
         dense=dense,
+        guarantee=node["guarantee"].string(nonempty=True, default=None),
+        distance_bound=(
+            node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
+        ),
         **checks,
     )
 
