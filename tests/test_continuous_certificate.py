@@ -168,3 +168,17 @@ def test_pendulum_speed_bound_against_finite_differences():
     assert speed.max() <= bound
     assert speed.max() > 0.999 * bound  # the bound is reached at the bottom
     assert FixedPose.from_xyz_rpy((1, 2, 3)).max_point_speed((0.0, 0.0, 1.0), 0.5) == 0.0
+
+
+def test_fast_certificate_same_verdict(dip):
+    """exact=False (broad-phase bounds above the influence distance) decides as the exact
+    certificate: on the dip (rejected) and on the clear pass (certified, same minimum)."""
+    problem, x = dip
+    assert not certify(problem, x, exact=False).feasible
+    clear = _problem((_thin_post(1.0, 1.2),))
+    x = clear.trajectory.straight_line(T)
+    fast, exact = certify(clear, x, exact=False), certify(clear, x)
+    assert fast.certified
+    assert exact.certified
+    assert fast.distance_bound <= exact.distance_bound
+    assert fast.min_distance <= exact.min_distance

@@ -247,6 +247,7 @@ def certify(
     tolerance: float = DEFAULT_TOLERANCE,
     continuous: bool = True,
     max_depth: int = DEFAULT_MAX_DEPTH,
+    exact: bool = True,
 ) -> Certificate:
     """Verify the trajectory ``x`` of ``problem`` on a dense uniform grid.
 
@@ -265,6 +266,13 @@ def certify(
         ``False``: the uniform samples only (guarantee ``"sampled at N Hz"``).
     max_depth:
         Most bisections of a sample interval (integer ≥ 0).
+    exact:
+        ``True``: every pair's exact distance at every sample. ``False`` (fast, for
+        certifying a whole front): a pair whose broad-phase lower bound exceeds the
+        checker's ``influence`` [m] (≥ the margin) keeps that bound instead of a coal call.
+        The verdict is the same (every distance ≤ ``influence`` is exact) and the
+        continuous bound stays sound (it only needs lower bounds at the samples); the
+        distances reported above ``influence`` are then lower bounds.
 
     Returns
     -------
@@ -291,6 +299,7 @@ def certify(
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
     check_type(continuous, bool, "continuous")
     depth = as_integer(max_depth, "max_depth", minimum=0)
+    check_type(exact, bool, "exact")
     robot, lim = problem.robot, problem.robot.limits
     span = _limits(lim)
     check_certificate_memory(problem, rate, T)
@@ -304,11 +313,11 @@ def certify(
 
     checker = problem.checker
     if checker.n_obstacles and checker.n_solids:
-        pairs = checker.distances(q[None], t[None], exact=True).distance[0]  # (n, ns, no)
+        pairs = checker.distances(q[None], t[None], exact=exact).distance[0]  # (n, ns, no)
         per_sample = pairs.min(axis=(1, 2))
         grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth)
+            found = continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact)
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:

@@ -156,6 +156,7 @@ def continuous_distance(
     pairs: np.ndarray,
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
+    exact: bool = True,
 ) -> DistanceGuarantee:
     """Lower-bound the distance between the samples and refine where needed.
 
@@ -164,9 +165,11 @@ def continuous_distance(
         x: (n_var,) checked decision vector.
         t: (n,) sample times [s], increasing, ``t[0] = 0``, ``t[-1] = T``.
         qd: (n, nq) joint speeds at ``t`` [rad/s | m/s].
-        pairs: (n, ns, no) exact distances at ``t`` [m].
+        pairs: (n, ns, no) exact distances at ``t`` [m], or lower bounds of them.
         rate_hz: the uniform grid's rate [Hz], ``(n − 1) / T`` (for the guarantee's name).
         max_depth: most bisections (≥ 0).
+        exact: distances at the midpoints exact for every pair (``False``: lower bounds above
+            the checker's influence distance, as :meth:`CollisionChecker.distances`).
 
     Returns:
         :class:`DistanceGuarantee`.
@@ -203,7 +206,7 @@ def continuous_distance(
         t_a, t_b, d_a, d_b, v_a, v_b = (a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b))
         t_m = 0.5 * (t_a + t_b)
         smp = problem.trajectory.sample(x, t_m / T, orders=(0, 1))
-        d_m = problem.checker.distances(smp.q[None], t_m[None], exact=True).distance[0]
+        d_m = problem.checker.distances(smp.q[None], t_m[None], exact=exact).distance[0]
         n_refined += len(t_m)
         k, s, o = np.unravel_index(int(np.argmin(d_m)), d_m.shape)
         if d_m[k, s, o] < best[0]:
