@@ -168,8 +168,9 @@ def continuous_distance(
         pairs: (n, ns, no) exact distances at ``t`` [m], or lower bounds of them.
         rate_hz: the uniform grid's rate [Hz], ``(n − 1) / T`` (for the guarantee's name).
         max_depth: most bisections (≥ 0).
-        exact: distances at the midpoints exact for every pair (``False``: lower bounds above
-            the checker's influence distance, as :meth:`CollisionChecker.distances`).
+        exact: distances at the midpoints exact for every pair (``False``: lower bounds
+            above the checker's influence distance, as
+            :meth:`~adept_traj.collision.CollisionChecker.distances`).
 
     Returns:
         :class:`DistanceGuarantee`.
