@@ -122,6 +122,31 @@ def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecor
     return records
 
 
+#: Influence distance above the margin [m] for the front's certificates (see _certify_front).
+_CERTIFY_INFLUENCE_ABOVE_MARGIN = 0.01
+
+
+def _certifying_problem(problem: TrajectoryProblem) -> TrajectoryProblem:
+    """The problem with the influence distance lowered to ``margin + 0.01 m`` (never raised):
+    a pair whose broad-phase bound exceeds it needs no coal call in ``certify(...,
+    exact=False)``. The verdict is unchanged (influence ≥ margin) and the continuous bound
+    stays sound; it only refines a little more where a bound is used. 100 paper-front
+    certificates: 0.85 s instead of 1.6 s with the default 0.05 m."""
+    st = problem.settings
+    influence = min(st.influence, st.margin + _CERTIFY_INFLUENCE_ABOVE_MARGIN)
+    if influence == st.influence:
+        return problem
+    return TrajectoryProblem(
+        problem.robot,
+        problem.scene,
+        problem.start,
+        problem.goal,
+        st,
+        influence=influence,
+        workers=1,
+    )
+
+
 def _certify_front(
     problem: TrajectoryProblem,
     front: Front,
@@ -135,15 +160,19 @@ def _certify_front(
     Only members the optimiser marked feasible are certified (a member that violates a
     constraint at the optimiser's samples fails the dense check as well), in the trade-off
     ``order`` (n,), at most ``max_certify`` of them (``None``: all); the others are not
-    certified. The certificates use the broad phase's bounds above the influence distance
-    (``certify(..., exact=False)``: the same verdict, about 15× faster).
+    certified. The certificates use the broad phase's bounds above an influence distance of
+    ``margin + 0.01 m`` (``certify(..., exact=False)`` on :func:`_certifying_problem`: the
+    same verdict, about 30× faster than exact distances).
     """
     candidates = [int(k) for k in order if front.feasible[k]]
     if max_certify is not None:
         candidates = candidates[:max_certify]
     certified = np.zeros(len(front.x), dtype=bool)
+    if not candidates:
+        return certified
+    fast = _certifying_problem(problem)
     for k in candidates:
-        certified[k] = certify(problem, front.x[k], rate_hz=rate_hz, exact=False).certified
+        certified[k] = certify(fast, front.x[k], rate_hz=rate_hz, exact=False).certified
     return certified
 
 
