@@ -70,30 +70,55 @@ def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monk
 
 
 @pytest.mark.parametrize(
-    ("passes", "max_certify", "expected_tries", "reported"),
+    ("passes", "max_certify", "expected_tries", "certified", "reported"),
     [
-        ({3}, 10, [2, 1, 3], 3),  # 0 is infeasible at the samples: not tried
-        ({3}, 2, [2, 1], 2),  # out of tries: the trade-off choice, failing
-        ({2, 3}, 10, [2], 2),  # the trade-off choice passes
-        (set(), 10, [2, 1, 3], 2),  # none passes
+        ({3}, None, [2, 1, 3], [3], 3),  # 0 is infeasible at the samples: not tried
+        ({3}, 2, [2, 1], [], 2),  # out of tries: nothing certified, the trade-off choice
+        ({2, 3}, None, [2, 1, 3], [2, 3], 2),  # the trade-off choice passes
+        (set(), None, [2, 1, 3], [], 2),  # none passes
     ],
 )
-def test_further_candidates_are_feasible_members(
-    monkeypatch, passes, max_certify, expected_tries, reported
+def test_every_feasible_member_is_certified(
+    monkeypatch, passes, max_certify, expected_tries, certified, reported
 ) -> None:
     tried = []
 
-    def fake_certify(problem, x, rate_hz):
-        tried.append(int(x[0]))
-        return SimpleNamespace(feasible=int(x[0]) in passes, index=int(x[0]))
+    def fake_certify(problem, x, rate_hz, exact=True):
+        if not exact:
+            tried.append(int(x[0]))
+        return SimpleNamespace(certified=int(x[0]) in passes, index=int(x[0]))
 
     monkeypatch.setattr(planner, "certify", fake_certify)
+    monkeypatch.setattr(planner, "_certifying_problem", lambda problem: problem)
     front = SimpleNamespace(x=np.arange(4.0)[:, None], feasible=np.array([False, True, True, True]))
-    certificate, index = planner._certified_choice(
-        None, front, np.array([2, 0, 1, 3]), 1000.0, max_certify
-    )
+    order = np.array([2, 0, 1, 3])
+    mask = planner._certify_front(None, front, order, 1000.0, max_certify)
     assert tried == expected_tries
+    np.testing.assert_array_equal(np.flatnonzero(mask), certified)
+    front = SimpleNamespace(x=front.x, feasible=mask)
+    certificate, index = planner._certified_choice(None, front, order, 1000.0)
     assert (index, certificate.index) == (reported, reported)
+
+
+def test_front_feasible_means_certified(problem: at.TrajectoryProblem, small_run) -> None:
+    """Every member marked feasible passes an independent dense re-check at 10 kHz (the
+    uniform grid only, no continuous bound); the count is stored in the front."""
+    front = small_run.front
+    assert front.n_certified == int(front.feasible.sum()) > 0
+    for k in np.flatnonzero(front.feasible):
+        dense = certify(problem, front.x[k], rate_hz=10_000.0, continuous=False, exact=False)
+        assert dense.feasible
+    assert small_run.certificate.certified
+
+
+def test_certifying_problem_same_verdict(problem: at.TrajectoryProblem, small_run) -> None:
+    """The lowered influence distance changes no verdict: every member certifies the same
+    on the problem itself (exact distances)."""
+    fast = planner._certifying_problem(problem)
+    assert fast.settings.influence == pytest.approx(problem.settings.margin + 0.01)
+    assert fast.settings.influence < problem.settings.influence
+    for x in small_run.front.x[:8]:
+        assert certify(fast, x, exact=False).certified == certify(problem, x).certified
 
 
 def test_save_load_verify_round_trip(small_run, tmp_path: Path) -> None:

@@ -9,6 +9,14 @@ from adept_traj.analysis.certificate import (
     certify,
     check_certificate_memory,
 )
+from adept_traj.analysis.continuous import (
+    CONTINUOUS,
+    DEFAULT_MAX_DEPTH,
+    DistanceGuarantee,
+    continuous_distance,
+    obstacle_speeds,
+    solid_lever_arms,
+)
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -38,7 +46,9 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
+    "CONTINUOUS",
     "DEFAULT_HV_REFERENCE",
+    "DEFAULT_MAX_DEPTH",
     "DEFAULT_RATE_HZ",
     "DEFAULT_TOLERANCE",
     "LIMIT_KINDS",
@@ -46,6 +56,7 @@ __all__ = [
     "BestTradeoff",
     "Certificate",
     "DenseTrajectory",
+    "DistanceGuarantee",
     "LimitCheck",
     "algorithm_effort",
     "average_fitness",
@@ -54,6 +65,7 @@ __all__ = [
     "certify",
     "check_certificate_memory",
     "combined_objective",
+    "continuous_distance",
     "dense_samples",
     "hypervolume",
     "igd",
@@ -62,8 +74,10 @@ __all__ = [
     "normalised_hypervolume",
     "objective_bounds",
     "objective_weights",
+    "obstacle_speeds",
     "optimizer_overhead",
     "ratio_non_dominated",
+    "solid_lever_arms",
     "spread",
     "to_unit_minimisation",
 ]

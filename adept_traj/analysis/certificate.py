@@ -32,6 +32,15 @@ fraction of the joint range beyond the nearer limit otherwise; an infinite limit
 ratio 0). The certificate is feasible when every value is within its bound plus
 ``tolerance`` (default 1e-9) **and** the smallest distance over all samples and pairs is at
 least the problem's safety margin (no tolerance).
+
+**Between the samples** (``continuous=True``, the default), :mod:`~adept_traj.analysis.continuous`
+bounds the distance on every sample interval from the robot's and the obstacles' point
+speeds and bisects the intervals where the bound misses the margin; the refined samples join
+the distance check. :attr:`Certificate.guarantee` then says ``"continuous"`` (the distance is
+at least the margin at every instant: :attr:`Certificate.distance_bound` ≥ margin) or
+``"sampled at N Hz"`` (the finest rate reached); :attr:`Certificate.certified` is
+:attr:`~Certificate.feasible` with the continuous guarantee. The torque is checked at the
+samples only.
 """
 
 from __future__ import annotations
@@ -42,6 +51,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, continuous_distance
 from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
 from adept_traj.analysis.limit_check import (
     DEFAULT_TOLERANCE,
@@ -55,7 +65,15 @@ from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
-from adept_traj.validation import as_finite_array, as_scalar, as_vector, deep_equal, readonly_copy
+from adept_traj.validation import (
+    as_finite_array,
+    as_integer,
+    as_scalar,
+    as_vector,
+    check_type,
+    deep_equal,
+    readonly_copy,
+)
 
 __all__ = [
     "DEFAULT_RATE_HZ",
@@ -86,6 +104,10 @@ class Certificate:
     violations: human-readable description of every violated limit, e.g.
         ``"torque joint3: 1.042 × UC at t = 0.512 s"`` (empty when feasible).
     dense: the sampled :class:`DenseTrajectory`.
+    guarantee: ``"continuous"`` or ``"sampled at N Hz"`` for the distance (``None``: not
+        recorded, e.g. a result saved before the continuous check).
+    distance_bound: lower bound [m] of the distance at every instant of [0, T] (``None``:
+        not computed; ``inf``: no obstacle).
     """
 
     x: np.ndarray
@@ -101,6 +123,8 @@ class Certificate:
     closest_pair: tuple[str, str] | None
     violations: tuple[str, ...]
     dense: DenseTrajectory
+    guarantee: str | None = None
+    distance_bound: float | None = None
 
     def __post_init__(self) -> None:
         x = readonly_copy(as_finite_array(self.x, "x"))
@@ -130,6 +154,13 @@ class Certificate:
                 raise InvalidInputError(f"closest_pair must be (solid, obstacle); got {pair!r}")
             object.__setattr__(self, "closest_pair", pair)
         object.__setattr__(self, "violations", tuple(str(v) for v in self.violations))
+        if self.guarantee is not None:
+            object.__setattr__(self, "guarantee", str(self.guarantee))
+        if self.distance_bound is not None:
+            bound = float(self.distance_bound)
+            if math.isnan(bound):
+                raise InvalidInputError("distance_bound must be a number or ±inf; got nan")
+            object.__setattr__(self, "distance_bound", bound)
 
     # ------------------------------------------------------------------ summaries
     @property
@@ -161,6 +192,11 @@ class Certificate:
     def feasible(self) -> bool:
         """Verified feasible: :attr:`limits_ok` and :attr:`distance_ok`."""
         return self.limits_ok and self.distance_ok
+
+    @property
+    def certified(self) -> bool:
+        """:attr:`feasible` with the ``"continuous"`` distance guarantee."""
+        return self.feasible and self.guarantee == CONTINUOUS
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -209,6 +245,9 @@ def certify(
     rate_hz: float = DEFAULT_RATE_HZ,
     *,
     tolerance: float = DEFAULT_TOLERANCE,
+    continuous: bool = True,
+    max_depth: int = DEFAULT_MAX_DEPTH,
+    exact: bool = True,
 ) -> Certificate:
     """Verify the trajectory ``x`` of ``problem`` on a dense uniform grid.
 
@@ -222,6 +261,18 @@ def certify(
         Minimum sampling rate [Hz] (> 0): ``n = ceil(T·rate_hz) + 1`` samples over [0, T].
     tolerance:
         Slack on the limit values (dimensionless, ≥ 0); the distance has none.
+    continuous:
+        Bound the distance between the samples and refine where needed (module docstring);
+        ``False``: the uniform samples only (guarantee ``"sampled at N Hz"``).
+    max_depth:
+        Most bisections of a sample interval (integer ≥ 0).
+    exact:
+        ``True``: every pair's exact distance at every sample. ``False`` (fast, for
+        certifying a whole front): a pair whose broad-phase lower bound exceeds the
+        checker's ``influence`` [m] (≥ the margin) keeps that bound instead of a coal call.
+        The verdict is the same (every distance ≤ ``influence`` is exact) and the
+        continuous bound stays sound (it only needs lower bounds at the samples); the
+        distances reported above ``influence`` are then lower bounds.
 
     Returns
     -------
@@ -246,6 +297,9 @@ def certify(
         raise InvalidInputError(f"x[0] (travel time T [s]) must be > 0; got {T!r}")
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
+    check_type(continuous, bool, "continuous")
+    depth = as_integer(max_depth, "max_depth", minimum=0)
+    check_type(exact, bool, "exact")
     robot, lim = problem.robot, problem.robot.limits
     span = _limits(lim)
     check_certificate_memory(problem, rate, T)
@@ -259,11 +313,17 @@ def certify(
 
     checker = problem.checker
     if checker.n_obstacles and checker.n_solids:
-        pairs = checker.distances(q[None], t[None], exact=True).distance[0]  # (n, ns, no)
+        pairs = checker.distances(q[None], t[None], exact=exact).distance[0]  # (n, ns, no)
         per_sample = pairs.min(axis=(1, 2))
-        k, solid, obstacle = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
-        min_d = float(pairs[k, solid, obstacle])
-        t_min_d: float | None = float(t[k])
+        grid_hz = (n - 1) / T
+        if continuous:
+            found = continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact)
+            guarantee, bound = found.guarantee, found.lower_bound
+            min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
+        else:
+            guarantee, bound = f"sampled at {grid_hz:g} Hz", None
+            k, solid, obstacle = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
+            min_d, t_min_d = float(pairs[k, solid, obstacle]), float(t[k])
         pair: tuple[str, str] | None = (
             checker.solid_names[solid],
             checker.obstacle_names[obstacle],
@@ -271,6 +331,7 @@ def certify(
     else:
         per_sample = np.full(n, np.inf)
         min_d, t_min_d, pair = math.inf, None, None
+        guarantee, bound = CONTINUOUS, math.inf
 
     excess = np.maximum(q - lim.upper, lim.lower - q) / span  # (n, nq)
     exact_excess = np.maximum(bounds.q_max - lim.upper, lim.lower - bounds.q_min) / span
@@ -304,5 +365,7 @@ def certify(
         closest_pair=pair,
         violations=tuple(violations),
         dense=dense,
+        guarantee=guarantee,
+        distance_bound=bound,
         **checks,
     )

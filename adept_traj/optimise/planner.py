@@ -8,13 +8,15 @@ Steps:
    feasible, the least-infeasible ones (the 10 with the smallest total violation) with a
    warning — never an empty result.
 3. **Best trade-off**: :func:`~adept_traj.analysis.best_tradeoff` (f_c and F_avg ranks,
-   paper weights by default) on the front.
-4. **Certificate**: the chosen solution is re-verified on a ≥ 1 kHz grid
-   (:func:`~adept_traj.analysis.certify`). If it fails (e.g. a torque peak between
-   samples), the next candidates in the trade-off order that the optimiser marked
-   feasible are certified, and the first that passes is reported (up to ``max_certify``
-   certificates in all); if none passes, the trade-off choice is reported with its
-   failing certificate. A front of least-infeasible members thus costs one certificate.
+   paper weights by default) on the front (its order is the certification order).
+4. **Certificates**: every member the optimiser marked feasible is re-verified on a
+   ≥ 1 kHz grid with the continuous-time distance guarantee
+   (:func:`~adept_traj.analysis.certify`); ``front.feasible[i]`` is then that verdict
+   (a member that fails keeps its row, not feasible) and ``front.n_certified`` counts the
+   certified members. The reported solution is the first certified member in the
+   trade-off order (the best trade-off when it passes), with its exact certificate; if
+   none passes, the trade-off choice with its failing certificate. A front of
+   least-infeasible members thus costs one certificate.
 5. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
@@ -120,33 +122,69 @@ def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecor
     return records
 
 
-def _certified_choice(
+#: Influence distance above the margin [m] for the front's certificates (see _certify_front).
+_CERTIFY_INFLUENCE_ABOVE_MARGIN = 0.01
+
+
+def _certifying_problem(problem: TrajectoryProblem) -> TrajectoryProblem:
+    """The problem with the influence distance lowered to ``margin + 0.01 m`` (never raised):
+    a pair whose broad-phase bound exceeds it needs no coal call in ``certify(...,
+    exact=False)``. The verdict is unchanged (influence ≥ margin) and the continuous bound
+    stays sound; it only refines a little more where a bound is used. 100 paper-front
+    certificates: 0.85 s instead of 1.6 s with the default 0.05 m."""
+    st = problem.settings
+    influence = min(st.influence, st.margin + _CERTIFY_INFLUENCE_ABOVE_MARGIN)
+    if influence == st.influence:
+        return problem
+    return TrajectoryProblem(
+        problem.robot,
+        problem.scene,
+        problem.start,
+        problem.goal,
+        st,
+        influence=influence,
+        workers=1,
+    )
+
+
+def _certify_front(
     problem: TrajectoryProblem,
     front: Front,
     order: np.ndarray,
     rate_hz: float,
-    max_certify: int,
-) -> tuple[Certificate, int]:
-    """(certificate, front index) of the reported solution.
+    max_certify: int | None,
+) -> np.ndarray:
+    """(n,) bool: the members whose dense certificate passes with the continuous guarantee
+    (:attr:`~adept_traj.analysis.Certificate.certified`).
 
-    The best trade-off ``order[0]`` is certified; if it fails, the next members in the
-    trade-off ``order`` (n,) **that the optimiser marked feasible** are, up to
-    ``max_certify`` certificates in all, and the first that passes is reported. A member
-    that violates a constraint at the optimiser's samples is not tried: the dense check
-    (the same limits at ≥ ``rate_hz`` [Hz], samples and exact kinematic extrema) rejects it
-    anyway, and each certificate costs about a second. If none passes, the best trade-off
-    is reported with its failing certificate.
+    Only members the optimiser marked feasible are certified (a member that violates a
+    constraint at the optimiser's samples fails the dense check as well), in the trade-off
+    ``order`` (n,), at most ``max_certify`` of them (``None``: all); the others are not
+    certified. The certificates use the broad phase's bounds above an influence distance of
+    ``margin + 0.01 m`` (``certify(..., exact=False)`` on :func:`_certifying_problem`: the
+    same verdict, about 30× faster than exact distances).
     """
-    first = int(order[0])
-    certificate = certify(problem, front.x[first], rate_hz=rate_hz)
-    if certificate.feasible:
-        return certificate, first
-    further = [int(k) for k in order[1:] if front.feasible[k]]
-    for k in further[: max_certify - 1]:
-        candidate = certify(problem, front.x[k], rate_hz=rate_hz)
-        if candidate.feasible:
-            return candidate, k
-    return certificate, first
+    candidates = [int(k) for k in order if front.feasible[k]]
+    if max_certify is not None:
+        candidates = candidates[:max_certify]
+    certified = np.zeros(len(front.x), dtype=bool)
+    if not candidates:
+        return certified
+    fast = _certifying_problem(problem)
+    for k in candidates:
+        certified[k] = certify(fast, front.x[k], rate_hz=rate_hz, exact=False).certified
+    return certified
+
+
+def _certified_choice(
+    problem: TrajectoryProblem, front: Front, order: np.ndarray, rate_hz: float
+) -> tuple[Certificate, int]:
+    """(certificate, front index) of the reported solution: the first certified member in
+    the trade-off ``order`` (n,), or the best trade-off ``order[0]`` with its failing
+    certificate when none is; the certificate computes every distance exactly."""
+    passed = [int(k) for k in order if front.feasible[k]]
+    index = passed[0] if passed else int(order[0])
+    return certify(problem, front.x[index], rate_hz=rate_hz), index
 
 
 def plan(
@@ -161,7 +199,7 @@ def plan(
     resume: bool = False,
     progress: Callable[[GenerationInfo], None] | None = None,
     rate_hz: float = 1000.0,
-    max_certify: int = 10,
+    max_certify: int | None = None,
     **params: Any,
 ) -> PlanningResult:
     """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name).
@@ -175,16 +213,20 @@ def plan(
     checkpoint, resume: checkpoint folder and whether to resume from it.
     progress: called after every generation.
     rate_hz: rate of the dense verification (≥ 1000 Hz recommended).
-    max_certify: most certificates made: the trade-off choice and, if it fails, further
-        candidates among the members the optimiser marked feasible.
+    max_certify: most front members certified (in the trade-off order, among those the
+        optimiser marked feasible; ``None``: all). A member not certified is reported with
+        ``feasible = False``.
 
     Returns
     -------
     PlanningResult
-        Never empty; ``result.feasible`` is the dense certificate's verdict.
+        Never empty; ``result.feasible`` is the dense certificate's verdict, and
+        ``result.front.feasible[i]`` that of member ``i`` with the continuous guarantee
+        (``result.front.n_certified`` of them).
     """
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
-    max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
+    if max_certify is not None:
+        max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
     check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
     state = optimise(
@@ -217,7 +259,15 @@ def plan(
         feasible=feasible[rows],
     )
     choice = best_tradeoff(front.objectives, weights)
-    certificate, index = _certified_choice(problem, front, choice.order, rate_hz, max_certify)
+    certified = _certify_front(problem, front, choice.order, rate_hz, max_certify)
+    front = Front(
+        x=front.x,
+        objectives=front.objectives,
+        constraints=front.constraints,
+        feasible=certified,
+        n_certified=int(certified.sum()),
+    )
+    certificate, index = _certified_choice(problem, front, choice.order, rate_hz)
     lo, hi = objective_bounds(front.objectives)
     metrics = Metrics(
         ssm=spread(front.objectives) if len(rows) > 1 else None,

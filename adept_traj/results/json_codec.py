@@ -68,7 +68,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     ref = r.metrics.hv_reference_point
     metrics["HV_reference_point"] = None if ref is None else _floats(ref)
     history = None if r.history is None else [dataclasses.asdict(rec) for rec in r.history]
-    return {
+    out: dict[str, Any] = {
         "format": FORMAT,
         "version": VERSION,
         "warning": r.warning,
@@ -117,6 +117,9 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
         "best_trajectory": {name: _floats(getattr(c.dense, name)) for name in _DENSE_FIELDS},
         "history": history,
     }
+    if r.front.n_certified is not None:  # optional key (absent in files of older versions)
+        out["n_certified"] = r.front.n_certified
+    return out
 
 
 def _encode_certificate(c: Certificate) -> dict[str, Any]:
@@ -131,6 +134,10 @@ def _encode_certificate(c: Certificate) -> dict[str, Any]:
         "violations": list(c.violations),
         "x": _floats(c.x),
     }
+    if c.guarantee is not None:  # optional keys (absent in files of older versions)
+        out["guarantee"] = c.guarantee
+    if c.distance_bound is not None:
+        out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
     for check in c.checks:
         out[check.kind] = {
             "limit": check.symbol,
@@ -223,7 +230,7 @@ def _decode(top: Node) -> PlanningResult:
         T_min=lb["T_min"].number(),
         limiting_joint=lb["limiting_joint"].integer(),
     )
-    front = _decode_front(top["front"])
+    front = _decode_front(top["front"], top["n_certified"].integer(minimum=0, default=None))
     bd = top["best"]
     best = bd.build(
         BestSolution,
@@ -299,7 +306,7 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
             raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
 
 
-def _decode_front(node: Node) -> Front:
+def _decode_front(node: Node, n_certified: int | None) -> Front:
     xs, objs, cons, feas = [], [], [], []
     n_var = n_con = None
     for item in node.items(min_items=1):
@@ -314,6 +321,7 @@ def _decode_front(node: Node) -> Front:
         objectives=np.array(objs),
         constraints=np.array(cons),
         feasible=np.array(feas, dtype=bool),
+        n_certified=n_certified,
     )
 
 
@@ -347,6 +355,10 @@ def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
         closest_pair=None if pair.value is None else pair.strings(),
         violations=node["violations"].strings(),
         dense=dense,
+        guarantee=node["guarantee"].string(nonempty=True, default=None),
+        distance_bound=(
+            node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
+        ),
         **checks,
     )
 

@@ -133,12 +133,17 @@ class Front:
     objectives: (n, 6) z1…z6, **z4 positive** (as reported, not pymoo's negated value).
     constraints: (n, n_con) normalised constraints g (≤ 0 satisfied), the problem's order.
     feasible: (n,) bool, as decided by the engine (the certificate for "verified").
+    n_certified: members whose certificate passed with the continuous guarantee, when
+        :func:`~adept_traj.plan` certified every member: ``feasible`` is then the
+        certificate's verdict and ``n_certified == feasible.sum()``. ``None``: ``feasible``
+        is the optimiser's verdict at its samples (results saved before).
     """
 
     x: np.ndarray
     objectives: np.ndarray
     constraints: np.ndarray
     feasible: np.ndarray
+    n_certified: int | None = None
 
     def __post_init__(self) -> None:
         n = None
@@ -161,6 +166,14 @@ class Front:
             )
         feas.flags.writeable = False
         object.__setattr__(self, "feasible", feas)
+        if self.n_certified is not None:
+            count = as_integer(self.n_certified, "front.n_certified", minimum=0)
+            if count != int(feas.sum()):
+                raise InvalidInputError(
+                    f"front.n_certified must be the number of feasible (certified) members, "
+                    f"{int(feas.sum())}; got {count}"
+                )
+            object.__setattr__(self, "n_certified", count)
 
     @classmethod
     def from_evaluation(cls, x: Any, evaluation: Evaluation, feasible: Any | None = None) -> Front:
@@ -179,8 +192,10 @@ class Front:
 
     def subset(self, mask: Any) -> Front:
         """The solutions selected by a bool mask or index array."""
+        feasible = self.feasible[mask]
+        certified = None if self.n_certified is None else int(np.sum(feasible))
         return Front(
-            self.x[mask], self.objectives[mask], self.constraints[mask], self.feasible[mask]
+            self.x[mask], self.objectives[mask], self.constraints[mask], feasible, certified
         )
 
     def __eq__(self, other: object) -> bool:

@@ -72,6 +72,19 @@ class MotionLaw(_ValueObject, ABC):
             attached ball for every real t (a guarantee, not a sampled estimate).
         """
 
+    @abstractmethod
+    def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
+        """Largest speed of any point of a ball attached to the moving frame, at any time.
+
+        Args:
+            point: (3,) centre of the attached ball in the moving frame [m].
+            radius: radius of the attached ball [m], ≥ 0.
+
+        Returns:
+            An upper bound [m/s] of the world speed of every point of the ball, valid for every
+            real t (used by the continuous-time certificate).
+        """
+
 
 def _check_ball(point: Any, radius: Any) -> tuple[np.ndarray, float]:
     return as_vector(point, "point", 3, "[m]"), as_scalar(radius, "radius", "[m]", minimum=0.0)
@@ -116,6 +129,11 @@ class FixedPose(MotionLaw):
         """The attached ball itself, in world coordinates: ((3,) centre [m], radius [m])."""
         p, r = _check_ball(point, radius)
         return self.transform[:3, :3] @ p + self.transform[:3, 3], r
+
+    def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
+        """0 [m/s]: nothing moves (the arguments are checked as for every law)."""
+        _check_ball(point, radius)
+        return 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,6 +241,21 @@ class PendulumMotion(MotionLaw):
         """``a = v0 / (2 √(g l))``, so that ``φ = 2 arcsin(a cos ω t)``."""
         return self.v0 / (2.0 * math.sqrt(self.g * self.length))
 
+    @property
+    def max_angular_speed(self) -> float:
+        r"""Largest swing rate :math:`\max_t |\dot\varphi|` [rad/s].
+
+        From :math:`\varphi = 2 \arcsin(a \cos \omega t)`,
+
+        .. math::
+            |\dot\varphi| = \frac{2 a \omega |\sin \omega t|}{\sqrt{1 - a^2 \cos^2 \omega t}}
+            = 2 a \omega \sqrt{\frac{1 - c^2}{1 - a^2 c^2}} \le 2 a \omega,
+            \qquad c = \cos \omega t,
+
+        since :math:`a \le 1` (equality at the bottom, :math:`c = 0`).
+        """
+        return 2.0 * min(1.0, self._amplitude_factor) * self.omega
+
     # ------------------------------------------------------------------ time functions
     def angle(self, t: Any) -> np.ndarray:
         """Signed swing angle φ(t) from the downward vertical [rad].
@@ -299,3 +332,17 @@ class PendulumMotion(MotionLaw):
         if alpha <= 0.5 * math.pi:
             return axis_point + math.cos(alpha) * rest, rho * math.sin(alpha) + r
         return axis_point, rho + r
+
+    def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
+        r"""Speed bound [m/s] of a ball attached to the pendulum frame.
+
+        Every point turns about the normal axis through the pivot, so its speed is
+        :math:`|\dot\varphi|` times its distance from that axis:
+
+        .. math::
+            v \le \max_t |\dot\varphi| \,\bigl(\sqrt{a^2 + c^2} + r\bigr)
+
+        for the ball of centre ``(a, b, c)`` and radius ``r`` (:attr:`max_angular_speed`).
+        """
+        p, r = _check_ball(point, radius)
+        return self.max_angular_speed * (math.hypot(p[0], p[2]) + r)
