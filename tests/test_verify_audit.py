@@ -192,15 +192,25 @@ def test_feasible_member_marked_infeasible_is_named(tmp_path: Path) -> None:
     f = result.front
     found = audit(dataclasses.replace(result, front=Front(f.x, f.objectives, f.constraints, flags)))
     by_field = {m.field: m for m in found.mismatches}
-    assert set(by_field) == {f"front[{k}].feasible", f"front[{k}]"}
-    assert (
-        by_field[f"front[{k}].feasible"].stored,
-        by_field[f"front[{k}].feasible"].recomputed,
-    ) == (
-        False,
-        True,
-    )
-    assert by_field[f"front[{k}]"].stored == "infeasible member"
+    # the member itself belongs in the front (feasible at the samples): only its flag differs
+    assert set(by_field) == {f"front[{k}].feasible"}
+    flag = by_field[f"front[{k}].feasible"]
+    assert (flag.stored, flag.recomputed) == (False, True)
+
+
+def test_certified_front_flags_are_recomputed_from_certificates(tmp_path: Path) -> None:
+    """With every member certified (n_certified set), a member whose certificate passes but
+    is stored as failed is named; the stored verdicts of an untampered run pass."""
+    result = _planar_run(tmp_path)
+    assert result.front.n_certified == int(result.front.feasible.sum())
+    assert audit(result).mismatches == ()
+    k = int(np.flatnonzero(result.front.feasible)[-1])
+    flags = result.front.feasible.copy()
+    flags[k] = False
+    f = result.front
+    tampered = Front(f.x, f.objectives, f.constraints, flags, n_certified=int(flags.sum()))
+    found = audit(dataclasses.replace(result, front=tampered))
+    assert {m.field for m in found.mismatches} >= {f"front[{k}].feasible"}
 
 
 def test_mismatch_line_format(old, tmp_path, capsys) -> None:

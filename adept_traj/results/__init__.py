@@ -7,7 +7,8 @@
 from __future__ import annotations
 
 from adept_traj.errors import ResultFormatError
-from adept_traj.results.audit import AUDIT_RTOL, Audit, Mismatch, audit
+from adept_traj.results.audit import Audit, audit
+from adept_traj.results.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.results.parts import (
     SHIPPED_ROBOT,
     BestSolution,

@@ -11,8 +11,10 @@ field of ``result.json``:
   shipped paper scene when the stored one is named ``"paper"``, or the one given);
 - every front member's objectives and constraints against
   :meth:`~adept_traj.problem.TrajectoryProblem.evaluate_batch` of its decision vector, its
-  ``feasible`` flag against the recomputed constraints, and, when the front has a feasible
-  member, that every member is feasible and none dominates another (how ``plan`` builds it);
+  ``feasible`` flag against the recomputed constraints and, for a result whose members
+  are all certified (``front.n_certified``), each member's own continuous certificate;
+  when the front has a member feasible at the samples, that every member is and none
+  dominates another (how ``plan`` builds it);
 - the certificate (dense trajectory t, q, qd, qdd, qddd, tau, min_distance; every limit
   check, the minimum distance, its time and pair, the violations, the verdict) against a
   fresh :func:`~adept_traj.analysis.certify` at the stored rate and tolerance;
@@ -63,43 +65,19 @@ from adept_traj.analysis import (
     spread,
 )
 from adept_traj.problem import OBJECTIVE_NAMES, TrajectoryProblem
+from adept_traj.results.mismatches import Mismatch, MismatchLog, close
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot import LIMITS
 from adept_traj.scene import Scene
-from adept_traj.validation import check_type, deep_equal
+from adept_traj.validation import check_type
 
-__all__ = ["AUDIT_RTOL", "Audit", "Mismatch", "audit"]
+__all__ = ["Audit", "audit"]
 
-#: Relative tolerance of the comparison of a stored and a recomputed number (module doc).
-AUDIT_RTOL = 1e-9
 #: What cannot be recomputed from a result folder.
 NOT_RECOMPUTABLE = (
     "metrics.RNI (needs the final population, which is not stored)",
     "history[*].hypervolume (needs every generation's front, which is not stored)",
 )
-
-
-@dataclass(frozen=True)
-class Mismatch:
-    """A stored value that differs from its recomputation.
-
-    Attributes
-    ----------
-    field: its path in ``result.json``, e.g. ``front[3].objectives[1]``,
-        ``best_trajectory.tau[12][2]`` (for an array: its worst element).
-    stored: the stored value.
-    recomputed: the recomputed value.
-    note: what else the reader should know (how many values of the field differ, …).
-    """
-
-    field: str
-    stored: Any
-    recomputed: Any
-    note: str = ""
-
-    def __str__(self) -> str:
-        text = f"{self.field}: stored {_show(self.stored)}, recomputed {_show(self.recomputed)}"
-        return f"{text} ({self.note})" if self.note else text
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,93 +143,16 @@ def audit(
         return _Auditor(result, built, w, scene).run()
 
 
-def _show(value: Any) -> str:
-    """A value as printed in a mismatch: floats in shortest round-trip form."""
-    if isinstance(value, (float, np.floating)):
-        return repr(float(value))
-    if isinstance(value, (np.integer, np.bool_)):
-        return repr(value.item())
-    return repr(value) if isinstance(value, str) else str(value)
-
-
-def _index(idx: tuple[int, ...]) -> str:
-    return "".join(f"[{int(i)}]" for i in idx)
-
-
-class _Auditor:
-    """Collects the comparisons of one audit."""
+class _Auditor(MismatchLog):
+    """The comparisons of one audit."""
 
     def __init__(
         self, result: PlanningResult, problem: TrajectoryProblem, weights: Any, scene: Any
     ) -> None:
+        super().__init__()
         self.r, self.p, self.weights, self.scene = result, problem, weights, scene
-        self.mismatches: list[Mismatch] = []
         self.not_checked = list(NOT_RECOMPUTABLE)
-        self.n_fields = self.n_values = 0
 
-    # ------------------------------------------------------------------ comparisons
-    def numbers(self, path: str, stored: Any, recomputed: Any, rows: bool = False) -> None:
-        """Compare two arrays of numbers (module doc); ``rows``: one field per row, named
-        ``path.format(row)``."""
-        s, c = np.asarray(stored, dtype=float), np.asarray(recomputed, dtype=float)
-        if s.shape != c.shape:
-            self.count(1, 1)
-            self.add(path.format("*"), f"shape {s.shape}", f"shape {c.shape}")
-            return
-        finite = np.isfinite(s) & np.isfinite(c)
-        mag = np.where(finite, np.maximum(np.abs(s), np.abs(c)), 0.0)
-        scale = mag.max(axis=0) if s.ndim == 2 and s.size else (mag.max() if s.size else 0.0)
-        gap = np.abs(np.subtract(s, c, out=np.full(s.shape, np.inf), where=finite))
-        bad = (s != c) & (gap > AUDIT_RTOL * scale)
-        if rows:
-            blocks = [(path.format(i), s[i], c[i], bad[i], gap[i]) for i in range(len(s))]
-        else:
-            blocks = [(path, s, c, bad, gap)]
-        self.count(len(blocks), s.size)
-        for name, sv, cv, bv, gv in blocks:
-            if bv.any():
-                worst = np.unravel_index(int(np.argmax(np.where(bv, gv, -1.0))), bv.shape)
-                n_bad = int(bv.sum())
-                note = f"{n_bad} of {bv.size} values differ" if n_bad > 1 else ""
-                self.add(name + _index(worst), sv[worst], cv[worst], note)
-
-    def value(self, path: str, stored: Any, recomputed: Any, note: str = "") -> None:
-        """Compare two values of any other kind (exactly, :func:`deep_equal`)."""
-        self.count(1, 1)
-        if not deep_equal(stored, recomputed):
-            self.add(path, stored, recomputed, note)
-
-    def optional(self, path: str, stored: float | None, recomputed: float | None) -> None:
-        """Compare two numbers either of which may be ``None`` (not computed)."""
-        if stored is None or recomputed is None:
-            self.value(path, stored, recomputed)
-        else:
-            self.numbers(path, stored, recomputed)
-
-    def tree(self, path: str, stored: Any, recomputed: Any) -> None:
-        """Compare two parsed documents (dicts, lists, leaves) leaf by leaf."""
-        if isinstance(stored, dict) and isinstance(recomputed, dict):
-            for key in sorted(set(stored) | set(recomputed), key=str):
-                missing = "(absent)"
-                self.tree(f"{path}.{key}", stored.get(key, missing), recomputed.get(key, missing))
-        elif isinstance(stored, list) and isinstance(recomputed, list):
-            if len(stored) != len(recomputed):
-                self.count(1, 1)
-                self.add(path, len(stored), len(recomputed), "number of items")
-                return
-            for i, (a, b) in enumerate(zip(stored, recomputed, strict=True)):
-                self.tree(f"{path}[{i}]", a, b)
-        else:
-            self.value(path, stored, recomputed)
-
-    def count(self, fields: int, values: int) -> None:
-        self.n_fields += fields
-        self.n_values += values
-
-    def add(self, path: str, stored: Any, recomputed: Any, note: str = "") -> None:
-        self.mismatches.append(Mismatch(path, stored, recomputed, note))
-
-    # ------------------------------------------------------------------ the audit
     def run(self) -> Audit:
         self.robot()
         self.scenes()
@@ -306,16 +207,32 @@ class _Auditor:
         ev = self.p.evaluate_batch(front.x)
         self.numbers("front[{}].objectives", front.objectives, ev.objectives, rows=True)
         self.numbers("front[{}].constraints", front.constraints, ev.constraints, rows=True)
-        for i, (stored, now) in enumerate(zip(front.feasible, ev.feasible, strict=True)):
+        feasible = self.certified_members(ev.feasible)
+        for i, (stored, now) in enumerate(zip(front.feasible, feasible, strict=True)):
             self.value(f"front[{i}].feasible", bool(stored), bool(now))
-        if not front.feasible.any():
+        if not ev.feasible.any():
             return  # the least-infeasible members of a population that is not stored
-        rule = "plan keeps only the feasible non-dominated members when one is feasible"
+        rule = "plan keeps only the non-dominated members feasible at its samples"
         kept = non_dominated(front.objectives)
         self.count(len(front), len(front))
-        for i in np.flatnonzero(~front.feasible | ~kept):
-            member = "infeasible member" if not front.feasible[i] else "dominated member"
+        for i in np.flatnonzero(~ev.feasible | ~kept):
+            member = "infeasible member" if not ev.feasible[i] else "dominated member"
             self.add(f"front[{i}]", member, "not in the front", rule)
+
+    def certified_members(self, sampled: np.ndarray) -> np.ndarray:
+        """(n,) the recomputed ``front.feasible``: the optimiser's verdict ``sampled`` (n,)
+        for a result of the earlier rule (``front.n_certified`` is None), else that verdict
+        and the member's own certificate with the continuous guarantee (as ``plan`` does)."""
+        if self.r.front.n_certified is None:
+            return np.asarray(sampled, dtype=bool)
+        rate = self.r.certificate.rate_hz
+        return np.array(
+            [
+                bool(ok) and certify(self.p, x, rate_hz=rate, exact=False).certified
+                for ok, x in zip(sampled, self.r.front.x)
+            ],
+            dtype=bool,
+        )
 
     def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
         self.value(f"{path}.feasible", stored.feasible, now.feasible)
@@ -344,15 +261,21 @@ class _Auditor:
         self.optional("best.F_avg", r.best.f_avg, float(choice.F_avg[i]))
         weights = ",".join(f"{w:g}" for w in self.weights)
         self.count(1, 1)
-        if r.best.f_c is not None and not _close(r.best.f_c, float(choice.f_c[i])):
+        if r.best.f_c is not None and not close(r.best.f_c, float(choice.f_c[i])):
             self.add("best.f_c", r.best.f_c, float(choice.f_c[i]), f"with weights {weights}")
         expected = self.expected_index(choice.order, certificate)
         self.value("best.index", i, expected, f"plan's rule with weights {weights}")
 
     def expected_index(self, order: np.ndarray, certificate: Certificate) -> int:
-        """``plan``'s choice: the first of the trade-off order, or when its certificate
-        fails, the first member after it marked feasible whose certificate passes."""
+        """``plan``'s choice. With every member certified (``front.n_certified`` set): the
+        first member of the trade-off order whose stored verdict is certified (checked
+        member by member in :meth:`front`), else the first of the order. Before that rule:
+        the first of the order, or when its certificate fails, the first member after it
+        marked feasible whose certificate passes."""
         r, first = self.r, int(order[0])
+        if r.front.n_certified is not None:
+            passed = [int(k) for k in order if r.front.feasible[k]]
+            return passed[0] if passed else first
         if r.best.index == first:
             return first  # the members after it are not certified again
         rank = int(np.flatnonzero(order == r.best.index)[0])
@@ -383,8 +306,3 @@ class _Auditor:
             self.value("metrics.HV_reference_point", m.hv_reference_point, ref)
         else:
             self.numbers("metrics.HV_reference_point", m.hv_reference_point, ref)
-
-
-def _close(a: float, b: float) -> bool:
-    """``a`` and ``b`` agree within :data:`AUDIT_RTOL` of the larger magnitude."""
-    return a == b or abs(a - b) <= AUDIT_RTOL * max(abs(a), abs(b))
