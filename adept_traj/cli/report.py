@@ -12,19 +12,26 @@ __all__ = ["save_figures", "summary"]
 
 def summary(result: PlanningResult, folder: Path) -> str:
     """A few lines on a finished run: evaluations and time, the best trade-off's objectives
-    z1 [s] … z6 and its gap to the kinematic lower bound, its dense certificate (violations
-    listed), the result's warning and where it was saved."""
+    z1 [s] … z6 and its gap to the kinematic lower bound, how many front members are
+    certified, its dense certificate and the guarantee it gives (violations listed), the
+    result's warning and where it was saved."""
     z = result.best_objectives
-    cert = result.certificate
+    cert, front = result.certificate, result.front
+    certified = (
+        f", {front.n_certified} certified (continuous guarantee)"
+        if front.n_certified is not None
+        else ""
+    )
     lines = [
         f"{result.algorithm}: {result.timing.n_evaluations} evaluations in "
         f"{result.timing.total_s:.1f} s ({result.timing.evaluation_s:.1f} s evaluating); "
-        f"front of {len(result.front)}",
+        f"front of {len(front)}{certified}",
         f"best trade-off: T = {z[0]:.3f} s (lower bound {result.lower_bound.T_min:.3f} s, "
         f"gap {result.gap:.2f}x), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, z4 = {z[3]:.4g} m², "
         f"z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
         f"verified at {cert.rate_hz:g} Hz: {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
-        f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m)",
+        f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m; "
+        f"guarantee: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'})",
     ]
     lines += [f"  violation: {v}" for v in cert.violations]
     if result.warning:
