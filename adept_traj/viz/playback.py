@@ -29,7 +29,6 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -50,6 +49,7 @@ from adept_traj.results import (
 )
 from adept_traj.validation import as_scalar, check_type, readonly_copy
 from adept_traj.viz.closest_points import closest_points
+from adept_traj.viz.framing import camera, floor
 from adept_traj.viz.inputs import as_result
 from adept_traj.viz.meshcat_geometry import (
     Part,
@@ -82,16 +82,10 @@ TOOL_PATH_COLOR = 0x1E8449
 START_COLOR = 0x1E8449
 GOAL_COLOR = 0x0B5345
 CLOSEST_COLOR = 0xF1C40F
-FLOOR_COLOR = 0xE5E7E9
-GRID_COLOR = 0xB3B6B7
 
 _MARKER_RADIUS = 0.012  # tool path start/goal spheres [m]
 _SEGMENT_RADIUS = 0.005  # closest-point segment [m]
 _POINT_RADIUS = 0.01  # closest-point end spheres [m]
-_FOV_DEG = 75.0  # meshcat's default camera: vertical field of view
-_VIEW_DIRECTION = np.array([-0.7, -1.2, 0.9])  # camera offset direction from the target
-_GRID_STEP = 0.1  # floor grid spacing [m]
-_FLOOR_MARGIN = 0.3  # floor beyond the drawn scene [m]
 
 
 # ============================================================================ data
@@ -300,8 +294,8 @@ def build_animation(
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
     seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
     seen_points = np.vstack(seen)
-    objects.extend(_floor(seen_points))
-    target, position = _camera(seen_points)
+    objects.extend(SceneObject(path, parts, pose) for path, parts, pose in floor(seen_points))
+    target, position = camera(seen_points)
     return Playback(
         objects=tuple(objects),
         times=readonly_copy(times),
@@ -386,41 +380,3 @@ def _closest_objects(points: np.ndarray) -> list[SceneObject]:
         ball = Part(mg.Mesh(mg.Sphere(_POINT_RADIUS), material), np.eye(4))
         ends.append(SceneObject(f"closest/{name}", (ball,), poses))
     return [SceneObject("closest/segment", (rod,), seg_poses, scales), *ends]
-
-
-def _floor(points: np.ndarray) -> list[SceneObject]:
-    """The floor z = 0 under ``points`` (n, 3) [m]: a light slab with a 0.1 m grid, and the
-    world axes (x red, y green, z blue, 0.2 m) at the origin."""
-    lo = np.floor((points[:, :2].min(axis=0) - _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
-    hi = np.ceil((points[:, :2].max(axis=0) + _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
-    size = hi - lo
-    slab = mg.Mesh(mg.Box([*size, 0.004]), mg.MeshLambertMaterial(color=FLOOR_COLOR))
-    centre = translation([*(0.5 * (lo + hi)), -0.0021])
-    segments: list[Any] = []
-    for axis in (0, 1):
-        n = round(size[axis] / _GRID_STEP)
-        for v in lo[axis] + _GRID_STEP * np.arange(n + 1):
-            a, b = np.zeros(3), np.zeros(3)
-            a[axis] = b[axis] = v
-            a[1 - axis], b[1 - axis] = lo[1 - axis], hi[1 - axis]
-            segments += [a, b]
-    grid = mg.LineSegments(
-        mg.PointsGeometry(np.ascontiguousarray(np.array(segments).T, dtype=np.float32)),
-        mg.LineBasicMaterial(color=GRID_COLOR),
-    )
-    return [
-        SceneObject("floor/slab", (Part(slab, np.eye(4)),), centre),
-        SceneObject("floor/grid", (Part(grid, np.eye(4)),), np.eye(4)),
-        SceneObject("floor/axes", (Part(mg.triad(0.2), np.eye(4)),), np.eye(4)),
-    ]
-
-
-def _camera(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A camera target (the centre of the box around ``points`` (n, 3)) and a position from
-    which all of it is in view [m]."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    target = 0.5 * (lo + hi)
-    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.3) + 0.15
-    distance = 1.05 * radius / math.tan(math.radians(0.5 * _FOV_DEG))
-    direction = _VIEW_DIRECTION / np.linalg.norm(_VIEW_DIRECTION)
-    return target, target + distance * direction
