@@ -90,6 +90,8 @@ def test_ros_dense_round_trip(result: PlanningResult) -> None:
         "certified",
         "certificate_rate_hz",
         "warning",
+        "member",
+        "best_tradeoff",
         "header",
         "joint_names",
         "points",
@@ -264,7 +266,7 @@ def test_saved_json_is_valid_and_equal(result: PlanningResult, tmp_path: Path) -
     assert "NaN" not in text
     assert "Infinity" not in text
     assert data == to_ros_joint_trajectory(result)  # exact floats after the round trip
-    assert len(text.splitlines()) == len(data["points"]) + 9  # one point per line
+    assert len(text.splitlines()) == len(data["points"]) + 11  # one point per line
 
 
 def test_saved_json_resampled(result: PlanningResult, tmp_path: Path) -> None:

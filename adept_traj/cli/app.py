@@ -9,8 +9,10 @@ Sub-commands, one module each:
   the same problem, with the paper's Tables 3–5 beside ours (``DIR/comparison.md``).
 - ``adept-traj verify DIR`` (:mod:`adept_traj.cli.verify`) — re-run the dense
   verification of a saved result.
+- ``adept-traj front DIR`` (:mod:`adept_traj.cli.front`) — list the members of a saved
+  front (objectives, f_c, F_avg, certified), sorted by any column, to pick one.
 - ``adept-traj show DIR`` (:mod:`adept_traj.cli.show`) — play a saved result in the
-  browser (meshcat, 127.0.0.1).
+  browser (meshcat, 127.0.0.1); ``--member N`` plays another member of the front.
 - ``adept-traj robot`` (:mod:`adept_traj.cli.robot`) — the robot-model demo (torques and
   manipulability along a move).
 - ``adept-traj build-urdf PARAMS --output URDF`` (:mod:`adept_traj.cli.build_urdf`) —
@@ -28,7 +30,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 
-from adept_traj.cli import build_urdf, compare, plan, robot, show, status, verify
+from adept_traj.cli import build_urdf, compare, front, plan, robot, show, status, verify
 from adept_traj.errors import AdeptTrajError
 
 __all__ = ["main"]
@@ -41,6 +43,7 @@ _COMMANDS = {
     "compare": compare,
     "show": show,
     "verify": verify,
+    "front": front,
     "robot": robot,
     "build-urdf": build_urdf,
 }

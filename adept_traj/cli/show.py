@@ -1,5 +1,11 @@
 """``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1).
 
+``--member N`` plays member N of the front (the index of ``adept-traj front DIR``) instead
+of the best trade-off; an uncertified member
+(:func:`~adept_traj.results.certified_members`) is refused unless ``--allow-infeasible``,
+and a member out of range is refused, both before the server starts (exit status 2).
+Without ``--member`` the best trade-off is played, certified or not, as before.
+
 Loops until stopped. Ctrl-C (SIGINT) stops the meshcat server and exits with status 0;
 SIGTERM (``kill``, a supervisor, a CI timeout) does the same and exits with status 143
 (128 + 15, the shell's code for a process ended by SIGTERM), so that the caller still
@@ -18,7 +24,8 @@ from types import FrameType
 from typing import NoReturn
 
 from adept_traj.cli import status
-from adept_traj.results import PlanningResult
+from adept_traj.errors import InvalidInputError
+from adept_traj.results import PlanningResult, certified_members, member_index
 
 __all__ = ["add_parser", "run"]
 
@@ -30,6 +37,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
     p.add_argument("--closest", action="store_true", help="draw the closest-point segment")
     p.add_argument("--open", action="store_true", help="open the page in a web browser")
+    p.add_argument(
+        "--member",
+        type=int,
+        help="play member N of the front (see adept-traj front DIR; default: the best trade-off)",
+    )
+    p.add_argument(
+        "--allow-infeasible",
+        action="store_true",
+        help="with --member: play the member even if it is not certified",
+    )
     return p
 
 
@@ -58,11 +75,24 @@ def _play(args: argparse.Namespace) -> NoReturn:
     from adept_traj.viz import server
 
     result = PlanningResult.load(args.folder)
+    index = member_index(result, args.member)
+    certified = bool(certified_members(result)[index])
+    if args.member is not None and not certified and not args.allow_infeasible:
+        raise InvalidInputError(
+            f"member {index} of the front is not certified (adept-traj front "
+            f"{args.folder}); pass --allow-infeasible to play it anyway"
+        )
     vis = server.show(  # closes its own server if interrupted while starting
-        result, speed=args.speed, show_closest=args.closest, open_browser=args.open
+        result,
+        speed=args.speed,
+        show_closest=args.closest,
+        open_browser=args.open,
+        member=index,
     )
+    which = "best trade-off" if index == result.best.index else "member"
+    label = f"{which} {index}, {'certified' if certified else 'NOT CERTIFIED'}"
     try:  # the URL is printed inside: a Ctrl-C right after it must still stop cleanly
-        print(f"playing {args.folder} at {vis.url()} (Ctrl-C to stop)", flush=True)
+        print(f"playing {args.folder} ({label}) at {vis.url()} (Ctrl-C to stop)", flush=True)
         while True:
             time.sleep(1.0)
     finally:

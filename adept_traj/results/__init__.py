@@ -1,13 +1,15 @@
 """Planning results: the record (:mod:`~adept_traj.results.record`, its parts in
 :mod:`~adept_traj.results.parts`), its file codecs (:mod:`~adept_traj.results.json_codec`,
 :mod:`~adept_traj.results.csv_codec`), the motion built once for viewing
-(:mod:`~adept_traj.results.replay`) and the ROS export
+(:mod:`~adept_traj.results.replay`), the choice of a front member
+(:mod:`~adept_traj.results.members`) and the ROS export
 (:mod:`~adept_traj.results.ros_export`)."""
 
 from __future__ import annotations
 
 from adept_traj.errors import ResultFormatError
 from adept_traj.results.audit import Audit, audit
+from adept_traj.results.members import certified_members, member_index, member_replay
 from adept_traj.results.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.results.parts import (
     SHIPPED_ROBOT,
@@ -60,6 +62,9 @@ __all__ = [
     "RobotInfo",
     "Timing",
     "audit",
+    "certified_members",
+    "member_index",
+    "member_replay",
     "save_ros_joint_trajectory",
     "software_versions",
     "to_csv",

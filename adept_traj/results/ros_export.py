@@ -1,4 +1,4 @@
-"""Export the best trajectory of a planning result: CSV and ROS ``JointTrajectory`` JSON.
+"""Export a trajectory of a planning result: CSV and ROS ``JointTrajectory`` JSON.
 
 - :func:`to_csv` writes the certified dense trajectory in exactly the format of the result
   folder's ``best_trajectory.csv`` (``docs/results.md``): header ``t, q_<joint>…,
@@ -7,14 +7,18 @@
 - :func:`to_ros_joint_trajectory` builds a dictionary shaped like a ROS 2
   ``trajectory_msgs/msg/JointTrajectory`` (``time_from_start`` as
   ``builtin_interfaces/Duration``: ``sec``, ``nanosec``); :func:`save_ros_joint_trajectory`
-  writes it as JSON. The points are the certificate's dense samples, or the spline
-  resampled at a given rate. Units are SI, as ROS expects: rad, m, rad/s, m/s, rad/s²,
+  writes it as JSON. The move is the best trade-off by default, or any member of the front
+  (``member=N``). The points are the best trade-off's stored dense samples, or the spline
+  resampled at a given rate (always resampled for another member: only the best trade-off
+  stores its dense samples). Units are SI, as ROS expects: rad, m, rad/s, m/s, rad/s²,
   m/s², N·m, N.
 
-The ROS export refuses a best trade-off whose dense certificate failed
-(``result.feasible`` false) unless ``allow_infeasible=True``: the file is meant to be sent
-to a controller. Either way the output says whether it was certified (``"certified"``,
-``"certificate_rate_hz"``) and, when it was not, a ``"warning"`` names the violations.
+The ROS export refuses an uncertified member (the best trade-off: ``result.feasible``;
+another member: :func:`~adept_traj.results.certified_members`) unless
+``allow_infeasible=True``: the file is meant to be sent to a controller. Either way the
+output says whether it was certified (``"certified"``, ``"certificate_rate_hz"``; when it
+was not, a ``"warning"`` says why) and which member it is (``"member"``,
+``"best_tradeoff"``).
 Resampling goes through a :class:`~adept_traj.results.Replay` (robot and spline,
 built once or handed in), never the full problem. See ``docs/plots-and-export.md`` and
 ``docs/results.md``.
@@ -33,6 +37,7 @@ from adept_traj.analysis.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
 from adept_traj.results.csv_codec import _write_trajectory_csv
+from adept_traj.results.members import certified_members, member_index, member_replay
 from adept_traj.results.record import PlanningResult
 from adept_traj.results.replay import Replay
 from adept_traj.validation import as_scalar, check_type
@@ -95,41 +100,64 @@ def _duration(t: float) -> dict[str, int]:
     return {"sec": int(sec), "nanosec": int(nanosec)}
 
 
-def _resample(r: PlanningResult, rate: float, replay: Any) -> tuple[np.ndarray, ...]:
-    """(t, q, qd, qdd, tau) of the best trajectory on ``ceil(T·rate) + 1`` uniform samples."""
-    n = dense_samples(float(r.best_x[0]), rate)  # the grid of analysis.certify
+def _resample(r: PlanningResult, index: int, rate: float, replay: Any) -> tuple[np.ndarray, ...]:
+    """(t, q, qd, qdd, tau) of member ``index`` on ``ceil(T·rate) + 1`` uniform samples."""
+    motion = member_replay(r, index, replay)
+    n = dense_samples(motion.duration, rate)  # the grid of analysis.certify
     if n > MAX_ROS_POINTS:
         raise InvalidInputError(
-            f"rate_hz = {rate:g} Hz gives {n} points over T = {float(r.best_x[0]):.6g} s; at "
+            f"rate_hz = {rate:g} Hz gives {n} points over T = {motion.duration:.6g} s; at "
             f"most {MAX_ROS_POINTS} are exported"
         )
-    motion = Replay.of_best(r, replay)
     smp = motion.sample_uniform(n)
     return smp.t, smp.q, smp.qd, smp.qdd, motion.torques(smp)
 
 
-def _certification(r: PlanningResult) -> dict[str, Any]:
-    """The top-level ``certified``, ``certificate_rate_hz`` and ``warning`` entries."""
+def _certification(r: PlanningResult, index: int) -> dict[str, Any]:
+    """The top-level ``certified``, ``certificate_rate_hz``, ``warning``, ``member`` and
+    ``best_tradeoff`` entries."""
     c = r.certificate
+    best = index == r.best.index
+    certified = bool(certified_members(r)[index])
     warning = None
-    if not c.feasible:
+    if not certified and best:
         found = "; ".join(c.violations) or "see result.certificate"
         warning = (
             f"NOT CERTIFIED: the dense check at {c.rate_hz:g} Hz failed ({found}); exported "
             "with allow_infeasible=True, do not send it to a robot as is"
         )
-    return {"certified": bool(c.feasible), "certificate_rate_hz": c.rate_hz, "warning": warning}
+    elif not certified:
+        warning = (
+            f"NOT CERTIFIED: member {index} of the front {_why_not(r)}; exported with "
+            "allow_infeasible=True, do not send it to a robot as is"
+        )
+    return {
+        "certified": certified,
+        "certificate_rate_hz": c.rate_hz,
+        "warning": warning,
+        "member": index,
+        "best_tradeoff": best,
+    }
+
+
+def _why_not(r: PlanningResult) -> str:
+    """Why a member other than the best trade-off is not certified."""
+    if r.front.n_certified is None:
+        return "has no certificate (result saved before every member was certified)"
+    return "failed its continuous certificate (run adept-traj verify for the violations)"
 
 
 def to_ros_joint_trajectory(
     result: PlanningResult,
     *,
+    member: int | None = None,
     rate_hz: float | None = None,
     allow_infeasible: bool = False,
     replay: Replay | None = None,
 ) -> dict[str, Any]:
-    """The best trajectory as a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` dictionary,
-    with whether it was certified.
+    """A member's trajectory (default: the best trade-off) as a ROS 2
+    ``trajectory_msgs/msg/JointTrajectory`` dictionary, with which member it is and whether
+    it was certified.
 
     Shape::
 
@@ -137,6 +165,8 @@ def to_ros_joint_trajectory(
             "certified": true,
             "certificate_rate_hz": 1000.0,
             "warning": null,
+            "member": 5,
+            "best_tradeoff": true,
             "header": {"frame_id": ""},
             "joint_names": ["joint1", ...],
             "points": [
@@ -151,11 +181,15 @@ def to_ros_joint_trajectory(
             ],
         }
 
-    ``certified`` is ``result.feasible`` (the dense certificate of the best trade-off
-    passed) and ``certificate_rate_hz`` the rate [Hz] it was checked at. An uncertified
-    export (``allow_infeasible=True``) has ``"certified": false`` and a ``warning`` that
-    names every violation; a certified one has ``"warning": null``. These three entries
-    are not fields of ``JointTrajectory``: drop them before filling the message.
+    ``member`` is the row of ``result.front`` exported and ``best_tradeoff`` whether it
+    is ``result.best.index``. ``certified`` is, for the best trade-off, ``result.feasible``
+    (its dense certificate passed), for another member ``result.front.feasible[member]``
+    when every member was certified (``front.n_certified`` set; else false:
+    :func:`~adept_traj.results.certified_members`); ``certificate_rate_hz`` is the rate
+    [Hz] of the result's certificate. An uncertified export (``allow_infeasible=True``)
+    has ``"certified": false`` and a ``warning`` saying why (every violation, for the best
+    trade-off); a certified one has ``"warning": null``. These five entries are not fields
+    of ``JointTrajectory``: drop them before filling the message.
 
     ``header.stamp`` is left out (zero: start on receipt). ``time_from_start`` is the
     sample time rounded to the nanosecond, split into whole seconds and nanoseconds
@@ -164,17 +198,21 @@ def to_ros_joint_trajectory(
     Parameters
     ----------
     result: the planning result.
-    rate_hz: ``None`` (default): the certificate's dense samples
-        (``result.best_trajectory``, ≥ ``certificate.rate_hz``), values exactly as stored.
-        A rate [Hz] (> 0): the B-spline of the best solution resampled on
+    member: the row of ``result.front`` to export, in [0, ``len(result.front)`` − 1];
+        ``None`` (default): the best trade-off, ``result.best.index``.
+    rate_hz: ``None`` (default): for the best trade-off, the certificate's dense samples
+        (``result.best_trajectory``, ≥ ``certificate.rate_hz``), values exactly as stored;
+        for another member (whose dense samples are not stored), its spline resampled at
+        ``certificate.rate_hz`` as below.
+        A rate [Hz] (> 0): the B-spline of the member resampled on
         ``ceil(T·rate_hz) + 1`` uniform samples over [0, T] (both ends included, spacing
         ≤ 1/rate_hz; the grid of the dense verification), exact positions, velocities and
         accelerations from the spline and efforts from the robot's inverse dynamics.
-    allow_infeasible: export even when the dense certificate of the best trade-off failed
-        (the output then says ``"certified": false`` and why).
-    replay: the :class:`~adept_traj.results.Replay` of the best solution when the caller
-        has one (no robot reload); by default ``Replay.of(result)`` is built when
-        resampling. Never the full problem.
+    allow_infeasible: export even when the member is not certified (the output then says
+        ``"certified": false`` and why).
+    replay: the :class:`~adept_traj.results.Replay` of the member when the caller has one
+        (no robot reload); by default ``Replay.of(result, result.front.x[member])`` is
+        built when resampling. Never the full problem.
 
     Returns
     -------
@@ -184,25 +222,34 @@ def to_ros_joint_trajectory(
     Raises
     ------
     InvalidInputError
+        ``member`` not an integer in [0, n − 1] (the message names the range);
         ``rate_hz`` not a finite number > 0, or more than :data:`MAX_ROS_POINTS` points;
-        the best trade-off is not verified feasible and ``allow_infeasible`` is false;
-        ``allow_infeasible`` not a bool; ``replay`` not a Replay of the best solution.
+        the member is not certified and ``allow_infeasible`` is false;
+        ``allow_infeasible`` not a bool; ``replay`` not a Replay of the member.
     """
     r = _as_result(result)
+    index = member_index(r, member)
     check_type(allow_infeasible, bool, "allow_infeasible")
-    if not r.feasible and not allow_infeasible:
+    best = index == r.best.index
+    if best and not r.feasible and not allow_infeasible:
         detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
         raise InvalidInputError(
             "the best trade-off is not verified feasible (" + detail + "); refusing to export "
             "it for a robot controller (pass allow_infeasible=True to export anyway)"
         )
-    if rate_hz is None:
+    if not best and not certified_members(r)[index] and not allow_infeasible:
+        raise InvalidInputError(
+            f"member {index} of the front is not certified: it {_why_not(r)}; refusing to "
+            "export it for a robot controller (pass allow_infeasible=True to export anyway)"
+        )
+    if rate_hz is None and best:
         if replay is not None:
             Replay.of_best(r, replay)
         d = r.best_trajectory
         t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
     else:
-        t, q, qd, qdd, tau = _resample(r, _rate(rate_hz), replay)
+        rate = r.certificate.rate_hz if rate_hz is None else _rate(rate_hz)
+        t, q, qd, qdd, tau = _resample(r, index, rate, replay)
     for name, arr in (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau), ("t", t)):
         if not np.isfinite(arr).all():
             raise InvalidInputError(f"the trajectory's {name} is not finite; cannot export")
@@ -217,7 +264,7 @@ def to_ros_joint_trajectory(
         for k in range(t.shape[0])
     ]
     return {
-        **_certification(r),
+        **_certification(r, index),
         "header": {"frame_id": ""},
         "joint_names": list(r.robot.joint_names),
         "points": points,
@@ -228,18 +275,20 @@ def save_ros_joint_trajectory(
     result: PlanningResult,
     path: str | os.PathLike[str],
     *,
+    member: int | None = None,
     rate_hz: float | None = None,
     allow_infeasible: bool = False,
     replay: Replay | None = None,
 ) -> Path:
     """Write :func:`to_ros_joint_trajectory` as a JSON file (UTF-8, one entry per line and
     one point per line, floats in shortest round-trip form, no NaN); folders are created, an
-    existing file replaced. The file starts with ``"certified"``,
-    ``"certificate_rate_hz"`` and ``"warning"`` (see :func:`to_ros_joint_trajectory`).
+    existing file replaced. The file starts with ``"certified"``, ``"certificate_rate_hz"``,
+    ``"warning"``, ``"member"`` and ``"best_tradeoff"`` (see
+    :func:`to_ros_joint_trajectory`).
     Returns the path written. Arguments and errors as :func:`to_ros_joint_trajectory`."""
     out = _as_path(path)
     msg = to_ros_joint_trajectory(
-        result, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
+        result, member=member, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
     )
 
     def dump(value: Any) -> str:

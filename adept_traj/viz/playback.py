@@ -1,7 +1,8 @@
 """The playback of a planning result: what is drawn, where, at which frame — independent
 of any visualizer.
 
-:func:`build_animation` turns a result's best trajectory (through its
+:func:`build_animation` turns a result's best trajectory, or another member of its front
+(``member=N``), (through its
 :class:`~adept_traj.results.Replay`: robot, scene and B-spline, loaded once) into a
 :class:`Playback`: the frames, the joint positions, and every drawn node with its world
 poses [m]. :mod:`~adept_traj.viz.meshcat_scene` draws a playback into a meshcat visualizer
@@ -10,7 +11,7 @@ or an HTML page; :mod:`~adept_traj.viz.server` serves it live.
 What is drawn, all in the **world** frame of the scene [m]: the robot's link solids in the
 colours of its visual model (poses ``scene.robot_base @`` the base-frame poses), the fixed
 obstacles (red), the moving obstacles (purple: the pendulum's rod and bob) at the physical
-time of each frame, the tool path of the best trajectory (a green line with a sphere at the
+time of each frame, the tool path of the move (a green line with a sphere at the
 start and the goal), the floor z = 0 with a 0.1 m grid and the world axes and, optionally,
 the closest-point segment (yellow) between the robot's collision solids and the nearest
 obstacle at every frame (:mod:`~adept_traj.viz.closest_points`).
@@ -28,7 +29,6 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -38,11 +38,19 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     from meshcat.animation import Animation, AnimationFrameVisualizer
     from meshcat.path import Path as MeshcatPath
 
+from adept_traj.analysis import dense_samples
 from adept_traj.errors import InvalidInputError
-from adept_traj.results import PlanningResult, Replay
+from adept_traj.results import (
+    PlanningResult,
+    Replay,
+    certified_members,
+    member_index,
+    member_replay,
+)
 from adept_traj.validation import as_scalar, check_type, readonly_copy
 from adept_traj.viz.closest_points import closest_points
-from adept_traj.viz.inputs import as_result, replay_for
+from adept_traj.viz.framing import camera, floor
+from adept_traj.viz.inputs import as_result
 from adept_traj.viz.meshcat_geometry import (
     Part,
     hex_colour,
@@ -74,16 +82,10 @@ TOOL_PATH_COLOR = 0x1E8449
 START_COLOR = 0x1E8449
 GOAL_COLOR = 0x0B5345
 CLOSEST_COLOR = 0xF1C40F
-FLOOR_COLOR = 0xE5E7E9
-GRID_COLOR = 0xB3B6B7
 
 _MARKER_RADIUS = 0.012  # tool path start/goal spheres [m]
 _SEGMENT_RADIUS = 0.005  # closest-point segment [m]
 _POINT_RADIUS = 0.01  # closest-point end spheres [m]
-_FOV_DEG = 75.0  # meshcat's default camera: vertical field of view
-_VIEW_DIRECTION = np.array([-0.7, -1.2, 0.9])  # camera offset direction from the target
-_GRID_STEP = 0.1  # floor grid spacing [m]
-_FLOOR_MARGIN = 0.3  # floor beyond the drawn scene [m]
 
 
 # ============================================================================ data
@@ -133,7 +135,10 @@ class Playback:
     q: (n_frames, nq) joint positions at the frames [rad | m].
     fps: frames per second of playback [1/s].
     speed: playback rate (1 = real time).
-    duration: travel time T of the best trajectory [s].
+    duration: travel time T of the move [s].
+    member: the row of ``result.front`` shown (``result.best.index``: the best trade-off).
+    certified: whether that member is certified
+        (:func:`~adept_traj.results.certified_members`).
     tool_path: (n_points, 3) world tool positions along the dense trajectory [m].
     closest_points: (n_frames, 2, 3) world points on the robot and on the nearest obstacle
         at each frame [m], or ``None`` (not requested, or no obstacle).
@@ -154,6 +159,8 @@ class Playback:
     closest_distance: np.ndarray | None
     camera_target: np.ndarray
     camera_position: np.ndarray
+    member: int = 0
+    certified: bool = False
 
     @property
     def n_frames(self) -> int:
@@ -215,8 +222,10 @@ def build_animation(
     fps: float = 30.0,
     show_closest: bool = False,
     replay: Replay | None = None,
+    member: int | None = None,
 ) -> Playback:
-    """Compute the scene and the animation of ``result``'s best trajectory.
+    """Compute the scene and the animation of a member of ``result``'s front (default: the
+    best trade-off).
 
     Parameters
     ----------
@@ -226,9 +235,13 @@ def build_animation(
         ``ceil(fps · T / speed) + 1`` frames (at most :data:`MAX_FRAMES`).
     show_closest: also compute the closest-point segment between the robot's collision
         solids and the nearest obstacle at each frame.
-    replay: the result's :class:`~adept_traj.results.Replay` if the caller has one (it must
-        replay ``result.best_x``); default ``Replay.of(result)``, which loads the robot
-        files named in the result (they must exist) and parses its stored scene.
+    replay: the member's :class:`~adept_traj.results.Replay` if the caller has one (it must
+        replay ``result.front.x[member]``); default
+        ``Replay.of(result, result.front.x[member])``, which loads the robot files named in
+        the result (they must exist) and parses its stored scene.
+    member: the row of ``result.front`` to show, in [0, ``len(result.front)`` − 1];
+        ``None`` (default): the best trade-off, ``result.best.index``. Any member is shown,
+        certified or not: :attr:`Playback.certified` says which.
 
     Returns
     -------
@@ -236,15 +249,16 @@ def build_animation(
 
     Raises
     ------
-    InvalidInputError: ``result`` is not a PlanningResult, ``replay`` not one of its best
-        solution, ``speed`` or ``fps`` is not a positive finite number, too many frames, or
-        a robot solid meshcat cannot draw.
+    InvalidInputError: ``result`` is not a PlanningResult, ``member`` not a row of its
+        front, ``replay`` not one of that member, ``speed`` or ``fps`` is not a positive
+        finite number, too many frames, or a robot solid meshcat cannot draw.
     """
     result = as_result(result)
     speed = as_scalar(speed, "speed", "(playback rate, 1 = real time)", minimum=0, strict=True)
     fps = as_scalar(fps, "fps", "[frames/s]", minimum=0, strict=True)
     check_type(show_closest, (bool, np.bool_), "show_closest")
-    replay = replay_for(result, replay)
+    index = member_index(result, member)
+    replay = member_replay(result, index, replay)
     robot, scene, duration = replay.robot, replay.scene, replay.duration
     frames, times = frame_times(duration, speed, fps)
     q = replay.sample(times, orders=(0,)).q
@@ -267,8 +281,8 @@ def build_animation(
         poses = obstacle_poses[i] if ob.is_moving else obstacle_poses[i, 0]
         objects.append(SceneObject(f"obstacles/{ob.name}", shape_parts(ob.shape, material), poses))
 
-    # --- tool path of the dense (certified) trajectory
-    tool = _tool_path(result, replay)
+    # --- tool path of the dense trajectory
+    tool = _tool_path(result, replay, index)
     objects.extend(_tool_path_objects(tool))
 
     # --- closest-point segment
@@ -280,8 +294,8 @@ def build_animation(
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
     seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
     seen_points = np.vstack(seen)
-    objects.extend(_floor(seen_points))
-    target, position = _camera(seen_points)
+    objects.extend(SceneObject(path, parts, pose) for path, parts, pose in floor(seen_points))
+    target, position = camera(seen_points)
     return Playback(
         objects=tuple(objects),
         times=readonly_copy(times),
@@ -295,13 +309,20 @@ def build_animation(
         closest_distance=None if distance is None else readonly_copy(distance),
         camera_target=readonly_copy(target),
         camera_position=readonly_copy(position),
+        member=index,
+        certified=bool(certified_members(result)[index]),
     )
 
 
-def _tool_path(result: PlanningResult, replay: Replay) -> np.ndarray:
-    """(n, 3) world tool positions [m] at the certified dense samples (at most
-    :data:`MAX_PATH_POINTS`, thinned evenly)."""
-    dense_q = np.asarray(result.best_trajectory.q, dtype=float)
+def _tool_path(result: PlanningResult, replay: Replay, index: int) -> np.ndarray:
+    """(n, 3) world tool positions [m] at the dense samples of the certificate's rate (at
+    most :data:`MAX_PATH_POINTS`, thinned evenly): the stored ones for the best trade-off,
+    the replay's for another member."""
+    if index != result.best.index:
+        n = dense_samples(replay.duration, result.certificate.rate_hz)
+        dense_q = replay.sample_uniform(min(n, MAX_PATH_POINTS), orders=(0,)).q
+    else:
+        dense_q = np.asarray(result.best_trajectory.q, dtype=float)
     if dense_q.shape[0] > MAX_PATH_POINTS:
         keep = np.unique(np.linspace(0, dense_q.shape[0] - 1, MAX_PATH_POINTS).round().astype(int))
         dense_q = dense_q[keep]
@@ -359,41 +380,3 @@ def _closest_objects(points: np.ndarray) -> list[SceneObject]:
         ball = Part(mg.Mesh(mg.Sphere(_POINT_RADIUS), material), np.eye(4))
         ends.append(SceneObject(f"closest/{name}", (ball,), poses))
     return [SceneObject("closest/segment", (rod,), seg_poses, scales), *ends]
-
-
-def _floor(points: np.ndarray) -> list[SceneObject]:
-    """The floor z = 0 under ``points`` (n, 3) [m]: a light slab with a 0.1 m grid, and the
-    world axes (x red, y green, z blue, 0.2 m) at the origin."""
-    lo = np.floor((points[:, :2].min(axis=0) - _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
-    hi = np.ceil((points[:, :2].max(axis=0) + _FLOOR_MARGIN) / _GRID_STEP) * _GRID_STEP
-    size = hi - lo
-    slab = mg.Mesh(mg.Box([*size, 0.004]), mg.MeshLambertMaterial(color=FLOOR_COLOR))
-    centre = translation([*(0.5 * (lo + hi)), -0.0021])
-    segments: list[Any] = []
-    for axis in (0, 1):
-        n = round(size[axis] / _GRID_STEP)
-        for v in lo[axis] + _GRID_STEP * np.arange(n + 1):
-            a, b = np.zeros(3), np.zeros(3)
-            a[axis] = b[axis] = v
-            a[1 - axis], b[1 - axis] = lo[1 - axis], hi[1 - axis]
-            segments += [a, b]
-    grid = mg.LineSegments(
-        mg.PointsGeometry(np.ascontiguousarray(np.array(segments).T, dtype=np.float32)),
-        mg.LineBasicMaterial(color=GRID_COLOR),
-    )
-    return [
-        SceneObject("floor/slab", (Part(slab, np.eye(4)),), centre),
-        SceneObject("floor/grid", (Part(grid, np.eye(4)),), np.eye(4)),
-        SceneObject("floor/axes", (Part(mg.triad(0.2), np.eye(4)),), np.eye(4)),
-    ]
-
-
-def _camera(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A camera target (the centre of the box around ``points`` (n, 3)) and a position from
-    which all of it is in view [m]."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    target = 0.5 * (lo + hi)
-    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.3) + 0.15
-    distance = 1.05 * radius / math.tan(math.radians(0.5 * _FOV_DEG))
-    direction = _VIEW_DIRECTION / np.linalg.norm(_VIEW_DIRECTION)
-    return target, target + distance * direction

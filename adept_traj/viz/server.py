@@ -137,8 +137,10 @@ def show(
     show_closest: bool = False,
     open_browser: bool = False,
     replay: Replay | None = None,
+    member: int | None = None,
 ) -> meshcat.Visualizer:
-    """Start a local meshcat server and play ``result``'s best trajectory in it.
+    """Start a local meshcat server and play a member of ``result``'s front in it (default:
+    the best trade-off).
 
     The server (a subprocess) listens on 127.0.0.1 only: its ZeroMQ socket and its web
     server. Nothing is printed; ``vis.url()`` is the page to open, ``vis.close()`` stops the
@@ -147,7 +149,7 @@ def show(
     Parameters
     ----------
     result: the planning result.
-    speed, fps, show_closest, replay: see
+    speed, fps, show_closest, replay, member: see
         :func:`~adept_traj.viz.playback.build_animation`.
     loop: loop the animation forever (else play it once).
     open_browser: also open the page in the default web browser.
@@ -164,7 +166,7 @@ def show(
     MeshcatServerError: the server did not start or does not answer.
     """
     playback = build_animation(
-        result, speed=speed, fps=fps, show_closest=show_closest, replay=replay
+        result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )
     window = _LocalWindow()
     vis = meshcat.Visualizer(window=window)

@@ -1,0 +1,149 @@
+"""``adept-traj front DIR``: list the members of a saved front, to pick one.
+
+One row per member of ``result.front``: its index (the ``N`` of ``show --member N`` and
+of :func:`~adept_traj.results.to_ros_joint_trajectory`'s ``member=N``), the travel time
+``T`` [s], the objectives z2…z6 (units in the header, see
+:mod:`adept_traj.problem.objectives`), the combined objective ``f_c`` (lower is better)
+and the average fitness ``F_avg`` (higher is better) of
+:func:`~adept_traj.analysis.best_tradeoff` with ``--weights`` (default: the paper's),
+whether the member is certified, and its minimum clearance [m] when ``result.json``
+holds it (only the best trade-off's dense certificate stores one; the others show
+``-``). The best trade-off (``result.best.index``) is marked ``*``.
+
+``certified`` is ``front.feasible`` when :func:`~adept_traj.plan` certified every member
+(``front.n_certified`` set). A result saved before that (``n_certified`` absent, e.g.
+``result.json`` v1) only certified its best trade-off: the other members show ``no`` and
+a note says that their ``feasible`` flag was the optimiser's verdict at its samples.
+
+Rows are sorted by ``--sort COLUMN`` (default ``index``), ascending unless
+``--descending``; ties keep the index order. Reads ``result.json`` only: nothing is
+recomputed, no robot file is loaded.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from adept_traj.analysis import PAPER_WEIGHTS, best_tradeoff
+from adept_traj.cli import status
+from adept_traj.cli.arguments import floats
+from adept_traj.errors import InvalidInputError
+from adept_traj.results import PlanningResult, certified_members
+
+__all__ = ["COLUMNS", "add_parser", "front_table", "run"]
+
+#: The columns of the listing, in order, with their units (``-``: dimensionless; ``""``:
+#: no unit shown, ``index`` and ``certified``, which is ``yes`` or ``no``).
+COLUMNS: dict[str, str] = {
+    "index": "",
+    "T": "s",
+    "z2": "N²·m²·s",
+    "z3": "-",
+    "z4": "m²",
+    "z5": "rad²/s⁵",
+    "z6": "rad²/s³",
+    "f_c": "-",
+    "F_avg": "-",
+    "certified": "",
+    "clearance": "m",
+}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``front`` and its options."""
+    p = sub.add_parser("front", help="list the members of a saved front (to pick one)")
+    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    p.add_argument(
+        "--sort",
+        default="index",
+        choices=list(COLUMNS),
+        help="column to sort by (default: index)",
+    )
+    p.add_argument("--descending", action="store_true", help="sort in descending order")
+    p.add_argument(
+        "--weights",
+        type=floats,
+        default=list(PAPER_WEIGHTS),
+        help="w1,...,w6 for f_c and F_avg (default: the paper's)",
+    )
+    return p
+
+
+def _columns(result: PlanningResult, weights: list[float]) -> dict[str, np.ndarray]:
+    """Every column of the listing, each (n,) (``clearance``: NaN when not stored)."""
+    front = result.front
+    n = len(front)
+    choice = best_tradeoff(front.objectives, weights)
+    certified = certified_members(result)
+    clearance = np.full(n, np.nan)
+    clearance[result.best.index] = result.certificate.min_distance
+    cols = {"index": np.arange(n), "T": front.x[:, 0]}
+    cols.update({f"z{i + 1}": front.objectives[:, i] for i in range(1, 6)})
+    cols.update(f_c=choice.f_c, F_avg=choice.F_avg, certified=certified, clearance=clearance)
+    return cols
+
+
+def _cell(name: str, value: float | bool) -> str:
+    if name == "index":
+        return str(int(value))
+    if name == "certified":
+        return "yes" if value else "no"
+    if name == "clearance" and np.isnan(value):
+        return "-"
+    return f"{float(value):.6g}"
+
+
+def front_table(
+    result: PlanningResult,
+    *,
+    sort: str = "index",
+    descending: bool = False,
+    weights: list[float] | tuple[float, ...] = PAPER_WEIGHTS,
+) -> str:
+    """The listing printed by ``adept-traj front``: a header line with units, then one row
+    per member, the best trade-off marked ``*``.
+
+    Parameters
+    ----------
+    result: the planning result.
+    sort: a key of :data:`COLUMNS`.
+    descending: sort in descending order (ties keep the index order).
+    weights: (6,) w1…w6 for ``f_c`` and ``F_avg`` (:func:`~adept_traj.analysis.best_tradeoff`).
+
+    Raises
+    ------
+    InvalidInputError: ``sort`` is not a column, or bad ``weights``.
+    """
+    if sort not in COLUMNS:
+        raise InvalidInputError(f"sort must be one of {', '.join(COLUMNS)}; got {sort!r}")
+    cols = _columns(result, list(weights))
+    key = np.asarray(cols[sort], dtype=float)
+    key = np.where(np.isnan(key), -np.inf if descending else np.inf, key)  # '-' last
+    order = np.argsort(-key if descending else key, kind="stable")
+    header = [f"{name} [{unit}]" if unit else name for name, unit in COLUMNS.items()]
+    rows = [[_cell(name, cols[name][k]) for name in COLUMNS] for k in order]
+    width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(header)]
+    best = result.best.index
+    lines = ["  " + "  ".join(h.rjust(w) for h, w in zip(header, width, strict=True))]
+    for k, row in zip(order, rows, strict=True):
+        mark = "* " if k == best else "  "
+        lines.append(mark + "  ".join(c.rjust(w) for c, w in zip(row, width, strict=True)))
+    front = result.front
+    count = int(cols["certified"].sum())
+    lines.append(f"* best trade-off (member {best}); {count} of {len(front)} members certified")
+    if front.n_certified is None:
+        lines.append(
+            "note: saved before every member was certified: only the best trade-off has a "
+            "certificate; the others' 'feasible' flag was the optimiser's verdict at its samples"
+        )
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the listing; exit status 0."""
+    result = PlanningResult.load(args.folder)
+    print(front_table(result, sort=args.sort, descending=args.descending, weights=args.weights))
+    return status.OK
