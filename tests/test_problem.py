@@ -124,7 +124,8 @@ def test_search_buffer_tightens_only_the_distance_constraint(
     buffer = clearance + 1e-3
     buffered = TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=buffer)
     ev = buffered.evaluate_batch(x)
-    assert plain.feasible and not ev.feasible
+    assert plain.feasible
+    assert not ev.feasible
     influence = problem.settings.influence
     # Closed form: g_d = (m + b − min(d_min, δ)) / δ, with d_min from the unbuffered problem.
     assert ev.constraints[-1] == pytest.approx(
