@@ -134,6 +134,8 @@ def test_search_buffer_tightens_only_the_distance_constraint(
     assert ev.constraints[-1] - plain.constraints[-1] == pytest.approx(buffer / influence)
     np.testing.assert_array_equal(ev.constraints[:-1], plain.constraints[:-1])
     np.testing.assert_array_equal(ev.objectives, plain.objectives)
+    reference = evaluate_reference(buffered, x)
+    np.testing.assert_allclose(ev.constraints, reference.constraints, rtol=1e-9, atol=1e-12)
 
 
 def test_search_buffer_range(robot: Robot, scene: Scene) -> None:
