@@ -119,7 +119,8 @@ def test_search_buffer_tightens_only_the_distance_constraint(
     """The optimiser asks margin + search_buffer at its samples: a move clearing the margin
     by less than the buffer becomes infeasible; objectives and other constraints stay."""
     x = lift_then_lower(problem)
-    plain = problem.evaluate_batch(x)
+    unbuffered = TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=0.0)
+    plain = unbuffered.evaluate_batch(x)
     clearance = float(plain.min_distance.min()) - problem.settings.margin  # [m] > 0
     buffer = clearance + 1e-3
     buffered = TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=buffer)

@@ -110,7 +110,7 @@ class ProblemSettings:
     t_bounds: tuple[float, float] | None = None
     z3: str = "clearance"
     workers: int = 1
-    search_buffer: float = 0.0
+    search_buffer: float = 0.002
 
     def __post_init__(self) -> None:
         if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
