@@ -130,3 +130,26 @@ def test_save_load_verify_round_trip(small_run, tmp_path: Path) -> None:
 def test_bad_seed(problem: at.TrajectoryProblem) -> None:
     with pytest.raises(at.ConfigurationError, match="seed"):
         at.plan(problem, seed=-1, pop_size=4, n_gen=1)
+
+
+def test_search_buffer_recorded_and_certificate_keeps_margin(
+    problem: at.TrajectoryProblem, tmp_path: Path
+) -> None:
+    """The buffer tightens the search only: the result records it (and reloads it), the
+    certificates check the true margin, and it is part of the checkpoint fingerprint."""
+    buffered = at.TrajectoryProblem(
+        problem.robot, problem.scene, problem.start, problem.goal, search_buffer=0.003
+    )
+    res = at.plan(buffered, "nsga2", seed=3, pop_size=20, n_gen=4)
+    assert res.problem_settings.search_buffer == 0.003
+    assert res.certificate.margin == problem.settings.margin == 0.01
+    res.save(tmp_path)
+    assert at.PlanningResult.load(tmp_path).problem_settings.search_buffer == 0.003
+    settings = SimpleNamespace(to_dict=dict)
+    with_buffer = planner._fingerprint(buffered, settings, 3)["problem_settings"]
+    assert with_buffer["search_buffer"] == 0.003
+    # A zero buffer is left out: checkpoints written before the field keep resuming.
+    unbuffered = at.TrajectoryProblem(
+        problem.robot, problem.scene, problem.start, problem.goal, search_buffer=0.0
+    )
+    assert "search_buffer" not in planner._fingerprint(unbuffered, settings, 3)["problem_settings"]

@@ -113,6 +113,38 @@ def test_a_collision_free_move_exists(problem: TrajectoryProblem) -> None:
     assert slower.min_distance[2] < margin
 
 
+def test_search_buffer_tightens_only_the_distance_constraint(
+    robot: Robot, scene: Scene, problem: TrajectoryProblem
+) -> None:
+    """The optimiser asks margin + search_buffer at its samples: a move clearing the margin
+    by less than the buffer becomes infeasible; objectives and other constraints stay."""
+    x = lift_then_lower(problem)
+    unbuffered = TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=0.0)
+    plain = unbuffered.evaluate_batch(x)
+    clearance = float(plain.min_distance.min()) - problem.settings.margin  # [m] > 0
+    buffer = clearance + 1e-3
+    buffered = TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=buffer)
+    ev = buffered.evaluate_batch(x)
+    assert plain.feasible
+    assert not ev.feasible
+    influence = problem.settings.influence
+    # Closed form: g_d = (m + b − min(d_min, δ)) / δ, with d_min from the unbuffered problem.
+    assert ev.constraints[-1] == pytest.approx(
+        (problem.settings.margin + buffer - min(plain.min_distance.min(), influence)) / influence
+    )
+    assert ev.constraints[-1] - plain.constraints[-1] == pytest.approx(buffer / influence)
+    np.testing.assert_array_equal(ev.constraints[:-1], plain.constraints[:-1])
+    np.testing.assert_array_equal(ev.objectives, plain.objectives)
+    reference = evaluate_reference(buffered, x)
+    np.testing.assert_allclose(ev.constraints, reference.constraints, rtol=1e-9, atol=1e-12)
+
+
+def test_search_buffer_range(robot: Robot, scene: Scene) -> None:
+    for bad in (-1e-3, 0.041):  # margin 0.01, influence 0.05: 0 ≤ buffer ≤ 0.04 m
+        with pytest.raises(ConfigurationError, match=r"search_buffer ≤ influence − margin"):
+            TrajectoryProblem(robot, scene, scene.start, scene.goal, search_buffer=bad)
+
+
 def test_pymoo_interface_negates_z4(problem: TrajectoryProblem) -> None:
     x = np.vstack([problem.trajectory.straight_line(1.3), lift_then_lower(problem)])
     out = problem.evaluate(x, return_as_dictionary=True)

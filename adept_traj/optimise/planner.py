@@ -74,9 +74,12 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
             {
                 "start": problem.start.tolist(),
                 "goal": problem.goal.tolist(),
-                # workers change nothing in the results: a run may resume with others.
+                # workers change nothing in the results; a zero search_buffer is left out
+                # so that checkpoints written before the field existed still resume.
                 "problem_settings": {
-                    k: v for k, v in problem.settings.__dict__.items() if k != "workers"
+                    k: v
+                    for k, v in problem.settings.__dict__.items()
+                    if k != "workers" and not (k == "search_buffer" and v == 0.0)
                 },
                 "scene": problem.scene.to_dict(),
                 "robot": problem.robot.name,
@@ -143,6 +146,7 @@ def _certifying_problem(problem: TrajectoryProblem) -> TrajectoryProblem:
         problem.goal,
         st,
         influence=influence,
+        search_buffer=0.0,  # the certificate checks the true margin; the buffer is unused
         workers=1,
     )
 

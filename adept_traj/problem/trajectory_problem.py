@@ -27,10 +27,12 @@ where :math:`d_o` is the exact smallest signed distance between any robot solid 
     g^{v}_i = \frac{\max|\dot q_i|}{VC_i} - 1,\quad g^{a}_i = \frac{\max|\ddot q_i|}{WC_i} - 1,
 
     g^{j}_i = \frac{\max|\dddot q_i|}{JC_i} - 1,\quad g^{u}_i = \frac{\max_k |u_i(t_k)|}{UC_i} - 1,
-    \quad g^{d} = \frac{m - \min(\min_o d_o,\ \delta)}{\delta}
+    \quad g^{d} = \frac{m + b - \min(\min_o d_o,\ \delta)}{\delta}
 
 (paper eqs. 7–12; the extrema of q … q⃛ are exact per spline segment, the torque maximum is
-taken at the samples, the distance constraint uses the safety margin ``m``).
+taken at the samples, the distance constraint uses the safety margin ``m`` plus the search
+buffer ``b``: the distance may dip between the samples, and the certificate, which keeps
+the true margin ``m``, holds for every instant).
 :func:`adept_traj.testing.reference.evaluate_reference` computes the same numbers with
 plain per-sample loops and no code shared with this module: the oracle for tests and the
 baseline for benchmarks. With ``workers > 1`` populations are evaluated by a
@@ -76,7 +78,13 @@ class ProblemSettings:
         Gauss–Legendre nodes per spline segment where torques, manipulability and distances
         are sampled (default 6: 114 samples, plus both ends).
     margin:
-        Safety distance [m]: the constraint is :math:`\\min_o d_o \\ge` margin.
+        Safety distance [m] that the certificate checks at every instant.
+    search_buffer:
+        Distance [m] added to the margin in the optimiser's distance constraint only: the
+        search asks :math:`\\min_o d_o \\ge` margin + search_buffer at its samples, so that
+        the distance, which can drop between two samples, still clears the margin there
+        (see docs/problem.md for the measurement behind the default). The certificate keeps
+        the true margin. Need margin + search_buffer ≤ influence.
     influence:
         Distance δ [m] below which distances are exact and the clearance penalty z3 acts.
     t_bounds:
@@ -102,6 +110,7 @@ class ProblemSettings:
     t_bounds: tuple[float, float] | None = None
     z3: str = "clearance"
     workers: int = 1
+    search_buffer: float = 0.002
 
     def __post_init__(self) -> None:
         if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
@@ -112,6 +121,11 @@ class ProblemSettings:
             raise ConfigurationError(
                 f"need 0 ≤ margin ≤ influence and influence > 0 [m]; got margin={self.margin}, "
                 f"influence={self.influence}"
+            )
+        if not (0 <= self.search_buffer <= self.influence - self.margin):
+            raise ConfigurationError(
+                f"need 0 ≤ search_buffer ≤ influence − margin = "
+                f"{self.influence - self.margin:.4g} [m]; got search_buffer={self.search_buffer}"
             )
         for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
             value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
@@ -336,5 +350,5 @@ class TrajectoryProblem(Problem):
         g_q = np.maximum(q_max - lim.upper, lim.lower - q_min) / span
         scales = [lim.bound(kind.name) for kind in LIMITS[1:]]
         g_rest = [m / s - 1.0 for m, s in zip(abs_max, scales)]
-        g_d = (st.margin - np.minimum(min_dist, st.influence)) / st.influence
+        g_d = (st.margin + st.search_buffer - np.minimum(min_dist, st.influence)) / st.influence
         return np.concatenate([g_q, *g_rest, g_d[:, None]], axis=-1)

@@ -62,6 +62,15 @@ def _read_json(path: Path) -> PlanningResult:
 
 
 # ============================================================================ encoding
+def _problem_settings(settings: ProblemSettings) -> dict[str, Any]:
+    """The settings as stored: a zero ``search_buffer`` is left out, so that files written
+    before the field existed are written back unchanged (absent reads back as 0)."""
+    out = dataclasses.asdict(settings)
+    if out["search_buffer"] == 0.0:
+        del out["search_buffer"]
+    return out
+
+
 def _encode(r: PlanningResult) -> dict[str, Any]:
     lim, lb, c = r.limits, r.lower_bound, r.certificate
     metrics: dict[str, Any] = {key: getattr(r.metrics, name) for name, key in _JSON_METRICS.items()}
@@ -77,7 +86,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
         "goal": _floats(r.goal),
         "seed": r.seed,
         "algorithm": {"name": r.algorithm, "settings": r.algorithm_settings},
-        "problem_settings": _jsonable(dataclasses.asdict(r.problem_settings)),
+        "problem_settings": _jsonable(_problem_settings(r.problem_settings)),
         "scene": r.scene,
         "limits": {
             "joint_names": list(lim.names),
@@ -206,6 +215,7 @@ def _decode(top: Node) -> PlanningResult:
     nq = len(robot.joint_names)
     ps = top["problem_settings"].check_keys([f.name for f in dataclasses.fields(ProblemSettings)])
     settings = {k: tuple(v) if isinstance(v, list) else v for k, v in ps.table().items()}
+    settings.setdefault("search_buffer", 0.0)  # absent: written before the field (no buffer)
     scene = top["scene"]
     scene.build(Scene.from_dict, scene.table(), source=f"{top.file} (scene)")
     lim = top["limits"]

@@ -143,7 +143,8 @@ def _constraints(
     peaks = {"qd": extrema["qd"], "qdd": extrema["qdd"], "qddd": extrema["qddd"], "tau": tau_max}
     for kind in LIMITS[1:]:
         g.append(peaks[kind.quantity] / lim.bound(kind.name) - 1.0)
-    g.append(np.array([(st.margin - min(d_min, st.influence)) / st.influence]))
+    required = st.margin + st.search_buffer  # the search asks the margin plus its buffer
+    g.append(np.array([(required - min(d_min, st.influence)) / st.influence]))
     return np.concatenate(g)
 
 
