@@ -100,6 +100,7 @@ def test_every_feasible_member_is_certified(
     assert (index, certificate.index) == (reported, reported)
 
 
+@pytest.mark.slow  # 10 kHz re-check of every member: ~7 s (slow tier, run by .ci/run)
 def test_front_feasible_means_certified(problem: at.TrajectoryProblem, small_run) -> None:
     """Every member marked feasible passes an independent dense re-check at 10 kHz (the
     uniform grid only, no continuous bound); the count is stored in the front."""
