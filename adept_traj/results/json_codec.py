@@ -147,6 +147,8 @@ def _encode_certificate(c: Certificate) -> dict[str, Any]:
         out["guarantee"] = c.guarantee
     if c.distance_bound is not None:
         out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
+    if c.torque_guarantee is not None:
+        out["torque_guarantee"] = c.torque_guarantee
     for check in c.checks:
         out[check.kind] = {
             "limit": check.symbol,
@@ -369,6 +371,7 @@ def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
         distance_bound=(
             node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
         ),
+        torque_guarantee=node["torque_guarantee"].string(nonempty=True, default=None),
         **checks,
     )
 
