@@ -1,20 +1,25 @@
-"""The continuous-time distance guarantee of the certificate (issue #11, step 1).
+"""The continuous-time distance guarantee of the certificate (issue #11, step 1), and the
+torque refined between the samples near its limit.
 
 References are independent of the code under test: coal called directly on the solid and
-obstacle poses (pinocchio's geometry placements), at 20–100 kHz, and finite differences of
-the pendulum's bob position.
+obstacle poses (pinocchio's geometry placements), at 20–100 kHz, finite differences of
+the pendulum's bob position, and pinocchio's RNEA called directly for the torque.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import coal
 import numpy as np
+import pinocchio as pin
 import pytest
 
-from adept_traj import Robot, Scene
+from adept_traj import PlanningResult, Robot, Scene
 from adept_traj.analysis import certify
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.scene import Cylinder, FixedPose, Obstacle, PendulumMotion
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 
 START = np.array([0.0, 0.5, 0.1, 0.0])
 GOAL = np.array([2.0, 0.5, 0.1, 0.0])
@@ -182,3 +187,59 @@ def test_fast_certificate_same_verdict(dip):
     assert exact.certified
     assert fast.distance_bound <= exact.distance_bound
     assert fast.min_distance <= exact.min_distance
+
+
+# ---------------------------------------------------------------- the torque between samples
+def _reference_torques(problem: TrajectoryProblem, x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(n, nq) joint torques [N·m | N] at times ``t`` [s]: pinocchio's RNEA called directly
+    (it adds the rotor inertia, ``model.armature``) plus viscous and Coulomb friction."""
+    model = problem.robot.model
+    data = model.createData()
+    smp = problem.trajectory.sample(x, np.asarray(t) / x[0])
+    coulomb = model.friction * np.sign(smp.qd) * (np.abs(smp.qd) > 1e-9)
+    rnea = [pin.rnea(model, data, q, v, a) for q, v, a in zip(smp.q, smp.qd, smp.qdd)]
+    return np.array(rnea) + model.damping * smp.qd + coulomb
+
+
+def test_torque_peak_between_samples_rejected_with_refinement():
+    """A fast θ1 swing whose joint-1 torque peaks (at a spline knot, ≈ 0.3684 s) between two
+    1 kHz samples; UC1 is set half-way between the 1 kHz and the 100 kHz maxima."""
+    robot = Robot.adept_one_xl()
+    scene = Scene(obstacles=(), start=START, goal=GOAL, name="empty")
+    reference = TrajectoryProblem(robot, scene, START, GOAL)
+    x = reference.trajectory.straight_line(T)
+    sampled_max = np.abs(_reference_torques(reference, x, np.linspace(0.0, T, 1401))).max(0)
+    fine_max = np.abs(_reference_torques(reference, x, np.linspace(0.0, T, 140001))).max(0)
+    assert fine_max[0] - sampled_max[0] > 1e-2  # [N·m]: the peak is missed by the samples
+    torque = robot.limits.torque.copy()
+    torque[0] = 0.5 * (sampled_max[0] + fine_max[0])
+    robot.limits = dataclasses.replace(robot.limits, torque=torque)
+    problem = TrajectoryProblem(robot, scene, START, GOAL)
+
+    sampled = certify(problem, x, continuous=False)
+    assert sampled.feasible
+    assert sampled.torque_guarantee == "sampled at 1000 Hz"
+
+    refined = certify(problem, x)
+    assert not refined.feasible
+    assert refined.torque_guarantee == "sampled at 1000 Hz, refined to 64000 Hz near the limit"
+    assert [v.split(":")[0] for v in refined.violations] == ["torque joint1"]
+    assert 1.0 < refined.torque.dense[0] <= fine_max[0] / torque[0] + 1e-12
+    assert 0.368 < refined.torque.t_worst[0] < 0.369
+
+
+def test_paper_move_torque_unaffected(problem):
+    """A normal paper move keeps its verdict and worst torques; the label says why."""
+    x = lift_then_lower(problem)
+    sampled, refined = certify(problem, x, continuous=False), certify(problem, x)
+    assert refined.feasible == sampled.feasible
+    assert refined.feasible
+    np.testing.assert_allclose(refined.torque.dense, sampled.torque.dense, rtol=1e-3)
+    assert refined.torque_guarantee == "sampled at 1000 Hz, below 0.9 × UC"
+
+
+def test_torque_guarantee_round_trips_through_result_json(problem, tmp_path):
+    result = single_result(problem, lift_then_lower(problem))
+    loaded = PlanningResult.load(result.save(tmp_path / "run"))
+    assert loaded.certificate.torque_guarantee == "sampled at 1000 Hz, below 0.9 × UC"
+    assert loaded.certificate == result.certificate
