@@ -31,7 +31,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
         f"z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
         f"verified at {cert.rate_hz:g} Hz: {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m; "
-        f"guarantee: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'})",
+        f"distance: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'}; "
+        f"torque: {cert.torque_guarantee or f'sampled at {cert.rate_hz:g} Hz'})",
     ]
     lines += [f"  violation: {v}" for v in cert.violations]
     if result.warning:
