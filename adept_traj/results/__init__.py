@@ -9,7 +9,13 @@ from __future__ import annotations
 
 from adept_traj.errors import ResultFormatError
 from adept_traj.results.audit import Audit, audit
-from adept_traj.results.members import certified_members, member_index, member_replay
+from adept_traj.results.members import (
+    MAX_MEMBER_SAMPLES,
+    certified_members,
+    member_dense,
+    member_index,
+    member_replay,
+)
 from adept_traj.results.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.results.parts import (
     SHIPPED_ROBOT,
@@ -44,6 +50,7 @@ __all__ = [
     "AUDIT_RTOL",
     "FORMAT",
     "FRONT_FILE",
+    "MAX_MEMBER_SAMPLES",
     "MAX_ROS_POINTS",
     "NO_FEASIBLE_WARNING",
     "RESULT_FILE",
@@ -63,6 +70,7 @@ __all__ = [
     "Timing",
     "audit",
     "certified_members",
+    "member_dense",
     "member_index",
     "member_replay",
     "save_ros_joint_trajectory",

@@ -1,9 +1,10 @@
 """Export a trajectory of a planning result: CSV and ROS ``JointTrajectory`` JSON.
 
-- :func:`to_csv` writes the certified dense trajectory in exactly the format of the result
-  folder's ``best_trajectory.csv`` (``docs/results.md``): header ``t, q_<joint>…,
-  qd_<joint>…, qdd_<joint>…, qddd_<joint>…, tau_<joint>…, min_distance``, one row per
-  sample, floats in Python's shortest round-trip form.
+- :func:`to_csv` writes a member's trajectory (default: the best trade-off's certified
+  dense samples) in exactly the format of the result folder's ``best_trajectory.csv``
+  (``docs/results.md``): header ``t, q_<joint>…, qd_<joint>…, qdd_<joint>…,
+  qddd_<joint>…, tau_<joint>…, min_distance``, one row per sample of the certificate's
+  grid, floats in Python's shortest round-trip form.
 - :func:`to_ros_joint_trajectory` builds a dictionary shaped like a ROS 2
   ``trajectory_msgs/msg/JointTrajectory`` (``time_from_start`` as
   ``builtin_interfaces/Duration``: ``sec``, ``nanosec``); :func:`save_ros_joint_trajectory`
@@ -13,10 +14,10 @@
   stores its dense samples). Units are SI, as ROS expects: rad, m, rad/s, m/s, rad/s²,
   m/s², N·m, N.
 
-The ROS export refuses an uncertified member (the best trade-off: ``result.feasible``;
+Both exports refuse an uncertified member (the best trade-off: ``result.feasible``;
 another member: :func:`~adept_traj.results.certified_members`) unless
 ``allow_infeasible=True``: the file is meant to be sent to a controller. Either way the
-output says whether it was certified (``"certified"``, ``"certificate_rate_hz"``; when it
+ROS output says whether it was certified (``"certified"``, ``"certificate_rate_hz"``; when it
 was not, a ``"warning"`` says why) and which member it is (``"member"``,
 ``"best_tradeoff"``).
 Resampling goes through a :class:`~adept_traj.results.Replay` (robot and spline,
@@ -36,8 +37,13 @@ import numpy as np
 from adept_traj.analysis.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
-from adept_traj.results.csv_codec import _write_trajectory_csv
-from adept_traj.results.members import certified_members, member_index, member_replay
+from adept_traj.results.csv_codec import _csv_text, _trajectory_header
+from adept_traj.results.members import (
+    certified_members,
+    member_dense,
+    member_index,
+    member_replay,
+)
 from adept_traj.results.record import PlanningResult
 from adept_traj.results.replay import Replay
 from adept_traj.validation import as_scalar, check_type
@@ -67,26 +73,74 @@ def _as_path(path: Any, name: str = "path") -> Path:
 
 
 # ============================================================================ CSV
-def to_csv(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
-    """Write the certified best trajectory as CSV, in the format of ``best_trajectory.csv``.
+def to_csv(
+    result: PlanningResult,
+    path: str | os.PathLike[str],
+    *,
+    member: int | None = None,
+    allow_infeasible: bool = False,
+    replay: Replay | None = None,
+) -> Path:
+    """Write a member's trajectory (default: the best trade-off) as CSV, in the format of
+    ``best_trajectory.csv``.
 
     Columns: ``t`` [s], ``q_<joint>`` [rad | m], ``qd_<joint>`` [rad/s | m/s],
     ``qdd_<joint>`` [rad/s² | m/s²], ``qddd_<joint>`` [rad/s³ | m/s³], ``tau_<joint>``
     [N·m | N], ``min_distance`` [m] (``inf`` when the scene has no obstacle); one row per
-    dense sample (``result.best_trajectory``), values exact (shortest round-trip floats).
-    The file is byte-identical to the one :meth:`PlanningResult.save` writes.
+    sample of the certificate's grid, values in shortest round-trip form.
+    For the best trade-off the rows are its stored dense samples
+    (``result.best_trajectory``) and the file is byte-identical to the one
+    :meth:`PlanningResult.save` writes. For another member they are its spline resampled
+    on the same grid (``ceil(T·certificate.rate_hz) + 1`` samples), torques from the
+    robot's inverse dynamics and exact distances by coal
+    (:func:`~adept_traj.results.members.member_dense`).
 
     Parameters
     ----------
     result: the planning result.
     path: the file to write (folders created, an existing file replaced).
+    member: the row of ``result.front`` to export, in [0, ``len(result.front)`` − 1];
+        ``None`` (default): the best trade-off, ``result.best.index``.
+    allow_infeasible: export even when the member is not certified
+        (:func:`~adept_traj.results.certified_members`).
+    replay: the :class:`~adept_traj.results.Replay` of the member when the caller has one
+        (no robot reload).
 
     Returns
     -------
     The path written.
+
+    Raises
+    ------
+    InvalidInputError
+        ``member`` not an integer in [0, n − 1] (the message names the range); the member
+        is not certified and ``allow_infeasible`` is false; ``allow_infeasible`` not a bool;
+        ``replay`` not a Replay of the member.
     """
     r = _as_result(result)
-    return _write_trajectory_csv(r, _as_path(path))
+    out = _as_path(path)
+    index = member_index(r, member)
+    check_type(allow_infeasible, bool, "allow_infeasible")
+    _refuse_uncertified(r, index, allow_infeasible)
+    d = member_dense(r, index, replay)
+    rows = np.column_stack([d.t, d.q, d.qd, d.qdd, d.qddd, d.tau, d.min_distance])
+    return write_text_atomic(out, _csv_text(_trajectory_header(r.robot.joint_names), rows))
+
+
+def _refuse_uncertified(r: PlanningResult, index: int, allow_infeasible: bool) -> None:
+    """Raise unless member ``index`` is certified or ``allow_infeasible``."""
+    if allow_infeasible or certified_members(r)[index]:
+        return
+    if index == r.best.index:
+        detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
+        raise InvalidInputError(
+            "the best trade-off is not verified feasible (" + detail + "); refusing to export "
+            "it for a robot controller (pass allow_infeasible=True to export anyway)"
+        )
+    raise InvalidInputError(
+        f"member {index} of the front is not certified: it {_why_not(r)}; refusing to "
+        "export it for a robot controller (pass allow_infeasible=True to export anyway)"
+    )
 
 
 # ============================================================================ ROS
@@ -231,17 +285,7 @@ def to_ros_joint_trajectory(
     index = member_index(r, member)
     check_type(allow_infeasible, bool, "allow_infeasible")
     best = index == r.best.index
-    if best and not r.feasible and not allow_infeasible:
-        detail = "; ".join(r.certificate.violations[:3]) or "see result.certificate"
-        raise InvalidInputError(
-            "the best trade-off is not verified feasible (" + detail + "); refusing to export "
-            "it for a robot controller (pass allow_infeasible=True to export anyway)"
-        )
-    if not best and not certified_members(r)[index] and not allow_infeasible:
-        raise InvalidInputError(
-            f"member {index} of the front is not certified: it {_why_not(r)}; refusing to "
-            "export it for a robot controller (pass allow_infeasible=True to export anyway)"
-        )
+    _refuse_uncertified(r, index, allow_infeasible)
     if rate_hz is None and best:
         if replay is not None:
             Replay.of_best(r, replay)

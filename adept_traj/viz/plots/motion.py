@@ -1,5 +1,6 @@
-"""The motion of the best trade-off: position, velocity, acceleration, jerk and torque of
-every joint against time, with their limits (the paper's Figs. 8–9)."""
+"""The motion of a front member (default: the best trade-off): position, velocity,
+acceleration, jerk and torque of every joint against time, with their limits (the paper's
+Figs. 8–9)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.results import PlanningResult
+from adept_traj.results import PlanningResult, certified_members, member_dense, member_index
 from adept_traj.robot import LIMITS
 from adept_traj.viz.inputs import as_result
 from adept_traj.viz.plots.common import (
@@ -37,9 +38,14 @@ def _limit_lines(limits: Any, kind: str, j: int) -> list[float]:
     return [v for v in values if math.isfinite(v)]
 
 
-def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
+def joint_motion(
+    result: PlanningResult, path: str | os.PathLike[str], *, member: int | None = None
+) -> Path:
     """Position, velocity, acceleration, jerk and torque of every joint against time
-    (Figs. 8–9), from the certified dense trajectory of the best trade-off.
+    (Figs. 8–9) of a front member: by default the best trade-off, from its certified dense
+    trajectory; another member's spline is resampled on the certificate's grid
+    (:func:`~adept_traj.results.member_dense`). The title names the member and whether it
+    is certified (:func:`~adept_traj.results.certified_members`).
 
     One row per quantity, one column per joint; the limits are dashed lines (position:
     lower and upper; the others ±limit; an infinite limit is not drawn). Each panel
@@ -51,14 +57,23 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     ----------
     result: a :class:`~adept_traj.results.PlanningResult`.
     path: the PNG file to write.
+    member: the row of ``result.front`` to draw, in [0, ``len(result.front)`` − 1];
+        ``None`` (default): the best trade-off, ``result.best.index``.
 
     Returns
     -------
     The path written.
+
+    Raises
+    ------
+    InvalidInputError
+        ``member`` is not an integer in [0, n − 1] (the message names the range).
     """
     r = as_result(result)
     out = png_path(path)
-    dense, limits = r.best_trajectory, r.limits
+    index = member_index(r, member)
+    best = index == r.best.index
+    dense, limits = member_dense(r, index), r.limits
     t, nq = dense.t, dense.nq
     fig = new_figure(4.0 * nq + 1.0, 13.5)
     axes = np.atleast_2d(fig.subplots(len(LIMITS), nq, sharex=True, squeeze=False))
@@ -110,9 +125,11 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
     ax0 = axes[0, 0]
     from matplotlib.lines import Line2D
 
+    who = "best trade-off" if best else f"member {index}"
+
     fig.legend(
         handles=[
-            Line2D([], [], color="tab:blue", label="best trade-off (dense certificate samples)"),
+            Line2D([], [], color="tab:blue", label=f"{who} (dense certificate samples)"),
             Line2D([], [], color="tab:red", ls="--", label="limit (QC, VC, WC, JC, UC)"),
         ],
         loc="upper right",
@@ -121,10 +138,16 @@ def joint_motion(result: PlanningResult, path: str | os.PathLike[str]) -> Path:
         bbox_to_anchor=(0.99, 0.965),
     )
     ax0.set_xlim(float(t[0]), float(t[-1]))
+    if best:
+        what, T = "the best trade-off", float(r.best_objectives[0])
+        verdict = f"{status(r)} at {r.certificate.rate_hz:g} Hz"
+        details = violations_line(r)
+    else:
+        what, T = f"member {index} of the front", float(t[-1])
+        verdict = "certified" if certified_members(r)[index] else "NOT certified"
+        details = ""
     fig.suptitle(
-        f"{display_name(r.algorithm)}: joint motion of the best trade-off, "
-        f"T = {r.best_objectives[0]:.3f} s "
-        f"({status(r)} at {r.certificate.rate_hz:g} Hz)" + violations_line(r),
+        f"{display_name(r.algorithm)}: joint motion of {what}, T = {T:.3f} s ({verdict})" + details,
         fontsize=13,
         x=0.06,
         ha="left",
