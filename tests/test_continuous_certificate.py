@@ -137,7 +137,9 @@ def test_continuous_guarantee_clear_pass():
     assert problem.settings.margin <= cert.distance_bound <= cert.min_distance
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize(
+    "seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
+)
 def test_bound_is_sound_on_random_moves(seed):
     """The certified lower bound never exceeds the true minimum (coal at 20 kHz), on random
     moves past the thin post, with a coarse 100 Hz grid and no refinement (loose bounds)."""

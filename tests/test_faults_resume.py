@@ -122,8 +122,9 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     [
         ("kill", "evaluate", 2),  # during generation 2
         ("int", "certify", 1),  # after the last generation, during the certificate
-        ("kill", "front_csv", 1),  # while saving: result.json written, front.csv not
-        ("kill", "commit", 1),  # every file written, run.json not yet removed
+        # the other phases run in the slow tier too (the sweep covers every instant)
+        pytest.param("kill", "front_csv", 1, marks=pytest.mark.slow),  # result.json only
+        pytest.param("kill", "commit", 1, marks=pytest.mark.slow),  # run.json not removed
     ],
 )
 def test_an_interrupted_run_resumes_to_the_same_result(

@@ -204,8 +204,14 @@ def titles(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     ("member", "words"),
     [
         (1, "member 1 of the front, T = 2.300 s (certified)"),
-        (2, "member 2 of the front, T = 1.500 s (NOT certified)"),
-        (None, "the best trade-off, T = 2.100 s (verified feasible at 1000 Hz)"),
+        pytest.param(  # drawing takes ~1.4 s a figure: the other two in the slow tier
+            2, "member 2 of the front, T = 1.500 s (NOT certified)", marks=pytest.mark.slow
+        ),
+        pytest.param(
+            None,
+            "the best trade-off, T = 2.100 s (verified feasible at 1000 Hz)",
+            marks=pytest.mark.slow,
+        ),
     ],
 )
 def test_the_figure_of_a_member_is_a_png_whose_title_names_it(

@@ -304,9 +304,12 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
     ``gap``, ``certificate.n_samples``, each check's ``worst`` and ``within``, …) disagree
     with what the rest of the file gives: the file re-encoded from the decoded result must be
     the file read. The walk is iterative (the nesting is already bounded)."""
-    stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(_dumps(_encode(result))), "")]
+    # json.dumps (C) gives the same data as the file's own layout (_dumps), 4× faster
+    stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(json.dumps(_encode(result))), "")]
     while stack:
         stored, derived, path = stack.pop()
+        if stored == derived:  # whole subtrees at C speed; the walk below only finds where
+            continue  # (the reader has already checked the types: bools, ints, numbers)
         if isinstance(stored, dict) and isinstance(derived, dict):
             if stored.keys() != derived.keys():
                 extra = sorted(set(stored) ^ set(derived))
@@ -314,7 +317,7 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
             stack.extend((stored[k], derived[k], f"{path}.{k}" if path else k) for k in stored)
         elif isinstance(stored, list) and isinstance(derived, list) and len(stored) == len(derived):
             stack.extend((s, d, f"{path}[{i}]") for i, (s, d) in enumerate(zip(stored, derived)))
-        elif stored != derived or type(stored) is not type(derived):
+        else:
             raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
 
 
