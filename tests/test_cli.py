@@ -85,14 +85,14 @@ def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[st
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(plan_command, "ProgressReporter", StopAfterTwo)
-        argv = ["plan", "--pop", "12", "--gens", "4", "--out", str(interrupted)]
+        light = ["--no-plots", "--no-html"]  # the drawing is tested elsewhere
+        argv = ["plan", "--pop", "12", "--gens", "4", *light, "--out", str(interrupted)]
         assert main(argv) == 130
     assert "--resume" in capsys.readouterr().err
     assert main(["plan", "--resume", str(interrupted), "--quiet"]) == 0
     resumed = PlanningResult.load(interrupted)
-    assert (
-        main(["plan", "--pop", "12", "--gens", "4", "--out", str(tmp_path / "u"), "--quiet"]) == 0
-    )
+    argv = ["plan", "--pop", "12", "--gens", "4", *light, "--out", str(tmp_path / "u")]
+    assert main([*argv, "--quiet"]) == 0
     uninterrupted = PlanningResult.load(tmp_path / "u")
     np.testing.assert_array_equal(resumed.front.x, uninterrupted.front.x)
 

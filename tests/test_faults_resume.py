@@ -174,13 +174,19 @@ def test_resume_of_a_complete_run_changes_nothing(
     assert after == before
 
 
-@pytest.fixture
-def in_progress(tmp_path: Path) -> Path:
-    """A run interrupted (Ctrl-C) after its first generation."""
-    out = tmp_path / "run"
+@pytest.fixture(scope="module")
+def interrupted_once(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A run interrupted (Ctrl-C) after its first generation, made once for the module."""
+    out = tmp_path_factory.mktemp("interrupted") / "run"
     stopped = _interrupted("int", "evaluate", 2, [*_RUN, *_LIGHT, "--out", str(out)])
     assert stopped.returncode == 130, stopped.stderr
     return out
+
+
+@pytest.fixture
+def in_progress(interrupted_once: Path, tmp_path: Path) -> Path:
+    """A fresh copy of the interrupted run (each test may resume or change it)."""
+    return Path(shutil.copytree(interrupted_once, tmp_path / "run"))
 
 
 @pytest.mark.parametrize(
