@@ -18,7 +18,6 @@ ROS and CSV exports and the joint-motion figure (``member=N``) and the listing
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
@@ -28,7 +27,7 @@ from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.results.record import PlanningResult
 from adept_traj.results.replay import Replay
-from adept_traj.validation import as_integer, check_type, deep_equal
+from adept_traj.validation import as_integer, check_type
 
 __all__ = [
     "MAX_MEMBER_SAMPLES",
@@ -87,13 +86,7 @@ def member_replay(result: PlanningResult, index: int, replay: Any = None) -> Rep
     if replay is None:
         return Replay.of(result, x)
     check_type(replay, Replay, "replay")
-    same = deep_equal(replay.x, x)
-    if same:  # joints, start, goal and knots: the checks of Replay.of_best, on the best's x
-        try:
-            Replay.of_best(result, dataclasses.replace(replay, x=result.best_x))
-        except InvalidInputError:
-            same = False
-    if not same:
+    if not replay.shows(result, x):
         raise InvalidInputError(
             f"replay must show member {index} of the front, result.front.x[{index}] "
             f"(Replay.of(result, result.front.x[{index}])); its joints, start, goal, n_knots "

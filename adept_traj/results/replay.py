@@ -117,14 +117,7 @@ class Replay:
         if replay is None:
             return cls.of(result)
         check_type(replay, Replay, "replay")
-        tr = replay.trajectory
-        if not (
-            tuple(replay.robot.joint_names) == tuple(result.robot.joint_names)
-            and tr.n_knots == int(result.problem_settings.n_knots)
-            and deep_equal(tr.start, result.start)
-            and deep_equal(tr.goal, result.goal)
-            and deep_equal(replay.x, result.best_x)
-        ):
+        if not replay.shows(result, result.best_x):
             raise InvalidInputError(
                 "replay must show the result's best solution, result.best_x "
                 "(Replay.of(result)); its joints, start, goal, n_knots or x differ from the "
@@ -132,6 +125,18 @@ class Replay:
                 f"{float(result.best_x[0]):.6g} s)"
             )
         return replay
+
+    def shows(self, result: PlanningResult, x: Any) -> bool:
+        """Whether this replay is the move of decision vector ``x`` (n_var,) of ``result``:
+        the same joints, start, goal, knots and decision vector."""
+        tr = self.trajectory
+        return (
+            tuple(self.robot.joint_names) == tuple(result.robot.joint_names)
+            and tr.n_knots == int(result.problem_settings.n_knots)
+            and deep_equal(tr.start, result.start)
+            and deep_equal(tr.goal, result.goal)
+            and deep_equal(self.x, np.asarray(x, dtype=float))
+        )
 
     @property
     def duration(self) -> float:
