@@ -287,9 +287,7 @@ def to_ros_joint_trajectory(
     best = index == r.best.index
     _refuse_uncertified(r, index, allow_infeasible)
     if rate_hz is None and best:
-        if replay is not None:
-            Replay.of_best(r, replay)
-        d = r.best_trajectory
+        d = member_dense(r, index, replay)  # the stored certificate samples (replay checked)
         t, q, qd, qdd, tau = d.t, d.q, d.qd, d.qdd, d.tau
     else:
         rate = r.certificate.rate_hz if rate_hz is None else _rate(rate_hz)
