@@ -123,10 +123,21 @@ def test_front_scores_are_best_tradeoff_with_the_given_weights(
 def test_front_of_a_certified_run(
     run_dir: Path, run: PlanningResult, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """A version-2 result lists every certified member's clearance from its own stored
+    certificate (the best's from its exact certificate)."""
+    raw = json.loads((run_dir / "result.json").read_text(encoding="utf-8"))
+    assert raw["version"] == 2
     assert main(["front", str(run_dir)]) == 0
     _, rows, rest = _table(capsys.readouterr().out)
     assert [r[10] for r in rows] == ["yes", "yes"]
     assert rest == [f"* best trade-off (member {run.best.index}); 2 of 2 members certified"]
+    other = 1 - run.best.index
+    member = raw["front"][other]["certificate"]
+    cell = rows[other][11]
+    assert cell.startswith("≥") != member["min_distance_exact"]
+    assert float(cell.lstrip("≥")) == pytest.approx(member["min_distance"], rel=1e-5)
+    best = float(rows[run.best.index][11])
+    assert best == pytest.approx(raw["certificate"]["min_distance"], rel=1e-5)
 
 
 def test_front_refuses_an_unknown_column(capsys: pytest.CaptureFixture[str]) -> None:

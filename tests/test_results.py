@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from adept_traj import Robot, Scene
-from adept_traj.analysis import certify
+from adept_traj.analysis import certify, certify_members
 from adept_traj.errors import AdeptTrajError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import (
@@ -34,12 +34,16 @@ from adept_traj.testing.paper_moves import lift_then_lower
 
 
 def make_result(problem: TrajectoryProblem, x: np.ndarray, **overrides: Any) -> PlanningResult:
+    """A result of version 2: the members feasible at the optimiser's samples certified."""
     ev = problem.evaluate_batch(x)
+    summaries = certify_members(problem, x, np.flatnonzero(ev.feasible))
+    certified = np.array([s is not None and s.feasible for s in summaries])
+    front = Front(x, ev.objectives, ev.constraints, certified, int(certified.sum()), summaries)
     kwargs: dict[str, Any] = {
         "algorithm": "NSGA-II",
         "algorithm_settings": {"pop_size": np.int64(100), "eta_c": 15.0, "ops": ("sbx", "pm")},
         "seed": 7,
-        "front": Front.from_evaluation(x, ev),
+        "front": front,
         "best": BestSolution(0, f_c=0.25, f_avg=0.5),
         "certificate": certify(problem, x[0]),
         "timing": Timing(total_s=12.5, evaluation_s=10.0, n_evaluations=300, n_generations=3),
@@ -143,7 +147,7 @@ def test_json_schema(result: PlanningResult, saved: Path) -> None:
     assert "Infinity" not in text
     data = load_json(saved)
     assert data["format"] == FORMAT == "adept_traj.result"
-    assert data["version"] == VERSION == 1
+    assert data["version"] == VERSION == 2
     for key in (
         "start", "goal", "seed", "algorithm", "problem_settings", "scene", "robot", "versions",
         "front", "best", "best_trajectory", "limits", "certificate", "metrics", "timing",
@@ -331,7 +335,17 @@ def test_json_with_nan(saved: Path) -> None:
 @pytest.mark.parametrize(
     ("edit", "field"),
     [
-        (lambda d: d.update(version=2), "version"),
+        (lambda d: d.update(version=3), "version"),
+        (lambda d: d.update(version=1), "front[2]"),  # version 1 has no member certificates
+        (lambda d: d.pop("n_certified"), "n_certified"),
+        (lambda d: d["front"][0].pop("certificate"), "front[0].certificate"),
+        (lambda d: d["front"][0]["certificate"].pop("guarantee"), "front[0].certificate.guarantee"),
+        (
+            lambda d: d["front"][0]["certificate"]["worst"].update(speed=1.0),
+            "front[0].certificate.worst.speed",
+        ),
+        (lambda d: d["front"][0]["certificate"].update(feasible=False), "front"),
+        (lambda d: d["front"][1].update(certificate=None), "front"),
         (lambda d: d.update(version=True), "version"),
         (lambda d: d.update(format="something.else"), "format"),
         (lambda d: d.pop("timing"), "timing"),

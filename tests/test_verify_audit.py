@@ -213,6 +213,26 @@ def test_certified_front_flags_are_recomputed_from_certificates(tmp_path: Path) 
     assert {m.field for m in found.mismatches} >= {f"front[{k}].feasible"}
 
 
+def test_member_certificates_are_recomputed(tmp_path: Path) -> None:
+    """Every stored member certificate (result.json version 2) is compared field by field
+    with a fresh one: an untampered run passes, a changed clearance or worst ratio is named."""
+    result = _planar_run(tmp_path)
+    f = result.front
+    assert f.certificates is not None
+    k = int(np.flatnonzero(f.feasible)[-1])
+    stored = f.certificates[k]
+    changed = dataclasses.replace(
+        stored,
+        min_distance=stored.min_distance + 0.01,
+        worst=(stored.worst[0], stored.worst[1] / 2, *stored.worst[2:]),
+    )
+    certificates = (*f.certificates[:k], changed, *f.certificates[k + 1 :])
+    tampered = dataclasses.replace(f, certificates=certificates)
+    found = {m.field for m in audit(dataclasses.replace(result, front=tampered)).mismatches}
+    path = f"front[{k}].certificate"
+    assert found == {f"{path}.min_distance", f"{path}.worst[1]"}
+
+
 def test_mismatch_line_format(old, tmp_path, capsys) -> None:
     r = PlanningResult.load(old)
     F = r.front.objectives.copy()

@@ -37,6 +37,11 @@ from adept_traj.analysis.indicators import (
     to_unit_minimisation,
 )
 from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, LimitCheck
+from adept_traj.analysis.member_certificate import (
+    FRONT_INFLUENCE_ABOVE_MARGIN,
+    MemberCertificate,
+    certify_members,
+)
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
     optimizer_overhead,
@@ -51,6 +56,7 @@ __all__ = [
     "DEFAULT_MAX_DEPTH",
     "DEFAULT_RATE_HZ",
     "DEFAULT_TOLERANCE",
+    "FRONT_INFLUENCE_ABOVE_MARGIN",
     "LIMIT_KINDS",
     "PAPER_WEIGHTS",
     "BestTradeoff",
@@ -58,11 +64,13 @@ __all__ = [
     "DenseTrajectory",
     "DistanceGuarantee",
     "LimitCheck",
+    "MemberCertificate",
     "algorithm_effort",
     "average_fitness",
     "best_tradeoff",
     "certificate_bytes",
     "certify",
+    "certify_members",
     "check_certificate_memory",
     "combined_objective",
     "continuous_distance",

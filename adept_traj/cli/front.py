@@ -6,9 +6,12 @@ of :func:`~adept_traj.results.to_ros_joint_trajectory`'s ``member=N``), the trav
 :mod:`adept_traj.problem.objectives`), the combined objective ``f_c`` (lower is better)
 and the average fitness ``F_avg`` (higher is better) of
 :func:`~adept_traj.analysis.best_tradeoff` with ``--weights`` (default: the paper's),
-whether the member is certified, and its minimum clearance [m] when ``result.json``
-holds it (only the best trade-off's dense certificate stores one; the others show
-``-``). The best trade-off (``result.best.index``) is marked ``*``.
+whether the member is certified, and its minimum clearance [m] from its certificate
+(``result.json`` version 2 stores one per certified member; ``-``: not certified, or a
+version-1 file, which holds the best trade-off's only). A clearance shown as ``≥ d`` is a
+lower bound: the member stays farther than ``margin + 0.01 m`` from everything, where its
+certificate keeps the broad phase's bounds (:mod:`adept_traj.analysis.member_certificate`).
+The best trade-off (``result.best.index``) is marked ``*``; its clearance is always exact.
 
 ``certified`` is ``front.feasible`` when :func:`~adept_traj.plan` certified every member
 (``front.n_certified`` set). A result saved before that (``n_certified`` absent, e.g.
@@ -73,26 +76,34 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def _columns(result: PlanningResult, weights: list[float]) -> dict[str, np.ndarray]:
-    """Every column of the listing, each (n,) (``clearance``: NaN when not stored)."""
+    """Every column of the listing, each (n,) (``clearance``: NaN when not stored), and
+    ``clearance_exact`` (n,) bool: whether the clearance is exact, not a lower bound."""
     front = result.front
     n = len(front)
     choice = best_tradeoff(front.objectives, weights)
     certified = certified_members(result)
-    clearance = np.full(n, np.nan)
-    clearance[result.best.index] = result.certificate.min_distance
+    clearance, exact = np.full(n, np.nan), np.ones(n, dtype=bool)
+    for k, member in enumerate(front.certificates or ()):
+        if member is not None:
+            clearance[k], exact[k] = member.min_distance, member.min_distance_exact
+    clearance[result.best.index] = result.certificate.min_distance  # exact distances
     cols = {"index": np.arange(n), "T": front.x[:, 0]}
     cols.update({f"z{i + 1}": front.objectives[:, i] for i in range(1, 6)})
     cols.update(f_c=choice.f_c, F_avg=choice.F_avg, certified=certified, clearance=clearance)
+    exact[result.best.index] = True
+    cols["clearance_exact"] = exact
     return cols
 
 
-def _cell(name: str, value: float | bool) -> str:
+def _cell(name: str, value: float | bool, exact: bool = True) -> str:
     if name == "index":
         return str(int(value))
     if name == "certified":
         return "yes" if value else "no"
     if name == "clearance" and np.isnan(value):
         return "-"
+    if name == "clearance" and not exact:
+        return f"≥{float(value):.6g}"
     return f"{float(value):.6g}"
 
 
@@ -124,7 +135,8 @@ def front_table(
     key = np.where(np.isnan(key), -np.inf if descending else np.inf, key)  # '-' last
     order = np.argsort(-key if descending else key, kind="stable")
     header = [f"{name} [{unit}]" if unit else name for name, unit in COLUMNS.items()]
-    rows = [[_cell(name, cols[name][k]) for name in COLUMNS] for k in order]
+    exact = cols["clearance_exact"]
+    rows = [[_cell(name, cols[name][k], exact[k]) for name in COLUMNS] for k in order]
     width = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(header)]
     best = result.best.index
     lines = ["  " + "  ".join(h.rjust(w) for h, w in zip(header, width, strict=True))]

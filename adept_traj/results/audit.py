@@ -12,7 +12,8 @@ field of ``result.json``:
 - every front member's objectives and constraints against
   :meth:`~adept_traj.problem.TrajectoryProblem.evaluate_batch` of its decision vector, its
   ``feasible`` flag against the recomputed constraints and, for a result whose members
-  are all certified (``front.n_certified``), each member's own continuous certificate;
+  are all certified (``front.n_certified``), each member's own continuous certificate
+  (and, version 2, its stored summary ``front[i].certificate`` field by field);
   when the front has a member feasible at the samples, that every member is and none
   dominates another (how ``plan`` builds it);
 - the certificate (dense trajectory t, q, qd, qdd, qddd, tau, min_distance; every limit
@@ -57,6 +58,7 @@ from adept_traj.analysis import (
     algorithm_effort,
     best_tradeoff,
     certify,
+    certify_members,
     non_dominated,
     normalised_hypervolume,
     objective_bounds,
@@ -222,17 +224,46 @@ class _Auditor(MismatchLog):
     def certified_members(self, sampled: np.ndarray) -> np.ndarray:
         """(n,) the recomputed ``front.feasible``: the optimiser's verdict ``sampled`` (n,)
         for a result of the earlier rule (``front.n_certified`` is None), else that verdict
-        and the member's own certificate with the continuous guarantee (as ``plan`` does)."""
-        if self.r.front.n_certified is None:
+        and the member's own certificate with the continuous guarantee (as ``plan`` does).
+        The stored member certificates (version 2) are compared with the fresh ones."""
+        front = self.r.front
+        if front.n_certified is None:
             return np.asarray(sampled, dtype=bool)
-        rate = self.r.certificate.rate_hz
+        stored = front.certificates
+        if stored is None:  # n_certified without the certificates: certify what could pass
+            rows = [int(i) for i in np.flatnonzero(sampled)]
+        else:
+            rows = [i for i, c in enumerate(stored) if c is not None]
+            skipped = [int(i) for i in np.flatnonzero(sampled) if stored[i] is None]
+            if skipped:
+                self.not_checked.append(
+                    f"front{skipped}: feasible at the samples but not certified by plan "
+                    f"(plan(max_certify=...)); stored as not feasible"
+                )
+        fresh = certify_members(
+            self.p,
+            front.x,
+            rows,
+            rate_hz=self.r.certificate.rate_hz,
+            tolerance=self.r.certificate.position.tolerance,
+        )
+        for i in rows if stored is not None else ():
+            self.member_certificate(f"front[{i}].certificate", stored[i], fresh[i])
         return np.array(
-            [
-                bool(ok) and certify(self.p, x, rate_hz=rate, exact=False).certified
-                for ok, x in zip(sampled, self.r.front.x)
-            ],
+            [bool(ok) and c is not None and c.feasible for ok, c in zip(sampled, fresh)],
             dtype=bool,
         )
+
+    def member_certificate(self, path: str, stored: Any, now: Any) -> None:
+        """Compare two :class:`~adept_traj.analysis.MemberCertificate` field by field."""
+        exact = ("feasible", "guarantee", "torque_guarantee", "worst_joint")
+        for field in (*exact, "min_distance_exact", "closest_pair", "violations"):
+            self.value(f"{path}.{field}", getattr(stored, field), getattr(now, field))
+        self.numbers(f"{path}.worst", stored.worst, now.worst)
+        self.numbers(f"{path}.t_worst", stored.t_worst, now.t_worst)
+        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
+        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
+        self.optional(f"{path}.distance_bound", stored.distance_bound, now.distance_bound)
 
     def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
         self.value(f"{path}.feasible", stored.feasible, now.feasible)

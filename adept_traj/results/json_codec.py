@@ -1,4 +1,4 @@
-"""``result.json`` (format ``"adept_traj.result"``, version 1): encode a
+"""``result.json`` (format ``"adept_traj.result"``, version 2; version 1 read): encode a
 :class:`~adept_traj.results.PlanningResult` as JSON text and decode it back.
 
 The schema is in ``docs/results.md``. Floats are written in Python's shortest round-trip
@@ -24,10 +24,18 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
-from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
+from adept_traj.results.certificate_codec import (
+    _DENSE_FIELDS,
+    _decode_certificate,
+    _decode_dense,
+    _decode_member_certificate,
+    _encode_certificate,
+    _float,
+    _floats,
+    _member_certificate,
+)
 from adept_traj.results.parts import (
     METRIC_NAMES,
     BestSolution,
@@ -38,8 +46,8 @@ from adept_traj.results.parts import (
     Timing,
 )
 from adept_traj.results.reader import _open_json
-from adept_traj.results.record import FORMAT, VERSION, PlanningResult, _jsonable
-from adept_traj.robot.limits import LIMIT_KINDS, LIMITS, JointLimits
+from adept_traj.results.record import FORMAT, READ_VERSIONS, VERSION, PlanningResult, _jsonable
+from adept_traj.robot.limits import LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.schema import Node
 from adept_traj.validation import deep_equal
@@ -48,7 +56,6 @@ __all__: list[str] = []
 
 #: JSON key of each metric of :class:`Metrics`.
 _JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
-_DENSE_FIELDS = ("t", *(kind.quantity for kind in LIMITS), "min_distance")
 
 
 def _write_json(r: PlanningResult, path: Path) -> Path:
@@ -79,7 +86,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     history = None if r.history is None else [dataclasses.asdict(rec) for rec in r.history]
     out: dict[str, Any] = {
         "format": FORMAT,
-        "version": VERSION,
+        "version": _version(r),
         "warning": r.warning,
         "robot": dataclasses.asdict(r.robot) | {"joint_names": list(r.robot.joint_names)},
         "start": _floats(r.start),
@@ -121,6 +128,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
                 "constraints": _floats(r.front.constraints[i]),
                 "feasible": bool(r.front.feasible[i]),
             }
+            | _member_certificate(r.front, i)
             for i in range(len(r.front))
         ],
         "best_trajectory": {name: _floats(getattr(c.dense, name)) for name in _DENSE_FIELDS},
@@ -131,51 +139,10 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     return out
 
 
-def _encode_certificate(c: Certificate) -> dict[str, Any]:
-    out: dict[str, Any] = {
-        "feasible": c.feasible,
-        "rate_hz": c.rate_hz,
-        "n_samples": c.n_samples,
-        "margin": c.margin,
-        "min_distance": _float(c.min_distance),
-        "t_min_distance": c.t_min_distance,
-        "closest_pair": None if c.closest_pair is None else list(c.closest_pair),
-        "violations": list(c.violations),
-        "x": _floats(c.x),
-    }
-    if c.guarantee is not None:  # optional keys (absent in files of older versions)
-        out["guarantee"] = c.guarantee
-    if c.distance_bound is not None:
-        out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
-    if c.torque_guarantee is not None:
-        out["torque_guarantee"] = c.torque_guarantee
-    for check in c.checks:
-        out[check.kind] = {
-            "limit": check.symbol,
-            "worst": _floats(check.worst),
-            "within": [bool(b) for b in check.within],
-            "dense": _floats(check.dense),
-            "exact": None if check.exact is None else _floats(check.exact),
-            "t_worst": _floats(check.t_worst),
-            "tolerance": check.tolerance,
-        }
-    return out
-
-
-def _float(value: float) -> float | None:
-    """A finite float as is; ±inf as ``None``; NaN refused."""
-    v = float(value)
-    if math.isnan(v):
-        raise InvalidInputError("NaN cannot be saved")
-    return v if math.isfinite(v) else None
-
-
-def _floats(arr: Any) -> Any:
-    """Nested lists of floats (±inf → ``None``) from an array; NaN refused."""
-    a = np.asarray(arr, dtype=float)
-    if np.isnan(a).any():
-        raise InvalidInputError("NaN cannot be saved")
-    return np.where(np.isinf(a), None, a).tolist() if np.isinf(a).any() else a.tolist()
+def _version(r: PlanningResult) -> int:
+    """2 when the front carries its members' certificates, else 1 (a result read from a
+    version-1 file is written back as it was)."""
+    return VERSION if r.front.certificates is not None else 1
 
 
 def _dumps(value: Any, level: int = 0) -> str:
@@ -203,8 +170,11 @@ def _decode(top: Node) -> PlanningResult:
     top.table()
     top["format"].string(choices=(FORMAT,))
     version = top["version"].integer()
-    if version != VERSION:
-        raise top["version"].error(f"unsupported version {version} (this adept_traj reads 1)")
+    if version not in READ_VERSIONS:
+        readable = ", ".join(map(str, READ_VERSIONS))
+        raise top["version"].error(
+            f"unsupported version {version} (this adept_traj reads {readable})"
+        )
     rob = top["robot"]
     robot = rob.build(
         RobotInfo,
@@ -242,7 +212,10 @@ def _decode(top: Node) -> PlanningResult:
         T_min=lb["T_min"].number(),
         limiting_joint=lb["limiting_joint"].integer(),
     )
-    front = _decode_front(top["front"], top["n_certified"].integer(minimum=0, default=None))
+    n_certified = top["n_certified"]
+    if version >= 2 and not n_certified.present:
+        raise n_certified.error("is required in a result of version 2")
+    front = _decode_front(top["front"], n_certified.integer(minimum=0, default=None), version)
     bd = top["best"]
     best = bd.build(
         BestSolution,
@@ -313,7 +286,9 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
         if isinstance(stored, dict) and isinstance(derived, dict):
             if stored.keys() != derived.keys():
                 extra = sorted(set(stored) ^ set(derived))
-                raise top.error_at(path, f"fields {extra} are not those of a result of version 1")
+                raise top.error_at(
+                    path, f"fields {extra} are not those of a result of version {_version(result)}"
+                )
             stack.extend((stored[k], derived[k], f"{path}.{k}" if path else k) for k in stored)
         elif isinstance(stored, list) and isinstance(derived, list) and len(stored) == len(derived):
             stack.extend((s, d, f"{path}[{i}]") for i, (s, d) in enumerate(zip(stored, derived)))
@@ -321,8 +296,8 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
             raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
 
 
-def _decode_front(node: Node, n_certified: int | None) -> Front:
-    xs, objs, cons, feas = [], [], [], []
+def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:
+    xs, objs, cons, feas, certificates = [], [], [], [], []
     n_var = n_con = None
     for item in node.items(min_items=1):
         xs.append(item["x"].array((n_var,)))
@@ -330,6 +305,8 @@ def _decode_front(node: Node, n_certified: int | None) -> Front:
         cons.append(item["constraints"].array((n_con,)))
         feas.append(item["feasible"].boolean())
         n_var, n_con = xs[-1].size, cons[-1].size
+        if version >= 2:
+            certificates.append(_decode_member_certificate(item["certificate"]))
     return node.build(
         Front,
         x=np.array(xs),
@@ -337,45 +314,7 @@ def _decode_front(node: Node, n_certified: int | None) -> Front:
         constraints=np.array(cons),
         feasible=np.array(feas, dtype=bool),
         n_certified=n_certified,
-    )
-
-
-def _decode_dense(node: Node, nq: int) -> DenseTrajectory:
-    t = node["t"].array((None,))
-    arrays = {name: node[name].array((t.size, nq)) for name in _DENSE_FIELDS[1:-1]}
-    distance = node["min_distance"].array((t.size,), null=math.inf)
-    return node.build(DenseTrajectory, t=t, **arrays, min_distance=distance)
-
-
-def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
-    nq, checks = dense.nq, {}
-    for kind in LIMIT_KINDS:
-        cd = node[kind]
-        checks[kind] = cd.build(
-            LimitCheck,
-            kind=kind,
-            dense=cd["dense"].array((nq,)),
-            exact=cd["exact"].array((nq,), nullable=True),
-            t_worst=cd["t_worst"].array((nq,)),
-            tolerance=cd["tolerance"].number(),
-        )
-    pair = node["closest_pair"]
-    return node.build(
-        Certificate,
-        x=node["x"].array((None,)),
-        rate_hz=node["rate_hz"].number(),
-        margin=node["margin"].number(),
-        min_distance=node["min_distance"].number(null=math.inf),
-        t_min_distance=node["t_min_distance"].number(null=None),
-        closest_pair=None if pair.value is None else pair.strings(),
-        violations=node["violations"].strings(),
-        dense=dense,
-        guarantee=node["guarantee"].string(nonempty=True, default=None),
-        distance_bound=(
-            node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
-        ),
-        torque_guarantee=node["torque_guarantee"].string(nonempty=True, default=None),
-        **checks,
+        certificates=tuple(certificates) if version >= 2 else None,
     )
 
 

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
 from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
 from adept_traj.robot.robot import Robot, shipped_file
@@ -144,6 +145,7 @@ class Front:
     constraints: np.ndarray
     feasible: np.ndarray
     n_certified: int | None = None
+    certificates: tuple[MemberCertificate | None, ...] | None = None
 
     def __post_init__(self) -> None:
         n = None
@@ -174,6 +176,32 @@ class Front:
                     f"{int(feas.sum())}; got {count}"
                 )
             object.__setattr__(self, "n_certified", count)
+        if self.certificates is not None:
+            object.__setattr__(self, "certificates", self._checked_certificates(feas))
+
+    def _checked_certificates(self, feasible: np.ndarray) -> tuple[MemberCertificate | None, ...]:
+        """The member certificates as a tuple, one per member, each agreeing with
+        ``feasible`` (n,)."""
+        if self.n_certified is None:
+            raise InvalidInputError("front.certificates needs front.n_certified")
+        certificates = tuple(self.certificates)
+        if len(certificates) != len(feasible):
+            raise InputShapeError(
+                f"front.certificates must have one entry per member, {len(feasible)}; "
+                f"got {len(certificates)}"
+            )
+        for i, (c, ok) in enumerate(zip(certificates, feasible)):
+            if c is not None and not isinstance(c, MemberCertificate):
+                raise InvalidInputError(
+                    f"front.certificates[{i}] must be a MemberCertificate or None; "
+                    f"got {type(c).__name__}"
+                )
+            if bool(ok) != (c is not None and c.feasible):
+                raise InvalidInputError(
+                    f"front.feasible[{i}] is {bool(ok)} but its certificate says "
+                    f"{'not certified' if c is None else c.feasible}"
+                )
+        return certificates
 
     @classmethod
     def from_evaluation(cls, x: Any, evaluation: Evaluation, feasible: Any | None = None) -> Front:
@@ -194,8 +222,16 @@ class Front:
         """The solutions selected by a bool mask or index array."""
         feasible = self.feasible[mask]
         certified = None if self.n_certified is None else int(np.sum(feasible))
+        certificates = None
+        if self.certificates is not None:
+            certificates = tuple(self.certificates[i] for i in np.arange(len(self))[mask])
         return Front(
-            self.x[mask], self.objectives[mask], self.constraints[mask], feasible, certified
+            self.x[mask],
+            self.objectives[mask],
+            self.constraints[mask],
+            feasible,
+            certified,
+            certificates,
         )
 
     def __eq__(self, other: object) -> bool:

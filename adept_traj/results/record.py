@@ -59,6 +59,7 @@ __all__ = [
     "FORMAT",
     "FRONT_FILE",
     "NO_FEASIBLE_WARNING",
+    "READ_VERSIONS",
     "RESULT_FILE",
     "TRAJECTORY_FILE",
     "VERSION",
@@ -67,8 +68,11 @@ __all__ = [
 
 #: Value of the ``"format"`` key of ``result.json``.
 FORMAT = "adept_traj.result"
-#: Schema version written (and the only one read).
-VERSION = 1
+#: Newest schema version: written when the front carries its members' certificates
+#: (version 1, without them, is still read, and written back for a result read from it).
+VERSION = 2
+#: Schema versions read.
+READ_VERSIONS = (1, 2)
 #: File names inside a result folder.
 RESULT_FILE = "result.json"
 FRONT_FILE = "front.csv"
