@@ -16,7 +16,7 @@ from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot import Robot
-from adept_traj.scene import Scene
+from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import as_scalar
 
 __all__ = [
@@ -44,7 +44,11 @@ def floats(text: str) -> list[float]:
 def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
     workers and ``--quiet``."""
-    parser.add_argument("--scene", default="paper", help="'paper' or a scene TOML file")
+    parser.add_argument(
+        "--scene",
+        default="paper",
+        help="a shipped scene (paper, detour) or a scene TOML file (default: paper)",
+    )
     parser.add_argument("--start", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
     parser.add_argument("--goal", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
@@ -64,6 +68,12 @@ def check_rate(rate: float) -> float:
     return as_scalar(rate, "--rate", "[Hz]", minimum=MIN_RATE_HZ)
 
 
+def scene_from_argument(value: str) -> Scene:
+    """The scene named by ``--scene``: a shipped scene's name (``SHIPPED_SCENES``, which
+    takes precedence over a file of that name) or a scene TOML file's path."""
+    return Scene.shipped(value) if value in SHIPPED_SCENES else Scene.from_file(value)
+
+
 def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     """The problem the options describe, on the shipped AdeptOne XL.
 
@@ -77,7 +87,7 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     InvalidInputError
         Bad weights or rate, or a start/goal outside the joint limits.
     """
-    scene = Scene.paper() if args.scene == "paper" else Scene.from_file(args.scene)
+    scene = scene_from_argument(args.scene)
     start = args.start if args.start is not None else scene.start
     goal = args.goal if args.goal is not None else scene.goal
     if start is None or goal is None:

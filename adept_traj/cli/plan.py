@@ -53,6 +53,7 @@ from adept_traj.optimise import (
 )
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
+from adept_traj.scene import SHIPPED_SCENES
 from adept_traj.validation import as_integer
 
 __all__ = ["RUN_FILE", "add_parser", "run"]
@@ -104,7 +105,7 @@ def _option(key: str) -> str:
 
 def _comparable(key: str, value: Any) -> Any:
     """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
-    if value is None or (key == "scene" and value == "paper"):
+    if value is None or (key == "scene" and value in SHIPPED_SCENES):
         return value
     if key in ("scene", "ros"):
         return str(Path(value).resolve())

@@ -25,10 +25,9 @@ import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS, LimitCheck, certify, check_certificate_memory
 from adept_traj.cli import status
-from adept_traj.cli.arguments import check_rate, floats
+from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.results import PlanningResult, audit
 from adept_traj.robot import JointLimits
-from adept_traj.scene import Scene
 
 __all__ = ["add_parser", "run"]
 
@@ -46,8 +45,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--scene",
-        help="'paper' or the scene TOML file the run was planned on, compared with the stored "
-        "scene (default: the paper scene when the stored scene is named 'paper')",
+        help="a shipped scene (paper, detour) or the scene TOML file the run was planned on, "
+        "compared with the stored scene (default: the shipped scene of the stored name)",
     )
     return p
 
@@ -72,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     result = PlanningResult.load(args.folder)
     scene = None
     if args.scene is not None:
-        scene = Scene.paper() if args.scene == "paper" else Scene.from_file(args.scene)
+        scene = scene_from_argument(args.scene)
     problem = result.problem()
     try:
         check_certificate_memory(problem, rate, float(result.best_x[0]), option="--rate")

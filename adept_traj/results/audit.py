@@ -8,7 +8,7 @@ field of ``result.json``:
 - the robot's name, joints, tool frame and limits, and the kinematic lower bound of the
   travel time, against the reloaded robot (:func:`~adept_traj.problem.kinematic_lower_bound`);
 - the stored scene against the scene rebuilt from it and against a reference scene (the
-  shipped paper scene when the stored one is named ``"paper"``, or the one given);
+  shipped scene of the stored name (``"paper"``, ``"detour"``), or the one given);
 - every front member's objectives and constraints against
   :meth:`~adept_traj.problem.TrajectoryProblem.evaluate_batch` of its decision vector, its
   ``feasible`` flag against the recomputed constraints and, for a result whose members
@@ -70,7 +70,7 @@ from adept_traj.problem import OBJECTIVE_NAMES, TrajectoryProblem
 from adept_traj.results.mismatches import Mismatch, MismatchLog, close
 from adept_traj.results.record import PlanningResult
 from adept_traj.robot import LIMITS
-from adept_traj.scene import Scene
+from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import check_type
 
 __all__ = ["Audit", "audit"]
@@ -123,7 +123,8 @@ def audit(
     result: the loaded result.
     weights: (6,) the weights of f_c given to ``plan`` (default: the paper's).
     scene: the scene the run was planned on, to compare the stored one with; default: the
-        shipped paper scene when the stored scene is named ``"paper"``, else none.
+        shipped scene of the stored scene's name (``adept_traj.scene.SHIPPED_SCENES``),
+        else none.
     problem: ``result.problem()`` if the caller has built it (left open); default: built
         here and closed.
 
@@ -136,8 +137,8 @@ def audit(
     w = objective_weights(weights, len(OBJECTIVE_NAMES))
     if scene is not None:
         check_type(scene, Scene, "scene")
-    elif result.scene.get("name") == "paper":
-        scene = Scene.paper()
+    elif result.scene.get("name") in SHIPPED_SCENES:
+        scene = Scene.shipped(result.scene["name"])
     if problem is not None:
         check_type(problem, TrajectoryProblem, "problem")
         return _Auditor(result, problem, w, scene).run()

@@ -16,8 +16,10 @@ from adept_traj.scene.scene import (
     pendulum_obstacles,
 )
 from adept_traj.scene.scene_file import (
+    SHIPPED_SCENES,
     read_paper_scene,
     read_scene_file,
+    read_shipped_scene,
     scene_from_dict,
     scene_to_dict,
     scene_to_toml,
@@ -34,6 +36,7 @@ from adept_traj.scene.shapes import (
 
 __all__ = [
     "MAX_OBSTACLES",
+    "SHIPPED_SCENES",
     "Box",
     "Capsule",
     "Cylinder",
@@ -50,6 +53,7 @@ __all__ = [
     "pendulum_obstacles",
     "read_paper_scene",
     "read_scene_file",
+    "read_shipped_scene",
     "scene_from_dict",
     "scene_to_dict",
     "scene_to_toml",

@@ -293,6 +293,19 @@ class Scene(_ValueObject):
         return read_paper_scene()
 
     @classmethod
+    def shipped(cls, name: str) -> Scene:
+        """A scene shipped with the package, by name: ``"paper"`` (:meth:`paper`) or
+        ``"detour"`` (the paper's cell with a post on the straight path and the pendulum
+        across the arm's way on fast moves: ``docs/detour-scene.md``).
+
+        Raises:
+            SceneError: ``name`` is not one of ``adept_traj.scene.SHIPPED_SCENES``.
+        """
+        from adept_traj.scene.scene_file import read_shipped_scene
+
+        return read_shipped_scene(name)
+
+    @classmethod
     def from_file(cls, path: str | os.PathLike[str]) -> Scene:
         """Read a TOML scene file (format: ``docs/scene-files.md``).
 

@@ -36,13 +36,20 @@ from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
 
 __all__ = [
+    "SHIPPED_SCENES",
     "read_paper_scene",
     "read_scene_file",
+    "read_shipped_scene",
     "scene_from_dict",
     "scene_to_dict",
     "scene_to_toml",
     "write_scene_file",
 ]
+
+#: The scenes shipped in ``adept_traj/data/scenes/``: the paper's
+#: (``docs/paper-scenario.md``) and a harder one where the obstacles bind the fastest moves
+#: (``docs/detour-scene.md``).
+SHIPPED_SCENES = ("paper", "detour")
 
 #: First lines of a written scene file (TOML comments; tomli-w writes none).
 _HEADER = (
@@ -67,14 +74,22 @@ def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     return _parse_scene(data, str(p), p.stem or "scene")
 
 
-def read_paper_scene() -> Scene:
-    """The paper's scene, read from the shipped ``adept_traj/data/scenes/paper.toml``."""
-    source = "adept_traj/data/scenes/paper.toml"
+def read_shipped_scene(name: str) -> Scene:
+    """The shipped scene ``name`` (one of :data:`SHIPPED_SCENES`), read from
+    ``adept_traj/data/scenes/<name>.toml``."""
+    if name not in SHIPPED_SCENES:
+        raise SceneError(f"shipped scene must be one of {', '.join(SHIPPED_SCENES)}; got {name!r}")
+    source = f"adept_traj/data/scenes/{name}.toml"
     try:
-        raw = resources.files("adept_traj.data").joinpath("scenes", "paper.toml").read_bytes()
+        raw = resources.files("adept_traj.data").joinpath("scenes", f"{name}.toml").read_bytes()
     except OSError as exc:
         raise SceneError(f"{source}: cannot read: {exc}") from None
-    return _parse_scene(parse_toml(raw, source, SceneError), source, "paper")
+    return _parse_scene(parse_toml(raw, source, SceneError), source, name)
+
+
+def read_paper_scene() -> Scene:
+    """The paper's scene, read from the shipped ``adept_traj/data/scenes/paper.toml``."""
+    return read_shipped_scene("paper")
 
 
 def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
