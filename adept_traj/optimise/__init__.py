@@ -1,7 +1,7 @@
 """The optimiser.
 
-Algorithms, sampling, repair, fast-end search, the generation loop, its checkpoints and
-:func:`plan`."""
+Algorithms, sampling, repair, fast-end search, the generation loop, its checkpoints, gradient-based
+polishing (``polish``) and :func:`plan`."""
 
 from __future__ import annotations
 
@@ -33,6 +33,11 @@ from adept_traj.optimise.loop import (
 from adept_traj.optimise.planner import (
     plan,
 )
+from adept_traj.optimise.polish import (
+    PolishOutcome,
+    minimum_time,
+    time_optimal,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -53,6 +58,7 @@ __all__ = [
     "GenerationInfo",
     "KinematicTimeRepair",
     "PlanningInterrupted",
+    "PolishOutcome",
     "RampSampling",
     "RunState",
     "check_population_memory",
@@ -60,9 +66,11 @@ __all__ = [
     "kinematic_time",
     "load_checkpoint",
     "make_algorithm",
+    "minimum_time",
     "optimise",
     "plan",
     "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
+    "time_optimal",
 ]
