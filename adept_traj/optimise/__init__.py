@@ -38,6 +38,11 @@ from adept_traj.optimise.polish import (
     minimum_time,
     time_optimal,
 )
+from adept_traj.optimise.polish_step import (
+    TIME_OPTIMAL,
+    polish_fastest,
+    time_optimal_run,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -49,6 +54,7 @@ from adept_traj.optimise.sampling import (
 )
 
 __all__ = [
+    "TIME_OPTIMAL",
     "ALGORITHMS",
     "BLOCK_PAIRS",
     "CHECKPOINT_VERSION",
@@ -69,8 +75,10 @@ __all__ = [
     "minimum_time",
     "optimise",
     "plan",
+    "polish_fastest",
     "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
     "time_optimal",
+    "time_optimal_run",
 ]

@@ -54,7 +54,8 @@ of two black boxes, taken by *central differences in the state* (a few batched c
 all samples at once, never through the decision vector): :math:`\partial u/\partial(q,
 \dot q, \ddot q)` of the inverse dynamics (step ``1e-6``; the Coulomb term's derivative is
 0 away from rest and is left out exactly) and :math:`\partial d/\partial(q, t)` of the
-distances (step ``1e-6``; coal's GJK tolerance is 1e-9 m). The analytic distance gradient
+distances (step ``1e-6``; coal's GJK tolerance is 1e-9 m; only at samples within
+``influence`` + 1 mm of an obstacle, the others have a zero gradient). The analytic distance gradient
 (coal's nearest points and normal through the frame Jacobians, the pendulum through its
 motion law) is not implemented yet.
 
@@ -82,6 +83,10 @@ CONSTRAINT_KINDS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "torque
 #: Central-difference steps in the state: joint positions [rad | m], speeds, accelerations,
 #: time [s].
 _H = 1e-6
+
+#: Samples farther than ``influence + _NEAR`` [m] from every obstacle get no distance
+#: derivative (their clipped distance stays at ``influence`` under a step of ``_H``).
+_NEAR = 1e-3
 
 
 @dataclass(frozen=True)
@@ -235,24 +240,29 @@ def _torque(problem: Any, x: np.ndarray):
 
 
 def _distance(problem: Any, x: np.ndarray):
-    """Distance rows at the problem's samples, one per sample and obstacle."""
+    """Distance rows at the problem's samples, one per sample and obstacle. The state
+    derivatives are taken only at the samples closer than ``influence + _NEAR`` to some
+    obstacle (elsewhere the clipped distance is constant: zero gradient)."""
     traj, st, checker = problem.trajectory, problem.settings, problem.checker
     s = problem.s
     smp = traj.sample(x, s, orders=(0,))
     q, t = smp.q, smp.t  # (pop, n_s, nq), (pop, n_s)
     nq = traj.nq
-    # Base state, then ± each joint, then ± time: (pop, 2 nq + 3, n_s, ·)
-    dq = np.concatenate([np.zeros((1, nq)), _H * np.eye(nq), -_H * np.eye(nq), np.zeros((2, nq))])
-    dt = np.concatenate([np.zeros(2 * nq + 1), [_H, -_H]])
-    qs = q[:, None] + dq[None, :, None, :]
-    ts = t[:, None] + dt[None, :, None]
-    d = checker.distances(qs, ts).distance.min(axis=-2)  # (pop, 2nq+3, n_s, n_obs)
-    d = np.minimum(d, st.influence)
-    d0 = d[:, 0]
-    grad_q = np.moveaxis((d[:, 1 : nq + 1] - d[:, nq + 1 : 2 * nq + 1]) / (2 * _H), 1, -1)
-    grad_t = (d[:, -2] - d[:, -1]) / (2 * _H)  # (pop, n_s, n_obs)
+    d0 = np.minimum(checker.distances(q, t).distance.min(axis=-2), st.influence)
     pop, n_s, n_obs = d0.shape
-    # (pop, n_s, n_obs, nq) -> rows per (sample, obstacle)
+    grad_q = np.zeros((pop, n_s, n_obs, nq))
+    grad_t = np.zeros((pop, n_s, n_obs))
+    near = np.flatnonzero((d0 < st.influence + _NEAR).any(axis=-1).ravel())
+    if len(near):
+        # ± each joint, then ± time: (n_near, 2 nq + 2, ·)
+        dq = np.concatenate([_H * np.eye(nq), -_H * np.eye(nq), np.zeros((2, nq))])
+        dt = np.concatenate([np.zeros(2 * nq), [_H, -_H]])
+        qs = q.reshape(-1, nq)[near][:, None, :] + dq
+        ts = t.reshape(-1)[near][:, None] + dt
+        d = np.minimum(checker.distances(qs, ts).distance.min(axis=-2), st.influence)
+        g_q = np.moveaxis((d[:, :nq] - d[:, nq : 2 * nq]) / (2 * _H), 1, -1)
+        grad_q.reshape(-1, n_obs, nq)[near] = g_q
+        grad_t.reshape(-1, n_obs)[near] = (d[:, -2] - d[:, -1]) / (2 * _H)
     d_free = _chain(grad_q, _free_basis(traj, s, 0))  # (pop, n_s, n_obs, nq·n_free)
     d_T = grad_t * s[None, :, None]
     jac = -np.concatenate([d_T[..., None], d_free], axis=-1) / st.influence
