@@ -54,10 +54,10 @@ from adept_traj.optimise.sampling import (
 )
 
 __all__ = [
-    "TIME_OPTIMAL",
     "ALGORITHMS",
     "BLOCK_PAIRS",
     "CHECKPOINT_VERSION",
+    "TIME_OPTIMAL",
     "AlgorithmSettings",
     "BlockedDuplicateElimination",
     "FastEndSearch",

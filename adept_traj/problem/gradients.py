@@ -55,9 +55,9 @@ all samples at once, never through the decision vector): :math:`\partial u/\part
 \dot q, \ddot q)` of the inverse dynamics (step ``1e-6``; the Coulomb term's derivative is
 0 away from rest and is left out exactly) and :math:`\partial d/\partial(q, t)` of the
 distances (step ``1e-6``; coal's GJK tolerance is 1e-9 m; only at samples within
-``influence`` + 1 mm of an obstacle, the others have a zero gradient). The analytic distance gradient
-(coal's nearest points and normal through the frame Jacobians, the pendulum through its
-motion law) is not implemented yet.
+``influence`` + 1 mm of an obstacle, the others have a zero gradient). The analytic
+distance gradient (coal's nearest points and normal through the frame Jacobians, the
+pendulum through its motion law) is not implemented yet.
 
 Between the velocity samples the speed can exceed its sample maximum a little; the local
 solver therefore finishes by raising T to the spline's exact kinematic minimum
