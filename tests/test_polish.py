@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from adept_traj import TrajectoryProblem
+from adept_traj import TrajectoryProblem, plan
 from adept_traj.analysis import certify
 from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.optimise import RampSampling, minimum_time, time_optimal
@@ -89,3 +89,37 @@ def test_minimum_time_from_the_straight_move_reaches_drakes_optimum(problem) -> 
     assert first.feasible
     assert problem.lower_bound.T_min <= first.x[0] <= 1.001 * DRAKE_T
     assert certify(problem, first.x, rate_hz=1000.0).certified
+
+
+@pytest.fixture(scope="module")
+def small_runs(problem: TrajectoryProblem):
+    """The same small NSGA-II run without and with polish."""
+    options = {"seed": 1, "pop_size": 16, "n_gen": 4}
+    return plan(problem, "nsga2", polish=False, **options), plan(problem, "nsga2", **options)
+
+
+def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
+    """The polished run's front holds minimum_time of the unpolished run's fastest feasible
+    member (same seed: same population), certified, faster than every unpolished member;
+    its evaluations are the run's plus the solver's."""
+    raw, polished = small_runs
+    ok = np.flatnonzero(np.all(raw.front.constraints <= 0.0, axis=1))
+    start = raw.front.x[ok[np.argmin(raw.front.x[ok, 0])]]
+    expected = minimum_time(problem, start, max_iter=30)
+    rows = np.flatnonzero(np.all(polished.front.x == expected.x, axis=1))
+    assert len(rows) == 1
+    assert polished.front.feasible[rows[0]]
+    assert expected.x[0] < raw.front.x[:, 0].min()
+    assert expected.x[0] == polished.front.x[:, 0].min()
+    assert polished.timing.n_evaluations == raw.timing.n_evaluations + expected.n_evaluations
+    assert polished.algorithm_settings["polish"] is True
+    assert raw.algorithm_settings["polish"] is False
+
+
+def test_time_optimal_mode_gives_a_certified_result(problem) -> None:
+    result = plan(problem, "time-optimal", seed=1, n_starts=2)
+    assert result.algorithm == "time-optimal"
+    assert result.feasible
+    assert result.front.n_certified == len(result.front.x)
+    assert result.front.x[:, 0].min() <= 1.001 * DRAKE_T
+    assert result.timing.n_generations == 0

@@ -1,8 +1,9 @@
 r"""The polish steps of :func:`~adept_traj.plan`: after the search, and instead of it.
 
 :func:`polish_fastest` takes a run's final population (a
-:class:`~adept_traj.optimise.RunState`), polishes its fastest feasible member (or, when no
-member is feasible, the least infeasible one) by :func:`~adept_traj.optimise.minimum_time`,
+:class:`~adept_traj.optimise.RunState`), polishes its fastest feasible member (none when
+no member is feasible: the result then stays the least-infeasible front) by
+:func:`~adept_traj.optimise.minimum_time`,
 and adds the polished move to the population when it passes its certificate (the
 certificate decides, not the solver) and is faster than its start. The front is taken from
 the population afterwards, so the polished move replaces the members it dominates. Its wall
@@ -34,8 +35,9 @@ __all__ = ["TIME_OPTIMAL", "polish_fastest", "time_optimal_run"]
 #: The name of the single-objective mode of :func:`~adept_traj.plan`.
 TIME_OPTIMAL = "time-optimal"
 
-#: SLSQP iterations of the polish (a start near an optimum converges in 3–10).
-_POLISH_ITERATIONS = 50
+#: SLSQP iterations of the polish (a start near an optimum converges in 3–10; from a slow
+#: detour SLSQP may not converge at all).
+_POLISH_ITERATIONS = 30
 
 
 def polish_fastest(
@@ -56,14 +58,10 @@ def polish_fastest(
         Rate [Hz] of that certificate.
     """
     X = np.asarray(state.X, dtype=float)
-    if len(X) == 0:
+    feasible = np.flatnonzero(np.all(np.asarray(state.G) <= 0.0, axis=1))
+    if len(feasible) == 0:
         return state
-    G = np.asarray(state.G, dtype=float)
-    feasible = np.flatnonzero(np.all(G <= 0.0, axis=1))
-    if len(feasible):
-        start = feasible[np.argmin(X[feasible, 0])]
-    else:
-        start = int(np.argmin(np.maximum(G, 0.0).sum(axis=1)))
+    start = feasible[np.argmin(X[feasible, 0])]
     outcome = minimum_time(problem, X[start], max_iter=_POLISH_ITERATIONS)
     tic = time.perf_counter()
     keep = (
