@@ -15,7 +15,8 @@ Run: ``python benchmarks/bench_polish.py [--seeds 1,2,3,4,5] [--algorithms nsga2
    SLSQP from the unpolished run's fastest feasible member, as ``plan`` does it, plus its
    certificate; the two runs' totals differ by machine noise as much as by the polish).
    Targets: fastest certified T ≤ 1.005 × T_lb, HV(polished) ≥ HV(unpolished) on every
-   seed, polish ≤ 25 % of the run. This part takes minutes (≈ 2 × 16 s per NSGA-II seed, ≈ 2 × 60 s per MODE).
+   seed, polish ≤ 25 % of the run. This part takes minutes (≈ 2 × 16 s per NSGA-II seed,
+   ≈ 2 × 60 s per MODE).
 """
 
 from __future__ import annotations
