@@ -77,6 +77,10 @@ def test_bad_input_is_refused(problem) -> None:
         local_constraints(problem, problem.xl, points_per_segment=0)
     with pytest.raises(ConfigurationError, match="inside the decision bounds"):
         minimum_time(problem, problem.xu + 1.0)
+    with pytest.raises(ConfigurationError, match="n_starts and max_iter"):
+        plan(problem, "time-optimal", pop_size_typo=3)
+    with pytest.raises(ConfigurationError, match="n_starts"):
+        plan(problem, "time-optimal", n_starts=0)
 
 
 def test_minimum_time_from_the_straight_move_reaches_drakes_optimum(problem) -> None:

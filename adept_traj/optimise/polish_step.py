@@ -81,13 +81,20 @@ def polish_fastest(
     return _with_members(counted, [outcome])
 
 
-def time_optimal_run(
-    problem: Any, seed: int, *, n_starts: int = 3, max_iter: int = _POLISH_ITERATIONS
-) -> tuple[RunState, dict[str, Any]]:
+def time_optimal_run(problem: Any, seed: int, **params: Any) -> tuple[RunState, dict[str, Any]]:
     """The population of ``plan(problem, algorithm="time-optimal")`` and its settings: the
     moves of :func:`~adept_traj.optimise.time_optimal` from ``n_starts`` starts (≥ 1)
     with at most ``max_iter`` SLSQP iterations each (≥ 1). A move equal to an earlier one
-    (every entry within 1e-9 of it) is left out."""
+    (every entry within 1e-9 of it) is left out. ``params``: ``n_starts`` (default 3) and
+    ``max_iter`` (default 30); any other name is refused (:class:`ConfigurationError`)."""
+    unknown = sorted(set(params) - {"n_starts", "max_iter"})
+    if unknown:
+        raise ConfigurationError(
+            f"unknown parameter(s) {unknown} of algorithm {TIME_OPTIMAL!r}: it takes n_starts "
+            "and max_iter"
+        )
+    n_starts = params.get("n_starts", 3)
+    max_iter = params.get("max_iter", _POLISH_ITERATIONS)
     started = time.perf_counter()
     outcomes = time_optimal(problem, seed, n_starts=n_starts, max_iter=max_iter)
     empty = RunState(
