@@ -144,7 +144,10 @@ def test_show_serves_on_localhost_and_stops_on_ctrl_c(tmp_path: Path) -> None:
     import signal
 
     out = tmp_path / "run"
-    assert main(["plan", "--pop", "8", "--gens", "2", "--out", str(out), "--quiet"]) == 0
+    assert (
+        main(["plan", "--pop", "8", "--gens", "2", "--no-polish", "--out", str(out), "--quiet"])
+        == 0
+    )
     assert (out / "playback.html").is_file()  # plan writes the static playback page
     proc = subprocess.Popen(
         [sys.executable, "-m", "adept_traj.cli", "show", str(out)],
@@ -267,7 +270,7 @@ def test_quiet_reports_nothing() -> None:
 def test_plan_progress_in_a_log_has_no_carriage_returns(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    argv = ["plan", "--pop", "8", "--gens", "3", "--no-html", "--no-plots"]
+    argv = ["plan", "--pop", "8", "--gens", "3", "--no-html", "--no-plots", "--no-polish"]
     assert main([*argv, "--out", str(tmp_path / "log")]) == 0
     err = capsys.readouterr().err
     assert "\r" not in err
@@ -293,7 +296,7 @@ shape = "box"
 min = [0.0, -1.0, -1.0]
 max = [1.2, 2.0, 1.0]
 """
-_TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quiet"]
+_TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quiet", "--no-polish"]
 
 
 def test_plan_exports_an_uncertified_trajectory_only_when_allowed(

@@ -17,7 +17,7 @@ from adept_traj.errors import InvalidInputError
 from adept_traj.results import Front, PlanningResult, Replay, to_ros_joint_trajectory
 
 OLD = Path(__file__).parent / "data" / "result_v1"
-_TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quiet"]
+_TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quiet", "--no-polish"]
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
     ("script", "args", "expect"),
     [
         ("robot_dynamics.py", [], "kinematic lower bound on T: 1.073 s"),
-        ("plan_paper.py", ["--gens", "2", "--small"], "mode: 32 evaluations"),
+        ("plan_paper.py", ["--gens", "2", "--small"], "mode: 39 evaluations"),
         ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
         ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
     ],

@@ -16,11 +16,11 @@ from adept_traj.results import NO_FEASIBLE_WARNING
 
 @pytest.fixture(scope="module")
 def small_run(problem: at.TrajectoryProblem) -> at.PlanningResult:
-    return at.plan(problem, "nsga2", seed=2, pop_size=40, n_gen=25)
+    return at.plan(problem, "nsga2", seed=2, pop_size=40, n_gen=25, polish=False)
 
 
 def test_same_seed_same_front(problem: at.TrajectoryProblem, small_run) -> None:
-    again = at.plan(problem, "nsga2", seed=2, pop_size=40, n_gen=25)
+    again = at.plan(problem, "nsga2", seed=2, pop_size=40, n_gen=25, polish=False)
     np.testing.assert_array_equal(again.front.x, small_run.front.x)
     np.testing.assert_array_equal(again.front.objectives, small_run.front.objectives)
     assert again.best.index == small_run.best.index

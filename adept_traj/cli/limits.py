@@ -13,7 +13,7 @@ allows); the table of limits is in ``docs/cli.md``.
 from __future__ import annotations
 
 from adept_traj.analysis import check_certificate_memory
-from adept_traj.optimise import check_population_memory, make_algorithm
+from adept_traj.optimise import TIME_OPTIMAL, check_population_memory, make_algorithm
 from adept_traj.problem import TrajectoryProblem
 
 __all__ = ["check_run_options"]
@@ -46,9 +46,11 @@ def check_run_options(
         The population (``pop_option``), the generations (``gens_option``) or the rate
         (``--rate``) would need more memory than the budget.
     """
-    _, settings = make_algorithm(algorithm, pop, gens)
-    run = check_population_memory(
-        settings.pop_size, settings.n_gen, options=(pop_option, gens_option)
-    )
+    run = 0
+    if algorithm != TIME_OPTIMAL:  # no population
+        _, settings = make_algorithm(algorithm, pop, gens)
+        run = check_population_memory(
+            settings.pop_size, settings.n_gen, options=(pop_option, gens_option)
+        )
     certificate = check_certificate_memory(problem, rate_hz, option="--rate")
     return max(run, certificate)

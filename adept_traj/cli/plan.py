@@ -46,6 +46,7 @@ from adept_traj.cli.report import save_figures, summary
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
     ALGORITHMS,
+    TIME_OPTIMAL,
     PlanningInterrupted,
     has_checkpoint,
     make_algorithm,
@@ -61,7 +62,7 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
-    "workers", "no_html", "no_plots", "ros", "allow_infeasible",
+    "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
@@ -72,7 +73,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("plan", help="plan a trajectory and save a verified result")
     add_problem_arguments(p)
     p.add_argument(
-        "--algorithm", default="nsga2", help=f"one of {', '.join(ALGORITHMS)} (default nsga2)"
+        "--algorithm",
+        default="nsga2",
+        help=f"one of {', '.join(ALGORITHMS)} (default nsga2), or {TIME_OPTIMAL} (one "
+        "fastest move by multi-start SLSQP, no evolutionary search)",
+    )
+    p.add_argument(
+        "--no-polish",
+        action="store_true",
+        help="do not polish the fastest member by SLSQP after the evolutionary search",
     )
     p.add_argument("--pop", type=int, help="population size (default: the paper's)")
     p.add_argument("--gens", type=int, help="generations (default: the paper's, 100)")
@@ -201,7 +210,8 @@ def run(args: argparse.Namespace) -> int:
             folder, overwrite=args.overwrite, html=not opts.no_html, figures=not opts.no_plots
         )
     as_integer(opts.seed, "--seed", minimum=0, error=ConfigurationError)
-    make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
+    if opts.algorithm != TIME_OPTIMAL:
+        make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
     problem = problem_from_arguments(opts)
     try:
         # memory of the population and of the dense certificate, before anything is written
@@ -233,6 +243,7 @@ def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, res
                 resume=resume and has_checkpoint(checkpoint),
                 progress=progress,
                 rate_hz=opts.rate,
+                polish=not opts.no_polish,
             )
         return _finish(result, problem, folder, opts)
     except PlanningInterrupted as exc:

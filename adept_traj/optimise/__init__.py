@@ -1,7 +1,7 @@
 """The optimiser.
 
-Algorithms, sampling, repair, fast-end search, the generation loop, its checkpoints and
-:func:`plan`."""
+Algorithms, sampling, repair, fast-end search, the generation loop, its checkpoints, gradient-based
+polishing (``polish``) and :func:`plan`."""
 
 from __future__ import annotations
 
@@ -33,6 +33,16 @@ from adept_traj.optimise.loop import (
 from adept_traj.optimise.planner import (
     plan,
 )
+from adept_traj.optimise.polish import (
+    PolishOutcome,
+    minimum_time,
+    time_optimal,
+)
+from adept_traj.optimise.polish_step import (
+    TIME_OPTIMAL,
+    polish_fastest,
+    time_optimal_run,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -47,12 +57,14 @@ __all__ = [
     "ALGORITHMS",
     "BLOCK_PAIRS",
     "CHECKPOINT_VERSION",
+    "TIME_OPTIMAL",
     "AlgorithmSettings",
     "BlockedDuplicateElimination",
     "FastEndSearch",
     "GenerationInfo",
     "KinematicTimeRepair",
     "PlanningInterrupted",
+    "PolishOutcome",
     "RampSampling",
     "RunState",
     "check_population_memory",
@@ -60,9 +72,13 @@ __all__ = [
     "kinematic_time",
     "load_checkpoint",
     "make_algorithm",
+    "minimum_time",
     "optimise",
     "plan",
+    "polish_fastest",
     "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
+    "time_optimal",
+    "time_optimal_run",
 ]

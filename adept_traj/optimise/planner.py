@@ -17,7 +17,12 @@ Steps:
    trade-off order (the best trade-off when it passes), with its exact certificate; if
    none passes, the trade-off choice with its failing certificate. A front of
    least-infeasible members thus costs one certificate.
-5. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
+5. **Polish** (default; before steps 2–4): the fastest feasible member of the final
+   population is polished by SLSQP (:func:`~adept_traj.optimise.polish_fastest`); a
+   polished move that passes its certificate joins the population, so it replaces the
+   members it dominates in the front. ``algorithm="time-optimal"`` replaces step 1 and this
+   one by :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
+6. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
 """
@@ -49,6 +54,7 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.loop import GenerationInfo, optimise
+from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_fastest, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
@@ -60,7 +66,7 @@ from adept_traj.results.record import (
     PlanningResult,
     Timing,
 )
-from adept_traj.validation import as_integer
+from adept_traj.validation import as_integer, check_type
 
 __all__ = ["plan"]
 
@@ -170,9 +176,11 @@ def plan(
     progress: Callable[[GenerationInfo], None] | None = None,
     rate_hz: float = 1000.0,
     max_certify: int | None = None,
+    polish: bool = True,
     **params: Any,
 ) -> PlanningResult:
-    """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name).
+    """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name), or find one
+    fastest move by gradient-based local search (``"time-optimal"``).
 
     Parameters
     ----------
@@ -186,6 +194,13 @@ def plan(
     max_certify: most front members certified (in the trade-off order, among those the
         optimiser marked feasible; ``None``: all). A member not certified is reported with
         ``feasible = False``.
+    polish: after the evolutionary search, polish its fastest feasible member by SLSQP
+        (:func:`~adept_traj.optimise.polish_fastest`; its time and evaluations are counted
+        in ``result.timing``). Default True; ignored by ``"time-optimal"``.
+
+    With ``algorithm="time-optimal"`` the parameters ``pop_size``, ``n_gen``,
+    ``checkpoint``, ``resume`` and ``progress`` are not used; ``params`` may give
+    ``n_starts`` and ``max_iter`` (:func:`~adept_traj.optimise.time_optimal_run`).
 
     Returns
     -------
@@ -197,18 +212,27 @@ def plan(
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
-    alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
-    check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
-    state = optimise(
-        problem,
-        alg,
-        settings.n_gen,
-        seed,
-        checkpoint=checkpoint,
-        resume=resume,
-        fingerprint=_fingerprint(problem, settings, seed),
-        progress=progress,
-    )
+    check_type(polish, bool, "polish")
+    if algorithm == TIME_OPTIMAL:
+        state, settings_dict = time_optimal_run(problem, seed, **params)
+        name = TIME_OPTIMAL
+    else:
+        alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
+        check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
+        state = optimise(
+            problem,
+            alg,
+            settings.n_gen,
+            seed,
+            checkpoint=checkpoint,
+            resume=resume,
+            fingerprint=_fingerprint(problem, settings, seed),
+            progress=progress,
+        )
+        settings_dict = {**settings.to_dict(), "polish": polish}
+        name = settings.name
+        if polish:
+            state = polish_fastest(problem, state, rate_hz)
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)
@@ -251,8 +275,8 @@ def plan(
     )
     return PlanningResult.from_problem(
         problem,
-        algorithm=settings.name,
-        algorithm_settings=settings.to_dict(),
+        algorithm=name,
+        algorithm_settings=settings_dict,
         seed=seed,
         front=front,
         best=BestSolution(

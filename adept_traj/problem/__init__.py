@@ -2,7 +2,8 @@
 
 The B-spline trajectory (``bspline``; its per-segment arithmetic in ``spline_segments``),
 the kinematic lower bound of the travel time (``time_bound``), the objective table, pymoo's
-sign convention and the paper's penalty (``objectives``), :class:`TrajectoryProblem`
+sign convention and the paper's penalty (``objectives``), smooth per-sample constraints
+with their Jacobians for local solvers (``gradients``), :class:`TrajectoryProblem`
 (``trajectory_problem``) with its :class:`Evaluation` (``evaluation``), its parallel
 evaluator (``evaluator``) and its plain-loop reference (``reference``).
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator
+from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, local_constraints
 from adept_traj.problem.objectives import (
     MAXIMISED,
     OBJECTIVE_NAMES,
@@ -30,12 +32,14 @@ from adept_traj.problem.time_bound import KinematicBound, kinematic_lower_bound
 from adept_traj.problem.trajectory_problem import ProblemSettings, TrajectoryProblem
 
 __all__ = [
+    "CONSTRAINT_KINDS",
     "MAXIMISED",
     "OBJECTIVES",
     "OBJECTIVE_NAMES",
     "BSplineTrajectory",
     "Evaluation",
     "KinematicBound",
+    "LocalConstraints",
     "Objective",
     "ParallelEvaluator",
     "ProblemSettings",
@@ -45,6 +49,7 @@ __all__ = [
     "TrajectorySamples",
     "from_pymoo",
     "kinematic_lower_bound",
+    "local_constraints",
     "paper_penalty",
     "to_pymoo",
 ]
