@@ -4,12 +4,27 @@
 Pinocchio model with its collision and visual geometry (solids named ``<link>/<name>``), and a
 parameter file's values (limits [rad | m, rad/s | m/s, …], friction, rotor inertia) are
 written into the model and its :class:`~adept_traj.robot.limits.JointLimits`.
+
+Joint kinds beyond 1-DoF revolute and prismatic joints:
+
+- **continuous** joints become revolute joints with **one angle coordinate** [rad] (not
+  Pinocchio's (cos θ, sin θ) pair) and the planning range
+  ``[-CONTINUOUS_RANGE, CONTINUOUS_RANGE]`` = [−2π, 2π] (two turns: every angle is
+  reachable from every start without a joint stop in the way; a parameter file's
+  ``lower``/``upper`` narrow or widen it);
+- **mimic** joints follow their leader (Pinocchio's own mimic support,
+  ``q_follower = multiplier · q_leader + offset``): they have no coordinate of their own
+  (the Panda plans with 8 coordinates, not 9);
+- **locked** joints (``locked_joints={name: value}``) are removed from the model with
+  Pinocchio's ``buildReducedModel``, fixed at the given value [rad | m].
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Mapping
 from importlib import resources
 from pathlib import Path
 
@@ -18,9 +33,19 @@ import pinocchio as pin
 
 from adept_traj.errors import RobotModelError
 from adept_traj.robot.limits import JointLimits
+from adept_traj.robot.package_paths import resolve_package_uris
 from adept_traj.robot.parameter_file import RobotParameters
 
-__all__ = ["apply_parameters", "load_urdf_models", "shipped_file"]
+__all__ = [
+    "CONTINUOUS_RANGE",
+    "apply_parameters",
+    "coordinate_joints",
+    "load_urdf_models",
+    "shipped_file",
+]
+
+#: Half-width [rad] of the planning range given to a continuous joint: [−2π, 2π].
+CONTINUOUS_RANGE = 2.0 * math.pi
 
 
 def shipped_file(name: str) -> Path:
@@ -42,12 +67,19 @@ def shipped_file(name: str) -> Path:
     )
 
 
-def load_urdf_models(path: Path) -> tuple[str, pin.Model, pin.GeometryModel, pin.GeometryModel]:
-    """``(name, model, collision model, visual model)`` of the URDF at ``path``.
+def load_urdf_models(
+    path: Path,
+    package_dirs: Iterable[str | Path] = (),
+    locked_joints: Mapping[str, float] | None = None,
+) -> tuple[str, pin.Model, pin.GeometryModel, pin.GeometryModel, tuple[Path, ...]]:
+    """``(name, model, collision model, visual model, package folders used)`` of the URDF at
+    ``path`` (see the module docstring for continuous, mimic and locked joints; the package
+    folders are those of :func:`~adept_traj.robot.package_paths.resolve_package_uris`).
 
     Raises :class:`~adept_traj.errors.RobotModelError` for a missing file, malformed XML, a
-    root element other than ``<robot>``, a URDF Pinocchio cannot load, or a robot without a
-    moving joint.
+    root element other than ``<robot>``, a ``package://`` mesh not found, a URDF Pinocchio
+    cannot load, a locked joint that is not a joint with a coordinate (or a value that is
+    not a finite number), or a robot without a moving joint.
     """
     if not path.is_file():
         raise RobotModelError(f"URDF not found: {path}")
@@ -57,17 +89,74 @@ def load_urdf_models(path: Path) -> tuple[str, pin.Model, pin.GeometryModel, pin
         raise RobotModelError(f"{path}: malformed XML: {exc}") from None
     if root.tag != "robot":
         raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
+    dirs = resolve_package_uris(root, path, package_dirs)
     try:
-        model = pin.buildModelFromUrdf(str(path))
-        collision = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION)
-        visual = pin.buildGeomFromUrdf(model, str(path), pin.VISUAL)
+        model = pin.buildModelFromXML(_continuous_as_revolute(root), mimic=True)
+        collision = pin.buildGeomFromUrdf(
+            model, str(path), pin.COLLISION, package_dirs=[str(d) for d in dirs]
+        )
+        visual = pin.buildGeomFromUrdf(
+            model, str(path), pin.VISUAL, package_dirs=[str(d) for d in dirs]
+        )
     except (RuntimeError, ValueError) as exc:
         raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
+    if locked_joints:
+        model, collision, visual = _lock(model, collision, visual, locked_joints, path)
     if model.nq == 0:
         raise RobotModelError(f"{path}: the robot has no moving joint")
     _name_geometries(collision, root, "collision")
     _name_geometries(visual, root, "visual")
-    return root.get("name", path.stem), model, collision, visual
+    return root.get("name", path.stem), model, collision, visual, dirs
+
+
+def coordinate_joints(model: pin.Model) -> tuple[str, ...]:
+    """Names of the joints that own a coordinate of q, in the order of q (mimic joints,
+    which follow a leader, are left out)."""
+    return tuple(model.names[i] for i in range(1, model.njoints) if model.joints[i].nq > 0)
+
+
+def _continuous_as_revolute(root: ET.Element) -> str:
+    """The URDF text with every continuous joint made revolute over
+    [−CONTINUOUS_RANGE, CONTINUOUS_RANGE] (a copy; ``root`` is not changed)."""
+    root = ET.fromstring(ET.tostring(root))
+    for joint in root.iter("joint"):
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
+        limit.set("lower", repr(-CONTINUOUS_RANGE))
+        limit.set("upper", repr(CONTINUOUS_RANGE))
+    return ET.tostring(root, encoding="unicode")
+
+
+def _lock(
+    model: pin.Model,
+    collision: pin.GeometryModel,
+    visual: pin.GeometryModel,
+    locked: Mapping[str, float],
+    path: Path,
+) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
+    """The model and geometry with the ``locked`` joints fixed at their values."""
+    names = coordinate_joints(model)
+    q_ref = pin.neutral(model)
+    ids = []
+    for name, value in locked.items():
+        if name not in names:
+            raise RobotModelError(
+                f"{path}: locked joint {name!r} is not a joint with a coordinate; "
+                f"those are {list(names)}"
+            )
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise RobotModelError(
+                f"{path}: locked joint {name!r} needs a finite value [rad | m]; got {value!r}"
+            )
+        joint_id = model.getJointId(name)
+        q_ref[model.joints[joint_id].idx_q] = float(value)
+        ids.append(joint_id)
+    reduced, (collision, visual) = pin.buildReducedModel(model, [collision, visual], ids, q_ref)
+    return reduced, collision, visual
 
 
 def apply_parameters(model: pin.Model, params: RobotParameters | None, path: Path) -> JointLimits:
@@ -78,8 +167,8 @@ def apply_parameters(model: pin.Model, params: RobotParameters | None, path: Pat
     error messages."""
     acceleration, jerk = _write_parameters(model, params, path)
     return JointLimits(
-        names=tuple(model.names[1:]),
-        units=tuple(_joint_unit(model, i) for i in range(1, model.njoints)),
+        names=coordinate_joints(model),
+        units=tuple(_joint_unit(model, model.getJointId(n)) for n in coordinate_joints(model)),
         lower=model.lowerPositionLimit,
         upper=model.upperPositionLimit,
         velocity=model.velocityLimit,
@@ -114,7 +203,7 @@ def _write_parameters(
     jerk = np.full(model.nq, np.inf)
     if params is None:
         return acceleration, jerk
-    known = set(model.names[1:])
+    known = set(coordinate_joints(model))
     unknown = [j.name for j in params.joints if j.name not in known]
     if unknown:
         raise RobotModelError(
