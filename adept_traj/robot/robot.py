@@ -14,7 +14,7 @@ AdeptOne XL they are exactly the DH variables (θ1, θ2, d3, θ4) of the paper's
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +60,8 @@ class Robot:
     collision_model : pinocchio.GeometryModel
         The link solids, named ``"<link>/<solid>"`` when the URDF names its collisions.
     visual_model : pinocchio.GeometryModel
-        The visual geometry (same solids for the AdeptOne XL), for display.
+        The visual geometry (same solids for the AdeptOne XL), for display (given, or read
+        on first access by a loader given instead).
     limits : JointLimits
         Position, velocity, acceleration, jerk and torque limits (``inf`` when unknown).
     tool_frame : str
@@ -81,7 +82,7 @@ class Robot:
         self,
         model: pin.Model,
         collision_model: pin.GeometryModel,
-        visual_model: pin.GeometryModel,
+        visual_model: pin.GeometryModel | Callable[[], pin.GeometryModel],
         limits: JointLimits,
         tool_frame: str,
         task_rows: tuple[str, ...] | None,
@@ -95,7 +96,7 @@ class Robot:
     ) -> None:
         self.model = model
         self.collision_model = collision_model
-        self.visual_model = visual_model
+        self._visual_model = visual_model
         self.limits = limits
         self.name = name
         self.urdf_path = urdf_path
@@ -203,6 +204,13 @@ class Robot:
         )
 
     # ------------------------------------------------------------------ basic facts
+    @property
+    def visual_model(self) -> pin.GeometryModel:
+        """The visual geometry (read on first access when a loader was given)."""
+        if callable(self._visual_model):
+            self._visual_model = self._visual_model()
+        return self._visual_model
+
     @property
     def tool_frame(self) -> str:
         """Name of the tool frame (fixed at construction; build another Robot to change it)."""

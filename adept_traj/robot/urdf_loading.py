@@ -24,7 +24,7 @@ from __future__ import annotations
 import contextlib
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from importlib import resources
 from pathlib import Path
 
@@ -71,10 +71,12 @@ def load_urdf_models(
     path: Path,
     package_dirs: Iterable[str | Path] = (),
     locked_joints: Mapping[str, float] | None = None,
-) -> tuple[str, pin.Model, pin.GeometryModel, pin.GeometryModel, tuple[Path, ...]]:
-    """``(name, model, collision model, visual model, package folders used)`` of the URDF at
-    ``path`` (see the module docstring for continuous, mimic and locked joints; the package
-    folders are those of :func:`~adept_traj.robot.package_paths.resolve_package_uris`).
+) -> tuple[str, pin.Model, pin.GeometryModel, Callable[[], pin.GeometryModel], tuple[Path, ...]]:
+    """``(name, model, collision model, visual model loader, package folders used)`` of the
+    URDF at ``path`` (see the module docstring for continuous, mimic and locked joints; the
+    package folders are those of
+    :func:`~adept_traj.robot.package_paths.resolve_package_uris`). The visual model is
+    loaded by calling the loader (display only; its meshes can take a second to read).
 
     Raises :class:`~adept_traj.errors.RobotModelError` for a missing file, malformed XML, a
     root element other than ``<robot>``, a ``package://`` mesh not found, a URDF Pinocchio
@@ -91,22 +93,27 @@ def load_urdf_models(
         raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
     dirs = resolve_package_uris(root, path, package_dirs)
     try:
-        model = pin.buildModelFromXML(_continuous_as_revolute(root), mimic=True)
-        collision = pin.buildGeomFromUrdf(
-            model, str(path), pin.COLLISION, package_dirs=[str(d) for d in dirs]
-        )
-        visual = pin.buildGeomFromUrdf(
-            model, str(path), pin.VISUAL, package_dirs=[str(d) for d in dirs]
-        )
+        full = pin.buildModelFromXML(_continuous_as_revolute(root), mimic=True)
     except (RuntimeError, ValueError) as exc:
         raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
-    if locked_joints:
-        model, collision, visual = _lock(model, collision, visual, locked_joints, path)
+    model, lock = full, _lock(full, locked_joints or {}, path)
+
+    def geometry(kind: pin.GeometryType) -> pin.GeometryModel:
+        try:
+            gm = pin.buildGeomFromUrdf(full, str(path), kind, package_dirs=[str(d) for d in dirs])
+        except (RuntimeError, ValueError) as exc:
+            raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
+        if lock is not None:
+            gm = pin.buildReducedModel(full, gm, *lock)[1]
+        _name_geometries(gm, root, "collision" if kind == pin.COLLISION else "visual")
+        return gm
+
+    if lock is not None:
+        model = pin.buildReducedModel(full, *lock)
     if model.nq == 0:
         raise RobotModelError(f"{path}: the robot has no moving joint")
-    _name_geometries(collision, root, "collision")
-    _name_geometries(visual, root, "visual")
-    return root.get("name", path.stem), model, collision, visual, dirs
+    collision = geometry(pin.COLLISION)
+    return root.get("name", path.stem), model, collision, lambda: geometry(pin.VISUAL), dirs
 
 
 def coordinate_joints(model: pin.Model) -> tuple[str, ...]:
@@ -132,13 +139,12 @@ def _continuous_as_revolute(root: ET.Element) -> str:
 
 
 def _lock(
-    model: pin.Model,
-    collision: pin.GeometryModel,
-    visual: pin.GeometryModel,
-    locked: Mapping[str, float],
-    path: Path,
-) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
-    """The model and geometry with the ``locked`` joints fixed at their values."""
+    model: pin.Model, locked: Mapping[str, float], path: Path
+) -> tuple[list[int], np.ndarray] | None:
+    """``(joint ids, reference configuration)`` for ``pinocchio.buildReducedModel`` that fix
+    the ``locked`` joints at their values; ``None`` when there are none."""
+    if not locked:
+        return None
     names = coordinate_joints(model)
     q_ref = pin.neutral(model)
     ids = []
@@ -155,8 +161,7 @@ def _lock(
         joint_id = model.getJointId(name)
         q_ref[model.joints[joint_id].idx_q] = float(value)
         ids.append(joint_id)
-    reduced, (collision, visual) = pin.buildReducedModel(model, [collision, visual], ids, q_ref)
-    return reduced, collision, visual
+    return ids, q_ref
 
 
 def apply_parameters(model: pin.Model, params: RobotParameters | None, path: Path) -> JointLimits:

@@ -1,0 +1,198 @@
+"""Real robots from example-robot-data (UR5, Panda, Kinova Jaco2): package:// meshes,
+continuous and mimic joints, locked joints, the tool frame, sound mesh collision.
+
+References are independent of the code under test: Pinocchio's own models of the same
+URDFs (Pinocchio's RUBZ joints for continuous joints, no mimic), coal against the raw
+meshes, and a ray-parity test for "inside a mesh".
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from adept_traj.collision import CollisionChecker
+from adept_traj.errors import RobotModelError
+from adept_traj.robot import Robot, installed_data_dirs
+from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
+
+ROBOTS = next(
+    (
+        d / "example-robot-data" / "robots"
+        for d in installed_data_dirs()
+        if (d / "example-robot-data" / "robots").is_dir()
+    ),
+    None,
+)
+pytestmark = pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
+UR5 = ROBOTS / "ur_description/urdf/ur5_robot.urdf" if ROBOTS else None
+PANDA = ROBOTS / "panda_description/urdf/panda.urdf" if ROBOTS else None
+JACO = ROBOTS / "kinova_description/robots/kinova.urdf" if ROBOTS else None
+
+
+@pytest.fixture(scope="module")
+def ur5() -> Robot:
+    return Robot.from_urdf(UR5)
+
+
+def _pin_reference(path: Path) -> tuple[pin.Model, pin.GeometryModel]:
+    """Pinocchio's own model of the URDF (continuous joints as RUBZ, mimic joints free)."""
+    share = ROBOTS.parents[1]
+    model = pin.buildModelFromUrdf(str(path))
+    geom = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION, package_dirs=[str(share)])
+    return model, geom
+
+
+def _joint_poses(model: pin.Model, q: np.ndarray) -> np.ndarray:
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    return np.array([m.homogeneous for m in data.oMi])
+
+
+def test_package_meshes_are_found_without_ros_package_path(monkeypatch, ur5: Robot) -> None:
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    robot = Robot.from_urdf(UR5)
+    assert robot.package_dirs == (ROBOTS.parents[1].resolve(),)
+    assert robot.nq == 6
+    assert len(robot.mesh_hulls) == 7  # seven link meshes (and a box)
+
+
+def test_a_missing_package_mesh_names_the_folders_searched(tmp_path: Path) -> None:
+    text = UR5.read_text().replace("package://example-robot-data/", "package://no-such-pkg/")
+    path = tmp_path / "ur5.urdf"
+    path.write_text(text)
+    with pytest.raises(RobotModelError, match=r"no-such-pkg.*not found in the package folders"):
+        Robot.from_urdf(path)
+    (tmp_path / "no-such-pkg").symlink_to(ROBOTS.parent)  # the package, found by package_dirs
+    robot = Robot.from_urdf(path, package_dirs=[tmp_path])
+    assert robot.package_dirs == (tmp_path.resolve(),)
+
+
+def test_continuous_joints_have_one_angle_coordinate() -> None:
+    robot = Robot.from_urdf(JACO)
+    reference, _ = _pin_reference(JACO)
+    assert (robot.nq, reference.nq) == (6, 9)  # three continuous joints: (cos, sin) in Pinocchio
+    continuous = [reference.joints[i].nq == 2 for i in range(1, reference.njoints)]
+    assert np.array_equal(robot.limits.upper[continuous], np.full(3, 2 * np.pi))
+    assert np.array_equal(robot.limits.lower[continuous], np.full(3, -2 * np.pi))
+    rng = np.random.default_rng(3)
+    q = rng.uniform(np.maximum(robot.limits.lower, -7), np.minimum(robot.limits.upper, 7), (20, 6))
+    poses = robot.kinematics.joint_poses(q)
+    for k in range(len(q)):
+        q_ref = np.concatenate(
+            [[np.cos(v), np.sin(v)] if c else [v] for v, c in zip(q[k], continuous)]
+        )
+        np.testing.assert_allclose(poses[k], _joint_poses(reference, q_ref), atol=1e-12)
+
+
+def test_mimic_fingers_follow_their_leader() -> None:
+    robot = Robot.from_urdf(PANDA)
+    reference, _ = _pin_reference(PANDA)
+    assert (robot.nq, reference.nq) == (8, 9)
+    assert robot.joint_names[-1] == "panda_finger_joint1"
+    rng = np.random.default_rng(4)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, (20, 8))
+    poses = robot.kinematics.joint_poses(q)
+    for k in range(len(q)):
+        q_ref = np.concatenate([q[k], q[k, -1:]])  # finger 2 mimics finger 1 (multiplier 1)
+        np.testing.assert_allclose(poses[k], _joint_poses(reference, q_ref), atol=1e-12)
+    # The Jacobian sums a mimic's motion into its leader's column: central differences of
+    # the right finger (moved by the mimic joint only) against it.
+    finger = Robot.from_urdf(PANDA, tool_frame="panda_rightfinger")
+    eps = 1e-6
+    dq = np.zeros(8)
+    dq[-1] = eps
+    moved = finger.tool_pose(q + dq)[:, :3, 3] - finger.tool_pose(q - dq)[:, :3, 3]
+    column = finger.tool_jacobian(q)[:, :3, -1]
+    np.testing.assert_allclose(column, moved / (2 * eps), atol=1e-8)
+    assert np.linalg.norm(column, axis=1).min() > 0.99  # a prismatic finger: unit speed
+
+
+def test_locked_joints_are_fixed_at_their_value(ur5: Robot) -> None:
+    robot = Robot.from_urdf(UR5, locked_joints={"wrist_3_joint": 0.3})
+    assert robot.nq == 5
+    assert "wrist_3_joint" not in robot.joint_names
+    q = np.random.default_rng(5).uniform(-2, 2, (10, 5))
+    full = np.concatenate([q, np.full((10, 1), 0.3)], axis=1)
+    np.testing.assert_allclose(robot.tool_pose(q), ur5.tool_pose(full), atol=1e-12)
+    with pytest.raises(RobotModelError, match=r"locked joint 'nope'.*shoulder_pan_joint"):
+        Robot.from_urdf(UR5, locked_joints={"nope": 0.0})
+
+
+def test_an_unknown_tool_frame_lists_the_frames() -> None:
+    with pytest.raises(RobotModelError, match=r"no frame 'tcp'.*'tool0'"):
+        Robot.from_urdf(UR5, tool_frame="tcp")
+    assert Robot.from_urdf(UR5, tool_frame="wrist_2_link").tool_frame == "wrist_2_link"
+
+
+def _inside(point: np.ndarray, triangles: np.ndarray, direction: np.ndarray) -> bool:
+    """Ray-parity test (Möller–Trumbore): is ``point`` inside the closed mesh?"""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = point - a
+    u = np.einsum("ij,ij->i", s, p) * inv
+    qv = np.cross(s, e1)
+    v = (qv @ direction) * inv
+    t = np.einsum("ij,ij->i", e2, qv) * inv
+    hits = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+    return bool(hits.sum() % 2)
+
+
+def test_an_obstacle_inside_a_link_mesh_is_a_collision(ur5: Robot) -> None:
+    _, raw = _pin_reference(UR5)
+    k = [g.name for g in raw.geometryObjects].index("forearm_link_0")
+    mesh = raw.geometryObjects[k].geometry
+    vertices = np.asarray(mesh.vertices())
+    index = np.array(
+        [[t[0], t[1], t[2]] for t in map(mesh.tri_indices, range(mesh.num_tris))], dtype=int
+    )
+    triangles = vertices[index]
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    local = 0.5 * (lo + hi)
+    local[2] = lo[2] + 0.5 * (hi[2] - lo[2])
+    for direction in np.eye(3):
+        assert _inside(local, triangles, direction)  # the centre is inside the forearm
+    q = np.array([0.3, -1.0, 1.2, -0.5, 0.4, 0.0])
+    pose = ur5.geometry_poses(q)[k]
+    centre = pose[:3, :3] @ local + pose[:3, 3]
+    ball = Obstacle("ball", Sphere(0.01), FixedPose.from_xyz_rpy(tuple(centre)))
+    checker = CollisionChecker(ur5, Scene(obstacles=(ball,)))
+    d = checker.distances(q[None], np.zeros(1), exact=True).distance[0, k, 0]
+    assert d < -0.01
+    # coal against the raw (hollow) mesh reports a clearance: what the hull fixes
+    tf = coal.Transform3s(pose[:3, :3], pose[:3, 3])
+    raw_d = coal.distance(
+        mesh,
+        tf,
+        coal.Sphere(0.01),
+        coal.Transform3s(np.eye(3), centre),
+        coal.DistanceRequest(),
+        coal.DistanceResult(),
+    )
+    assert raw_d > 0.01
+
+
+def test_hull_distance_brackets_the_mesh_distance(ur5: Robot) -> None:
+    _, raw = _pin_reference(UR5)
+    k = [g.name for g in raw.geometryObjects].index("wrist_3_link_0")
+    mesh, hull = raw.geometryObjects[k].geometry, ur5.collision_model.geometryObjects[k].geometry
+    report = next(r for r in ur5.mesh_hulls if r.solid == "wrist_3_link_0")
+    assert 0 < report.gap < 0.05
+    rng = np.random.default_rng(6)
+    ident = coal.Transform3s()
+    for _ in range(200):
+        centre = rng.uniform(-0.2, 0.2, 3)
+        ball, at = coal.Sphere(0.005), coal.Transform3s(np.eye(3), centre)
+        d_mesh = coal.distance(mesh, ident, ball, at, coal.DistanceRequest(), coal.DistanceResult())
+        d_hull = coal.distance(hull, ident, ball, at, coal.DistanceRequest(), coal.DistanceResult())
+        if d_mesh > 0:  # outside the mesh surface (inside points: the hull is in penetration)
+            assert d_hull <= d_mesh + 1e-6  # coal's GJK tolerance
+            assert d_mesh <= max(d_hull, 0.0) + report.gap + 1e-6
