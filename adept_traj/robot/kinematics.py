@@ -91,9 +91,12 @@ class BatchKinematics:
         self.nq = model.nq
         #: ``support[i, k]`` is true when q_k moves joint frame i (row 0 = universe).
         self.support = np.zeros((model.njoints, model.nq), dtype=bool)
+        #: ``ancestor[i, k]`` is true when joint k moves joint frame i (k = i included).
+        self._ancestor = np.eye(model.njoints, dtype=bool)
         for i, j in enumerate(joints, start=1):
             self.support[i] = self.support[j.parent]
             self.support[i, j.index] = True
+            self._ancestor[i] |= self._ancestor[j.parent]
         self.revolute = np.array([j.revolute for j in joints])
         #: Unit axis (njoints - 1, 3) of every joint in its own frame.
         self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
@@ -167,7 +170,7 @@ class BatchKinematics:
         n = frames.shape[-1]
         jac = np.zeros((6, self.nq, n))
         for i, j in enumerate(self._joints, start=1):
-            if not self.support[point_joint, j.index]:
+            if not self._ancestor[point_joint, i]:  # (a mimic shares its leader's index)
                 continue
             z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
             z = z if j.scale == 1.0 else j.scale * z  # a mimic moves scale × its leader
