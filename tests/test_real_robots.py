@@ -8,6 +8,9 @@ meshes, and a ray-parity test for "inside a mesh".
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import coal
@@ -15,8 +18,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from adept_traj.cli import main
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import RobotModelError
+from adept_traj.optimise import plan
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot, installed_data_dirs
 from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
 
@@ -196,3 +203,51 @@ def test_hull_distance_brackets_the_mesh_distance(ur5: Robot) -> None:
         if d_mesh > 0:  # outside the mesh surface (inside points: the hull is in penetration)
             assert d_hull <= d_mesh + 1e-6  # coal's GJK tolerance
             assert d_mesh <= max(d_hull, 0.0) + report.gap + 1e-6
+
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "data"
+
+
+def test_a_result_verifies_in_a_fresh_process_without_environment(tmp_path: Path) -> None:
+    """The meshes come from a package only ``package_dirs`` names (not installed, no
+    ROS_PACKAGE_PATH): the result records the folder, and ``verify`` finds it again."""
+    (tmp_path / "pkgs").mkdir()
+    (tmp_path / "pkgs" / "my_ur").symlink_to(ROBOTS / "ur_description")
+    text = UR5.read_text().replace(
+        "package://example-robot-data/robots/ur_description/", "package://my_ur/"
+    )
+    urdf = tmp_path / "ur5.urdf"
+    urdf.write_text(text)
+    robot = Robot.from_urdf(urdf, EXAMPLES / "ur5.toml", package_dirs=[tmp_path / "pkgs"])
+    scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, n_knots=6)
+    result = plan(problem, "nsga2", seed=1, pop_size=12, n_gen=3)
+    result.save(tmp_path / "run")
+    env = {"PATH": os.environ["PATH"], "PYTHONPATH": os.environ.get("PYTHONPATH", "")}
+    done = subprocess.run(
+        [sys.executable, "-m", "adept_traj.cli", "verify", str(tmp_path / "run")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert "no mismatch" in done.stdout, done.stdout + done.stderr
+    assert "not found" not in done.stderr
+
+
+def test_plan_refuses_a_start_of_the_wrong_joint_count(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["plan", "--scene", str(EXAMPLES / "ur5_box.toml"), "--start", "0,0,0,0", "--out", "x"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "start must hold 6 joint values for robot 'ur5'" in err
+
+
+def test_the_command_line_plans_the_robot_a_scene_file_names(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    argv = ["plan", "--scene", str(EXAMPLES / "ur5_box.toml"), "--pop", "16", "--gens", "4"]
+    assert main([*argv, "--out", str(out), "--quiet", "--no-html", "--no-plots"]) == 0
+    result = PlanningResult.load(out)
+    assert result.robot.name == "ur5"
+    assert len(result.robot.joint_names) == 6
+    assert main(["verify", str(out)]) in (0, 1)  # 1: a certificate failure, reported

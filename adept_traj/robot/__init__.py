@@ -36,6 +36,7 @@ from adept_traj.robot.manipulability import (
 from adept_traj.robot.package_paths import (
     installed_data_dirs,
     package_search_dirs,
+    resolve_package_file,
     resolve_package_uris,
 )
 from adept_traj.robot.parameter_file import (
@@ -99,6 +100,7 @@ __all__ = [
     "manipulability_measure",
     "package_search_dirs",
     "place_solids",
+    "resolve_package_file",
     "resolve_package_uris",
     "shipped_file",
     "solid_frames",

@@ -24,7 +24,12 @@ from pathlib import Path
 
 from adept_traj.errors import RobotModelError
 
-__all__ = ["installed_data_dirs", "package_search_dirs", "resolve_package_uris"]
+__all__ = [
+    "installed_data_dirs",
+    "package_search_dirs",
+    "resolve_package_file",
+    "resolve_package_uris",
+]
 
 _SCHEME = "package://"
 
@@ -57,6 +62,26 @@ def package_uris(root: ET.Element) -> tuple[str, ...]:
     """The ``package://`` file names of a URDF's ``<mesh>`` elements, in document order."""
     names = (m.get("filename", "") for m in root.iter("mesh"))
     return tuple(dict.fromkeys(n for n in names if n.startswith(_SCHEME)))
+
+
+def resolve_package_file(uri: str, package_dirs: Iterable[str | Path] = ()) -> Path:
+    """The file a ``package://pkg/rest`` URI names (the first searched folder holding it,
+    see :func:`resolve_package_uris`); a URI without the scheme is returned as a path.
+
+    Raises :class:`~adept_traj.errors.RobotModelError` when no searched folder holds it."""
+    if not uri.startswith(_SCHEME):
+        return Path(uri)
+    search = package_search_dirs(package_dirs)
+    package, _, rest = uri[len(_SCHEME) :].partition("/")
+    for d in search:
+        for candidate in (d / package / rest, d / rest if d.name == package else None):
+            if candidate is not None and candidate.is_file():
+                return candidate
+    raise RobotModelError(
+        f"'{uri}' not found in the package folders {[str(d) for d in search]}; give its "
+        "package's parent folder with package_dirs (command line: --package-dir), set "
+        "ROS_PACKAGE_PATH, or install the package that ships it"
+    )
 
 
 def resolve_package_uris(

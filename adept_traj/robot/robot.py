@@ -26,6 +26,7 @@ from adept_traj.robot.forward_kinematics import ForwardKinematics, place_solids,
 from adept_traj.robot.kinematics import BatchKinematics, compose, frames_to_poses
 from adept_traj.robot.limits import JointLimits
 from adept_traj.robot.manipulability import manipulability_measure
+from adept_traj.robot.package_paths import resolve_package_file
 from adept_traj.robot.parameter_file import TASK_ROWS, RobotParameters
 from adept_traj.robot.urdf_loading import apply_parameters, load_urdf_models, shipped_file
 from adept_traj.validation import as_batch
@@ -143,8 +144,9 @@ class Robot:
         Parameters
         ----------
         urdf:
-            Path of the URDF. Its ``<inertial>``, ``<limit>`` and ``<dynamics damping
-            friction>`` give masses, position/velocity/torque (URDF: effort) limits and friction.
+            Path of the URDF, or a ``package://pkg/path`` URI (found like its meshes).
+            Its ``<inertial>``, ``<limit>`` and ``<dynamics damping friction>`` give masses,
+            position/velocity/torque (URDF: effort) limits and friction.
         params:
             Optional parameter file (TOML path or :class:`RobotParameters`): acceleration
             and jerk limits, rotor inertia × gear ratio² (→ ``model.armature``), and
@@ -170,7 +172,7 @@ class Robot:
             Missing or malformed URDF or parameter file, unsupported joint types, a
             parameter file naming a joint the URDF does not have, an unknown tool frame.
         """
-        path = Path(urdf)
+        path = resolve_package_file(str(urdf), package_dirs)
         name, model, collision, visual, dirs = load_urdf_models(path, package_dirs, locked_joints)
         hulls = convex_hull_solids(collision, path)
 

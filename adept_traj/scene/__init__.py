@@ -17,6 +17,7 @@ from adept_traj.scene.scene import (
 )
 from adept_traj.scene.scene_file import (
     read_paper_scene,
+    read_robot_files,
     read_scene_file,
     scene_from_dict,
     scene_to_dict,
@@ -49,6 +50,7 @@ __all__ = [
     "coal_transform",
     "pendulum_obstacles",
     "read_paper_scene",
+    "read_robot_files",
     "read_scene_file",
     "scene_from_dict",
     "scene_to_dict",
