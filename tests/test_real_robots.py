@@ -251,3 +251,17 @@ def test_the_command_line_plans_the_robot_a_scene_file_names(tmp_path: Path) -> 
     assert result.robot.name == "ur5"
     assert len(result.robot.joint_names) == 6
     assert main(["verify", str(out)]) in (0, 1)  # 1: a certificate failure, reported
+
+
+def test_missing_acceleration_and_jerk_limits_warn_and_show_as_no_limit(
+    ur5: Robot, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
+    problem = TrajectoryProblem(ur5, scene, scene.start, scene.goal, n_knots=6)
+    with pytest.warns(UserWarning, match=r"no acceleration limit for joint\(s\) shoulder_pan"):
+        result = plan(problem, "nsga2", seed=1, pop_size=8, n_gen=2)
+    result.save(tmp_path / "run")
+    main(["verify", str(tmp_path / "run")])
+    out = capsys.readouterr().out
+    assert "acceleration  no limit" in out
+    assert "jerk          no limit" in out

@@ -32,6 +32,7 @@ from adept_traj.optimise.loop import (
 )
 from adept_traj.optimise.planner import (
     plan,
+    warn_missing_limits,
 )
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
@@ -65,4 +66,5 @@ __all__ = [
     "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
+    "warn_missing_limits",
 ]
