@@ -19,7 +19,7 @@ import pinocchio as pin
 import pytest
 
 from adept_traj.cli import main
-from adept_traj.collision import CollisionChecker
+from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import RobotModelError
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
@@ -265,3 +265,43 @@ def test_missing_acceleration_and_jerk_limits_warn_and_show_as_no_limit(
     out = capsys.readouterr().out
     assert "acceleration  no limit" in out
     assert "jerk          no limit" in out
+
+
+def _reference_self_distance(robot: Robot, q: np.ndarray, a: str, b: str) -> float:
+    """coal distance of two solids placed by Pinocchio (not by the code under test)."""
+    gm = robot.collision_model
+    data, gdata = robot.model.createData(), gm.createData()
+    pin.updateGeometryPlacements(robot.model, data, gm, gdata, q)
+    ia, ib = gm.getGeometryId(a), gm.getGeometryId(b)
+    pa, pb = gdata.oMg[ia], gdata.oMg[ib]
+    return coal.distance(
+        gm.geometryObjects[ia].geometry, coal.Transform3s(pa.rotation, pa.translation),
+        gm.geometryObjects[ib].geometry, coal.Transform3s(pb.rotation, pb.translation),
+        coal.DistanceRequest(), coal.DistanceResult(),
+    )  # fmt: skip
+
+
+def test_self_collision_finds_a_folded_pose_and_skips_adjacent_links(ur5: Robot) -> None:
+    srdf = ROBOTS / "ur_description/srdf/ur5.srdf"
+    robot = Robot.from_urdf(UR5, srdf=srdf)
+    check = SelfCollision(robot)
+    names = {frozenset(p) for p in check.pair_names}
+    # adjacent links (sharing a joint) are never checked, with or without the SRDF
+    for a, b in [("upper_arm_link_0", "forearm_link_0"), ("shoulder_link_0", "upper_arm_link_0")]:
+        assert frozenset((a, b)) not in names
+        assert frozenset((a, b)) not in {frozenset(p) for p in SelfCollision(ur5).pair_names}
+    # ... and they touch at every pose: they would be flagged
+    home = np.array([0.0, -1.57, 0.0, -1.57, 0.0, 0.0])
+    assert _reference_self_distance(robot, home, "upper_arm_link_0", "forearm_link_0") <= 0.0
+    # the SRDF pairs are left out
+    assert len(check.pair_names) < len(SelfCollision(ur5).pair_names)
+    assert frozenset(("wrist_1_link_0", "wrist_3_link_0")) not in names
+    folded = np.array([0.0, -1.57, 3.1, 0.0, 0.0, 0.0])  # the elbow folded flat
+    d = check.distances(np.stack([home, folded]))
+    assert d[0].min() > 0.0
+    assert d[1].min() < 0.0
+    k = int(np.argmin(d[1]))
+    a, b = check.pair_names[k]
+    assert d[1, k] == pytest.approx(_reference_self_distance(robot, folded, a, b), abs=1e-6)
+    with pytest.raises(RobotModelError, match=r"link\(s\) \['nope'\] have no collision solid"):
+        SelfCollision(robot, disabled=[("nope", "base_link")])

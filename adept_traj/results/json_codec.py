@@ -215,6 +215,7 @@ def _decode(top: Node) -> PlanningResult:
         params=rob["params"].string(null=None, default=None),
         tool_frame=rob["tool_frame"].string(null=None, default=None),
         package_dirs=rob["package_dirs"].strings(default=()),
+        srdf=rob["srdf"].string(default=None),
         locked_joints={k: lock[k].number("[rad | m]") for k in lock.table()}
         if lock.present
         else {},

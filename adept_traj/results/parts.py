@@ -77,6 +77,7 @@ class RobotInfo:
     package_dirs: the folders where the URDF's ``package://`` meshes were found (absolute),
         searched first when the robot is rebuilt (no ``ROS_PACKAGE_PATH`` needed).
     locked_joints: joints fixed at a value [rad | m] (name → value).
+    srdf: the SRDF given (its ``disable_collisions`` pairs), or ``None``.
     """
 
     name: str
@@ -86,6 +87,7 @@ class RobotInfo:
     tool_frame: str | None = None
     package_dirs: tuple[str, ...] = ()
     locked_joints: Mapping[str, float] = field(default_factory=dict)
+    srdf: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "joint_names", tuple(str(n) for n in self.joint_names))
@@ -110,17 +112,19 @@ class RobotInfo:
             tool_frame=robot.tool_frame,
             package_dirs=tuple(str(p.resolve()) for p in robot.package_dirs),
             locked_joints=robot.locked_joints,
+            srdf=None if robot.srdf_path is None else str(Path(robot.srdf_path).resolve()),
         )
 
     def as_json(self) -> dict[str, Any]:
-        """The ``robot`` object of ``result.json``; ``package_dirs`` and ``locked_joints``
-        only when not empty (files written before them have neither, and must re-encode
+        """The ``robot`` object of ``result.json``; ``package_dirs``, ``locked_joints`` and
+        ``srdf`` only when not empty (files written before them have neither, and must re-encode
         to themselves)."""
         out = dataclasses.asdict(self) | {
             "joint_names": list(self.joint_names),
             "package_dirs": list(self.package_dirs),
         }
-        return {k: v for k, v in out.items() if v or k not in ("package_dirs", "locked_joints")}
+        optional = ("package_dirs", "locked_joints", "srdf")
+        return {k: v for k, v in out.items() if v or k not in optional}
 
     def load(self) -> Robot:
         """Rebuild the robot (raises :class:`~adept_traj.errors.RobotModelError` when its
@@ -133,6 +137,7 @@ class RobotInfo:
             package_dirs=self.package_dirs,
             tool_frame=self.tool_frame,
             locked_joints=self.locked_joints or None,
+            srdf=self.srdf,
         )
 
 

@@ -63,6 +63,7 @@ from adept_traj.robot.urdf_loading import (
     apply_parameters,
     coordinate_joints,
     load_urdf_models,
+    read_srdf_disabled_pairs,
     shipped_file,
 )
 
@@ -100,6 +101,7 @@ __all__ = [
     "manipulability_measure",
     "package_search_dirs",
     "place_solids",
+    "read_srdf_disabled_pairs",
     "resolve_package_file",
     "resolve_package_uris",
     "shipped_file",

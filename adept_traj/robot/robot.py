@@ -28,7 +28,12 @@ from adept_traj.robot.limits import JointLimits
 from adept_traj.robot.manipulability import manipulability_measure
 from adept_traj.robot.package_paths import resolve_package_file
 from adept_traj.robot.parameter_file import TASK_ROWS, RobotParameters
-from adept_traj.robot.urdf_loading import apply_parameters, load_urdf_models, shipped_file
+from adept_traj.robot.urdf_loading import (
+    apply_parameters,
+    load_urdf_models,
+    read_srdf_disabled_pairs,
+    shipped_file,
+)
 from adept_traj.validation import as_batch
 
 __all__ = [
@@ -74,6 +79,8 @@ class Robot:
         The folders where the URDF's ``package://`` meshes were found (recorded in results).
     locked_joints : dict
         Joints fixed at a value [rad | m] (name → value), removed from q.
+    srdf_path : pathlib.Path or None
+        The SRDF given (its ``disable_collisions`` pairs: :attr:`disabled_pairs`).
     mesh_hulls : tuple of HullReport
         The collision meshes replaced by their convex hulls (see
         :mod:`adept_traj.robot.collision_meshes`).
@@ -94,7 +101,8 @@ class Robot:
         package_dirs: Sequence[Path] = (),
         locked_joints: Mapping[str, float] | None = None,
         mesh_hulls: tuple[HullReport, ...] = (),
-    ) -> None:
+        srdf_path: Path | None = None,
+    ) -> None:  # the keyword-only arguments: see the class attributes
         self.model = model
         self.collision_model = collision_model
         self._visual_model = visual_model
@@ -105,6 +113,8 @@ class Robot:
         self.package_dirs = tuple(Path(p) for p in package_dirs)
         self.locked_joints = dict(locked_joints or {})
         self.mesh_hulls = tuple(mesh_hulls)
+        self.srdf_path = srdf_path  # its pairs are excluded from self-collision checks
+        self.disabled_pairs = () if srdf_path is None else read_srdf_disabled_pairs(srdf_path)
         if not model.existFrame(tool_frame):
             frames = [f.name for f in model.frames]
             raise RobotModelError(f"robot '{name}': no frame '{tool_frame}'; frames are {frames}")
@@ -135,6 +145,7 @@ class Robot:
         params: str | Path | RobotParameters | None = None,
         *,
         package_dirs: Sequence[str | Path] = (),
+        srdf: str | Path | None = None,
         tool_frame: str | None = None,
         locked_joints: Mapping[str, float] | None = None,
         task_rows: Sequence[str] | None = None,
@@ -154,6 +165,9 @@ class Robot:
         package_dirs:
             Folders searched first for ``package://`` meshes (then ``ROS_PACKAGE_PATH``,
             then installed robot data; :mod:`adept_traj.robot.package_paths`).
+        srdf:
+            Optional SRDF: its ``disable_collisions`` link pairs are left out of the
+            self-collision check (:class:`~adept_traj.collision.SelfCollision`).
         tool_frame:
             Tool frame name; default: the parameter file's ``tool_frame``, else the last
             frame of the model. An unknown name is refused with the list of frames.
@@ -203,6 +217,7 @@ class Robot:
             package_dirs=dirs,
             locked_joints=locked_joints,
             mesh_hulls=hulls,
+            srdf_path=None if srdf is None else Path(srdf),
         )
 
     # ------------------------------------------------------------------ basic facts

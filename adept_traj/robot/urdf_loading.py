@@ -41,6 +41,7 @@ __all__ = [
     "apply_parameters",
     "coordinate_joints",
     "load_urdf_models",
+    "read_srdf_disabled_pairs",
     "shipped_file",
 ]
 
@@ -114,6 +115,20 @@ def load_urdf_models(
         raise RobotModelError(f"{path}: the robot has no moving joint")
     collision = geometry(pin.COLLISION)
     return root.get("name", path.stem), model, collision, lambda: geometry(pin.VISUAL), dirs
+
+
+def read_srdf_disabled_pairs(path: Path) -> tuple[tuple[str, str], ...]:
+    """The ``(link1, link2)`` pairs of an SRDF's ``<disable_collisions>`` elements (the
+    MoveIt convention: link pairs never checked for self-collision).
+
+    Raises :class:`~adept_traj.errors.RobotModelError` for a missing or malformed file."""
+    if not path.is_file():
+        raise RobotModelError(f"SRDF not found: {path}")
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise RobotModelError(f"{path}: malformed XML: {exc}") from None
+    return tuple((e.get("link1", ""), e.get("link2", "")) for e in root.iter("disable_collisions"))
 
 
 def coordinate_joints(model: pin.Model) -> tuple[str, ...]:
