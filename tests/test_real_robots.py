@@ -20,7 +20,7 @@ import pytest
 
 from adept_traj.cli import main
 from adept_traj.collision import CollisionChecker, SelfCollision
-from adept_traj.errors import RobotModelError
+from adept_traj.errors import RobotModelError, SceneError
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
@@ -305,3 +305,32 @@ def test_self_collision_finds_a_folded_pose_and_skips_adjacent_links(ur5: Robot)
     assert d[1, k] == pytest.approx(_reference_self_distance(robot, folded, a, b), abs=1e-6)
     with pytest.raises(RobotModelError, match=r"link\(s\) \['nope'\] have no collision solid"):
         SelfCollision(robot, disabled=[("nope", "base_link")])
+
+
+def test_a_permanent_floor_contact_is_allowed_by_name(ur5: Robot, tmp_path: Path) -> None:
+    text = (EXAMPLES / "ur5_box.toml").read_text() + (
+        '\n[[obstacle]]\nname = "floor"\nshape = "box"\nsize = [2.0, 2.0, 0.02]\n'
+        "xyz = [0.0, 0.0, -0.005]\n"
+    )
+    touching = tmp_path / "floor.toml"
+    touching.write_text(text)
+    allowed = tmp_path / "allowed.toml"
+    allowed.write_text('allowed_contacts = [["base_link", "floor"]]\n' + text)
+    scene_touching, scene_allowed = Scene.from_file(touching), Scene.from_file(allowed)
+    assert scene_allowed.allowed_contacts == (("base_link", "floor"),)
+    assert Scene.from_dict(scene_allowed.to_dict()) == scene_allowed  # written and read back
+    q = np.stack([scene_allowed.start, scene_allowed.goal])[None]
+    t = np.zeros((1, 2))
+    floor = scene_touching.obstacles[-1].name
+    for exact in (False, True):
+        touch = CollisionChecker(ur5, scene_touching).distances(q, t, exact=exact).distance
+        free = CollisionChecker(ur5, scene_allowed).distances(q, t, exact=exact).distance
+        k = [g.name for g in ur5.collision_model.geometryObjects].index("base_link_0")
+        assert floor == "floor"
+        assert touch[0, :, k, -1].max() < 0.0  # the base sits in the floor: a collision
+        assert np.all(free[0, :, k, -1] == np.inf)  # allowed: never checked
+        np.testing.assert_array_equal(free[0, :, :, 0], touch[0, :, :, 0])  # the box unchanged
+    mind = CollisionChecker(ur5, scene_allowed).min_distances(q, t)
+    assert mind.distance[0, -1] > 0.0  # the other links clear the floor
+    with pytest.raises(SceneError, match=r"obstacle\(s\) \['nope'\]"):
+        Scene(obstacles=scene_allowed.obstacles, allowed_contacts=(("base_link", "nope"),))

@@ -131,6 +131,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     out["robot"] = {"xyz": _floats(xyz), "rpy": _floats(rpy)}
     if scene.start is not None and scene.goal is not None:
         out["task"] = {"start": _floats(scene.start), "goal": _floats(scene.goal)}
+    if scene.allowed_contacts:
+        out["allowed_contacts"] = [list(pair) for pair in scene.allowed_contacts]
     obstacles: list[dict[str, Any]] = []
     pendulums: list[dict[str, Any]] = []
     by_name = {ob.name: ob for ob in scene.obstacles}
@@ -244,7 +246,7 @@ def _pendulum_dict(
 
 #: Errors of a scene file: SceneError naming the source (file) and the field path.
 _ERROR = error_factory(SceneError)
-_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum")
+_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "allowed_contacts")
 _ROBOT_KEYS = ("xyz", "rpy", "urdf", "params", "tool_frame", "package_dirs")
 _TASK_KEYS = ("start", "goal")
 _SHAPE_KEYS = {
@@ -342,6 +344,17 @@ def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
         obstacles.append(_parse_obstacle(entry_name, node))
     for entry_name, node in top["pendulum"].named_tables():
         obstacles.extend(_parse_pendulum(entry_name, node))
+    allowed = tuple(
+        tuple(n.strings(min_items=2)) for n in top["allowed_contacts"].items(default=[])
+    )
+    if any(len(pair) != 2 for pair in allowed):
+        raise top["allowed_contacts"].error("must hold [link, obstacle] pairs of names")
     return top.build(
-        Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
+        Scene,
+        obstacles=tuple(obstacles),
+        robot_base=base,
+        start=start,
+        goal=goal,
+        name=name,
+        allowed_contacts=allowed,
     )
