@@ -84,12 +84,7 @@ def load_urdf_models(
     cannot load, a locked joint that is not a joint with a coordinate (or a value that is
     not a finite number), or a robot without a moving joint.
     """
-    if not path.is_file():
-        raise RobotModelError(f"URDF not found: {path}")
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise RobotModelError(f"{path}: malformed XML: {exc}") from None
+    root = _read_xml(path, "URDF")
     if root.tag != "robot":
         raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
     dirs = resolve_package_uris(root, path, package_dirs)
@@ -122,13 +117,19 @@ def read_srdf_disabled_pairs(path: Path) -> tuple[tuple[str, str], ...]:
     MoveIt convention: link pairs never checked for self-collision).
 
     Raises :class:`~adept_traj.errors.RobotModelError` for a missing or malformed file."""
+    root = _read_xml(path, "SRDF")
+    return tuple((e.get("link1", ""), e.get("link2", "")) for e in root.iter("disable_collisions"))
+
+
+def _read_xml(path: Path, what: str) -> ET.Element:
+    """The root element of the XML file ``path`` (a ``what``: URDF, SRDF), or
+    :class:`~adept_traj.errors.RobotModelError` for a missing file or malformed XML."""
     if not path.is_file():
-        raise RobotModelError(f"SRDF not found: {path}")
+        raise RobotModelError(f"{what} not found: {path}")
     try:
-        root = ET.parse(path).getroot()
+        return ET.parse(path).getroot()
     except ET.ParseError as exc:
         raise RobotModelError(f"{path}: malformed XML: {exc}") from None
-    return tuple((e.get("link1", ""), e.get("link2", "")) for e in root.iter("disable_collisions"))
 
 
 def coordinate_joints(model: pin.Model) -> tuple[str, ...]:
