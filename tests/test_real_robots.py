@@ -23,7 +23,7 @@ from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import RobotModelError, SceneError
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import PlanningResult
+from adept_traj.results import PlanningResult, RobotInfo
 from adept_traj.robot import Robot, installed_data_dirs
 from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
 
@@ -334,3 +334,18 @@ def test_a_permanent_floor_contact_is_allowed_by_name(ur5: Robot, tmp_path: Path
     assert mind.distance[0, -1] > 0.0  # the other links clear the floor
     with pytest.raises(SceneError, match=r"obstacle\(s\) \['nope'\]"):
         Scene(obstacles=scene_allowed.obstacles, allowed_contacts=(("base_link", "nope"),))
+
+
+def test_a_result_records_locked_joints_srdf_and_mesh_folders(tmp_path: Path) -> None:
+    srdf = ROBOTS / "ur_description/srdf/ur5.srdf"
+    robot = Robot.from_urdf(UR5, srdf=srdf, locked_joints={"wrist_3_joint": 0.25})
+    info = RobotInfo.of(robot)
+    assert info.locked_joints == {"wrist_3_joint": 0.25}
+    assert info.srdf == str(srdf.resolve())
+    assert info.package_dirs == (str(ROBOTS.parents[1].resolve()),)
+    again = info.load()
+    assert again.joint_names == robot.joint_names
+    assert again.disabled_pairs == robot.disabled_pairs
+    q = np.zeros((1, 5))
+    np.testing.assert_allclose(again.tool_pose(q), robot.tool_pose(q), atol=0.0)
+    assert RobotInfo(**info.as_json()) == info  # what result.json holds rebuilds it
