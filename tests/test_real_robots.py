@@ -25,7 +25,7 @@ from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult, RobotInfo
 from adept_traj.robot import Robot, installed_data_dirs
-from adept_traj.scene import FixedPose, Obstacle, Scene, Sphere
+from adept_traj.scene import Box, FixedPose, Obstacle, Scene, Sphere
 
 ROBOTS = next(
     (
@@ -349,3 +349,21 @@ def test_a_result_records_locked_joints_srdf_and_mesh_folders(tmp_path: Path) ->
     q = np.zeros((1, 5))
     np.testing.assert_allclose(again.tool_pose(q), robot.tool_pose(q), atol=0.0)
     assert RobotInfo(**info.as_json()) == info  # what result.json holds rebuilds it
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["panda", "jaco2"])
+def test_panda_and_a_robot_with_continuous_joints_plan_a_certified_move(name: str) -> None:
+    path = PANDA if name == "panda" else JACO
+    robot = Robot.from_urdf(path)
+    box = Obstacle("box", Box((0.1, 0.1, 0.1)), FixedPose.from_xyz_rpy((0.0, -0.6, 0.8)))
+    start = np.clip(np.zeros(robot.nq), robot.limits.lower + 0.3, robot.limits.upper - 0.3)
+    goal = start.copy()
+    goal[0] += 1.0
+    if name == "panda":
+        start[-1] = goal[-1] = 0.02  # the finger half open
+    problem = TrajectoryProblem(robot, Scene(obstacles=(box,)), start, goal, n_knots=6)
+    with pytest.warns(UserWarning, match="no acceleration limit"):
+        result = plan(problem, "nsga2", seed=1, pop_size=20, n_gen=5)
+    assert result.certificate.feasible
+    assert result.certificate.min_distance > problem.settings.margin
