@@ -367,3 +367,14 @@ def test_panda_and_a_robot_with_continuous_joints_plan_a_certified_move(name: st
         result = plan(problem, "nsga2", seed=1, pop_size=20, n_gen=5)
     assert result.certificate.feasible
     assert result.certificate.min_distance > problem.settings.margin
+
+
+def test_the_robot_command_reports_self_collision_with_an_srdf(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    srdf = ROBOTS / "ur_description/srdf/ur5.srdf"
+    folded = ["--start", "0,-1.57,0,-1.57,0,0", "--goal", "0,-1.57,3.1,-1.57,0,0"]
+    assert main(["robot", "--robot", str(UR5), "--srdf", str(srdf), *folded]) == 0
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line.startswith("  self-collision: min distance -0.")
+    assert main(["robot", "--srdf", str(srdf)]) == 2  # the AdeptOne XL: no --robot

@@ -61,7 +61,7 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
     "workers", "no_html", "no_plots", "ros", "allow_infeasible",
-    "robot", "params", "tool_frame", "package_dir",
+    "robot", "params", "tool_frame", "srdf", "package_dir",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
@@ -107,7 +107,7 @@ def _comparable(key: str, value: Any) -> Any:
     """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
     if value is None or (key == "scene" and value == "paper"):
         return value
-    if key in ("scene", "ros", "robot", "params"):
+    if key in ("scene", "ros", "robot", "params", "srdf"):
         return str(Path(value).resolve())
     if key == "package_dir":
         return [str(Path(v).resolve()) for v in value]
@@ -170,7 +170,7 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
         if out is None:
             raise ConfigurationError("give --out DIR (or --resume DIR)")
         folder, options = out, {**args.plan_defaults, **given}
-        for key in ("scene", "ros", "robot", "params", "package_dir"):
+        for key in ("scene", "ros", "robot", "params", "srdf", "package_dir"):
             options[key] = _comparable(key, options[key])
     else:
         folder = resume

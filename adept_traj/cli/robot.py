@@ -2,7 +2,8 @@
 
 Peak joint speeds, accelerations and torques, the torques' ratio to their limits (the
 paper's UC), the integral of the squared torques (z2) and the manipulability range (z4)
-along a rest-to-rest quintic move of the paper's task or of the one given.
+along a rest-to-rest quintic move of the paper's task or of the one given; with ``--srdf``,
+the smallest self-collision distance along it (:class:`~adept_traj.collision.SelfCollision`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
+from adept_traj.collision import SelfCollision
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.scene import Scene
@@ -92,4 +94,10 @@ def run(args: argparse.Namespace) -> int:
     if robot.task_rows is not None:
         w = robot.manipulability(q)
         print(f"  manipulability (paper z4): min {w.min():.5f}, max {w.max():.5f} [m²]")
+    check = SelfCollision(robot)
+    if robot.srdf_path is not None and len(check.pairs):  # --srdf: self-collision wanted
+        d = check.distances(q)  # (n, n_pairs)
+        k, p = np.unravel_index(int(np.argmin(d)), d.shape)
+        a, b = check.pair_names[p]
+        print(f"  self-collision: min distance {d[k, p]:.4f} m ({a}, {b}) at t = {t[k]:.3f} s")
     return status.OK

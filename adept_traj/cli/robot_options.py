@@ -1,5 +1,6 @@
 """The robot a command works on: ``--robot URDF [--params TOML] [--tool-frame NAME]
-[--package-dir DIR ...]``, else the scene file's ``[robot]`` table, else the AdeptOne XL.
+[--srdf FILE] [--package-dir DIR ...]``,
+else the scene file's ``[robot]`` table, else the AdeptOne XL.
 
 :func:`add_robot_arguments` declares the options; :func:`robot_from_arguments` loads the
 robot; :func:`check_task` checks a start/goal against the robot's joint count.
@@ -11,7 +12,7 @@ import argparse
 
 import numpy as np
 
-from adept_traj.errors import InputShapeError
+from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.robot import Robot
 from adept_traj.scene import read_robot_files
 
@@ -19,7 +20,8 @@ __all__ = ["add_robot_arguments", "check_task", "robot_from_arguments"]
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser, flag: str = "--robot") -> None:
-    """Declare ``--robot`` (or ``flag``), ``--params``, ``--tool-frame``, ``--package-dir``."""
+    """Declare ``--robot`` (or ``flag``), ``--params``, ``--tool-frame``, ``--srdf``,
+    ``--package-dir``."""
     parser.add_argument(
         flag,
         dest="robot",
@@ -27,6 +29,7 @@ def add_robot_arguments(parser: argparse.ArgumentParser, flag: str = "--robot") 
     )
     parser.add_argument("--params", help="parameter file (TOML) of the robot")
     parser.add_argument("--tool-frame", help="tool frame name (default: the parameter file's)")
+    parser.add_argument("--srdf", help="SRDF: its disable_collisions pairs are not self-checked")
     parser.add_argument(
         "--package-dir",
         action="append",
@@ -44,10 +47,13 @@ def robot_from_arguments(args: argparse.Namespace, scene: str | None = None) -> 
     urdf = args.robot if getattr(args, "robot", None) is not None else named["urdf"]
     params = getattr(args, "params", None) or named["params"]
     tool_frame = getattr(args, "tool_frame", None) or named["tool_frame"]
+    srdf = getattr(args, "srdf", None)
     dirs = tuple(getattr(args, "package_dir", None) or ()) + tuple(named["package_dirs"])
     if urdf is None:
+        if srdf is not None:
+            raise ConfigurationError("--srdf goes with --robot (or the scene file's [robot] urdf)")
         return Robot.adept_one_xl()
-    return Robot.from_urdf(str(urdf), params, package_dirs=dirs, tool_frame=tool_frame)
+    return Robot.from_urdf(str(urdf), params, package_dirs=dirs, srdf=srdf, tool_frame=tool_frame)
 
 
 def check_task(robot: Robot, q: object, option: str) -> np.ndarray:

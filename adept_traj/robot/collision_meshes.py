@@ -23,8 +23,7 @@ over the hull samples :math:`s` and the mesh samples :math:`m` (points of the me
 :math:`d(s, \text{mesh}) \le |s - m|`), with :math:`h` the hull grid's largest cell edge
 (the distance to the mesh is 1-Lipschitz). So the reported clearance is never larger than
 the true clearance of the link, and at most :math:`g` smaller; :attr:`Robot.mesh_hulls
-<adept_traj.robot.Robot.mesh_hulls>` lists :math:`g` per link, and ``adept-traj robot``
-prints it.
+<adept_traj.robot.Robot.mesh_hulls>` gives :math:`g` per link.
 
 Size budget: a hull with more than :data:`MAX_HULL_POINTS` vertices is refused (coal's
 support function is linear in them) with advice to simplify the collision mesh.
