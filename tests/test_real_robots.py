@@ -79,7 +79,25 @@ def test_a_missing_package_mesh_names_the_folders_searched(tmp_path: Path) -> No
     assert robot.package_dirs == (tmp_path.resolve(),)
 
 
-def test_continuous_joints_have_one_angle_coordinate() -> None:
+def test_a_continuous_joint_has_one_angle_coordinate(tmp_path: Path) -> None:
+    planar = Path(__file__).resolve().parents[1] / "examples" / "data" / "planar_2link.urdf"
+    text = planar.read_text().replace('type="revolute"', 'type="continuous"', 1)
+    path = tmp_path / "continuous.urdf"
+    path.write_text(text)
+    robot = Robot.from_urdf(path)
+    reference = pin.buildModelFromUrdf(str(path))  # Pinocchio: (cos θ, sin θ) for it
+    assert (robot.nq, reference.nq) == (2, 3)
+    assert (robot.limits.lower[0], robot.limits.upper[0]) == (-2 * np.pi, 2 * np.pi)
+    q = np.random.default_rng(2).uniform(-7.0, 7.0, (20, 2))
+    q[:, 1] = np.clip(q[:, 1], robot.limits.lower[1], robot.limits.upper[1])
+    poses = robot.kinematics.joint_poses(q)
+    for k in range(len(q)):
+        q_ref = np.array([np.cos(q[k, 0]), np.sin(q[k, 0]), q[k, 1]])
+        np.testing.assert_allclose(poses[k], _joint_poses(reference, q_ref), atol=1e-12)
+
+
+@pytest.mark.slow
+def test_continuous_joints_of_the_jaco2_have_one_angle_coordinate() -> None:
     robot = Robot.from_urdf(JACO)
     reference, _ = _pin_reference(JACO)
     assert (robot.nq, reference.nq) == (6, 9)  # three continuous joints: (cos, sin) in Pinocchio
@@ -243,6 +261,7 @@ def test_plan_refuses_a_start_of_the_wrong_joint_count(capsys: pytest.CaptureFix
     assert "start must hold 6 joint values for robot 'ur5'" in err
 
 
+@pytest.mark.slow
 def test_the_command_line_plans_the_robot_a_scene_file_names(tmp_path: Path) -> None:
     out = tmp_path / "run"
     argv = ["plan", "--scene", str(EXAMPLES / "ur5_box.toml"), "--pop", "16", "--gens", "4"]
@@ -253,18 +272,12 @@ def test_the_command_line_plans_the_robot_a_scene_file_names(tmp_path: Path) -> 
     assert main(["verify", str(out)]) in (0, 1)  # 1: a certificate failure, reported
 
 
-def test_missing_acceleration_and_jerk_limits_warn_and_show_as_no_limit(
-    ur5: Robot, capsys: pytest.CaptureFixture[str], tmp_path: Path
-) -> None:
+def test_missing_acceleration_and_jerk_limits_warn(ur5: Robot) -> None:
+    """(verify's "no limit" for such joints: tests/test_cli.py)"""
     scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
     problem = TrajectoryProblem(ur5, scene, scene.start, scene.goal, n_knots=6)
     with pytest.warns(UserWarning, match=r"no acceleration limit for joint\(s\) shoulder_pan"):
-        result = plan(problem, "nsga2", seed=1, pop_size=8, n_gen=2)
-    result.save(tmp_path / "run")
-    main(["verify", str(tmp_path / "run")])
-    out = capsys.readouterr().out
-    assert "acceleration  no limit" in out
-    assert "jerk          no limit" in out
+        plan(problem, "nsga2", seed=1, pop_size=8, n_gen=1, max_certify=1)
 
 
 def _reference_self_distance(robot: Robot, q: np.ndarray, a: str, b: str) -> float:
