@@ -9,6 +9,7 @@ meshes, and a ray-parity test for "inside a mesh".
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -94,6 +95,12 @@ def test_a_continuous_joint_has_one_angle_coordinate(tmp_path: Path) -> None:
     for k in range(len(q)):
         q_ref = np.array([np.cos(q[k, 0]), np.sin(q[k, 0]), q[k, 1]])
         np.testing.assert_allclose(poses[k], _joint_poses(reference, q_ref), atol=1e-12)
+    # without a <limit> element: unlimited speed and effort, as Pinocchio reads it
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(re.sub(r"<limit [^>]*/>", "", text, count=1))
+    unlimited = Robot.from_urdf(bare).limits
+    assert (unlimited.velocity[0], unlimited.torque[0]) == (np.inf, np.inf)
+    assert unlimited.upper[0] == 2 * np.pi
 
 
 @pytest.mark.slow

@@ -88,10 +88,14 @@ def load_urdf_models(
     if root.tag != "robot":
         raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
     dirs = resolve_package_uris(root, path, package_dirs)
+    text, unlimited = _continuous_as_revolute(root)
     try:
-        full = pin.buildModelFromXML(_continuous_as_revolute(root), mimic=True)
+        full = pin.buildModelFromXML(text, mimic=True)
     except (RuntimeError, ValueError) as exc:
         raise RobotModelError(f"{path}: Pinocchio cannot load this URDF: {exc}") from None
+    for name in unlimited:  # as Pinocchio does for a continuous joint without <limit>
+        k = full.joints[full.getJointId(name)].idx_q
+        full.velocityLimit[k] = full.effortLimit[k] = np.inf
     model, lock = full, _lock(full, locked_joints or {}, path)
 
     def geometry(kind: pin.GeometryType) -> pin.GeometryModel:
@@ -138,20 +142,24 @@ def coordinate_joints(model: pin.Model) -> tuple[str, ...]:
     return tuple(model.names[i] for i in range(1, model.njoints) if model.joints[i].nq > 0)
 
 
-def _continuous_as_revolute(root: ET.Element) -> str:
+def _continuous_as_revolute(root: ET.Element) -> tuple[str, tuple[str, ...]]:
     """The URDF text with every continuous joint made revolute over
-    [−CONTINUOUS_RANGE, CONTINUOUS_RANGE] (a copy; ``root`` is not changed)."""
+    [−CONTINUOUS_RANGE, CONTINUOUS_RANGE] (a copy; ``root`` is not changed), and the names
+    of those without a ``<limit>`` element (their speed and effort are unlimited: urdfdom
+    needs finite values in the text; they are set to ``inf`` in the model)."""
     root = ET.fromstring(ET.tostring(root))
+    unlimited = []
     for joint in root.iter("joint"):
         if joint.get("type") != "continuous":
             continue
         joint.set("type", "revolute")
         limit = joint.find("limit")
         if limit is None:
-            limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
+            limit = ET.SubElement(joint, "limit", effort="1", velocity="1")
+            unlimited.append(joint.get("name", ""))
         limit.set("lower", repr(-CONTINUOUS_RANGE))
         limit.set("upper", repr(CONTINUOUS_RANGE))
-    return ET.tostring(root, encoding="unicode")
+    return ET.tostring(root, encoding="unicode"), tuple(unlimited)
 
 
 def _lock(
