@@ -48,7 +48,7 @@ def test_build_urdf_writes_the_shipped_file(tmp_path: Path) -> None:
     ("argv", "message"),
     [
         (["robot", "--start", "0,0,0.5,0"], "joint 'joint3' = 0.5 m is outside its limits"),
-        (["robot", "--goal", "0,0,0.1"], r"--goal must have shape \(\.\.\., 4\)"),
+        (["robot", "--goal", "0,0,0.1"], r"--goal must hold 4 joint values for robot .*; got 3"),
         (["robot", "--duration", "-1"], "--duration must be a positive number"),
         (["robot", "--urdf", "missing.urdf"], "URDF not found"),
         (["build-urdf", "missing.toml"], "file not found"),

@@ -18,6 +18,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
         ("plan_paper.py", ["--gens", "2", "--small"], "mode: 39 evaluations"),
         ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
         ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
+        ("ur5_around_a_box.py", ["--gens", "2", "--pop", "12"], "certified feasible"),
     ],
 )
 def test_example_runs(script: str, args: list[str], expect: str, tmp_path: Path) -> None:
@@ -37,4 +38,10 @@ def test_example_runs(script: str, args: list[str], expect: str, tmp_path: Path)
 
 def test_every_example_is_tested() -> None:
     scripts = {p.name for p in EXAMPLES.glob("*.py")}
-    assert scripts == {"robot_dynamics.py", "plan_paper.py", "custom_scene.py", "other_robot.py"}
+    assert scripts == {
+        "robot_dynamics.py",
+        "plan_paper.py",
+        "custom_scene.py",
+        "other_robot.py",
+        "ur5_around_a_box.py",
+    }

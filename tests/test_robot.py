@@ -378,8 +378,8 @@ def test_missing_and_malformed_urdf(tmp_path: Path) -> None:
 
 
 def test_unsupported_joint_type(tmp_path: Path) -> None:
-    text = (DATA / "planar_2link.urdf").read_text().replace('type="revolute"', 'type="continuous"')
-    path = tmp_path / "continuous.urdf"
+    text = (DATA / "planar_2link.urdf").read_text().replace('type="revolute"', 'type="floating"', 1)
+    path = tmp_path / "floating.urdf"
     path.write_text(text)
     with pytest.raises(RobotModelError, match="only 1-DoF revolute and prismatic"):
         Robot.from_urdf(path)

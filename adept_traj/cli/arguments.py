@@ -2,8 +2,8 @@
 describe.
 
 :func:`add_problem_arguments` declares the options; :func:`problem_from_arguments` checks
-them and builds the :class:`~adept_traj.problem.TrajectoryProblem` on the shipped AdeptOne
-XL; :func:`check_rate` checks a verification rate [Hz].
+them and builds the :class:`~adept_traj.problem.TrajectoryProblem` (on ``--robot`` or the
+scene file's robot, else the AdeptOne XL); :func:`check_rate` checks a verification rate [Hz].
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import argparse
 import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.robot import Robot
 from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import as_scalar
 
@@ -49,14 +49,15 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
         default="paper",
         help="a shipped scene (paper, detour) or a scene TOML file (default: paper)",
     )
-    parser.add_argument("--start", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
-    parser.add_argument("--goal", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
+    parser.add_argument("--start", type=floats, help="q1,...,qn [rad|m] (default: the scene's)")
+    parser.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: the scene's)")
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     parser.add_argument(
         "--weights", type=floats, default=list(PAPER_WEIGHTS), help="w1,...,w6 for f_c"
     )
     parser.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
+    add_robot_arguments(parser)
     parser.add_argument(
         "--workers", type=int, default=1, help="processes evaluating in parallel (default 1)"
     )
@@ -75,7 +76,8 @@ def scene_from_argument(value: str) -> Scene:
 
 
 def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
-    """The problem the options describe, on the shipped AdeptOne XL.
+    """The problem the options describe, on the robot of
+    :func:`~adept_traj.cli.robot_options.robot_from_arguments` (default: the AdeptOne XL).
 
     ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights`` must be six
     finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
@@ -102,4 +104,6 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     if weights.sum() <= 0:
         raise InvalidInputError("--weights must not all be 0")
     check_rate(args.rate)
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal, workers=args.workers)
+    robot = robot_from_arguments(args, args.scene)
+    start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
+    return TrajectoryProblem(robot, scene, start, goal, workers=args.workers)

@@ -63,6 +63,7 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
     "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
+    "robot", "params", "tool_frame", "srdf", "package_dir",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
@@ -116,8 +117,10 @@ def _comparable(key: str, value: Any) -> Any:
     """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
     if value is None or (key == "scene" and value in SHIPPED_SCENES):
         return value
-    if key in ("scene", "ros"):
+    if key in ("scene", "ros", "robot", "params", "srdf"):
         return str(Path(value).resolve())
+    if key == "package_dir":
+        return [str(Path(v).resolve()) for v in value]
     if key in ("start", "goal", "weights"):
         return [float(x) for x in value]
     return value
@@ -177,8 +180,8 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
         if out is None:
             raise ConfigurationError("give --out DIR (or --resume DIR)")
         folder, options = out, {**args.plan_defaults, **given}
-        options["scene"] = _comparable("scene", options["scene"])
-        options["ros"] = _comparable("ros", options["ros"])
+        for key in ("scene", "ros", "robot", "params", "srdf", "package_dir"):
+            options[key] = _comparable(key, options[key])
     else:
         folder = resume
         if out is not None and out != folder:

@@ -2,21 +2,22 @@
 
 Peak joint speeds, accelerations and torques, the torques' ratio to their limits (the
 paper's UC), the integral of the squared torques (z2) and the manipulability range (z4)
-along a rest-to-rest quintic move of the paper's task or of the one given.
+along a rest-to-rest quintic move of the paper's task or of the one given; with ``--srdf``,
+the smallest self-collision distance along it (:class:`~adept_traj.collision.SelfCollision`).
 """
 
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
 from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
+from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
+from adept_traj.collision import SelfCollision
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
-from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 
 __all__ = ["add_parser", "run", "samples_bytes"]
@@ -37,8 +38,8 @@ def samples_bytes(n_samples: int, nq: int) -> int:
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``robot`` and its options."""
     p = sub.add_parser("robot", help="robot-model demo: torques and manipulability")
-    p.add_argument("--urdf", type=Path, help="URDF file (default: the AdeptOne XL)")
-    p.add_argument("--params", type=Path, help="parameter file for --urdf")
+    add_robot_arguments(p)
+    p.add_argument("--urdf", dest="robot", help="the same as --robot (older name)")
     p.add_argument("--start", type=floats, help="q1,...,qn [rad|m] (default: paper's)")
     p.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: paper's)")
     p.add_argument("--duration", type=float, default=1.1, help="move time T [s]")
@@ -60,12 +61,12 @@ def _quintic_move(
 
 def run(args: argparse.Namespace) -> int:
     """Run ``robot``; return the exit status (0)."""
-    robot = Robot.adept_one_xl() if args.urdf is None else Robot.from_urdf(args.urdf, args.params)
+    robot = robot_from_arguments(args)
     paper = Scene.paper()  # its [task]: the paper's start and goal (docs/paper-scenario.md)
-    start = robot.limits.check_position(
-        paper.start if args.start is None else args.start, "--start"
-    )
-    goal = robot.limits.check_position(paper.goal if args.goal is None else args.goal, "--goal")
+    start = check_task(robot, paper.start if args.start is None else args.start, "--start")
+    goal = check_task(robot, paper.goal if args.goal is None else args.goal, "--goal")
+    start = robot.limits.check_position(start, "--start")
+    goal = robot.limits.check_position(goal, "--goal")
     if not (np.isfinite(args.duration) and args.duration > 0):
         raise InvalidInputError(f"--duration must be a positive number [s]; got {args.duration}")
     if args.samples < 2:
@@ -93,4 +94,10 @@ def run(args: argparse.Namespace) -> int:
     if robot.task_rows is not None:
         w = robot.manipulability(q)
         print(f"  manipulability (paper z4): min {w.min():.5f}, max {w.max():.5f} [m²]")
+    check = SelfCollision(robot)
+    if robot.srdf_path is not None and len(check.pairs):  # --srdf: self-collision wanted
+        d = check.distances(q)  # (n, n_pairs)
+        k, p = np.unravel_index(int(np.argmin(d)), d.shape)
+        a, b = check.pair_names[p]
+        print(f"  self-collision: min distance {d[k, p]:.4f} m ({a}, {b}) at t = {t[k]:.3f} s")
     return status.OK

@@ -20,6 +20,7 @@ from adept_traj.collision.primitives import (
     distance_request,
     shape_of,
 )
+from adept_traj.collision.self_collision import SelfCollision
 
 __all__ = [
     "DISTANCE_TOLERANCE",
@@ -29,6 +30,7 @@ __all__ = [
     "DistanceTable",
     "MinDistances",
     "PairDistances",
+    "SelfCollision",
     "coal_kind",
     "distance_request",
     "point_signed_distance",

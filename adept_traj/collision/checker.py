@@ -112,6 +112,15 @@ class CollisionChecker:
         self.solid_names = tuple(g.name for g in objects)
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
         self._broad = BroadPhase(robot, scene, self.influence)
+        # Allowed contacts (scene.allowed_contacts: link, obstacle): never checked.
+        links = [robot.model.frames[g.parentFrame].name for g in objects]
+        self.allowed = np.array(
+            [
+                [(link, ob) in scene.allowed_contacts for ob in self.obstacle_names]
+                for link in links
+            ],
+            dtype=bool,
+        ).reshape(len(objects), len(self.obstacle_names))
         self._robot_geoms = [g.geometry for g in objects]
         self._functors = [
             [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
@@ -254,8 +263,9 @@ class CollisionChecker:
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)
         bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
-        lower = bounds.lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
-        known = bounds.exact.reshape(lower.shape)
+        lower = np.where(self.allowed, np.inf, bounds.lower)
+        lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
+        known = (bounds.exact | self.allowed).reshape(lower.shape)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
         where = np.full(best.shape, -1)
         closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
@@ -330,11 +340,12 @@ class CollisionChecker:
                         flat_d[:, k, o] = broad.static_distance[k, o]
                     elif broad.closed_form[k, o]:
                         flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
-            todo = ~(broad.static | broad.closed_form)[None] & known
+            todo = ~(broad.static | broad.closed_form | self.allowed)[None] & known
         else:
             bounds = broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
-            flat_d, known = bounds.lower, bounds.exact.copy()
+            flat_d, known = bounds.lower, bounds.exact | self.allowed
             todo = (flat_d <= self.influence) & ~known
+        flat_d[:, self.allowed] = np.inf
         samples, solids, obstacles = np.nonzero(todo)
         for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
             pose = self._broad.solid_poses(frames, n, s)

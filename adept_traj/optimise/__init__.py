@@ -32,6 +32,7 @@ from adept_traj.optimise.loop import (
 )
 from adept_traj.optimise.planner import (
     plan,
+    warn_missing_limits,
 )
 from adept_traj.optimise.polish import (
     PolishOutcome,
@@ -81,4 +82,5 @@ __all__ = [
     "save_checkpoint",
     "time_optimal",
     "time_optimal_run",
+    "warn_missing_limits",
 ]

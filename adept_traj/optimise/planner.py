@@ -30,6 +30,7 @@ Steps:
 from __future__ import annotations
 
 import json
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -66,9 +67,10 @@ from adept_traj.results.record import (
     PlanningResult,
     Timing,
 )
+from adept_traj.robot import JointLimits
 from adept_traj.validation import as_integer, check_type
 
-__all__ = ["plan"]
+__all__ = ["plan", "warn_missing_limits"]
 
 #: Size of the fallback front when nothing is feasible.
 _LEAST_INFEASIBLE = 10
@@ -163,6 +165,26 @@ def _certified_choice(
     return certify(problem, front.x[index], rate_hz=rate_hz), index
 
 
+def warn_missing_limits(robot: str, limits: JointLimits) -> None:
+    """Warn (a :class:`UserWarning`, shown once per robot and place by Python's default
+    filter) when joints have no acceleration or jerk limit: those constraints are then off,
+    and the certificate says "no limit" for them (``docs/your-robot.md``: how to set them
+    in a parameter file)."""
+    missing = []
+    for kind in ("acceleration", "jerk"):
+        free = [n for n, v in zip(limits.names, getattr(limits, kind)) if not np.isfinite(v)]
+        if free:
+            missing.append(f"no {kind} limit for joint(s) {', '.join(free)}")
+    if missing:
+        warnings.warn(
+            f"robot '{robot}': {'; '.join(missing)} (URDFs have none): those constraints are "
+            "off; give 'acceleration' and 'jerk' per [[joint]] in a parameter file "
+            "(docs/your-robot.md)",
+            UserWarning,
+            stacklevel=3,
+        )
+
+
 def plan(
     problem: TrajectoryProblem,
     algorithm: str = "nsga2",
@@ -213,6 +235,7 @@ def plan(
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     check_type(polish, bool, "polish")
+    warn_missing_limits(problem.robot.name, problem.robot.limits)
     if algorithm == TIME_OPTIMAL:
         state, settings_dict = time_optimal_run(problem, seed, **params)
         name = TIME_OPTIMAL

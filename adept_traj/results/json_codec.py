@@ -88,7 +88,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
         "format": FORMAT,
         "version": _version(r),
         "warning": r.warning,
-        "robot": dataclasses.asdict(r.robot) | {"joint_names": list(r.robot.joint_names)},
+        "robot": r.robot.as_json(),
         "start": _floats(r.start),
         "goal": _floats(r.goal),
         "seed": r.seed,
@@ -176,6 +176,7 @@ def _decode(top: Node) -> PlanningResult:
             f"unsupported version {version} (this adept_traj reads {readable})"
         )
     rob = top["robot"]
+    lock = rob["locked_joints"]
     robot = rob.build(
         RobotInfo,
         name=rob["name"].string(),
@@ -183,6 +184,11 @@ def _decode(top: Node) -> PlanningResult:
         urdf=rob["urdf"].string(),
         params=rob["params"].string(null=None, default=None),
         tool_frame=rob["tool_frame"].string(null=None, default=None),
+        package_dirs=rob["package_dirs"].strings(default=()),
+        srdf=rob["srdf"].string(default=None),
+        locked_joints={k: lock[k].number("[rad | m]") for k in lock.table()}
+        if lock.present
+        else {},
     )
     nq = len(robot.joint_names)
     ps = top["problem_settings"].check_keys([f.name for f in dataclasses.fields(ProblemSettings)])

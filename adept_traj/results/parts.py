@@ -10,9 +10,11 @@ computed" and becomes ``None``); bad input raises
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import platform
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +75,10 @@ class RobotInfo:
     params: parameter-file path, or ``None`` (no file, the shipped robot, or parameters
         given as an object, which cannot be recorded).
     tool_frame: the tool frame's name.
+    package_dirs: the folders where the URDF's ``package://`` meshes were found (absolute),
+        searched first when the robot is rebuilt (no ``ROS_PACKAGE_PATH`` needed).
+    locked_joints: joints fixed at a value [rad | m] (name → value).
+    srdf: the SRDF given (its ``disable_collisions`` pairs), or ``None``.
     """
 
     name: str
@@ -80,9 +86,15 @@ class RobotInfo:
     urdf: str
     params: str | None = None
     tool_frame: str | None = None
+    package_dirs: tuple[str, ...] = ()
+    locked_joints: Mapping[str, float] = field(default_factory=dict)
+    srdf: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "joint_names", tuple(str(n) for n in self.joint_names))
+        object.__setattr__(self, "package_dirs", tuple(str(p) for p in self.package_dirs))
+        locked = {str(k): float(v) for k, v in dict(self.locked_joints).items()}
+        object.__setattr__(self, "locked_joints", locked)
         if not self.joint_names:
             raise InvalidInputError("joint_names must not be empty")
 
@@ -99,14 +111,35 @@ class RobotInfo:
             urdf=urdf,
             params=params,
             tool_frame=robot.tool_frame,
+            package_dirs=tuple(str(p.resolve()) for p in robot.package_dirs),
+            locked_joints=robot.locked_joints,
+            srdf=None if robot.srdf_path is None else str(Path(robot.srdf_path).resolve()),
         )
+
+    def as_json(self) -> dict[str, Any]:
+        """The ``robot`` object of ``result.json``; ``package_dirs``, ``locked_joints`` and
+        ``srdf`` only when not empty (files written before them have neither, and must re-encode
+        to themselves)."""
+        out = dataclasses.asdict(self) | {
+            "joint_names": list(self.joint_names),
+            "package_dirs": list(self.package_dirs),
+        }
+        optional = ("package_dirs", "locked_joints", "srdf")
+        return {k: v for k, v in out.items() if v or k not in optional}
 
     def load(self) -> Robot:
         """Rebuild the robot (raises :class:`~adept_traj.errors.RobotModelError` when its
         files are gone)."""
         if self.urdf == SHIPPED_ROBOT:
             return Robot.adept_one_xl()
-        return Robot.from_urdf(self.urdf, self.params, tool_frame=self.tool_frame)
+        return Robot.from_urdf(
+            self.urdf,
+            self.params,
+            package_dirs=self.package_dirs,
+            tool_frame=self.tool_frame,
+            locked_joints=self.locked_joints or None,
+            srdf=self.srdf,
+        )
 
 
 def _is_shipped(robot: Robot) -> bool:

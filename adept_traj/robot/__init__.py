@@ -4,6 +4,14 @@ URDF + parameter file -> Pinocchio model, batched kinematics, joint limits, URDF
 
 from __future__ import annotations
 
+from adept_traj.robot.collision_meshes import (
+    HullReport,
+    convex_hull_solids,
+)
+from adept_traj.robot.forward_kinematics import (
+    place_solids,
+    solid_frames,
+)
 from adept_traj.robot.inertia import (
     MassProperties,
     box_inertia,
@@ -25,6 +33,12 @@ from adept_traj.robot.limits import (
 from adept_traj.robot.manipulability import (
     manipulability_measure,
 )
+from adept_traj.robot.package_paths import (
+    installed_data_dirs,
+    package_search_dirs,
+    resolve_package_file,
+    resolve_package_uris,
+)
 from adept_traj.robot.parameter_file import (
     TASK_ROWS,
     FrameParameters,
@@ -45,12 +59,16 @@ from adept_traj.robot.urdf_builder import (
     solid_inertia,
 )
 from adept_traj.robot.urdf_loading import (
+    CONTINUOUS_RANGE,
     apply_parameters,
+    coordinate_joints,
     load_urdf_models,
+    read_srdf_disabled_pairs,
     shipped_file,
 )
 
 __all__ = [
+    "CONTINUOUS_RANGE",
     "LIMITS",
     "LIMIT_KINDS",
     "TASK_ROWS",
@@ -58,6 +76,7 @@ __all__ = [
     "BatchKinematics",
     "ForwardKinematics",
     "FrameParameters",
+    "HullReport",
     "JointLimits",
     "JointParameters",
     "LimitKind",
@@ -71,13 +90,22 @@ __all__ = [
     "build_urdf",
     "combine",
     "compose",
+    "convex_hull_solids",
+    "coordinate_joints",
     "coulomb_sign",
     "cylinder_inertia",
     "frames_to_poses",
+    "installed_data_dirs",
     "link_mass_properties",
     "load_urdf_models",
     "manipulability_measure",
+    "package_search_dirs",
+    "place_solids",
+    "read_srdf_disabled_pairs",
+    "resolve_package_file",
+    "resolve_package_uris",
     "shipped_file",
+    "solid_frames",
     "solid_inertia",
     "sphere_inertia",
 ]

@@ -4,8 +4,10 @@ Pinocchio's Python API works one configuration per call (≈ 1.4 µs plus Python
 a planner evaluates 10⁴–10⁶ configurations per generation. :class:`BatchKinematics` reads
 the joint placements and axes of a Pinocchio model once and then evaluates whole
 ``(..., nq)`` batches with a few array operations per joint. It supports trees of 1-DoF
-revolute and prismatic joints (any axis), which covers serial industrial arms; other joint
-types raise :class:`~adept_traj.errors.RobotModelError`. Tests check it against Pinocchio.
+revolute and prismatic joints (any axis), which covers serial industrial arms, and mimic
+joints of those (:math:`q_i = m\\,q_\text{leader} + o`, Pinocchio's ``JointModelMimic``);
+other joint types raise :class:`~adept_traj.errors.RobotModelError`. Tests check it against
+Pinocchio.
 
 Conventions: world = the robot base frame (Pinocchio's universe); poses ``(..., 4, 4)``;
 Jacobians ``(..., 6, nq)`` with rows (v_x, v_y, v_z, ω_x, ω_y, ω_z) of the frame origin,
@@ -31,6 +33,8 @@ class _Joint:
     axis: np.ndarray  # (3,) unit, in the joint frame
     revolute: bool
     index: int  # index in q
+    scale: float = 1.0  # joint value = scale · q[index] + offset (mimic joints)
+    offset: float = 0.0
 
 
 def _rotation_to_axis(axis: np.ndarray) -> np.ndarray:
@@ -60,29 +64,17 @@ class BatchKinematics:
         joints: list[_Joint] = []
         for i in range(1, model.njoints):
             jm = model.joints[i]
+            if jm.shortname() == "JointModelMimic":
+                joints.append(_mimic_joint(model, i))
+                continue
             if jm.nq != 1 or jm.nv != 1:
                 raise RobotModelError(
                     f"joint '{model.names[i]}' is a {jm.shortname()} (nq={jm.nq}, nv={jm.nv}); "
-                    "only 1-DoF revolute and prismatic joints are supported"
+                    "only 1-DoF revolute and prismatic joints (and mimics of them) are supported"
                 )
             # The joint's motion subspace in its own frame: [v; ω] = [axis; 0] or [0; axis].
             s = pin.getJointJacobian(model, data, i, pin.LOCAL)[:, jm.idx_v]
-            lin, ang = np.linalg.norm(s[:3]), np.linalg.norm(s[3:])
-            revolute = ang > 0.5
-            if not (np.isclose(max(lin, ang), 1.0) and min(lin, ang) < 1e-12):
-                raise RobotModelError(
-                    f"joint '{model.names[i]}' ({jm.shortname()}) is neither a pure revolute "
-                    "nor a pure prismatic joint"
-                )
-            joints.append(
-                _Joint(
-                    parent=model.parents[i],
-                    placement=model.jointPlacements[i].homogeneous.copy(),
-                    axis=(s[3:] if revolute else s[:3]).copy(),
-                    revolute=bool(revolute),
-                    index=jm.idx_q,
-                )
-            )
+            joints.append(_one_dof_joint(model, i, s))
         self._joints = tuple(joints)
         # Revolute: T = P U Rz(q) U^T with U e_z = axis (pre = P U, post = U^T or None).
         self._pre, self._post = [], []
@@ -99,9 +91,12 @@ class BatchKinematics:
         self.nq = model.nq
         #: ``support[i, k]`` is true when q_k moves joint frame i (row 0 = universe).
         self.support = np.zeros((model.njoints, model.nq), dtype=bool)
+        #: ``ancestor[i, k]`` is true when joint k moves joint frame i (k = i included).
+        self._ancestor = np.eye(model.njoints, dtype=bool)
         for i, j in enumerate(joints, start=1):
             self.support[i] = self.support[j.parent]
             self.support[i, j.index] = True
+            self._ancestor[i] |= self._ancestor[j.parent]
         self.revolute = np.array([j.revolute for j in joints])
         #: Unit axis (njoints - 1, 3) of every joint in its own frame.
         self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
@@ -130,7 +125,11 @@ class BatchKinematics:
         for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
             a = compose(frames[j.parent], pre)
             dst = frames[i]
-            qi = qf[:, j.index]
+            qi = (
+                qf[:, j.index]
+                if j.scale == 1.0 and j.offset == 0.0
+                else j.scale * qf[:, j.index] + j.offset
+            )
             if j.revolute:
                 c, s = np.cos(qi), np.sin(qi)
                 dst[:, 0] = c * a[:, 0] + s * a[:, 1]
@@ -171,18 +170,62 @@ class BatchKinematics:
         n = frames.shape[-1]
         jac = np.zeros((6, self.nq, n))
         for i, j in enumerate(self._joints, start=1):
-            if not self.support[point_joint, j.index]:
+            if not self._ancestor[point_joint, i]:  # (a mimic shares its leader's index)
                 continue
             z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
+            z = z if j.scale == 1.0 else j.scale * z  # a mimic moves scale × its leader
             if j.revolute:
                 r = point - frames[i, :, 3]
-                jac[0, j.index] = z[1] * r[2] - z[2] * r[1]  # z × r
-                jac[1, j.index] = z[2] * r[0] - z[0] * r[2]
-                jac[2, j.index] = z[0] * r[1] - z[1] * r[0]
-                jac[3:, j.index] = z
+                jac[0, j.index] += z[1] * r[2] - z[2] * r[1]  # z × r
+                jac[1, j.index] += z[2] * r[0] - z[0] * r[2]
+                jac[2, j.index] += z[0] * r[1] - z[1] * r[0]
+                jac[3:, j.index] += z
             else:
-                jac[:3, j.index] = z
+                jac[:3, j.index] += z
         return jac
+
+
+def _one_dof_joint(model: pin.Model, i: int, s: np.ndarray) -> _Joint:
+    """Joint ``i`` of ``model`` (1-DoF) from its motion subspace ``s`` (6,) in its frame."""
+    lin, ang = np.linalg.norm(s[:3]), np.linalg.norm(s[3:])
+    revolute = ang > 0.5
+    if not (np.isclose(max(lin, ang), 1.0) and min(lin, ang) < 1e-12):
+        raise RobotModelError(
+            f"joint '{model.names[i]}' ({model.joints[i].shortname()}) is neither a pure "
+            "revolute nor a pure prismatic joint"
+        )
+    return _Joint(
+        parent=model.parents[i],
+        placement=model.jointPlacements[i].homogeneous.copy(),
+        axis=(s[3:] if revolute else s[:3]).copy(),
+        revolute=bool(revolute),
+        index=model.joints[i].idx_q,
+    )
+
+
+def _mimic_joint(model: pin.Model, i: int) -> _Joint:
+    """Mimic joint ``i``: its axis from its motion between two values of its leader (the
+    logarithm of the joint motion divided by the change of the joint value)."""
+    mimic = model.joints[i].extract()
+    data = model.createData()
+    motions = []
+    for leader in (0.0, 0.5):
+        q = pin.neutral(model)
+        q[mimic.idx_q] = leader
+        pin.forwardKinematics(model, data, q)
+        motion = model.jointPlacements[i].inverse() * data.liMi[i]
+        motions.append(pin.log6(motion).vector)
+    s = (motions[1] - motions[0]) / (0.5 * mimic.scaling)
+    joint = _one_dof_joint(model, i, s)
+    return _Joint(
+        joint.parent,
+        joint.placement,
+        joint.axis,
+        joint.revolute,
+        mimic.idx_q,
+        scale=float(mimic.scaling),
+        offset=float(mimic.offset),
+    )
 
 
 def compose(frames: np.ndarray, transform: np.ndarray) -> np.ndarray:

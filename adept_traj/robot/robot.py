@@ -14,20 +14,26 @@ AdeptOne XL they are exactly the DH variables (θ1, θ2, d3, θ4) of the paper's
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
-from functools import cached_property
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
+from adept_traj.robot.collision_meshes import HullReport, convex_hull_solids
+from adept_traj.robot.forward_kinematics import ForwardKinematics, place_solids, solid_frames
 from adept_traj.robot.kinematics import BatchKinematics, compose, frames_to_poses
 from adept_traj.robot.limits import JointLimits
 from adept_traj.robot.manipulability import manipulability_measure
+from adept_traj.robot.package_paths import resolve_package_file
 from adept_traj.robot.parameter_file import TASK_ROWS, RobotParameters
-from adept_traj.robot.urdf_loading import apply_parameters, load_urdf_models, shipped_file
+from adept_traj.robot.urdf_loading import (
+    apply_parameters,
+    load_urdf_models,
+    read_srdf_disabled_pairs,
+    shipped_file,
+)
 from adept_traj.validation import as_batch
 
 __all__ = [
@@ -45,54 +51,6 @@ VELOCITY_AT_REST = 1e-9
 _PARALLEL_MIN_BATCH = 16
 
 
-@dataclass(frozen=True)
-class ForwardKinematics:
-    """Everything the planner needs from one forward-kinematics pass over ``q`` (..., nq).
-
-    Attributes
-    ----------
-    joint_frames: (njoints, 3, 4, N) joint frames in the base frame, component-major
-        (:meth:`~adept_traj.robot.kinematics.BatchKinematics.joint_frames`; N = ∏ ``...``).
-    joint_poses: (..., njoints, 4, 4) the same as poses (index 0 = universe; formed on
-        first access).
-    tool_pose: (..., 4, 4) tool frame in the base frame.
-    manipulability: (...) as :meth:`Robot.manipulability` [m² for the SCARA], or ``None``
-        when the robot has no task rows.
-    geometry_poses: (..., n_geom, 4, 4) collision solids in the base frame (computed on
-        first access: the collision checker works from the joint poses and forms solid
-        poses only near obstacles).
-    """
-
-    joint_frames: np.ndarray
-    tool_pose: np.ndarray
-    manipulability: np.ndarray | None
-    #: (parent joint per solid (n_geom,), solid placements in them (n_geom, 4, 4)).
-    solid_frames: tuple[np.ndarray, np.ndarray] = field(repr=False)
-
-    @cached_property
-    def joint_poses(self) -> np.ndarray:
-        return frames_to_poses(self.joint_frames, self.tool_pose.shape[:-2])
-
-    @cached_property
-    def geometry_poses(self) -> np.ndarray:
-        return place_solids(self.joint_poses, self.solid_frames)
-
-
-def solid_frames(gm: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
-    """(parent joint of each object (n_geom,), its placement in that joint's frame
-    (n_geom, 4, 4)) of a geometry model."""
-    parents = np.array([g.parentJoint for g in gm.geometryObjects], dtype=int)
-    local = np.array([g.placement.homogeneous for g in gm.geometryObjects]).reshape(-1, 4, 4)
-    return parents, local
-
-
-def place_solids(joint_poses: np.ndarray, frames: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-    """Poses (..., n_geom, 4, 4) of the objects of :func:`solid_frames` ``frames`` for joint
-    poses (..., njoints, 4, 4)."""
-    parents, local = frames
-    return joint_poses[..., parents, :, :] @ local
-
-
 class Robot:
     """A serial robot: Pinocchio model, collision model, limits and batched evaluations.
 
@@ -108,7 +66,8 @@ class Robot:
     collision_model : pinocchio.GeometryModel
         The link solids, named ``"<link>/<solid>"`` when the URDF names its collisions.
     visual_model : pinocchio.GeometryModel
-        The visual geometry (same solids for the AdeptOne XL), for display.
+        The visual geometry (same solids for the AdeptOne XL), for display (given, or read
+        on first access by a loader given instead).
     limits : JointLimits
         Position, velocity, acceleration, jerk and torque limits (``inf`` when unknown).
     tool_frame : str
@@ -116,27 +75,46 @@ class Robot:
     task_rows : tuple of str or None
         Rows of the tool Jacobian (among ``vx vy vz wx wy wz``) used by
         :meth:`manipulability`.
+    package_dirs : tuple of pathlib.Path
+        The folders where the URDF's ``package://`` meshes were found (recorded in results).
+    locked_joints : dict
+        Joints fixed at a value [rad | m] (name → value), removed from q.
+    srdf_path : pathlib.Path or None
+        The SRDF given (its ``disable_collisions`` pairs: :attr:`disabled_pairs`).
+    mesh_hulls : tuple of HullReport
+        The collision meshes replaced by their convex hulls (see
+        :mod:`adept_traj.robot.collision_meshes`).
     """
 
     def __init__(
         self,
         model: pin.Model,
         collision_model: pin.GeometryModel,
-        visual_model: pin.GeometryModel,
+        visual_model: pin.GeometryModel | Callable[[], pin.GeometryModel],
         limits: JointLimits,
         tool_frame: str,
         task_rows: tuple[str, ...] | None,
         name: str,
         urdf_path: Path | None = None,
         params_path: Path | None = None,
-    ) -> None:
+        *,
+        package_dirs: Sequence[Path] = (),
+        locked_joints: Mapping[str, float] | None = None,
+        mesh_hulls: tuple[HullReport, ...] = (),
+        srdf_path: Path | None = None,
+    ) -> None:  # the keyword-only arguments: see the class attributes
         self.model = model
         self.collision_model = collision_model
-        self.visual_model = visual_model
+        self._visual_model = visual_model
         self.limits = limits
         self.name = name
         self.urdf_path = urdf_path
         self.params_path = params_path
+        self.package_dirs = tuple(Path(p) for p in package_dirs)
+        self.locked_joints = dict(locked_joints or {})
+        self.mesh_hulls = tuple(mesh_hulls)
+        self.srdf_path = srdf_path  # its pairs are excluded from self-collision checks
+        self.disabled_pairs = () if srdf_path is None else read_srdf_disabled_pairs(srdf_path)
         if not model.existFrame(tool_frame):
             frames = [f.name for f in model.frames]
             raise RobotModelError(f"robot '{name}': no frame '{tool_frame}'; frames are {frames}")
@@ -166,7 +144,10 @@ class Robot:
         urdf: str | Path,
         params: str | Path | RobotParameters | None = None,
         *,
+        package_dirs: Sequence[str | Path] = (),
+        srdf: str | Path | None = None,
         tool_frame: str | None = None,
+        locked_joints: Mapping[str, float] | None = None,
         task_rows: Sequence[str] | None = None,
     ) -> Robot:
         """Load a robot from a URDF file and an optional parameter file.
@@ -174,15 +155,27 @@ class Robot:
         Parameters
         ----------
         urdf:
-            Path of the URDF. Its ``<inertial>``, ``<limit>`` and ``<dynamics damping
-            friction>`` give masses, position/velocity/torque (URDF: effort) limits and friction.
+            Path of the URDF, or a ``package://pkg/path`` URI (found like its meshes).
+            Its ``<inertial>``, ``<limit>`` and ``<dynamics damping friction>`` give masses,
+            position/velocity/torque (URDF: effort) limits and friction.
         params:
             Optional parameter file (TOML path or :class:`RobotParameters`): acceleration
             and jerk limits, rotor inertia × gear ratio² (→ ``model.armature``), and
             overrides of any URDF joint value. See :mod:`adept_traj.robot.parameter_file`.
+        package_dirs:
+            Folders searched first for ``package://`` meshes (then ``ROS_PACKAGE_PATH``,
+            then installed robot data; :mod:`adept_traj.robot.package_paths`).
+        srdf:
+            Optional SRDF: its ``disable_collisions`` link pairs are left out of the
+            self-collision check (:class:`~adept_traj.collision.SelfCollision`).
         tool_frame:
             Tool frame name; default: the parameter file's ``tool_frame``, else the last
-            frame of the model.
+            frame of the model. An unknown name is refused with the list of frames.
+        locked_joints:
+            Joints fixed at a value [rad | m] (name → value), removed from q. Continuous
+            joints have one angle coordinate; mimic joints follow their leader and have none
+            (:mod:`adept_traj.robot.urdf_loading`). Collision meshes become their convex
+            hulls (:mod:`adept_traj.robot.collision_meshes`).
         task_rows:
             Jacobian rows for :meth:`manipulability`; default: the parameter file's, else
             all six rows for robots with ≥ 6 joints.
@@ -193,8 +186,9 @@ class Robot:
             Missing or malformed URDF or parameter file, unsupported joint types, a
             parameter file naming a joint the URDF does not have, an unknown tool frame.
         """
-        path = Path(urdf)
-        name, model, collision, visual = load_urdf_models(path)
+        path = resolve_package_file(str(urdf), package_dirs)
+        name, model, collision, visual, dirs = load_urdf_models(path, package_dirs, locked_joints)
+        hulls = convex_hull_solids(collision, path)
 
         if params is not None and not isinstance(params, RobotParameters):
             params_path: Path | None = Path(params)
@@ -220,9 +214,20 @@ class Robot:
             name=name,
             urdf_path=path,
             params_path=params_path,
+            package_dirs=dirs,
+            locked_joints=locked_joints,
+            mesh_hulls=hulls,
+            srdf_path=None if srdf is None else Path(srdf),
         )
 
     # ------------------------------------------------------------------ basic facts
+    @property
+    def visual_model(self) -> pin.GeometryModel:
+        """The visual geometry (read on first access when a loader was given)."""
+        if callable(self._visual_model):
+            self._visual_model = self._visual_model()
+        return self._visual_model
+
     @property
     def tool_frame(self) -> str:
         """Name of the tool frame (fixed at construction; build another Robot to change it)."""

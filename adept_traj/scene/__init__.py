@@ -18,6 +18,7 @@ from adept_traj.scene.scene import (
 from adept_traj.scene.scene_file import (
     SHIPPED_SCENES,
     read_paper_scene,
+    read_robot_files,
     read_scene_file,
     read_shipped_scene,
     scene_from_dict,
@@ -52,6 +53,7 @@ __all__ = [
     "coal_transform",
     "pendulum_obstacles",
     "read_paper_scene",
+    "read_robot_files",
     "read_scene_file",
     "read_shipped_scene",
     "scene_from_dict",

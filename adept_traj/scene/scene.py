@@ -179,6 +179,8 @@ class Scene(_ValueObject):
             [rad for revolute, m for prismatic joints]; given together with ``goal``.
         goal: optional (nq,) default goal configuration, same length as ``start``.
         name: the scene's name.
+        allowed_contacts: ``(robot link, obstacle)`` name pairs never checked (a floor under
+            the base): the link's solids and the obstacle count as always clear.
 
     Array-like inputs are copied into new read-only arrays.
     """
@@ -188,6 +190,7 @@ class Scene(_ValueObject):
     start: np.ndarray | None = None
     goal: np.ndarray | None = None
     name: str = "scene"
+    allowed_contacts: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -222,6 +225,14 @@ class Scene(_ValueObject):
                 raise SceneError(
                     f"start and goal must have the same length; got {start.size} and {goal.size}"
                 )
+        allowed = tuple((str(a), str(b)) for a, b in self.allowed_contacts)
+        unknown = sorted({b for _, b in allowed} - seen)
+        if unknown:
+            raise SceneError(
+                f"allowed_contacts name obstacle(s) {unknown} the scene does not have; its "
+                f"obstacles are {sorted(seen)}"
+            )
+        object.__setattr__(self, "allowed_contacts", allowed)
         object.__setattr__(self, "obstacles", obstacles)
         object.__setattr__(self, "robot_base", readonly_copy(base))
         object.__setattr__(self, "start", start)

@@ -38,6 +38,7 @@ from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
 __all__ = [
     "SHIPPED_SCENES",
     "read_paper_scene",
+    "read_robot_files",
     "read_scene_file",
     "read_shipped_scene",
     "scene_from_dict",
@@ -72,6 +73,33 @@ def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
     return _parse_scene(data, str(p), p.stem or "scene")
+
+
+def read_robot_files(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The robot a scene file's ``[robot]`` table names: ``{"urdf", "params", "tool_frame",
+    "package_dirs"}`` (each ``None`` or ``()`` when not given; file and folder paths relative
+    to the scene file's folder; ``urdf`` may be a ``package://`` URI). The scene itself
+    does not keep them (a :class:`~adept_traj.scene.Scene` is obstacles and the base pose);
+    the command line loads that robot.
+
+    Raises the errors of :func:`read_scene_file`.
+    """
+    p = Path(path)
+    data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
+    _parse_scene(data, str(p), p.stem or "scene")  # the whole file is checked
+    robot = Node(data, str(p), _ERROR)["robot"]
+    if not robot.present:
+        return {"urdf": None, "params": None, "tool_frame": None, "package_dirs": ()}
+
+    def here(text: str | None) -> Path | str | None:
+        return text if text is None or text.startswith("package://") else p.parent / text
+
+    return {
+        "urdf": here(robot["urdf"].string(nonempty=True, default=None)),
+        "params": here(robot["params"].string(nonempty=True, default=None)),
+        "tool_frame": robot["tool_frame"].string(nonempty=True, default=None),
+        "package_dirs": tuple(p.parent / d for d in robot["package_dirs"].strings(default=())),
+    }
 
 
 def read_shipped_scene(name: str) -> Scene:
@@ -118,6 +146,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     out["robot"] = {"xyz": _floats(xyz), "rpy": _floats(rpy)}
     if scene.start is not None and scene.goal is not None:
         out["task"] = {"start": _floats(scene.start), "goal": _floats(scene.goal)}
+    if scene.allowed_contacts:
+        out["allowed_contacts"] = [list(pair) for pair in scene.allowed_contacts]
     obstacles: list[dict[str, Any]] = []
     pendulums: list[dict[str, Any]] = []
     by_name = {ob.name: ob for ob in scene.obstacles}
@@ -231,8 +261,8 @@ def _pendulum_dict(
 
 #: Errors of a scene file: SceneError naming the source (file) and the field path.
 _ERROR = error_factory(SceneError)
-_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum")
-_ROBOT_KEYS = ("xyz", "rpy")
+_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "allowed_contacts")
+_ROBOT_KEYS = ("xyz", "rpy", "urdf", "params", "tool_frame", "package_dirs")
 _TASK_KEYS = ("start", "goal")
 _SHAPE_KEYS = {
     "box": ("size", "min", "max"),
@@ -329,6 +359,17 @@ def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
         obstacles.append(_parse_obstacle(entry_name, node))
     for entry_name, node in top["pendulum"].named_tables():
         obstacles.extend(_parse_pendulum(entry_name, node))
+    allowed = tuple(
+        tuple(n.strings(min_items=2)) for n in top["allowed_contacts"].items(default=[])
+    )
+    if any(len(pair) != 2 for pair in allowed):
+        raise top["allowed_contacts"].error("must hold [link, obstacle] pairs of names")
     return top.build(
-        Scene, obstacles=tuple(obstacles), robot_base=base, start=start, goal=goal, name=name
+        Scene,
+        obstacles=tuple(obstacles),
+        robot_base=base,
+        start=start,
+        goal=goal,
+        name=name,
+        allowed_contacts=allowed,
     )
