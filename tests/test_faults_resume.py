@@ -221,8 +221,8 @@ def test_resume_refuses_options_that_differ_from_the_run(
 
 
 def test_resume_accepts_the_run_s_own_options(in_progress: Path, reference: Path) -> None:
-    """Options given again with the run's values (1 is --workers' default: given all the
-    same) are accepted; scene paths compare as absolute paths."""
+    """Options given again with the run's values (and --workers, free on resume) are
+    accepted; scene paths compare as absolute paths."""
     argv = ["plan", "--resume", str(in_progress), "--pop", "8", "--seed", "1", "--no-plots"]
     assert main([*argv, "--no-html", "--workers", "1", "--scene", "paper", "--quiet"]) == 0
     _assert_same_run(in_progress, reference)

@@ -14,7 +14,7 @@ import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import TrajectoryProblem, available_cores
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 from adept_traj.validation import as_scalar
@@ -43,7 +43,8 @@ def floats(text: str) -> list[float]:
 
 def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
-    workers and ``--quiet``."""
+    workers (default ``None``: :func:`~adept_traj.problem.available_cores`) and
+    ``--quiet``."""
     parser.add_argument("--scene", default="paper", help="'paper' or a scene TOML file")
     parser.add_argument("--start", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
     parser.add_argument("--goal", type=floats, help="q1,...,q4 [rad|m] (default: the scene's)")
@@ -54,7 +55,10 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     parser.add_argument(
-        "--workers", type=int, default=1, help="processes evaluating in parallel (default 1)"
+        "--workers",
+        type=int,
+        help="processes evaluating in parallel (default: the cores available to the process; "
+        "1 evaluates in the main process; the results are the same)",
     )
 
 
@@ -92,4 +96,5 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     if weights.sum() <= 0:
         raise InvalidInputError("--weights must not all be 0")
     check_rate(args.rate)
-    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal, workers=args.workers)
+    workers = available_cores() if args.workers is None else args.workers
+    return TrajectoryProblem(Robot.adept_one_xl(), scene, start, goal, workers=workers)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
-from adept_traj.problem.evaluator import ParallelEvaluator
+from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
 from adept_traj.problem.objectives import (
     MAXIMISED,
     OBJECTIVE_NAMES,
@@ -43,6 +43,7 @@ __all__ = [
     "TrajectoryIntegrals",
     "TrajectoryProblem",
     "TrajectorySamples",
+    "available_cores",
     "from_pymoo",
     "kinematic_lower_bound",
     "paper_penalty",
