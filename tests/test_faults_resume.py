@@ -81,9 +81,10 @@ def _interrupted(how: str, where: str, n: int, argv: list[str]) -> subprocess.Co
 
 
 def _comparable_result(folder: Path) -> dict:
-    """``result.json`` without what depends on the wall clock."""
+    """``result.json`` without what depends on the wall clock, nor the number of workers
+    (free on resume, and it changes no other number)."""
     result = json.loads((folder / "result.json").read_text())
-    del result["timing"]
+    del result["timing"], result["problem_settings"]["workers"]
     del result["metrics"]["OO"], result["metrics"]["AE"]
     return result
 
