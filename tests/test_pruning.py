@@ -10,8 +10,7 @@ import pinocchio as pin
 import pytest
 
 from adept_traj import Box, FixedPose, Obstacle, Robot, Scene
-from adept_traj.collision import CollisionChecker
-from adept_traj.collision.pruning import ObstaclePruning, sweep_clearance
+from adept_traj.collision import CollisionChecker, ObstaclePruning, sweep_clearance
 from adept_traj.problem import TrajectoryProblem
 
 INFLUENCE = 0.05

@@ -1,7 +1,8 @@
 """Robot-obstacle distances over time.
 
-The checker, the conservative broad phase, distance tables, closed-form point distances and
-the coal primitives (``distance_request``: the settings every distance uses).
+The checker, the conservative broad phase, obstacle pruning, distance tables, closed-form
+point distances and the coal primitives (``distance_request``: the settings every distance
+uses).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from adept_traj.collision.primitives import (
     distance_request,
     shape_of,
 )
+from adept_traj.collision.pruning import ObstaclePruning, restrict_broad_phase, sweep_clearance
 
 __all__ = [
     "DISTANCE_TOLERANCE",
@@ -28,9 +30,12 @@ __all__ = [
     "CollisionChecker",
     "DistanceTable",
     "MinDistances",
+    "ObstaclePruning",
     "PairDistances",
     "coal_kind",
     "distance_request",
     "point_signed_distance",
+    "restrict_broad_phase",
     "shape_of",
+    "sweep_clearance",
 ]

@@ -26,7 +26,7 @@ import numpy as np
 
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.primitives import distance_request
-from adept_traj.collision.pruning import ObstaclePruning, restricted
+from adept_traj.collision.pruning import ObstaclePruning, restrict_broad_phase
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
@@ -278,7 +278,7 @@ class CollisionChecker:
         view = self._views.get(key)
         if view is None:
             view = copy.copy(self)
-            view._broad = restricted(self._broad, keep)
+            view._broad = restrict_broad_phase(self._broad, keep)
             view._functors = [[row[o] for o in key] for row in self._functors]
             view.obstacle_names = tuple(self.obstacle_names[o] for o in key)
             obstacles = tuple(self.scene.obstacles[o] for o in key)

@@ -43,7 +43,7 @@ from adept_traj.scene.scene import Scene
 if TYPE_CHECKING:
     from adept_traj.collision.broad_phase import BroadPhase
 
-__all__ = ["ObstaclePruning", "restricted", "sweep_clearance"]
+__all__ = ["ObstaclePruning", "restrict_broad_phase", "sweep_clearance"]
 
 
 class ObstaclePruning:
@@ -106,7 +106,7 @@ class ObstaclePruning:
         return np.flatnonzero((~(bounds > self.influence)).any(axis=0))
 
 
-def restricted(broad: BroadPhase, obstacles: np.ndarray) -> BroadPhase:
+def restrict_broad_phase(broad: BroadPhase, obstacles: np.ndarray) -> BroadPhase:
     """A view of ``broad`` on the obstacles of index ``obstacles`` (n,) only, in that order
     (its solids, tables and static distances shared, nothing recomputed)."""
     keep = np.asarray(obstacles, dtype=int)
