@@ -67,16 +67,19 @@ def machine() -> str:
                 break
     except OSError:
         pass
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     return (
         f"{model}; {available_cores()} cores available of {os.cpu_count()}; "
-        f"Python {platform.python_version()}; {platform.system()} {platform.release()}"
+        f"Python {platform.python_version()}; {platform.system()} {platform.release()}; "
+        f"load average at start {load} (other jobs on the machine slow every figure)"
     )
 
 
 def command() -> list[str]:
-    """How a user starts ``adept-traj``."""
-    script = shutil.which("adept-traj")
-    return [script] if script else [sys.executable, "-m", "adept_traj.cli"]
+    """How a user starts ``adept-traj``: the console script beside this Python (a pyenv
+    shim on the PATH would add its own start-up), else ``python -m adept_traj.cli``."""
+    script = Path(sys.executable).parent / "adept-traj"
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "adept_traj.cli"]
 
 
 def wall(argv: list[str]) -> float:
