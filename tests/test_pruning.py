@@ -57,7 +57,7 @@ def _coal_min(robot: Robot, scene: Scene, q: np.ndarray) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_pruned_obstacles_are_beyond_influence_by_coal(robot: Robot, seed: int) -> None:
     """Random cells of 25 boxes, random motions: every obstacle reported as pruned (a
     bound above influence, no sample) is farther than that bound at every sample (coal);
@@ -91,7 +91,7 @@ def test_pruning_changes_no_evaluation(robot: Robot, monkeypatch: pytest.MonkeyP
         goal=paper.goal,
     )
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
-    x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(40, problem.n_var))
+    x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(20, problem.n_var))
     kept, fewer = ObstaclePruning.kept, []
 
     def spy(self: ObstaclePruning, bounds: np.ndarray) -> np.ndarray:
