@@ -6,51 +6,56 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
-from importlib import metadata as _metadata
+import importlib as _importlib
+from typing import Any as _Any
 
-from adept_traj.analysis.certificate import Certificate, certify
-from adept_traj.analysis.decision import (
-    PAPER_WEIGHTS,
-    average_fitness,
-    best_tradeoff,
-    combined_objective,
-)
-from adept_traj.collision.checker import CollisionChecker
-from adept_traj.errors import (
-    AdeptTrajError,
-    ConfigurationError,
-    InputShapeError,
-    InvalidInputError,
-    JointLimitError,
-    PlanningInterrupted,
-    ResultFormatError,
-    RobotModelError,
-    SceneError,
-)
-from adept_traj.optimise.algorithms import ALGORITHMS, make_algorithm
-from adept_traj.optimise.planner import plan
-from adept_traj.problem import (
-    BSplineTrajectory,
-    Evaluation,
-    KinematicBound,
-    ProblemSettings,
-    TrajectoryProblem,
-    kinematic_lower_bound,
-    paper_penalty,
-)
-from adept_traj.results.audit import audit
-from adept_traj.results.record import PlanningResult
-from adept_traj.robot.limits import JointLimits
-from adept_traj.robot.parameter_file import RobotParameters
-from adept_traj.robot.robot import ForwardKinematics, Robot
-from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
-from adept_traj.scene.scene import Obstacle, Scene
-from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere
-
-try:  # the installed distribution's version (pyproject.toml), one source of truth
-    __version__ = _metadata.version("adept-traj")
-except _metadata.PackageNotFoundError:  # a source checkout that was never installed
-    __version__ = "0+unknown"
+#: Where each public name lives: imported on first use (PEP 562), so that ``import
+#: adept_traj`` (and ``adept-traj --help``) loads none of pinocchio, coal, pymoo or scipy
+#: before a name that needs them is used.
+_PUBLIC = {
+    "Certificate": "adept_traj.analysis.certificate",
+    "certify": "adept_traj.analysis.certificate",
+    "PAPER_WEIGHTS": "adept_traj.analysis.decision",
+    "average_fitness": "adept_traj.analysis.decision",
+    "best_tradeoff": "adept_traj.analysis.decision",
+    "combined_objective": "adept_traj.analysis.decision",
+    "CollisionChecker": "adept_traj.collision.checker",
+    "AdeptTrajError": "adept_traj.errors",
+    "ConfigurationError": "adept_traj.errors",
+    "InputShapeError": "adept_traj.errors",
+    "InvalidInputError": "adept_traj.errors",
+    "JointLimitError": "adept_traj.errors",
+    "PlanningInterrupted": "adept_traj.errors",
+    "ResultFormatError": "adept_traj.errors",
+    "RobotModelError": "adept_traj.errors",
+    "SceneError": "adept_traj.errors",
+    "ALGORITHMS": "adept_traj.optimise.algorithms",
+    "make_algorithm": "adept_traj.optimise.algorithms",
+    "plan": "adept_traj.optimise.planner",
+    "BSplineTrajectory": "adept_traj.problem",
+    "Evaluation": "adept_traj.problem",
+    "KinematicBound": "adept_traj.problem",
+    "ProblemSettings": "adept_traj.problem",
+    "TrajectoryProblem": "adept_traj.problem",
+    "kinematic_lower_bound": "adept_traj.problem",
+    "paper_penalty": "adept_traj.problem",
+    "audit": "adept_traj.results.audit",
+    "PlanningResult": "adept_traj.results.record",
+    "JointLimits": "adept_traj.robot.limits",
+    "RobotParameters": "adept_traj.robot.parameter_file",
+    "ForwardKinematics": "adept_traj.robot.forward_kinematics",
+    "Robot": "adept_traj.robot.robot",
+    "FixedPose": "adept_traj.scene.motion_laws",
+    "MotionLaw": "adept_traj.scene.motion_laws",
+    "PendulumMotion": "adept_traj.scene.motion_laws",
+    "Obstacle": "adept_traj.scene.scene",
+    "Scene": "adept_traj.scene.scene",
+    "Box": "adept_traj.scene.shapes",
+    "Capsule": "adept_traj.scene.shapes",
+    "Cylinder": "adept_traj.scene.shapes",
+    "Shape": "adept_traj.scene.shapes",
+    "Sphere": "adept_traj.scene.shapes",
+}
 
 __all__ = [
     "ALGORITHMS",
@@ -97,3 +102,30 @@ __all__ = [
     "paper_penalty",
     "plan",
 ]
+
+
+def _version() -> str:
+    """The installed distribution's version (pyproject.toml), one source of truth."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("adept-traj")
+    except metadata.PackageNotFoundError:  # a source checkout that was never installed
+        return "0+unknown"
+
+
+def __getattr__(name: str) -> _Any:
+    """The public name ``name`` (or ``__version__``), imported from its module on first use
+    (then cached)."""
+    if name == "__version__":
+        value: _Any = _version()
+    elif name in _PUBLIC:
+        value = getattr(_importlib.import_module(_PUBLIC[name]), name)
+    else:
+        raise AttributeError(f"module 'adept_traj' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_PUBLIC) | {"__version__"})

@@ -81,9 +81,10 @@ def _interrupted(how: str, where: str, n: int, argv: list[str]) -> subprocess.Co
 
 
 def _comparable_result(folder: Path) -> dict:
-    """``result.json`` without what depends on the wall clock."""
+    """``result.json`` without what depends on the wall clock, nor the number of workers
+    (free on resume, and it changes no other number)."""
     result = json.loads((folder / "result.json").read_text())
-    del result["timing"]
+    del result["timing"], result["problem_settings"]["workers"]
     del result["metrics"]["OO"], result["metrics"]["AE"]
     return result
 
@@ -221,8 +222,8 @@ def test_resume_refuses_options_that_differ_from_the_run(
 
 
 def test_resume_accepts_the_run_s_own_options(in_progress: Path, reference: Path) -> None:
-    """Options given again with the run's values (1 is --workers' default: given all the
-    same) are accepted; scene paths compare as absolute paths."""
+    """Options given again with the run's values (and --workers, free on resume) are
+    accepted; scene paths compare as absolute paths."""
     argv = ["plan", "--resume", str(in_progress), "--pop", "8", "--seed", "1", "--no-plots"]
     assert main([*argv, "--no-html", "--workers", "1", "--scene", "paper", "--quiet"]) == 0
     _assert_same_run(in_progress, reference)

@@ -165,7 +165,9 @@ def test_tool_path_with_a_replay_loads_nothing(
     monkeypatch.setattr(
         all_figures, "tool_path_3d", lambda _r, path, replay: drawn.append(replay) or path
     )
-    plots.save_all({"m": result, "n": results["nsga2"]}, tmp_path / "all", replays={"m": replay})
+    plots.save_all(
+        {"m": result, "n": results["nsga2"]}, tmp_path / "all", replays={"m": replay}, processes=1
+    )
     assert drawn == [replay, None]
 
 

@@ -26,36 +26,56 @@ status 130 and one line, without a traceback.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from collections.abc import Callable, Sequence
 
-from adept_traj.cli import build_urdf, compare, front, plan, robot, show, status, verify
+from adept_traj.cli import status
 from adept_traj.errors import AdeptTrajError
 
 __all__ = ["main"]
 
 _DESCRIPTION = "Multi-objective, collision-free trajectory planning of industrial robots."
 
-#: Each command's module: ``add_parser(sub)`` declares it, ``run(args)`` runs it.
+#: Each command's module (``add_parser(sub)`` declares it, ``run(args)`` runs it) and its
+#: line in ``adept-traj --help``. Only the module of the command given is imported: the
+#: listing of ``adept-traj --help`` loads none of them (nor pinocchio, coal or pymoo).
+#: Each module's own ``help=`` is the same line (tests/test_cli_startup.py checks it).
 _COMMANDS = {
-    "plan": plan,
-    "compare": compare,
-    "show": show,
-    "verify": verify,
-    "front": front,
-    "robot": robot,
-    "build-urdf": build_urdf,
+    "plan": ("plan", "plan a trajectory and save a verified result"),
+    "compare": ("compare", "NSGA-II vs MODE: the paper's Tables 3-5"),
+    "show": ("show", "play a saved result in the browser (meshcat)"),
+    "verify": ("verify", "re-run the dense verification of a saved result"),
+    "front": ("front", "list the members of a saved front (to pick one)"),
+    "robot": ("robot", "robot-model demo: torques and manipulability"),
+    "build-urdf": ("build_urdf", "write a URDF from a robot parameter file"),
 }
 
 
-def _parser() -> tuple[argparse.ArgumentParser, dict[str, Callable[[argparse.Namespace], int]]]:
+def _selected(argv: Sequence[str]) -> str | None:
+    """The command named in ``argv`` (its first argument that is not an option), if any."""
+    for arg in argv:
+        if not arg.startswith("-"):
+            return arg if arg in _COMMANDS else None
+    return None
+
+
+def _parser(
+    selected: str | None,
+) -> tuple[argparse.ArgumentParser, dict[str, Callable[[argparse.Namespace], int]]]:
+    """The parser of every command; only ``selected``'s module is imported and declares its
+    options (the others are listed by name and help line)."""
     parser = argparse.ArgumentParser(prog="adept-traj", description=_DESCRIPTION)
     sub = parser.add_subparsers(dest="command", required=True)
     runs = {}
-    for name, module in _COMMANDS.items():
-        module.add_parser(sub)
-        runs[name] = module.run
+    for name, (module_name, help_line) in _COMMANDS.items():
+        if name == selected:
+            module = importlib.import_module(f"adept_traj.cli.{module_name}")
+            module.add_parser(sub)
+            runs[name] = module.run
+        else:
+            sub.add_parser(name, help=help_line)
     return parser, runs
 
 
@@ -71,7 +91,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     The exit status (:mod:`adept_traj.cli.status`): 0 success, 2 bad input (one line on
     standard error), 130 interrupted, and the command's own statuses.
     """
-    parser, runs = _parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser, runs = _parser(_selected(argv))
     args = parser.parse_args(argv)
     try:
         return runs[args.command](args)

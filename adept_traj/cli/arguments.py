@@ -15,7 +15,7 @@ import numpy as np
 from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import TrajectoryProblem, available_cores
 from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import as_scalar
 
@@ -43,7 +43,8 @@ def floats(text: str) -> list[float]:
 
 def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
-    workers and ``--quiet``."""
+    workers (default ``None``: :func:`~adept_traj.problem.available_cores`) and
+    ``--quiet``."""
     parser.add_argument(
         "--scene",
         default="paper",
@@ -59,7 +60,10 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     add_robot_arguments(parser)
     parser.add_argument(
-        "--workers", type=int, default=1, help="processes evaluating in parallel (default 1)"
+        "--workers",
+        type=int,
+        help="processes evaluating in parallel (default: the cores available to the process; "
+        "1 evaluates in the main process; the results are the same)",
     )
 
 
@@ -106,4 +110,5 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     check_rate(args.rate)
     robot = robot_from_arguments(args, args.scene)
     start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
-    return TrajectoryProblem(robot, scene, start, goal, workers=args.workers)
+    workers = available_cores() if args.workers is None else args.workers
+    return TrajectoryProblem(robot, scene, start, goal, workers=workers)

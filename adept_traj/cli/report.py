@@ -11,12 +11,13 @@ __all__ = ["save_figures", "summary"]
 
 
 def summary(result: PlanningResult, folder: Path) -> str:
-    """A few lines on a finished run: evaluations and time, the best trade-off's objectives
-    z1 [s] … z6 and its gap to the kinematic lower bound, how many front members are
-    certified, its dense certificate and the guarantee it gives (violations listed), the
-    result's warning and where it was saved."""
+    """A few lines on a finished run: evaluations, time and evaluation workers, the best
+    trade-off's objectives z1 [s] … z6 and its gap to the kinematic lower bound, how many
+    front members are certified, its dense certificate and the guarantee it gives
+    (violations listed), the result's warning and where it was saved."""
     z = result.best_objectives
     cert, front = result.certificate, result.front
+    workers = result.problem_settings.workers
     certified = (
         f", {front.n_certified} certified (continuous guarantee)"
         if front.n_certified is not None
@@ -24,7 +25,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
     )
     lines = [
         f"{result.algorithm}: {result.timing.n_evaluations} evaluations in "
-        f"{result.timing.total_s:.1f} s ({result.timing.evaluation_s:.1f} s evaluating); "
+        f"{result.timing.total_s:.1f} s ({result.timing.evaluation_s:.1f} s evaluating, "
+        f"{workers} worker{'s' if workers != 1 else ''}); "
         f"front of {len(front)}{certified}",
         f"best trade-off: T = {z[0]:.3f} s (lower bound {result.lower_bound.T_min:.3f} s, "
         f"gap {result.gap:.2f}x), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, z4 = {z[3]:.4g} m², "

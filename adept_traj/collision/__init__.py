@@ -1,7 +1,8 @@
 """Robot-obstacle distances over time.
 
-The checker, the conservative broad phase, distance tables, closed-form point distances and
-the coal primitives (``distance_request``: the settings every distance uses).
+The checker, the conservative broad phase, obstacle pruning, distance tables, closed-form
+point distances and the coal primitives (``distance_request``: the settings every distance
+uses).
 """
 
 from __future__ import annotations
@@ -20,6 +21,12 @@ from adept_traj.collision.primitives import (
     distance_request,
     shape_of,
 )
+from adept_traj.collision.pruning import (
+    ObstaclePruning,
+    restrict_broad_phase,
+    restrict_checker,
+    sweep_clearance,
+)
 from adept_traj.collision.self_collision import SelfCollision
 
 __all__ = [
@@ -29,10 +36,14 @@ __all__ = [
     "CollisionChecker",
     "DistanceTable",
     "MinDistances",
+    "ObstaclePruning",
     "PairDistances",
     "SelfCollision",
     "coal_kind",
     "distance_request",
     "point_signed_distance",
+    "restrict_broad_phase",
+    "restrict_checker",
     "shape_of",
+    "sweep_clearance",
 ]

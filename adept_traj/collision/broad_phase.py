@@ -16,7 +16,8 @@ Levels, each on the rows the previous one left within ``influence``:
    :class:`~adept_traj.collision.DistanceTable` of exact distances over that joint's
    range bounds the distance to within about 0.6 mm (when the configurations ``q`` are
    given); level 1 is then skipped for the pair, except at samples outside the table's
-   grid. (Not for joints with an infinite or very long range, nor for sphere shapes.)
+   grid. (Not for joints with an infinite or very long range, nor for sphere shapes, nor
+   for obstacles farther than ``influence`` + :data:`TABLE_REACH` from the solid's sweep.)
 1. **Enclosing ball** of each solid (centre ``c``, radius ``R``), from the joint poses
    directly (no solid pose is formed for far samples):
 
@@ -68,6 +69,7 @@ from adept_traj.collision.primitives import (
     half_extent,
     shape_of,
 )
+from adept_traj.collision.pruning import sweep_clearance
 from adept_traj.errors import InvalidInputError
 from adept_traj.robot.kinematics import compose
 from adept_traj.robot.robot import Robot, solid_frames
@@ -78,6 +80,10 @@ __all__ = ["Bounds", "BroadPhase"]
 
 #: Grid step [rad | m] of the single-joint distance tables (level 0).
 TABLE_STEP = 1e-3
+#: A solid that stays farther than ``influence`` + this [m] from an obstacle over a full turn
+#: of its joint gets no table against it: its level-1 bound exceeds that distance anyway
+#: (the paper's cube 2, 0.37 m from the inner arm's sweep, keeps its tables).
+TABLE_REACH = 0.4
 #: Joints with a longer range (e.g. unlimited) get no table.
 _TABLE_MAX_POINTS = 20_000
 
@@ -168,8 +174,21 @@ class BroadPhase:
         for k in range(self.n_solids):
             for o in range(self.n_obstacles):
                 j = self._table_joint(robot, k, o)
-                if j is not None:
+                if j is not None and self._sweep_reaches(robot, scene, k, o):
                     self.tables[k, o] = self._table(robot, scene, k, o, j, objects[k].geometry)
+
+    @property
+    def ball_radius(self) -> np.ndarray:
+        """(n_solids,) radii [m] of the solids' enclosing balls."""
+        return self._ball_radius
+
+    def ball_centres(self, frames: np.ndarray) -> np.ndarray:
+        """(3, n_solids, N) centres [m] of the solids' enclosing balls in the base frame,
+        for joint frames (njoints, 3, 4, N) (component-major)."""
+        balls = np.empty((3, self.n_solids, frames.shape[-1]))
+        for p, ks in self._by_parent:
+            balls[:, ks] = points_in_joint(frames[p].reshape(12, -1), self._ball_in_joint[ks])
+        return balls
 
     # ------------------------------------------------------------------ exact pieces
     def closed_form_distance(
@@ -237,6 +256,25 @@ class BroadPhase:
             and all(kind[0] != "sphere" for kind in kinds)  # coal's sphere depths: see _refine
         )
         return j if tabulable else None
+
+    def _sweep_reaches(self, robot: Robot, scene: Scene, k: int, o: int) -> bool:
+        """Whether solid ``k``, turned through a full revolution of its parent joint (from
+        :meth:`_table_joint`), may come within ``influence`` + :data:`TABLE_REACH` of
+        fixed obstacle ``o``
+        (:func:`~adept_traj.collision.pruning.sweep_clearance`); a prismatic joint: yes."""
+        p, kin = int(self.parents[k]), robot.kinematics
+        if not kin.revolute[p - 1]:
+            return True
+        frames = kin.joint_frames(np.zeros((1, robot.nq)))
+        origin, rot = frames[p, :, 3, 0], frames[p, :, :3, 0]
+        centre = rot @ self._ball_in_joint[k] + origin
+        obstacle = scene.obstacles[o]
+        where = (scene.base_from_world @ obstacle.pose(0.0))[:3, 3]
+        clearance = sweep_clearance(
+            origin, rot @ kin.axes[p - 1], centre, self._ball_radius[k],
+            where, obstacle.shape.bounding_radius,
+        )  # fmt: skip
+        return clearance <= self.influence + TABLE_REACH
 
     def _table(
         self,

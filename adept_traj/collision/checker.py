@@ -25,6 +25,7 @@ import numpy as np
 
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.primitives import distance_request
+from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
@@ -114,13 +115,10 @@ class CollisionChecker:
         self._broad = BroadPhase(robot, scene, self.influence)
         # Allowed contacts (scene.allowed_contacts: link, obstacle): never checked.
         links = [robot.model.frames[g.parentFrame].name for g in objects]
-        self.allowed = np.array(
-            [
-                [(link, ob) in scene.allowed_contacts for ob in self.obstacle_names]
-                for link in links
-            ],
-            dtype=bool,
-        ).reshape(len(objects), len(self.obstacle_names))
+        pairs = [
+            (link, ob) in scene.allowed_contacts for link in links for ob in self.obstacle_names
+        ]
+        self.allowed = np.array(pairs, dtype=bool).reshape(len(objects), len(self.obstacle_names))
         self._robot_geoms = [g.geometry for g in objects]
         self._functors = [
             [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
@@ -129,6 +127,8 @@ class CollisionChecker:
         self._request = distance_request()
         self._result = coal.DistanceResult()
         self._tf = (coal.Transform3s(), coal.Transform3s())
+        self._pruning = ObstaclePruning(scene, self.influence)
+        self._views: dict[tuple[int, ...], CollisionChecker] = {}  # by obstacles kept
 
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:
@@ -259,6 +259,36 @@ class CollisionChecker:
         return poses
 
     def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
+        """Leave out the fixed obstacles that no motion comes within ``influence`` of
+        (:mod:`adept_traj.collision.pruning`: their distance is reported as the bound that
+        proves it), then search the others (:meth:`_search`)."""
+        n_motions = int(np.prod(q.shape[:-2]))
+        far = self._pruning.lower_bounds(
+            self._broad.ball_centres(frames), self._broad.ball_radius, n_motions
+        )
+        keep = self._pruning.kept(far)
+        part = self._restricted(keep)._search(q, t, frames)
+        out = [far.copy(), np.full(far.shape, -1), np.full(far.shape, -1)]
+        near = far[:, keep] <= self.influence  # else the motion's own bound, as if pruned
+        for full, kept in zip(out, (part.distance, part.sample, part.solid)):
+            full[:, keep] = np.where(near, kept.reshape(len(far), -1), full[:, keep])
+        shape = (*q.shape[:-2], self.n_obstacles)
+        return MinDistances(*(a.reshape(shape) for a in out), n_narrow=part.n_narrow)
+
+    def _restricted(self, keep: np.ndarray) -> CollisionChecker:
+        """This checker on the obstacles of index ``keep`` only (the last 32 sets kept)."""
+        key = tuple(keep.tolist())
+        if len(key) == self.n_obstacles:
+            return self
+        view = self._views.get(key)
+        if view is None:
+            if len(self._views) >= 32:  # a batch of motions usually meets the same few
+                self._views.clear()
+            view = self._views[key] = restrict_checker(self, keep)
+        return view
+
+    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
+        """The branch and bound of :meth:`min_distances` over every obstacle."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)

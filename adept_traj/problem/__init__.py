@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
-from adept_traj.problem.evaluator import ParallelEvaluator
+from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
 from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, local_constraints
 from adept_traj.problem.objectives import (
     MAXIMISED,
@@ -47,6 +47,7 @@ __all__ = [
     "TrajectoryIntegrals",
     "TrajectoryProblem",
     "TrajectorySamples",
+    "available_cores",
     "from_pymoo",
     "kinematic_lower_bound",
     "local_constraints",

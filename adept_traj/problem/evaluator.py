@@ -26,6 +26,7 @@ snapshot is a different object, so the pool does not keep its owner alive).
 from __future__ import annotations
 
 import multiprocessing
+import os
 import signal
 import weakref
 from collections.abc import Callable
@@ -37,7 +38,19 @@ from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.problem.evaluation import Evaluation, _concatenate
 from adept_traj.validation import as_batch, as_integer
 
-__all__ = ["ParallelEvaluator"]
+__all__ = ["ParallelEvaluator", "available_cores"]
+
+
+def available_cores() -> int:
+    """The number of CPU cores this process may run on (≥ 1): the size of its affinity
+    mask (:func:`os.sched_getaffinity`, which honours ``taskset`` and container CPU sets),
+    or :func:`os.cpu_count` where the platform has no affinity mask."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # no affinity mask on this platform (macOS, Windows)
+        n = os.cpu_count() or 1
+    return max(1, n)
+
 
 #: The evaluation function of this worker process, set once by the pool's initializer
 #: (:func:`_start_worker`); ``None`` in every process that is not a pool worker.

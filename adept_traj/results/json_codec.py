@@ -156,7 +156,7 @@ def _dumps(value: Any, level: int = 0) -> str:
         return "{\n" + ",\n".join(items) + "\n" + end + "}"
     if isinstance(value, list):
         if all(not isinstance(v, (dict, list)) for v in value):
-            return "[" + ", ".join(_scalar(v) for v in value) + "]"
+            return _scalar(value)  # one line "[a, b, …]", encoded at C speed
         return "[\n" + ",\n".join(pad + _dumps(v, level + 1) for v in value) + "\n" + end + "]"
     return _scalar(value)
 

@@ -1,17 +1,26 @@
-"""Every figure of one or more results into a folder: :func:`save_all`."""
+"""Every figure of one or more results into a folder: :func:`save_all`.
+
+The figures are drawn at once on the cores available (:func:`adept_traj.problem.available_cores`):
+the calling process draws one share, forked processes the others (Linux ``fork``: they
+inherit the results and matplotlib, nothing is pickled). A figure whose process fails (or
+is killed) is drawn again by the caller, so that its error, if any, is raised there.
+"""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.problem import available_cores
 from adept_traj.results import PlanningResult, Replay
-from adept_traj.validation import check_type
+from adept_traj.validation import as_integer, check_type
 from adept_traj.viz.inputs import replay_for
-from adept_traj.viz.plots.common import as_results, file_suffix
+from adept_traj.viz.plots.common import as_results, file_suffix, load_matplotlib
 from adept_traj.viz.plots.fronts import pareto_matrix
 from adept_traj.viz.plots.history import hypervolume_history
 from adept_traj.viz.plots.motion import joint_motion
@@ -26,6 +35,7 @@ def save_all(
     folder: str | os.PathLike[str],
     *,
     replays: Mapping[str, Replay] | None = None,
+    processes: int | None = None,
 ) -> list[Path]:
     """Write every figure into ``folder`` (created if needed).
 
@@ -43,6 +53,8 @@ def save_all(
         :class:`~adept_traj.results.Replay` (robot and scene) the caller already has, each
         of its result's best solution; the others are built with ``Replay.of(result)``
         (for :func:`~adept_traj.viz.plots.tool_path_3d`).
+    processes: processes drawing at once, ≥ 1 (default: the cores available; 1 draws
+        every figure in the calling process). The files are the same either way.
 
     Returns
     -------
@@ -57,18 +69,71 @@ def save_all(
     if len(set(suffixes.values())) != len(suffixes):
         raise InvalidInputError(f"result names give clashing file names: {list(res)}")
     given = _replays(replays, res)
+    n_proc = available_cores() if processes is None else processes
+    n_proc = as_integer(n_proc, "processes", minimum=1)
     root.mkdir(parents=True, exist_ok=True)
-    written = [
-        pareto_matrix(res, root / "pareto_matrix.png"),
-        best_tradeoffs(res, root / "best_tradeoffs.png"),
+    # (cost weight, file, drawing): the weights (relative drawing times on the paper's
+    # result) spread the figures evenly over the processes
+    figures: list[tuple[float, Path, Callable[[Path], Path]]] = [
+        (4.0, root / "pareto_matrix.png", partial(pareto_matrix, res)),
+        (1.0, root / "best_tradeoffs.png", partial(best_tradeoffs, res)),
     ]
     if any(r.history for r in res.values()):
-        written.append(hypervolume_history(res, root / "hypervolume_history.png"))
+        figures.append((0.5, root / "hypervolume_history.png", partial(hypervolume_history, res)))
     for key, r in res.items():
-        written.append(joint_motion(r, root / f"joint_motion_{suffixes[key]}.png"))
-        path = root / f"tool_path_{suffixes[key]}.png"
-        written.append(tool_path_3d(r, path, replay=given.get(key)))
-    return written
+        figures.append((5.0, root / f"joint_motion_{suffixes[key]}.png", partial(joint_motion, r)))
+        draw_path = partial(tool_path_3d, r, replay=given.get(key))
+        figures.append((2.0, root / f"tool_path_{suffixes[key]}.png", draw_path))
+    jobs = [(weight, partial(draw, path)) for weight, path, draw in figures]
+    _draw(jobs, n_proc)
+    return [path for _, path, _ in figures]
+
+
+def _draw(jobs: list[tuple[float, Callable[[], Path]]], processes: int) -> None:
+    """Run the figure ``jobs`` (cost weight, drawing) on up to ``processes`` processes (this
+    one included), the heaviest first, each to the least loaded process."""
+    processes = min(processes, len(jobs))
+    if processes == 1 or "fork" not in multiprocessing.get_all_start_methods():
+        for _, draw in jobs:
+            draw()
+        return
+    load_matplotlib()  # imported once, before the fork, for every process
+    shares: list[list[int]] = [[] for _ in range(processes)]
+    loads = [0.0] * processes
+    for i in sorted(range(len(jobs)), key=lambda i: -jobs[i][0]):  # longest first
+        k = loads.index(min(loads))
+        shares[k].append(i)
+        loads[k] += jobs[i][0]
+    context = multiprocessing.get_context("fork")
+    children = [
+        context.Process(target=_draw_share, args=([jobs[i][1] for i in share],), daemon=True)
+        for share in shares[1:]
+    ]
+    try:
+        for child in children:
+            child.start()
+        for i in shares[0]:
+            jobs[i][1]()
+        for child, share in zip(children, shares[1:]):
+            child.join()
+            if child.exitcode != 0:  # drawn again here: its error, if any, is raised here
+                for i in share:
+                    jobs[i][1]()
+    finally:
+        for child in children:
+            if child.is_alive():
+                child.terminate()
+                child.join()
+
+
+def _draw_share(draws: list[Callable[[], Path]]) -> None:
+    """Run in a forked process: draw these figures; any error ends it with status 1 (the
+    caller draws its figures again and reports the error)."""
+    try:
+        for draw in draws:
+            draw()
+    except BaseException:  # reported by the caller's second attempt
+        os._exit(1)
 
 
 def _replays(replays: Any, results: Mapping[str, PlanningResult]) -> dict[str, Replay]:

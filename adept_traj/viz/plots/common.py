@@ -33,6 +33,7 @@ __all__ = [
     "file_suffix",
     "front_rows",
     "legend_labels",
+    "load_matplotlib",
     "new_figure",
     "padded",
     "png_path",
@@ -147,9 +148,9 @@ def padded(lo: float, hi: float, frac: float = 0.06) -> tuple[float, float]:
 
 
 # ============================================================================ matplotlib
-def new_figure(width: float, height: float) -> Figure:
-    """A new figure of ``width`` × ``height`` [inch] on its own Agg canvas (no pyplot, no
-    backend switch, never shown)."""
+def load_matplotlib() -> tuple[type, type]:
+    """matplotlib's ``Figure`` and ``FigureCanvasAgg`` classes, imported on first call
+    (an :class:`ImportError` naming the ``plot`` extra when matplotlib is missing)."""
     try:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -157,8 +158,15 @@ def new_figure(width: float, height: float) -> Figure:
         raise ImportError(
             "adept_traj.viz.plots needs matplotlib: pip install 'adept-traj[plot]'"
         ) from exc
-    fig = Figure(figsize=(width, height), dpi=DPI)
-    FigureCanvasAgg(fig)
+    return Figure, FigureCanvasAgg
+
+
+def new_figure(width: float, height: float) -> Figure:
+    """A new figure of ``width`` × ``height`` [inch] on its own Agg canvas (no pyplot, no
+    backend switch, never shown)."""
+    figure_class, canvas_class = load_matplotlib()
+    fig = figure_class(figsize=(width, height), dpi=DPI)
+    canvas_class(fig)
     return fig
 
 
