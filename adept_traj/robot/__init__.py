@@ -11,6 +11,14 @@ from adept_traj.robot.inertia import (
     cylinder_inertia,
     sphere_inertia,
 )
+from adept_traj.robot.inverse_kinematics import (
+    ELBOWS,
+    ScaraGeometry,
+    numeric_ik,
+    scara_ik,
+    scara_location,
+    solve_location,
+)
 from adept_traj.robot.kinematics import (
     BatchKinematics,
     compose,
@@ -51,6 +59,7 @@ from adept_traj.robot.urdf_loading import (
 )
 
 __all__ = [
+    "ELBOWS",
     "LIMITS",
     "LIMIT_KINDS",
     "TASK_ROWS",
@@ -65,6 +74,7 @@ __all__ = [
     "MassProperties",
     "Robot",
     "RobotParameters",
+    "ScaraGeometry",
     "SolidParameters",
     "apply_parameters",
     "box_inertia",
@@ -77,7 +87,11 @@ __all__ = [
     "link_mass_properties",
     "load_urdf_models",
     "manipulability_measure",
+    "numeric_ik",
+    "scara_ik",
+    "scara_location",
     "shipped_file",
     "solid_inertia",
+    "solve_location",
     "sphere_inertia",
 ]
