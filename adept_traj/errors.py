@@ -13,6 +13,7 @@ from pathlib import Path
 __all__ = [
     "AdeptTrajError",
     "ConfigurationError",
+    "CycleError",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
@@ -115,3 +116,8 @@ class UnreachableLocationError(InvalidInputError):
         self.distance = float(distance)
         self.unit = unit
         super().__init__(f"location {location!r}: {message}")
+
+
+class CycleError(ConfigurationError):
+    """A cycle file (``docs/cycles.md``) is missing or malformed, or a cycle run folder
+    does not match its cycle. The message names the file, the field and the valid range."""

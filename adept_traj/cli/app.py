@@ -7,6 +7,8 @@ Sub-commands, one module each:
   checkpoints, ``--resume DIR`` continues.
 - ``adept-traj compare --out DIR`` (:mod:`adept_traj.cli.compare`) — NSGA-II and MODE on
   the same problem, with the paper's Tables 3–5 beside ours (``DIR/comparison.md``).
+- ``adept-traj cycle FILE --out DIR`` (:mod:`adept_traj.cli.cycle`) — plan every move of
+  a cycle file, each move a Dask task (local cluster or ``--scheduler``).
 - ``adept-traj verify DIR`` (:mod:`adept_traj.cli.verify`) — re-run the dense
   verification of a saved result.
 - ``adept-traj front DIR`` (:mod:`adept_traj.cli.front`) — list the members of a saved
@@ -30,7 +32,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 
-from adept_traj.cli import build_urdf, compare, front, plan, robot, show, status, verify
+from adept_traj.cli import build_urdf, compare, cycle, front, plan, robot, show, status, verify
 from adept_traj.errors import AdeptTrajError
 
 __all__ = ["main"]
@@ -41,6 +43,7 @@ _DESCRIPTION = "Multi-objective, collision-free trajectory planning of industria
 _COMMANDS = {
     "plan": plan,
     "compare": compare,
+    "cycle": cycle,
     "show": show,
     "verify": verify,
     "front": front,
