@@ -188,8 +188,9 @@ def run_tasks(
     else:
         cluster, client = None, Client(scheduler)
     try:
+        run_id = uuid.uuid4().hex  # keys unique on a shared scheduler
         futures = [
-            client.submit(function, t, key=f"adept-traj-{i}-{uuid.uuid4().hex}", pure=False, retries=RETRIES)
+            client.submit(function, t, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
             for i, t in enumerate(tasks)
         ]
         index = {f.key: i for i, f in enumerate(futures)}
