@@ -1,0 +1,241 @@
+"""Cycle files and ``adept-traj cycle``: moves planned as Dask tasks.
+
+One local Dask cluster (two single-threaded worker processes) is shared by the module;
+the commands reach it with ``--scheduler``."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from adept_traj.cli import main
+from adept_traj.cycle import (
+    CYCLE_FILE,
+    MOVE_FILE,
+    MOVES_FOLDER,
+    cycle_tasks,
+    plan_move,
+    read_cycle_file,
+    run_cycle,
+)
+from adept_traj.errors import CycleError, UnreachableLocationError
+from adept_traj.results import PlanningResult
+from adept_traj.robot import Robot
+
+distributed = pytest.importorskip("distributed")
+
+#: Three moves in an obstacle-free scene with a tiny budget (8 × 3: certified, 0.1 s each);
+#: the slow tier plans them in the paper scene at 16 × 8.
+THREE_MOVES = """\
+name = "three"
+scene = "empty.toml"
+
+[plan]
+pop_size = 8
+n_gen = 3
+seed = 1
+
+[[location]]
+name = "home"
+joints = [0.1682, 1.3849, 0.08, -0.7555]
+
+[[location]]
+name = "pick"
+pose = [0.3, 0.5, 0.55, 0.0]
+elbow = "righty"
+
+[[location]]
+name = "place"
+joints = [-0.761, 0.245, 0.2, 1.0095]
+
+[[move]]
+from = "home"
+to = "pick"
+
+[[move]]
+from = "pick"
+to = "home"
+
+[[move]]
+from = "home"
+to = "place"
+seed = 1
+"""
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def cycle_file(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("cycle") / "three.toml"
+    path.write_text(THREE_MOVES)
+    (path.parent / "empty.toml").write_text('name = "empty"\n')
+    return path
+
+
+@pytest.fixture(scope="module")
+def cycle_run(cycle_file, cluster) -> Path:
+    """The three-move cycle planned once by the command on the shared cluster."""
+    out = cycle_file.parent / "out"
+    code = main(
+        [
+            "cycle",
+            str(cycle_file),
+            "--out",
+            str(out),
+            "--scheduler",
+            cluster.scheduler_address,
+            "--quiet",
+            "--no-plots",
+        ]
+    )
+    assert code == 0
+    return out
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "c.toml"
+    path.write_text(text)
+    (tmp_path / "empty.toml").write_text('name = "empty"\n')
+    return path
+
+
+# --------------------------------------------------------------------------- the file
+def test_locations_resolved_with_the_chosen_elbow(cycle_file):
+    cycle = read_cycle_file(cycle_file)
+    pick = cycle.locations["pick"]
+    assert pick.elbow == "righty"
+    pose = Robot.adept_one_xl().tool_pose(pick.joints)
+    np.testing.assert_allclose(pose[:3, 3], [0.3, 0.5, 0.55], atol=1e-12)
+    assert [m.seed for m in cycle.moves] == [1, 2, 1]  # cycle seed + index, or the override
+    assert [m.name for m in cycle.moves] == ["home-pick", "pick-home", "home-place"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "error", "words"),
+    [
+        (('pose = [0.3, 0.5, 0.55, 0.0]', 'pose = [1.3, 0.5, 0.55, 0.0]'),
+         UnreachableLocationError, "field 'location\\[1\\].pose'.*beyond the arm's reach"),
+        (('pose = [0.3, 0.5, 0.55, 0.0]', 'pose = [0.3, 0.5, 0.55]'),
+         CycleError, "field 'location\\[1\\].pose': must be a list of 4"),
+        (('elbow = "righty"', 'elbow = "up"'),
+         CycleError, "field 'location\\[1\\].elbow': must be 'lefty' or 'righty'"),
+        (('to = "place"', 'to = "shelf"'),
+         CycleError, "field 'move\\[2\\].to': must be one of 'home', 'pick', 'place'"),
+        (('n_gen = 3', 'n_gen = 0'),
+         CycleError, "field 'plan.n_gen': must be an integer in \\[1, 100000\\]"),
+        (('joints = [0.1682, 1.3849', 'joints = [3.1682, 1.3849'),
+         CycleError, "field 'location\\[0\\].joints'.*joint1.*outside its limits"),
+        (('seed = 1\n"""', 'speed = 1\n"""'), CycleError, "unknown field"),
+    ],
+)  # fmt: skip
+def test_bad_cycle_files_are_refused_naming_file_and_field(tmp_path, edit, error, words):
+    text = THREE_MOVES.replace(*edit, 1) if edit[0] != 'seed = 1\n"""' else None
+    if text is None:
+        text = THREE_MOVES.rstrip("\n").removesuffix("seed = 1") + "speed = 1\n"
+    path = _write(tmp_path, text)
+    with pytest.raises(error, match=words) as info:
+        read_cycle_file(path)
+    assert str(path) in str(info.value)
+
+
+# --------------------------------------------------------------------------- running
+def test_three_move_cycle_is_certified_and_reported(cycle_run):
+    summary = json.loads((cycle_run / CYCLE_FILE).read_text())
+    assert [m["name"] for m in summary["moves"]] == ["home-pick", "pick-home", "home-place"]
+    assert summary["all_certified"]
+    assert summary["locations"]["pick"]["elbow"] == "righty"
+    total = 0.0
+    for m in summary["moves"]:
+        result = PlanningResult.load(cycle_run / m["folder"])
+        assert result.feasible
+        assert result.certificate.certified
+        assert m["T"] == result.best_objectives[0]
+        total += m["T"]
+    assert summary["cycle_time"] == pytest.approx(total)
+    assert (cycle_run / "cycle.md").read_text().count("| yes |") == 3
+
+
+def test_resume_plans_only_the_missing_moves(cycle_run, cycle_file, cluster, tmp_path):
+    out = tmp_path / "out"
+    shutil.copytree(cycle_run, out)
+    shutil.rmtree(out / MOVES_FOLDER / "pick-home")
+    kept = (out / MOVES_FOLDER / "home-pick" / MOVE_FILE).stat().st_mtime_ns
+    done: list[str] = []
+    cycle = read_cycle_file(cycle_file)
+    results = run_cycle(
+        cycle, out, scheduler=cluster.scheduler_address, resume=True, progress=done.append
+    )
+    assert done[-1] == "pick-home"  # the two kept moves are reported first, loaded
+    assert sorted(done[:2]) == ["home-pick", "home-place"]
+    assert (out / MOVES_FOLDER / "home-pick" / MOVE_FILE).stat().st_mtime_ns == kept
+    again = PlanningResult.load(cycle_run / MOVES_FOLDER / "pick-home")
+    np.testing.assert_array_equal(results[1].front.x, again.front.x)  # same seed, same front
+    with pytest.raises(CycleError, match="earlier cycle run"):
+        run_cycle(cycle, out, scheduler=cluster.scheduler_address)
+
+
+@pytest.mark.slow
+def test_result_does_not_depend_on_the_worker(cycle_run, cycle_file):
+    """A move planned in this process equals the one planned on the cluster."""
+    task = cycle_tasks(read_cycle_file(cycle_file))[0]
+    here = plan_move(task)
+    there = PlanningResult.load(cycle_run / MOVES_FOLDER / task.move.name)
+    np.testing.assert_array_equal(here.front.x, there.front.x)
+    np.testing.assert_array_equal(here.best_x, there.best_x)
+
+
+@pytest.mark.slow
+def test_paper_scene_cycle_is_certified(cluster, tmp_path):
+    path = tmp_path / "paper.toml"
+    text = THREE_MOVES.replace('"empty.toml"', '"paper"').replace("pop_size = 8", "pop_size = 16")
+    path.write_text(text.replace("n_gen = 3", "n_gen = 8"))
+    results = run_cycle(read_cycle_file(path), tmp_path / "out", scheduler=cluster.scheduler_address)
+    assert all(r.certificate.certified for r in results)
+
+
+@pytest.mark.slow
+def test_killing_a_worker_mid_cycle_still_completes(cycle_run, cycle_file, tmp_path):
+    cycle = read_cycle_file(cycle_file)
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        pids = client.run(os.getpid)  # worker address -> pid
+        killed: list[int] = []
+
+        def kill_busy_worker() -> None:
+            deadline = time.monotonic() + 120
+            while time.monotonic() < deadline and not killed:
+                busy = [w for w, tasks in client.processing().items() if tasks]
+                if busy:
+                    time.sleep(0.5)  # well into the task
+                    killed.append(pids[busy[0]])
+                    os.kill(pids[busy[0]], signal.SIGKILL)
+                time.sleep(0.05)
+
+        killer = threading.Thread(target=kill_busy_worker)
+        killer.start()
+        results = run_cycle(cycle, tmp_path / "out", scheduler=cluster.scheduler_address)
+        killer.join()
+    assert len(killed) == 1
+    for move, result in zip(cycle.moves, results, strict=True):
+        reference = PlanningResult.load(cycle_run / MOVES_FOLDER / move.name)
+        np.testing.assert_array_equal(result.front.x, reference.front.x)
+        assert result.feasible
