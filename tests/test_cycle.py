@@ -140,14 +140,11 @@ def test_locations_resolved_with_the_chosen_elbow(cycle_file):
          CycleError, "field 'plan.n_gen': must be an integer in \\[1, 100000\\]"),
         (('joints = [0.1682, 1.3849', 'joints = [3.1682, 1.3849'),
          CycleError, "field 'location\\[0\\].joints'.*joint1.*outside its limits"),
-        (('seed = 1\n"""', 'speed = 1\n"""'), CycleError, "unknown field"),
+        (("[plan]\n", "[plan]\nspeed = 1\n"), CycleError, "field 'plan.speed': unknown field"),
     ],
 )  # fmt: skip
 def test_bad_cycle_files_are_refused_naming_file_and_field(tmp_path, edit, error, words):
-    text = THREE_MOVES.replace(*edit, 1) if edit[0] != 'seed = 1\n"""' else None
-    if text is None:
-        text = THREE_MOVES.rstrip("\n").removesuffix("seed = 1") + "speed = 1\n"
-    path = _write(tmp_path, text)
+    path = _write(tmp_path, THREE_MOVES.replace(*edit, 1))
     with pytest.raises(error, match=words) as info:
         read_cycle_file(path)
     assert str(path) in str(info.value)
@@ -204,7 +201,8 @@ def test_paper_scene_cycle_is_certified(cluster, tmp_path):
     path = tmp_path / "paper.toml"
     text = THREE_MOVES.replace('"empty.toml"', '"paper"').replace("pop_size = 8", "pop_size = 16")
     path.write_text(text.replace("n_gen = 3", "n_gen = 8"))
-    results = run_cycle(read_cycle_file(path), tmp_path / "out", scheduler=cluster.scheduler_address)
+    address = cluster.scheduler_address
+    results = run_cycle(read_cycle_file(path), tmp_path / "out", scheduler=address)
     assert all(r.certificate.certified for r in results)
 
 
