@@ -182,7 +182,7 @@ def test_resume_plans_only_the_missing_moves(cycle_run, cycle_file, cluster, tmp
     assert (out / MOVES_FOLDER / "home-pick" / MOVE_FILE).stat().st_mtime_ns == kept
     again = PlanningResult.load(cycle_run / MOVES_FOLDER / "pick-home")
     np.testing.assert_array_equal(results[1].front.x, again.front.x)  # same seed, same front
-    with pytest.raises(CycleError, match="earlier cycle run"):
+    with pytest.raises(CycleError, match="holds an earlier run"):
         run_cycle(cycle, out, scheduler=cluster.scheduler_address)
 
 

@@ -23,6 +23,7 @@ from adept_traj.cycle.runner import (
     cycle_tasks,
     plan_move,
     run_cycle,
+    run_planning_tasks,
     run_tasks,
 )
 from adept_traj.cycle.summary import (
@@ -54,6 +55,7 @@ __all__ = [
     "plan_move",
     "read_cycle_file",
     "run_cycle",
+    "run_planning_tasks",
     "run_tasks",
     "save_gantt",
     "write_cycle_report",

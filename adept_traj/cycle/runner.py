@@ -46,6 +46,7 @@ __all__ = [
     "cycle_tasks",
     "plan_move",
     "run_cycle",
+    "run_planning_tasks",
     "run_tasks",
 ]
 
@@ -149,10 +150,10 @@ def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
         return None
 
 
-def _save(out: Path, task: MoveTask, result: PlanningResult) -> Path:
-    """Save ``result`` into ``out/moves/NAME`` at once and atomically (a temporary folder
+def _save(folder: Path, task: MoveTask, result: PlanningResult) -> Path:
+    """Save ``result`` into ``folder/NAME`` at once and atomically (a temporary folder
     renamed), with ``move.json``."""
-    final = out / MOVES_FOLDER / task.move.name
+    final = folder / task.move.name
     tmp = final.with_name(f".{task.move.name}.partial")
     shutil.rmtree(tmp, ignore_errors=True)
     result.save(tmp)
@@ -208,6 +209,55 @@ def run_tasks(
             cluster.close()
 
 
+def run_planning_tasks(
+    tasks: Sequence[MoveTask],
+    folder: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> list[PlanningResult]:
+    """Plan ``tasks`` on Dask (:func:`run_tasks`), each result saved as it arrives into
+    ``folder/NAME/`` (NAME: the task's move name); return the results in order.
+
+    ``resume``: a task whose folder holds the same task (``move.json``) is loaded, not
+    planned; without it a ``folder`` that already holds results is refused
+    (:class:`~adept_traj.errors.CycleError`). ``progress`` is called with each name as its
+    result is saved (or found saved)."""
+    where = Path(folder)
+    if not resume and where.exists() and any(where.iterdir()):
+        raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
+    results: list[PlanningResult | None] = [None] * len(tasks)
+    pending = []
+    for i, task in enumerate(tasks):
+        done = _finished(where / task.move.name, task) if resume else None
+        if done is None:
+            pending.append(i)
+        else:
+            results[i] = done
+            if progress is not None:
+                progress(task.move.name)
+
+    def saved(j: int, result: PlanningResult) -> None:
+        i = pending[j]
+        _save(where, tasks[i], result)
+        results[i] = result
+        if progress is not None:
+            progress(tasks[i].move.name)
+
+    if pending:
+        where.mkdir(parents=True, exist_ok=True)
+        run_tasks(
+            [tasks[i] for i in pending],
+            plan_move,
+            workers=workers,
+            scheduler=scheduler,
+            on_result=saved,
+        )
+    return results  # type: ignore[return-value]
+
+
 def run_cycle(
     cycle: Cycle,
     out: str | os.PathLike[str],
@@ -217,13 +267,14 @@ def run_cycle(
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> list[PlanningResult]:
-    """Plan every move of ``cycle`` on Dask; save each result as it finishes; return the
-    results in the order of the moves.
+    """Plan every move of ``cycle`` on Dask; save each result as it finishes
+    (``out/moves/NAME/``, :func:`run_planning_tasks`); return the results in the order of
+    the moves.
 
     Parameters
     ----------
     cycle: from :func:`~adept_traj.cycle.read_cycle_file`.
-    out: output folder (``out/moves/NAME/`` per move).
+    out: output folder.
     workers: local worker processes (default: one per core; ignored with ``scheduler``).
     scheduler: address of an existing Dask scheduler (``tcp://127.0.0.1:8786``).
     resume: keep the moves already saved for the same task (else ``out`` must not hold
@@ -235,38 +286,11 @@ def run_cycle(
     CycleError
         ``out`` holds an earlier run and ``resume`` is false.
     """
-    folder = Path(out)
-    moves = folder / MOVES_FOLDER
-    if not resume and moves.exists() and any(moves.iterdir()):
-        raise CycleError(
-            f"{folder} holds an earlier cycle run ({moves}): give --resume or another folder"
-        )
-    tasks = cycle_tasks(cycle)
-    results: list[PlanningResult | None] = [None] * len(tasks)
-    pending = []
-    for i, task in enumerate(tasks):
-        done = _finished(moves / task.move.name, task) if resume else None
-        if done is None:
-            pending.append(i)
-        else:
-            results[i] = done
-            if progress is not None:
-                progress(task.move.name)
-
-    def saved(j: int, result: PlanningResult) -> None:
-        i = pending[j]
-        _save(folder, tasks[i], result)
-        results[i] = result
-        if progress is not None:
-            progress(tasks[i].move.name)
-
-    if pending:
-        moves.mkdir(parents=True, exist_ok=True)
-        run_tasks(
-            [tasks[i] for i in pending],
-            plan_move,
-            workers=workers,
-            scheduler=scheduler,
-            on_result=saved,
-        )
-    return results  # type: ignore[return-value]
+    return run_planning_tasks(
+        cycle_tasks(cycle),
+        Path(out) / MOVES_FOLDER,
+        workers=workers,
+        scheduler=scheduler,
+        resume=resume,
+        progress=progress,
+    )
