@@ -28,6 +28,7 @@ __all__ = [
     "GANTT_FIGURE",
     "cycle_markdown",
     "cycle_summary",
+    "fastest_certified",
     "save_gantt",
     "write_cycle_report",
 ]
@@ -37,8 +38,9 @@ CYCLE_REPORT = "cycle.md"
 GANTT_FIGURE = "cycle_gantt.png"
 
 
-def _fastest_certified(result: PlanningResult) -> float | None:
-    """Smallest T [s] among the certified members of the front (``None``: none)."""
+def fastest_certified(result: PlanningResult) -> float | None:
+    """Smallest travel time T [s] among the certified members of ``result``'s front
+    (``None``: none is certified)."""
     f = result.front
     times = f.objectives[np.asarray(f.feasible, dtype=bool), 0]
     return float(times.min()) if times.size else None
@@ -59,7 +61,7 @@ def cycle_summary(cycle: Cycle, results: list[PlanningResult]) -> dict[str, Any]
                 "certified": bool(r.feasible),
                 "T": float(r.best_objectives[0]),
                 "f_c": float(r.best.f_c),
-                "fastest_certified_T": _fastest_certified(r),
+                "fastest_certified_T": fastest_certified(r),
                 "n_certified": int(r.front.n_certified),
             }
         )
@@ -122,13 +124,11 @@ def cycle_markdown(summary: dict[str, Any]) -> str:
 def save_gantt(summary: dict[str, Any], path: Path) -> Path:
     """A Gantt-like figure of one pass of the sequence: each move a bar from its start to
     its end time [s] (best trade-off), red when not certified. Needs matplotlib."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from adept_traj.viz.plots.common import new_figure, save_figure
 
     moves = summary["moves"]
-    fig, ax = plt.subplots(figsize=(8, 0.4 * len(moves) + 1.2))
+    fig = new_figure(8.0, 0.4 * len(moves) + 1.2)
+    ax = fig.add_subplot()
     t0 = 0.0
     for k, m in enumerate(moves):
         color = "tab:blue" if m["certified"] else "tab:red"
@@ -141,9 +141,7 @@ def save_gantt(summary: dict[str, Any], path: Path) -> Path:
     ax.set_title(f"{summary['name']}: {t0:.3f} s per pass × {summary['repeat']}")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def write_cycle_report(
