@@ -18,15 +18,22 @@ import pytest
 
 from adept_traj.cli import main
 from adept_traj.cycle import (
+    ALGORITHM_PAIR,
+    BOXPLOT_FIGURE,
     CYCLE_FILE,
+    METRICS,
     MOVE_FILE,
     MOVES_FOLDER,
+    RUNS_FOLDER,
+    STUDY_FILE,
     cycle_tasks,
+    parse_seeds,
     plan_move,
     read_cycle_file,
     run_cycle,
+    study_statistics,
 )
-from adept_traj.errors import CycleError, UnreachableLocationError
+from adept_traj.errors import ConfigurationError, CycleError, UnreachableLocationError
 from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot
 
@@ -237,3 +244,65 @@ def test_killing_a_worker_mid_cycle_still_completes(cycle_run, cycle_file, tmp_p
         reference = PlanningResult.load(cycle_run / MOVES_FOLDER / move.name)
         np.testing.assert_array_equal(result.front.x, reference.front.x)
         assert result.feasible
+
+
+# --------------------------------------------------------------------------- seed studies
+def test_compare_seeds_produces_statistics_and_plots(cluster, tmp_path):
+    out = tmp_path / "study"
+    argv = ["compare", "--seeds", "1-3", "--gens", "2", "--pop-nsga2", "6", "--pop-mode", "6"]
+    argv += [
+        "--rate",
+        "100",
+        "--out",
+        str(out),
+        "--scheduler",
+        cluster.scheduler_address,
+        "--quiet",
+    ]
+    assert main(argv) == 0
+    doc = json.loads((out / STUDY_FILE).read_text())
+    assert doc["seeds"] == [1, 2, 3]
+    rows = {r["metric"]: r for r in doc["statistics"]}
+    assert list(rows) == [m.key for m in METRICS]
+    for alg in ALGORITHM_PAIR:
+        z1 = [PlanningResult.load(out / RUNS_FOLDER / f"{alg}-seed{s}").best_objectives[0]
+              for s in (1, 2, 3)]  # fmt: skip
+        assert doc["runs"][alg]["z1"] == z1
+        assert rows["z1"][alg]["median"] == sorted(z1)[1]
+        assert rows["z1"][alg]["n"] == 3
+    assert 0.0 <= rows["z1"]["p"] <= 1.0
+    assert (out / BOXPLOT_FIGURE).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "| z1 time [s] |" in (out / "study.md").read_text()
+
+
+def test_study_statistics_closed_form():
+    """NSGA-II 1…5 against MODE 6…10: U = 0, exact two-sided p = 2 / C(10, 5), medians 3
+    and 8, IQR 2 (linear quartiles); lower z1 is better and the paper's single run had
+    MODE faster, so the study contradicts it."""
+    low, high = [1.0, 2.0, 3.0, 4.0, 5.0], [6.0, 7.0, 8.0, 9.0, 10.0]
+    metrics = {"nsga2": {m.key: low for m in METRICS}, "mode": {m.key: high for m in METRICS}}
+    rows = {r["metric"]: r for r in study_statistics(metrics)}
+    z1 = rows["z1"]
+    assert z1["U"] == 0.0
+    assert z1["p"] == pytest.approx(2.0 / 252.0)
+    assert (z1["nsga2"]["median"], z1["nsga2"]["iqr"]) == (3.0, 2.0)
+    assert z1["mode"]["median"] == 8.0
+    assert z1["better"] == "nsga2"
+    assert z1["verdict"] == "contradicted"
+    assert rows["RNI"]["better"] == "mode"  # higher is better
+    assert rows["RNI"]["verdict"] == "contradicted"
+    assert rows["SSM"]["verdict"] == "confirmed"  # the paper's SSM favoured NSGA-II
+    assert rows["T_run"]["verdict"] == "nsga2 better (paper: no comparison)"
+
+
+@pytest.mark.parametrize(
+    ("text", "seeds"), [("1-3", (1, 2, 3)), ("4,1", (4, 1)), ("1-2,7", (1, 2, 7)), ("0", (0,))]
+)
+def test_parse_seeds(text, seeds):
+    assert parse_seeds(text) == seeds
+
+
+@pytest.mark.parametrize("text", ["", "3-1", "a", "1,1", "-2", "1-20000"])
+def test_parse_seeds_refuses(text):
+    with pytest.raises(ConfigurationError, match="--seeds"):
+        parse_seeds(text)

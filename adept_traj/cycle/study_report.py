@@ -81,7 +81,7 @@ def save_boxplots(metrics: dict[str, dict[str, list[float | None]]], path: Path)
         ax.boxplot(data, tick_labels=[display_name(a) for a in ALGORITHM_PAIR])
         ax.set_title(m.label + (" ↓" if m.lower_is_better else " ↑"), fontsize=8)
         ax.tick_params(labelsize=7)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.05, top=0.95, wspace=0.35, hspace=0.45)
     path.parent.mkdir(parents=True, exist_ok=True)
     return save_figure(fig, path)
 
