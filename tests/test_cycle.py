@@ -26,6 +26,7 @@ from adept_traj.cycle import (
     MOVES_FOLDER,
     RUNS_FOLDER,
     STUDY_FILE,
+    cycle_playback,
     cycle_tasks,
     parse_seeds,
     plan_move,
@@ -81,7 +82,7 @@ seed = 1
 @pytest.fixture(scope="module")
 def cluster():
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
     ) as c:
         yield c
 
@@ -108,6 +109,7 @@ def cycle_run(cycle_file, cluster) -> Path:
             cluster.scheduler_address,
             "--quiet",
             "--no-plots",
+            "--no-playback",
         ]
     )
     assert code == 0
@@ -193,6 +195,32 @@ def test_resume_plans_only_the_missing_moves(cycle_run, cycle_file, cluster, tmp
         run_cycle(cycle, out, scheduler=cluster.scheduler_address)
 
 
+def test_cycle_playback_joins_the_moves_at_rest(cycle_run, cycle_file):
+    cycle = read_cycle_file(cycle_file)
+    names = [m.name for m in cycle.moves]
+    results = [PlanningResult.load(cycle_run / MOVES_FOLDER / n) for n in names]
+    robot = Robot.adept_one_xl()
+    playback = cycle_playback(results, names, robot=robot, scene=cycle.scene)
+    assert np.all(np.diff(playback.frame_numbers) > 0)
+    assert np.all(np.diff(playback.times) > 0)
+    assert playback.duration == pytest.approx(sum(r.best_objectives[0] for r in results), abs=0.2)
+    assert all(o.poses.shape[0] == playback.n_frames for o in playback.objects if o.animated)
+    # the robot passes through every location, at rest, in the order of the moves
+    at = 0
+    for m in cycle.moves:
+        for name in (m.start, m.goal):
+            there = np.abs(playback.q[at:] - cycle.locations[name].joints).max(axis=1) < 1e-9
+            assert there.any(), f"{m.name} does not pass through {name} after frame {at}"
+            at += int(np.argmax(there))
+    assert at == playback.n_frames - 1
+    paths = [o.path for o in playback.objects]
+    assert [p for p in paths if p.endswith("/line")] == [
+        "tool_path/00-home-pick/line",
+        "tool_path/01-pick-home/line",
+        "tool_path/02-home-place/line",
+    ]
+
+
 @pytest.mark.slow
 def test_result_does_not_depend_on_the_worker(cycle_run, cycle_file):
     """A move planned in this process equals the one planned on the cluster."""
@@ -218,7 +246,7 @@ def test_killing_a_worker_mid_cycle_still_completes(cycle_run, cycle_file, tmp_p
     cycle = read_cycle_file(cycle_file)
     with (
         distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
         ) as cluster,
         distributed.Client(cluster) as client,
     ):

@@ -5,7 +5,8 @@ cluster of ``--workers`` single-threaded worker processes (default: one per core
 command starts and stops; ``--scheduler ADDRESS`` uses a running cluster instead. Every
 finished move is saved at once in ``DIR/moves/NAME/``; ``--resume`` keeps those already
 saved for the same task. At the end ``DIR/cycle.json``, ``DIR/cycle.md`` and
-``DIR/cycle_gantt.png`` (unless ``--no-plots``) report each move and the cycle time.
+``DIR/cycle_gantt.png`` (unless ``--no-plots``) report each move and the cycle time, and
+``DIR/playback.html`` (unless ``--no-playback``) plays the whole cycle in a browser.
 
 Exit status 0 when every move's reported solution is certified, 1 otherwise
 (:data:`~adept_traj.cli.status.NOT_CERTIFIED`).
@@ -20,7 +21,13 @@ from pathlib import Path
 from tqdm import tqdm
 
 from adept_traj.cli import status
-from adept_traj.cycle import read_cycle_file, run_cycle, write_cycle_report
+from adept_traj.cycle import (
+    PLAYBACK_FILE,
+    cycle_html,
+    read_cycle_file,
+    run_cycle,
+    write_cycle_report,
+)
 from adept_traj.validation import as_integer
 
 __all__ = ["add_parser", "run"]
@@ -35,6 +42,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--resume", action="store_true", help="keep the moves already saved")
     p.add_argument("--no-plots", action="store_true", help="no cycle_gantt.png")
+    p.add_argument("--no-playback", action="store_true", help="no playback.html")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     return p
 
@@ -56,5 +64,9 @@ def run(args: argparse.Namespace) -> int:
             progress=lambda name: bar.update(1),
         )
     summary = write_cycle_report(cycle, results, args.out, figure=not args.no_plots)
+    if not args.no_playback:
+        names = [m.name for m in cycle.moves]
+        robot, page = cycle.robot.load(), args.out / PLAYBACK_FILE
+        cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
     print((args.out / "cycle.md").read_text(encoding="utf-8"))
     return status.OK if summary["all_certified"] else status.NOT_CERTIFIED

@@ -18,6 +18,7 @@ from adept_traj.cycle.cycle_file import (
     RobotSource,
     read_cycle_file,
 )
+from adept_traj.cycle.cycle_playback import PLAYBACK_FILE, cycle_html, cycle_playback
 from adept_traj.cycle.runner import (
     MOVE_FILE,
     MOVES_FOLDER,
@@ -68,6 +69,7 @@ __all__ = [
     "METRICS",
     "MOVES_FOLDER",
     "MOVE_FILE",
+    "PLAYBACK_FILE",
     "RETRIES",
     "RUNS_FOLDER",
     "STUDY_FILE",
@@ -78,7 +80,9 @@ __all__ = [
     "MoveSpec",
     "MoveTask",
     "RobotSource",
+    "cycle_html",
     "cycle_markdown",
+    "cycle_playback",
     "cycle_summary",
     "cycle_tasks",
     "fastest_certified",

@@ -183,7 +183,7 @@ def run_tasks(
             n_workers=min(n, max(len(tasks), 1)),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: 8787 may be taken
         )
         client = Client(cluster)
     else:
