@@ -11,7 +11,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adept_traj.errors import InputShapeError, InvalidInputError, UnreachableLocationError
+from adept_traj.errors import (
+    InputShapeError,
+    InvalidInputError,
+    RobotModelError,
+    UnreachableLocationError,
+)
 from adept_traj.robot import (
     ELBOWS,
     Robot,
@@ -169,3 +174,42 @@ def test_numeric_ik_unreachable_and_malformed(ur5):
     bad[0, 0] = 2.0
     with pytest.raises(InvalidInputError, match="rigid transform"):
         numeric_ik(model, frame, bad, name="bad")
+
+
+def _arm_urdf(path: Path) -> Path:
+    """A 6R arm with sphere solids (no meshes): z, y, y, z, y, z axes, 1.08 m long."""
+    inertial = (
+        '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0"'
+        ' izz="0.01"/></inertial><collision><geometry><sphere radius="0.03"/></geometry>'
+        "</collision>"
+    )
+    offsets = ["0 0 0.1", "0 0.1 0", "0 0 0.4", "0 0 0.35", "0 0 0.1", "0 0 0.08"]
+    axes = ["0 0 1", "0 1 0", "0 1 0", "0 0 1", "0 1 0", "0 0 1"]
+    parts = ['<?xml version="1.0"?>', '<robot name="arm6">', f'<link name="l0">{inertial}</link>']
+    for i, (xyz, axis) in enumerate(zip(offsets, axes, strict=True), start=1):
+        parts += [
+            f'<link name="l{i}">{inertial}</link>',
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+            f'<origin xyz="{xyz}"/><axis xyz="{axis}"/>'
+            '<limit lower="-3.1" upper="3.1" effort="100" velocity="3"/></joint>',
+        ]
+    parts += [
+        f'<link name="tool0">{inertial}</link>',
+        '<joint name="tool_joint" type="fixed"><parent link="l6"/><child link="tool0"/>'
+        '<origin xyz="0 0 0.05"/></joint>',
+        "</robot>",
+    ]
+    path.write_text("\n".join(parts))
+    return path
+
+
+def test_solve_location_of_a_six_axis_robot_is_numeric(tmp_path):
+    robot = Robot.from_urdf(_arm_urdf(tmp_path / "arm6.urdf"), tool_frame="tool0")
+    with pytest.raises(RobotModelError, match="not a SCARA"):
+        ScaraGeometry.of(robot)
+    target = robot.tool_pose(np.array([0.4, -0.6, 1.1, 0.3, 0.7, -0.2]))
+    q, elbow = solve_location(robot, target, name="bin")
+    assert elbow is None
+    np.testing.assert_allclose(robot.tool_pose(q), target, atol=1e-6)
+    with pytest.raises(InvalidInputError, match="only for SCARA"):
+        solve_location(robot, target, elbow="righty", name="bin")
