@@ -23,6 +23,7 @@ from adept_traj.robot import (
     ScaraGeometry,
     numeric_ik,
     scara_ik,
+    scara_location,
     solve_location,
 )
 
@@ -65,6 +66,14 @@ def test_scara_round_trip_pose_joints_pose(robot, geometry, elbow):
         joints = scara_ik(geometry, location, elbow)
         np.testing.assert_allclose(joints, q, atol=1e-9)
         np.testing.assert_allclose(_xyz_yaw(robot, joints), location, atol=1e-9)
+
+
+def test_scara_location_is_the_forward_kinematics(robot, geometry):
+    q = _configurations(robot, "lefty", n=5)
+    want = np.array([_xyz_yaw(robot, qk) for qk in q])
+    np.testing.assert_allclose(scara_location(geometry, q), want, atol=1e-12)
+    with pytest.raises(InputShapeError):
+        scara_location(geometry, np.zeros(3))
 
 
 def test_both_elbows_reach_the_same_location_differently(robot, geometry):

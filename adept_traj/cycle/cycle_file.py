@@ -27,6 +27,7 @@ from adept_traj.robot import ELBOWS, Robot, ScaraGeometry, solve_location
 from adept_traj.scene import Scene
 from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy
+from adept_traj.validation import readonly_copy
 
 __all__ = ["MAX_MOVES", "Cycle", "Location", "MoveSpec", "RobotSource", "read_cycle_file"]
 
@@ -192,7 +193,7 @@ def _locations(node: Node, robot: Robot) -> dict[str, Location]:
                 raise entry["elbow"].error("only for a 'pose' location")
             q = entry["joints"].array((robot.nq,), "[rad | m]")
             joints = entry["joints"].build(robot.limits.check_position, q, "joints")
-            out[name] = Location(name, joints, None, None)
+            out[name] = Location(name, readonly_copy(joints), None, None)
             continue
         pose = entry["pose"].array((pose_size,), f"({pose_text})")
         elbow = entry["elbow"].string(choices=ELBOWS, default=None) if pose_size == 4 else None
@@ -207,7 +208,7 @@ def _locations(node: Node, robot: Robot) -> dict[str, Location]:
             raise UnreachableLocationError(
                 name, exc.distance, exc.unit, f"{where}: {message}"
             ) from None
-        out[name] = Location(name, joints, tuple(float(v) for v in pose), used)
+        out[name] = Location(name, readonly_copy(joints), tuple(float(v) for v in pose), used)
     return out
 
 
