@@ -331,6 +331,8 @@ def test_study_statistics_closed_form():
     assert rows["RNI"]["verdict"] == "contradicted"
     assert rows["SSM"]["verdict"] == "confirmed"  # the paper's SSM favoured NSGA-II
     assert rows["T_run"]["verdict"] == "nsga2 better (paper: no comparison)"
+    assert rows["N_eval"]["better"] is None  # fixed by the budget, not a quality
+    assert rows["N_eval"]["verdict"] == "not a quality measure"
 
 
 @pytest.mark.parametrize(

@@ -64,12 +64,13 @@ MAX_SEEDS = 10_000
 
 @dataclass(frozen=True)
 class Metric:
-    """One metric of the study: its key, label, whether lower is better, and the paper's
-    single-run winner (``None`` when the paper prints no comparable value)."""
+    """One metric of the study: its key, label, whether lower is better (``None``: not a
+    quality, e.g. the evaluations a budget allows: no algorithm is called better), and the
+    paper's single-run winner (``None`` when the paper prints no comparable value)."""
 
     key: str
     label: str
-    lower_is_better: bool
+    lower_is_better: bool | None
     paper_winner: str | None
 
 
@@ -83,7 +84,7 @@ METRICS = (
     Metric("F_avg", "F_avg", False, "mode"),
     Metric("f_c", "f_c", True, "mode"),
     Metric("T_run", "T_run [s]", True, None),
-    Metric("N_eval", "N_eval", True, None),
+    Metric("N_eval", "N_eval", None, None),
     Metric("AE", "AE [s]", True, "mode"),
     Metric("SSM", "SSM", True, "nsga2"),
     Metric("RNI", "RNI", False, "nsga2"),
@@ -242,7 +243,7 @@ def study_statistics(metrics: dict[str, dict[str, list[float | None]]]) -> list[
             test = mannwhitneyu(xa, xb, alternative="two-sided")
             row["U"], row["p"] = float(test.statistic), float(test.pvalue)
             ma, mb = row[a]["median"], row[b]["median"]
-            if ma != mb:
+            if ma != mb and m.lower_is_better is not None:
                 row["better"] = a if (ma < mb) == m.lower_is_better else b
         row["verdict"] = _verdict(row, m)
         rows.append({k: _plain(v) for k, v in row.items()})
@@ -250,6 +251,8 @@ def study_statistics(metrics: dict[str, dict[str, list[float | None]]]) -> list[
 
 
 def _verdict(row: dict[str, Any], metric: Metric) -> str:
+    if metric.lower_is_better is None:
+        return "not a quality measure"
     significant = row["p"] is not None and np.isfinite(row["p"]) and row["p"] < ALPHA
     if not significant or row["better"] is None:
         return "not significant"

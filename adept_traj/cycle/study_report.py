@@ -79,7 +79,8 @@ def save_boxplots(metrics: dict[str, dict[str, list[float | None]]], path: Path)
         ax = fig.add_subplot(rows, cols, k + 1)
         data = [[v for v in metrics[a][m.key] if v is not None] for a in ALGORITHM_PAIR]
         ax.boxplot(data, tick_labels=[display_name(a) for a in ALGORITHM_PAIR])
-        ax.set_title(m.label + (" ↓" if m.lower_is_better else " ↑"), fontsize=8)
+        arrow = {True: " ↓", False: " ↑", None: ""}[m.lower_is_better]
+        ax.set_title(m.label + arrow, fontsize=8)
         ax.tick_params(labelsize=7)
     fig.subplots_adjust(left=0.06, right=0.98, bottom=0.05, top=0.95, wspace=0.35, hspace=0.45)
     path.parent.mkdir(parents=True, exist_ok=True)
