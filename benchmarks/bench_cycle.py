@@ -115,11 +115,13 @@ def run_on_tcp(file: Path, out: Path) -> float:
         time.sleep(5.0)  # both workers registered
         return timed(["adept-traj", "cycle", str(file), "--out", str(out), "--quiet",
                       "--no-plots", "--scheduler", address])  # fmt: skip
-    finally:
-        for p in [*workers, scheduler]:
+    finally:  # the workers first: a worker outliving its scheduler logs heartbeat errors
+        for p in workers:
             p.terminate()
-        for p in [*workers, scheduler]:
+        for p in workers:
             p.wait(timeout=30)
+        scheduler.terminate()
+        scheduler.wait(timeout=30)
 
 
 def same_results(file: Path, outs: list[Path]) -> bool:

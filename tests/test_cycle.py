@@ -33,6 +33,7 @@ from adept_traj.cycle import (
     read_cycle_file,
     run_cycle,
     study_statistics,
+    write_study_report,
 )
 from adept_traj.errors import ConfigurationError, CycleError, UnreachableLocationError
 from adept_traj.results import PlanningResult
@@ -285,6 +286,7 @@ def test_killing_a_worker_mid_cycle_still_completes(paper_cycle, tmp_path):
 
 
 # --------------------------------------------------------------------------- seed studies
+@pytest.mark.slow
 def test_compare_seeds_produces_statistics_and_plots(cluster, tmp_path):
     out = tmp_path / "study"
     argv = ["compare", "--seeds", "1-3", "--gens", "2", "--pop-nsga2", "6", "--pop-mode", "6"]
@@ -333,6 +335,17 @@ def test_study_statistics_closed_form():
     assert rows["T_run"]["verdict"] == "nsga2 better (paper: no comparison)"
     assert rows["N_eval"]["better"] is None  # fixed by the budget, not a quality
     assert rows["N_eval"]["verdict"] == "not a quality measure"
+
+
+def test_study_report_of_given_values(tmp_path):
+    """The report of the closed-form case: every metric a row, the box plots a PNG."""
+    low, high = [1.0, 2.0, None], [6.0, 7.0, 8.0]
+    metrics = {"nsga2": {m.key: low for m in METRICS}, "mode": {m.key: high for m in METRICS}}
+    rows = study_statistics(metrics)
+    text = write_study_report(rows, metrics, (1, 2, 3), tmp_path, figure=True)
+    assert text.count("| 1.5 [1.25, 1.75] | 7 [6.5, 7.5] |") == len(METRICS)
+    assert json.loads((tmp_path / STUDY_FILE).read_text())["runs"] == metrics
+    assert (tmp_path / BOXPLOT_FIGURE).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.mark.parametrize(
