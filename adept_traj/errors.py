@@ -13,6 +13,7 @@ from pathlib import Path
 __all__ = [
     "AdeptTrajError",
     "ConfigurationError",
+    "CycleError",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
@@ -23,6 +24,7 @@ __all__ = [
     "RobotModelError",
     "SceneError",
     "SceneFileNotFoundError",
+    "UnreachableLocationError",
 ]
 
 
@@ -93,3 +95,29 @@ class ResourceLimitError(InvalidInputError):
 
     The message names the option (or file), its value, the estimate and the limit.
     """
+
+
+class UnreachableLocationError(InvalidInputError):
+    """A tool location that the robot cannot reach: out of its workspace, or reachable only
+    with a joint outside its limits, or (numeric inverse kinematics) not reached from any
+    start.
+
+    Attributes
+    ----------
+    location: the location's name (``"<pose>"`` when it has none).
+    distance: how far it is out of reach, in ``unit`` (e.g. 0.12 [m] beyond the arm's
+        reach, 0.3 [rad] beyond a joint limit, or the smallest residual of the numeric
+        solver).
+    unit: ``"m"`` or ``"rad"``.
+    """
+
+    def __init__(self, location: str, distance: float, unit: str, message: str) -> None:
+        self.location = location
+        self.distance = float(distance)
+        self.unit = unit
+        super().__init__(f"location {location!r}: {message}")
+
+
+class CycleError(ConfigurationError):
+    """A cycle file (``docs/cycles.md``) is missing or malformed, or a cycle run folder
+    does not match its cycle. The message names the file, the field and the valid range."""

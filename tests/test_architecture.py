@@ -26,6 +26,7 @@ RANK = {
     "optimise": 9,
     "viz": 9,
     "testing": 10,
+    "cycle": 10,
     "cli": 11,
 }  # fmt: skip
 

@@ -444,6 +444,7 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 def test_show_stops_its_server_on_sigterm(tmp_path: Path) -> None:
     import signal

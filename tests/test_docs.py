@@ -75,6 +75,7 @@ def test_python_blocks_parser(tmp_path):
     assert [is_skipped(code) for _, code in blocks] == [False, True, False]
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_tutorial_runs(tmp_path, monkeypatch):
     """Run the tutorial as a reader would: block after block, one session."""
     monkeypatch.chdir(tmp_path)
@@ -134,11 +135,13 @@ def html(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_docs_build_without_warnings(html):
     for page in ("index", "tutorial", "api", *(p.stem for p in DOCS.glob("*.md"))):
         assert (html / f"{page}.html").is_file(), page
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_api_page_documents_the_public_api(html):
     api = (html / "api.html").read_text(encoding="utf-8")
     for anchor in (
@@ -161,6 +164,7 @@ def test_api_page_documents_the_public_api(html):
     assert "----------" not in api
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_pages_render_math_and_need_no_network(html):
     """Math is rendered by MathJax in the reader's browser: the pages only link it."""
     tutorial = (html / "tutorial.html").read_text(encoding="utf-8")

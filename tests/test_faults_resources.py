@@ -125,6 +125,7 @@ def test_certify_refuses_a_rate_beyond_the_budget(problem) -> None:
     assert time.perf_counter() - t0 < 2.0
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_certificate_estimate_bounds_the_measured_peak(problem) -> None:
     x = problem.trajectory.straight_line(1.0)
     certify(problem, x, rate_hz=200.0)  # warm caches outside the measurement

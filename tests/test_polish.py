@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from adept_traj import TrajectoryProblem, plan
+from adept_traj import Scene, TrajectoryProblem, plan
 from adept_traj.analysis import certify
 from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.optimise import RampSampling, minimum_time, time_optimal
@@ -127,3 +127,18 @@ def test_time_optimal_mode_gives_a_certified_result(problem) -> None:
     assert result.front.n_certified == len(result.front.x)
     assert result.front.x[:, 0].min() <= 1.001 * DRAKE_T
     assert result.timing.n_generations == 0
+
+
+def test_a_scene_without_obstacles_has_no_distance_rows(problem) -> None:
+    """No obstacle: no distance row, the other rows as with obstacles, and the polish runs
+    (the Jacobian's reshape failed on the empty distance block)."""
+    empty = TrajectoryProblem(problem.robot, Scene(()), problem.start, problem.goal)
+    x = lift_then_lower(problem)[None]
+    lc = local_constraints(empty, x)
+    assert not np.any(lc.kind == CONSTRAINT_KINDS.index("distance"))
+    with_obstacles = local_constraints(problem, x)
+    keep = with_obstacles.kind != CONSTRAINT_KINDS.index("distance")
+    np.testing.assert_array_equal(lc.values, with_obstacles.values[:, keep])
+    np.testing.assert_array_equal(lc.jacobian, with_obstacles.jacobian[:, keep])
+    outcome = minimum_time(empty, x[0], max_iter=5)
+    assert outcome.x[0] < x[0, 0]

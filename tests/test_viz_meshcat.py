@@ -338,6 +338,7 @@ def screenshot(exe: str, page: Path, png: Path, budget_ms: int, profile: Path) -
     return matplotlib.image.imread(png)[..., :3]
 
 
+@pytest.mark.slow  # default-tier time (≤ 3 min): the slow tier runs it in CI (.ci/run)
 def test_page_renders_in_headless_chromium(page: Path, tmp_path: Path) -> None:
     exe = chromium()
     shots = [

@@ -7,6 +7,8 @@ Sub-commands, one module each:
   checkpoints, ``--resume DIR`` continues.
 - ``adept-traj compare --out DIR`` (:mod:`adept_traj.cli.compare`) — NSGA-II and MODE on
   the same problem, with the paper's Tables 3–5 beside ours (``DIR/comparison.md``).
+- ``adept-traj cycle FILE --out DIR`` (:mod:`adept_traj.cli.cycle`) — plan every move of
+  a cycle file, each move a Dask task (local cluster or ``--scheduler``).
 - ``adept-traj verify DIR`` (:mod:`adept_traj.cli.verify`) — re-run the dense
   verification of a saved result.
 - ``adept-traj front DIR`` (:mod:`adept_traj.cli.front`) — list the members of a saved
@@ -45,6 +47,7 @@ _DESCRIPTION = "Multi-objective, collision-free trajectory planning of industria
 _COMMANDS = {
     "plan": ("plan", "plan a trajectory and save a verified result"),
     "compare": ("compare", "NSGA-II vs MODE: the paper's Tables 3-5"),
+    "cycle": ("cycle", "plan every move of a cycle file (TOML) on Dask"),
     "show": ("show", "play a saved result in the browser (meshcat)"),
     "verify": ("verify", "re-run the dense verification of a saved result"),
     "front": ("front", "list the members of a saved front (to pick one)"),

@@ -1,6 +1,12 @@
 """``adept-traj compare``: NSGA-II and MODE on the same problem and seed, with the paper's
 Tables 3–5 beside ours in ``DIR/comparison.md``.
 
+``--seeds 1-20`` runs both algorithms for every seed instead, each run a Dask task
+(:func:`~adept_traj.cycle.run_seed_study`; ``--workers`` local worker processes, or
+``--scheduler ADDRESS``; ``--resume`` keeps the runs already saved), and writes the median,
+interquartile range and rank-sum test of every metric to ``DIR/study.md`` and
+``DIR/study.json``, with box plots in ``DIR/figures/study_boxplots.png``.
+
 F_avg, f_c and HV are computed on common bounds: the extremes over both feasible fronts
 and both best trade-offs.
 """
@@ -14,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm import tqdm
 
 from adept_traj.analysis import (
     average_fitness,
@@ -26,6 +33,14 @@ from adept_traj.cli.arguments import add_problem_arguments, problem_from_argumen
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
+from adept_traj.cycle import (
+    parse_seeds,
+    run_metrics,
+    run_seed_study,
+    study_statistics,
+    write_study_report,
+)
+from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import PlanningInterrupted, plan
 from adept_traj.results import PlanningResult, Replay
 
@@ -41,6 +56,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--pop-mode", type=int, help="MODE population (default 500)")
     p.add_argument("--out", type=Path, required=True, help="output folder")
     p.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
+    p.add_argument(
+        "--seeds",
+        help="seed study: '1-20' or '1,5,9'; each run a Dask task (--workers: worker processes)",
+    )
+    p.add_argument("--scheduler", help="with --seeds: address of a running Dask scheduler")
+    p.add_argument("--resume", action="store_true", help="with --seeds: keep the saved runs")
     return p
 
 
@@ -157,8 +178,43 @@ def comparison_markdown(results: dict[str, PlanningResult], weights: Sequence[fl
     return "\n".join(out) + "\n"
 
 
+def _run_study(args: argparse.Namespace) -> int:
+    """``compare --seeds``: the seed study on Dask and its report."""
+    seeds = parse_seeds(args.seeds)
+    problem = problem_from_arguments(args)
+    problem.close()
+    for name, pop in (("nsga2", args.pop_nsga2), ("mode", args.pop_mode)):
+        check_run_options(problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}")
+    with tqdm(
+        total=2 * len(seeds), desc="runs", unit="run", disable=args.quiet, file=sys.stderr
+    ) as bar:
+        runs = run_seed_study(
+            problem.scene,
+            problem.start,
+            problem.goal,
+            seeds,
+            args.out,
+            populations={"nsga2": args.pop_nsga2, "mode": args.pop_mode},
+            n_gen=args.gens,
+            weights=args.weights,
+            rate_hz=args.rate,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=lambda name: bar.update(1),
+        )
+    metrics = run_metrics(runs, args.weights)
+    rows = study_statistics(metrics)
+    print(write_study_report(rows, metrics, seeds, args.out, figure=not args.no_plots))
+    return status.OK
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``; return the exit status (0, or 130 when interrupted)."""
+    if args.seeds is not None:
+        return _run_study(args)
+    if args.scheduler is not None or args.resume:
+        raise ConfigurationError("--scheduler and --resume need --seeds")
     problem = problem_from_arguments(args)
     runs = (("nsga2", args.pop_nsga2), ("mode", args.pop_mode))
     results = {}

@@ -165,7 +165,7 @@ def _chain(d_state: np.ndarray, basis: np.ndarray) -> np.ndarray:
     """(pop, n_s, r, nq·n_free) from per-sample state derivatives ``d_state`` (pop, n_s, r,
     nq) and the free basis (n_s, n_free): joint-major, as the decision vector."""
     out = np.einsum("pkrj,kc->pkrjc", d_state, basis)
-    return out.reshape(*out.shape[:3], -1)
+    return out.reshape(*out.shape[:3], out.shape[3] * out.shape[4])  # r may be 0
 
 
 def _two_sided(value: np.ndarray, d_free: np.ndarray, d_T: np.ndarray, scale: np.ndarray):
@@ -267,4 +267,4 @@ def _distance(problem: Any, x: np.ndarray):
     d_T = grad_t * s[None, :, None]
     jac = -np.concatenate([d_T[..., None], d_free], axis=-1) / st.influence
     vals = (st.margin + st.search_buffer - d0) / st.influence
-    return vals.reshape(pop, -1), jac.reshape(pop, n_s * n_obs, -1)
+    return vals.reshape(pop, n_s * n_obs), jac.reshape(pop, n_s * n_obs, jac.shape[-1])

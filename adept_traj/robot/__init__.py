@@ -19,6 +19,14 @@ from adept_traj.robot.inertia import (
     cylinder_inertia,
     sphere_inertia,
 )
+from adept_traj.robot.inverse_kinematics import (
+    ELBOWS,
+    ScaraGeometry,
+    numeric_ik,
+    scara_ik,
+    scara_location,
+    solve_location,
+)
 from adept_traj.robot.kinematics import (
     BatchKinematics,
     compose,
@@ -69,6 +77,7 @@ from adept_traj.robot.urdf_loading import (
 
 __all__ = [
     "CONTINUOUS_RANGE",
+    "ELBOWS",
     "LIMITS",
     "LIMIT_KINDS",
     "TASK_ROWS",
@@ -84,6 +93,7 @@ __all__ = [
     "MassProperties",
     "Robot",
     "RobotParameters",
+    "ScaraGeometry",
     "SolidParameters",
     "apply_parameters",
     "box_inertia",
@@ -99,13 +109,17 @@ __all__ = [
     "link_mass_properties",
     "load_urdf_models",
     "manipulability_measure",
+    "numeric_ik",
     "package_search_dirs",
     "place_solids",
     "read_srdf_disabled_pairs",
     "resolve_package_file",
     "resolve_package_uris",
+    "scara_ik",
+    "scara_location",
     "shipped_file",
     "solid_frames",
     "solid_inertia",
+    "solve_location",
     "sphere_inertia",
 ]

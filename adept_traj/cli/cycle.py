@@ -1,0 +1,72 @@
+"""``adept-traj cycle FILE --out DIR``: plan every move of a cycle file on Dask.
+
+Each move is a Dask task (:func:`~adept_traj.cycle.run_cycle`): by default on a local
+cluster of ``--workers`` single-threaded worker processes (default: one per core) that the
+command starts and stops; ``--scheduler ADDRESS`` uses a running cluster instead. Every
+finished move is saved at once in ``DIR/moves/NAME/``; ``--resume`` keeps those already
+saved for the same task. At the end ``DIR/cycle.json``, ``DIR/cycle.md`` and
+``DIR/cycle_gantt.png`` (unless ``--no-plots``) report each move and the cycle time, and
+``DIR/playback.html`` (unless ``--no-playback``) plays the whole cycle in a browser.
+
+Exit status 0 when every move's reported solution is certified, 1 otherwise
+(:data:`~adept_traj.cli.status.NOT_CERTIFIED`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from tqdm import tqdm
+
+from adept_traj.cli import status
+from adept_traj.cycle import (
+    PLAYBACK_FILE,
+    cycle_html,
+    read_cycle_file,
+    run_cycle,
+    write_cycle_report,
+)
+from adept_traj.validation import as_integer
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``cycle`` and its options."""
+    p = sub.add_parser("cycle", help="plan every move of a cycle file (TOML) on Dask")
+    p.add_argument("file", type=Path, help="cycle file (docs/cycles.md)")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
+    p.add_argument("--resume", action="store_true", help="keep the moves already saved")
+    p.add_argument("--no-plots", action="store_true", help="no cycle_gantt.png")
+    p.add_argument("--no-playback", action="store_true", help="no playback.html")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``cycle``; return the exit status."""
+    if args.workers is not None:
+        as_integer(args.workers, "--workers", minimum=1, maximum=1024)
+    cycle = read_cycle_file(args.file)  # every location solved before any task starts
+    with tqdm(
+        total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
+    ) as bar:
+        results = run_cycle(
+            cycle,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=lambda name: bar.update(1),
+        )
+    summary = write_cycle_report(cycle, results, args.out, figure=not args.no_plots)
+    if not args.no_playback:
+        names = [m.name for m in cycle.moves]
+        robot, page = cycle.robot.load(), args.out / PLAYBACK_FILE
+        cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
+    print((args.out / "cycle.md").read_text(encoding="utf-8"))
+    return status.OK if summary["all_certified"] else status.NOT_CERTIFIED

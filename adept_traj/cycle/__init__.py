@@ -1,0 +1,103 @@
+"""Planning at scale on Dask: work cycles (named locations, a sequence of moves, each move
+a task) and seed studies (NSGA-II vs MODE over many seeds, each run a task).
+
+A cycle file (TOML, ``docs/cycles.md``) is read by :func:`read_cycle_file`;
+:func:`run_cycle` plans its moves on a Dask cluster and saves each result as it finishes;
+:func:`write_cycle_report` writes ``cycle.json``, ``cycle.md`` and a Gantt-like figure;
+:func:`run_seed_study`, :func:`study_statistics` and :func:`write_study_report` make
+``adept-traj compare --seeds``.
+Dask (``distributed``) is imported only when a cycle runs."""
+
+from __future__ import annotations
+
+from adept_traj.cycle.cycle_file import (
+    MAX_MOVES,
+    Cycle,
+    Location,
+    MoveSpec,
+    RobotSource,
+    read_cycle_file,
+)
+from adept_traj.cycle.cycle_playback import PLAYBACK_FILE, cycle_html, cycle_playback
+from adept_traj.cycle.runner import (
+    MOVE_FILE,
+    MOVES_FOLDER,
+    RETRIES,
+    MoveTask,
+    cycle_tasks,
+    plan_move,
+    run_cycle,
+    run_planning_tasks,
+    run_tasks,
+)
+from adept_traj.cycle.study import (
+    ALGORITHM_PAIR,
+    METRICS,
+    RUNS_FOLDER,
+    Metric,
+    parse_seeds,
+    run_metrics,
+    run_seed_study,
+    study_statistics,
+)
+from adept_traj.cycle.study_report import (
+    BOXPLOT_FIGURE,
+    STUDY_FILE,
+    STUDY_REPORT,
+    save_boxplots,
+    study_markdown,
+    write_study_report,
+)
+from adept_traj.cycle.summary import (
+    CYCLE_FILE,
+    CYCLE_REPORT,
+    GANTT_FIGURE,
+    cycle_markdown,
+    cycle_summary,
+    fastest_certified,
+    save_gantt,
+    write_cycle_report,
+)
+
+__all__ = [
+    "ALGORITHM_PAIR",
+    "BOXPLOT_FIGURE",
+    "CYCLE_FILE",
+    "CYCLE_REPORT",
+    "GANTT_FIGURE",
+    "MAX_MOVES",
+    "METRICS",
+    "MOVES_FOLDER",
+    "MOVE_FILE",
+    "PLAYBACK_FILE",
+    "RETRIES",
+    "RUNS_FOLDER",
+    "STUDY_FILE",
+    "STUDY_REPORT",
+    "Cycle",
+    "Location",
+    "Metric",
+    "MoveSpec",
+    "MoveTask",
+    "RobotSource",
+    "cycle_html",
+    "cycle_markdown",
+    "cycle_playback",
+    "cycle_summary",
+    "cycle_tasks",
+    "fastest_certified",
+    "parse_seeds",
+    "plan_move",
+    "read_cycle_file",
+    "run_cycle",
+    "run_metrics",
+    "run_planning_tasks",
+    "run_seed_study",
+    "run_tasks",
+    "save_boxplots",
+    "save_gantt",
+    "study_markdown",
+    "study_statistics",
+    "write_cycle_report",
+    "write_study_report",
+]

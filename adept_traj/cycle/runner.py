@@ -1,0 +1,296 @@
+"""Planning the moves of a cycle as Dask tasks.
+
+:func:`run_cycle` submits one task per move to a Dask cluster — by default a
+``distributed.LocalCluster`` with one single-threaded worker process per core, started and
+stopped here; ``scheduler="tcp://host:8786"`` uses an existing cluster (``dask scheduler``
+and ``dask worker`` on several machines; the robot's files must exist at the same paths on
+every worker). Each task builds the problem and calls :func:`~adept_traj.optimise.plan`
+with the move's own seed, so a move's result does not depend on the worker, the number of
+workers or the order. The client saves each result as soon as it arrives
+(``DIR/moves/NAME/``: :meth:`~adept_traj.results.PlanningResult.save`, written into a
+temporary folder that is then renamed, plus ``move.json`` describing the task); with
+``resume=True`` a move whose folder holds the same task is loaded, not planned again.
+A task whose worker dies is rescheduled by the scheduler; a task that raises is retried
+(``retries``) before the run fails. Dask is imported only here, when a cycle runs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import uuid
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from adept_traj.cycle.cycle_file import Cycle, MoveSpec, RobotSource
+from adept_traj.errors import CycleError, ResultFormatError
+from adept_traj.files import write_text_atomic
+from adept_traj.optimise import plan
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import PlanningResult
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
+from adept_traj.validation import as_integer
+
+__all__ = [
+    "MOVES_FOLDER",
+    "MOVE_FILE",
+    "RETRIES",
+    "MoveTask",
+    "cycle_tasks",
+    "plan_move",
+    "run_cycle",
+    "run_planning_tasks",
+    "run_tasks",
+]
+
+#: Sub-folder of the output folder holding one result folder per move.
+MOVES_FOLDER = "moves"
+#: The task a move folder was planned for (what ``resume`` compares).
+MOVE_FILE = "move.json"
+#: Times a task that raised is submitted again.
+RETRIES = 2
+
+
+@dataclass(frozen=True)
+class MoveTask:
+    """Everything a worker needs to plan one move (pickled to it).
+
+    Attributes
+    ----------
+    move: the move; start, goal: (nq,) joints [rad | m].
+    robot: where the worker loads the robot; scene: the scene; rate_hz: certificate rate.
+    """
+
+    move: MoveSpec
+    start: np.ndarray
+    goal: np.ndarray
+    robot: RobotSource
+    scene: Scene
+    rate_hz: float
+
+    def description(self) -> dict[str, Any]:
+        """The JSON form written to ``move.json`` (what identifies the task's result)."""
+        m = self.move
+        return json.loads(
+            json.dumps(
+                {
+                    "name": m.name,
+                    "from": m.start,
+                    "to": m.goal,
+                    "start": self.start.tolist(),
+                    "goal": self.goal.tolist(),
+                    "algorithm": m.algorithm,
+                    "seed": m.seed,
+                    "pop_size": m.pop_size,
+                    "n_gen": m.n_gen,
+                    "weights": list(m.weights),
+                    "rate_hz": self.rate_hz,
+                    "robot": {"urdf": str(self.robot.urdf), "params": str(self.robot.params)},
+                    "scene": self.scene.to_dict(),
+                }
+            )
+        )
+
+
+def cycle_tasks(cycle: Cycle) -> list[MoveTask]:
+    """One :class:`MoveTask` per move of ``cycle``, in order."""
+    return [
+        MoveTask(
+            move=m,
+            start=cycle.locations[m.start].joints,
+            goal=cycle.locations[m.goal].joints,
+            robot=cycle.robot,
+            scene=cycle.scene,
+            rate_hz=cycle.rate_hz,
+        )
+        for m in cycle.moves
+    ]
+
+
+@lru_cache(maxsize=4)
+def _robot(source: RobotSource) -> Robot:
+    """The robot of ``source``, loaded once per worker process."""
+    return source.load()
+
+
+def plan_move(task: MoveTask) -> PlanningResult:
+    """Plan one move (the body of a Dask task; also callable directly)."""
+    m = task.move
+    problem = TrajectoryProblem(_robot(task.robot), task.scene, task.start, task.goal, workers=1)
+    try:
+        return plan(
+            problem,
+            m.algorithm,
+            seed=m.seed,
+            pop_size=m.pop_size,
+            n_gen=m.n_gen,
+            weights=m.weights,
+            rate_hz=task.rate_hz,
+        )
+    finally:
+        problem.close()
+
+
+def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
+    """The saved result of ``task`` in ``folder`` when it is complete and planned for the
+    same task; ``None`` otherwise (then it is planned again)."""
+    try:
+        saved = json.loads((folder / MOVE_FILE).read_text(encoding="utf-8"))
+        if saved != task.description():
+            return None
+        return PlanningResult.load(folder)
+    except (OSError, ValueError, ResultFormatError):
+        return None
+
+
+def _save(folder: Path, task: MoveTask, result: PlanningResult) -> Path:
+    """Save ``result`` into ``folder/NAME`` at once and atomically (a temporary folder
+    renamed), with ``move.json``."""
+    final = folder / task.move.name
+    tmp = final.with_name(f".{task.move.name}.partial")
+    shutil.rmtree(tmp, ignore_errors=True)
+    result.save(tmp)
+    write_text_atomic(tmp / MOVE_FILE, json.dumps(task.description(), indent=1))
+    shutil.rmtree(final, ignore_errors=True)
+    os.replace(tmp, final)
+    return final
+
+
+def run_tasks(
+    tasks: Sequence[Any],
+    function: Callable[[Any], Any],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    on_result: Callable[[int, Any], None] | None = None,
+) -> list[Any]:
+    """``[function(t) for t in tasks]``, each call a Dask task (``retries`` =
+    :data:`RETRIES`), on a new local cluster of ``workers`` single-threaded worker
+    processes (default: one per core) or on the scheduler at address ``scheduler``.
+    ``on_result(i, value)`` is called in this process as each task finishes."""
+    from distributed import Client, LocalCluster, as_completed
+
+    if scheduler is None:
+        n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
+        cluster = LocalCluster(
+            n_workers=min(n, max(len(tasks), 1)),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # any free port: 8787 may be taken
+        )
+        client = Client(cluster)
+    else:
+        cluster, client = None, Client(scheduler)
+    try:
+        run_id = uuid.uuid4().hex  # keys unique on a shared scheduler
+        futures = [
+            client.submit(function, t, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
+            for i, t in enumerate(tasks)
+        ]
+        index = {f.key: i for i, f in enumerate(futures)}
+        out: list[Any] = [None] * len(tasks)
+        for future in as_completed(futures):
+            i = index[future.key]
+            out[i] = future.result()
+            future.release()
+            if on_result is not None:
+                on_result(i, out[i])
+        return out
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def run_planning_tasks(
+    tasks: Sequence[MoveTask],
+    folder: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> list[PlanningResult]:
+    """Plan ``tasks`` on Dask (:func:`run_tasks`), each result saved as it arrives into
+    ``folder/NAME/`` (NAME: the task's move name); return the results in order.
+
+    ``resume``: a task whose folder holds the same task (``move.json``) is loaded, not
+    planned; without it a ``folder`` that already holds results is refused
+    (:class:`~adept_traj.errors.CycleError`). ``progress`` is called with each name as its
+    result is saved (or found saved)."""
+    where = Path(folder)
+    if not resume and where.exists() and any(where.iterdir()):
+        raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
+    results: list[PlanningResult | None] = [None] * len(tasks)
+    pending = []
+    for i, task in enumerate(tasks):
+        done = _finished(where / task.move.name, task) if resume else None
+        if done is None:
+            pending.append(i)
+        else:
+            results[i] = done
+            if progress is not None:
+                progress(task.move.name)
+
+    def saved(j: int, result: PlanningResult) -> None:
+        i = pending[j]
+        _save(where, tasks[i], result)
+        results[i] = result
+        if progress is not None:
+            progress(tasks[i].move.name)
+
+    if pending:
+        where.mkdir(parents=True, exist_ok=True)
+        run_tasks(
+            [tasks[i] for i in pending],
+            plan_move,
+            workers=workers,
+            scheduler=scheduler,
+            on_result=saved,
+        )
+    return results  # type: ignore[return-value]
+
+
+def run_cycle(
+    cycle: Cycle,
+    out: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> list[PlanningResult]:
+    """Plan every move of ``cycle`` on Dask; save each result as it finishes
+    (``out/moves/NAME/``, :func:`run_planning_tasks`); return the results in the order of
+    the moves.
+
+    Parameters
+    ----------
+    cycle: from :func:`~adept_traj.cycle.read_cycle_file`.
+    out: output folder.
+    workers: local worker processes (default: one per core; ignored with ``scheduler``).
+    scheduler: address of an existing Dask scheduler (``tcp://127.0.0.1:8786``).
+    resume: keep the moves already saved for the same task (else ``out`` must not hold
+        an earlier cycle run).
+    progress: called with a move's name as it finishes (or is found finished).
+
+    Raises
+    ------
+    CycleError
+        ``out`` holds an earlier run and ``resume`` is false.
+    """
+    return run_planning_tasks(
+        cycle_tasks(cycle),
+        Path(out) / MOVES_FOLDER,
+        workers=workers,
+        scheduler=scheduler,
+        resume=resume,
+        progress=progress,
+    )
