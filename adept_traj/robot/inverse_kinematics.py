@@ -195,13 +195,6 @@ def scara_ik(
 ) -> np.ndarray:
     r"""Joints (4,) [rad, rad, m, rad] placing the tool at ``location``.
 
-    Parameters
-    ----------
-    geometry: the robot's :class:`ScaraGeometry`.
-    location: (4,) x, y, z [m] and yaw [rad] of the tool in the robot base frame.
-    elbow: ``"righty"`` or ``"lefty"`` (see the module docstring).
-    name: the location's name, for messages.
-
     With :math:`r` the distance of the wrist from the shoulder axis, the relative angle of
     link 2 is
 
@@ -209,6 +202,13 @@ def scara_ik(
         \varphi = \pm\arccos\frac{r^2 - a_1^2 - a_2^2}{2 a_1 a_2}
 
     (+ righty, − lefty; seen from above with base z up).
+
+    Parameters
+    ----------
+    geometry: the robot's :class:`ScaraGeometry`.
+    location: (4,) x, y, z [m] and yaw [rad] of the tool in the robot base frame.
+    elbow: ``"righty"`` or ``"lefty"`` (see the module docstring).
+    name: the location's name, for messages.
 
     Raises
     ------
