@@ -35,7 +35,8 @@ extensions = [
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+# data/: run outputs kept as evidence (e.g. the seed study), not pages
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "data"]
 
 # Unresolved references to objects of other packages (numpy, pymoo, coal, pinocchio: no
 # intersphinx, which would need the network) are rendered as plain text, not reported.
