@@ -28,7 +28,6 @@ compares it field by field.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -133,13 +132,6 @@ class MemberCertificate:
         if kind not in LIMIT_KINDS:
             raise InvalidInputError(f"kind must be one of {LIMIT_KINDS}; got {kind!r}")
         return self.worst[LIMIT_KINDS.index(kind)]
-
-    def to_dict(self) -> dict[str, Any]:
-        """The fields as a plain dict (tuples as lists), in the order of the dataclass."""
-        return {
-            f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v
-            for f in dataclasses.fields(self)
-        }
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):

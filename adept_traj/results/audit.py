@@ -248,8 +248,9 @@ class _Auditor(MismatchLog):
             rate_hz=self.r.certificate.rate_hz,
             tolerance=self.r.certificate.position.tolerance,
         )
-        for i in rows if stored is not None else ():
-            self.member_certificate(f"front[{i}].certificate", stored[i], fresh[i])
+        if stored is not None:
+            for i in rows:
+                self.member_certificate(f"front[{i}].certificate", stored[i], fresh[i])
         return np.array(
             [bool(ok) and c is not None and c.feasible for ok, c in zip(sampled, fresh)],
             dtype=bool,
@@ -257,8 +258,15 @@ class _Auditor(MismatchLog):
 
     def member_certificate(self, path: str, stored: Any, now: Any) -> None:
         """Compare two :class:`~adept_traj.analysis.MemberCertificate` field by field."""
-        exact = ("feasible", "guarantee", "torque_guarantee", "worst_joint")
-        for field in (*exact, "min_distance_exact", "closest_pair", "violations"):
+        for field in (
+            "feasible",
+            "guarantee",
+            "torque_guarantee",
+            "worst_joint",
+            "min_distance_exact",
+            "closest_pair",
+            "violations",
+        ):
             self.value(f"{path}.{field}", getattr(stored, field), getattr(now, field))
         self.numbers(f"{path}.worst", stored.worst, now.worst)
         self.numbers(f"{path}.t_worst", stored.t_worst, now.t_worst)
