@@ -38,6 +38,7 @@ from adept_traj.cycle import (
 from adept_traj.errors import ConfigurationError, CycleError, UnreachableLocationError
 from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot
+from adept_traj.scene import Scene
 
 distributed = pytest.importorskip("distributed")
 
@@ -359,3 +360,12 @@ def test_parse_seeds(text, seeds):
 def test_parse_seeds_refuses(text):
     with pytest.raises(ConfigurationError, match="--seeds"):
         parse_seeds(text)
+
+
+@pytest.mark.parametrize("name", ["paper", "detour"])
+def test_a_shipped_scene_by_name(tmp_path, name):
+    """``scene`` names a shipped scene as ``--scene`` does, before any file of that name."""
+    (tmp_path / name).write_text("not a scene file")
+    path = tmp_path / "cycle.toml"
+    path.write_text(THREE_MOVES.replace('"empty.toml"', f'"{name}"'))
+    assert read_cycle_file(path).scene == Scene.shipped(name)

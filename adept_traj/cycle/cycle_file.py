@@ -24,7 +24,7 @@ from adept_traj.errors import CycleError, RobotModelError, UnreachableLocationEr
 from adept_traj.files import read_toml
 from adept_traj.optimise import ALGORITHMS
 from adept_traj.robot import ELBOWS, Robot, ScaraGeometry, solve_location
-from adept_traj.scene import Scene
+from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy
 from adept_traj.validation import readonly_copy
@@ -167,8 +167,8 @@ def _robot_source(node: Node, folder: Path) -> RobotSource:
 
 def _scene(node: Node, folder: Path) -> Scene:
     name = node.string(nonempty=True, default="paper")
-    if name == "paper":
-        return Scene.paper()
+    if name in SHIPPED_SCENES:  # the command line's rule (cli.arguments.scene_from_argument)
+        return Scene.shipped(name)
     return node.build(Scene.from_file, folder / name)
 
 
