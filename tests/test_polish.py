@@ -37,7 +37,8 @@ def test_jacobian_matches_central_differences(problem, ramps) -> None:
     keep = lc.kind != CONSTRAINT_KINDS.index("torque")
     keep[lc.kind == CONSTRAINT_KINDS.index("torque")] = torque_ok
     assert torque_ok.mean() > 0.5
-    assert np.any(lc.jacobian[0, lc.kind == CONSTRAINT_KINDS.index("distance")] != 0.0)
+    distance = lc.kind == CONSTRAINT_KINDS.index("distance")
+    assert np.any(lc.jacobian[0, distance] != 0.0)
     for c in columns:
         e = np.zeros(problem.n_var)
         e[c] = h
@@ -45,8 +46,12 @@ def test_jacobian_matches_central_differences(problem, ramps) -> None:
             local_constraints(problem, x + e).values[0]
             - local_constraints(problem, x - e).values[0]
         ) / (2 * h)
-        scale = 1.0 + np.abs(fd[keep])
-        np.testing.assert_array_less(np.abs(fd - lc.jacobian[0, :, c])[keep] / scale, 1e-6)
+        error = np.abs(fd - lc.jacobian[0, :, c]) / (1.0 + np.abs(fd))
+        np.testing.assert_array_less(error[keep & ~distance], 1e-6)
+        # The distance rows' reference is noisier: the checker's distances have GJK's
+        # 1e-9 m tolerance, ~1e-9 / h after the difference (the gradient's own witness
+        # points use 1e-14, tests/test_distance_gradient.py checks it more closely).
+        np.testing.assert_array_less(error[distance], 1e-4)
 
 
 def test_row_maxima_are_the_evaluators_constraints(problem, ramps) -> None:

@@ -13,6 +13,7 @@ from adept_traj.collision.checker import (
     MinDistances,
     PairDistances,
 )
+from adept_traj.collision.distance_gradient import DistanceGradients, distance_gradients
 from adept_traj.collision.distance_table import DistanceTable
 from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import (
@@ -34,12 +35,14 @@ __all__ = [
     "Bounds",
     "BroadPhase",
     "CollisionChecker",
+    "DistanceGradients",
     "DistanceTable",
     "MinDistances",
     "ObstaclePruning",
     "PairDistances",
     "SelfCollision",
     "coal_kind",
+    "distance_gradients",
     "distance_request",
     "point_signed_distance",
     "restrict_broad_phase",

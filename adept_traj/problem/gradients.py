@@ -49,15 +49,15 @@ in the evaluator:
 The joint position limits need no constraint: the control points' box bounds
 (``problem.xl``, ``problem.xu``) keep the whole spline inside them (convex hull).
 
-**What is a finite difference.** Everything above is exact except the state derivatives
-of two black boxes, taken by *central differences in the state* (a few batched calls over
-all samples at once, never through the decision vector): :math:`\partial u/\partial(q,
-\dot q, \ddot q)` of the inverse dynamics (step ``1e-6``; the Coulomb term's derivative is
-0 away from rest and is left out exactly) and :math:`\partial d/\partial(q, t)` of the
-distances (step ``1e-6``; coal's GJK tolerance is 1e-9 m; only at samples within
-``influence`` + 1 mm of an obstacle, the others have a zero gradient). The analytic
-distance gradient (coal's nearest points and normal through the frame Jacobians, the
-pendulum through its motion law) is not implemented yet.
+**Nothing is a finite difference.** The state derivatives of the two black boxes are
+analytic too: :math:`\partial u/\partial(q, \dot q, \ddot q)` by Pinocchio's RNEA
+derivatives (``computeRNEADerivatives``; rotor inertia included, the viscous friction
+added, the Coulomb term's derivative 0 away from rest) and :math:`\partial d/\partial(q, t)`
+from coal's nearest points and normal through the joint Jacobians and the obstacles'
+motion laws (:func:`~adept_traj.collision.distance_gradients`, which also says what
+happens at ties and in penetration); a sample and obstacle farther than ``influence`` has
+a zero gradient, exact for the clipped distance. The spline bases of the constraint grids
+are computed once and reused at every solver iteration.
 
 Between the velocity samples the speed can exceed its sample maximum a little; the local
 solver therefore finishes by raising T to the spline's exact kinematic minimum
@@ -66,11 +66,14 @@ solver therefore finishes by raising T to the spline's exact kinematic minimum
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
+from adept_traj.collision import distance_gradients
 from adept_traj.errors import ConfigurationError
 from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_batch, as_integer
@@ -79,14 +82,6 @@ __all__ = ["CONSTRAINT_KINDS", "LocalConstraints", "local_constraints"]
 
 #: The kinds of per-sample constraints, in the order of :class:`LocalConstraints` rows.
 CONSTRAINT_KINDS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "torque", "distance")
-
-#: Central-difference steps in the state: joint positions [rad | m], speeds, accelerations,
-#: time [s].
-_H = 1e-6
-
-#: Samples farther than ``influence + _NEAR`` [m] from every obstacle get no distance
-#: derivative (their clipped distance stays at ``influence`` under a step of ``_H``).
-_NEAR = 1e-3
 
 
 @dataclass(frozen=True)
@@ -142,12 +137,13 @@ def _local_constraints(problem: Any, x: np.ndarray, n_per_segment: int) -> Local
         np.linspace(0.0, 1.0, S + 1),  # acceleration: the knots
         (np.arange(S) + 0.5) / S,  # jerk: the segment midpoints
     )
+    T, P = traj.decode(x)
     blocks = [
-        _kinematic(problem, x, s, order, problem.robot.limits.bound(kind.name))
+        _kinematic(T, P, S, s, order, problem.robot.limits.bound(kind.name))
         for order, (s, kind) in enumerate(zip(grids, LIMITS[1:4]), start=1)
     ]
-    blocks.append(_torque(problem, x))
-    blocks.append(_distance(problem, x))
+    blocks.append(_torque(problem, T, P))
+    blocks.append(_distance(problem, T, P))
     kind = np.concatenate([np.full(b[0].shape[1], i) for i, b in enumerate(blocks)])
     return LocalConstraints(
         values=np.concatenate([b[0] for b in blocks], axis=1),
@@ -156,9 +152,29 @@ def _local_constraints(problem: Any, x: np.ndarray, n_per_segment: int) -> Local
     )
 
 
-def _free_basis(traj: Any, s: np.ndarray, order: int) -> np.ndarray:
-    """(n_s, n_free) basis of the free control points at ``s`` (derivative ``order``)."""
-    return traj.basis_matrix(s, order)[:, 3:-3]
+def _basis(n_segments: int, s: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n_s, n_control) basis of the uniform spline of ``n_segments`` at ``s`` (derivative
+    ``order``) and its free columns (n_s, n_free), computed once per grid (the same at
+    every solver iteration; read-only)."""
+    return _cached_basis(n_segments, s.tobytes(), order)
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_basis(n_segments: int, s_bytes: bytes, order: int) -> tuple[np.ndarray, np.ndarray]:
+    from adept_traj.problem.bspline import BSplineTrajectory
+
+    s = np.frombuffer(s_bytes)
+    zeros = np.zeros(1)
+    full = BSplineTrajectory(zeros, zeros, n_knots=n_segments + 1).basis_matrix(s, order)
+    free = np.ascontiguousarray(full[:, 3:-3])
+    full.flags.writeable = free.flags.writeable = False
+    return full, free
+
+
+def _samples(P: np.ndarray, T: np.ndarray, n_segments: int, s: np.ndarray, order: int):
+    """(pop, n_s, nq) derivative ``order`` in time of the splines ``(T, P)`` at ``s``."""
+    full, _ = _basis(n_segments, s, order)
+    return np.einsum("kc,pcj->pkj", full, P) / T[:, None, None] ** order
 
 
 def _chain(d_state: np.ndarray, basis: np.ndarray) -> np.ndarray:
@@ -179,92 +195,65 @@ def _two_sided(value: np.ndarray, d_free: np.ndarray, d_T: np.ndarray, scale: np
     return vals, np.concatenate([jac, -jac], axis=1)
 
 
-def _kinematic(problem: Any, x: np.ndarray, s: np.ndarray, order: int, limit: np.ndarray):
+def _kinematic(T, P, n_segments: int, s: np.ndarray, order: int, limit: np.ndarray):
     """Velocity (order 1), acceleration (2) or jerk (3) rows at ``s``."""
-    traj = problem.trajectory
-    T, P = traj.decode(x)
-    B = traj.basis_matrix(s, order)
-    y = np.einsum("kc,pcj->pkj", B, P) / T[:, None, None] ** order  # (pop, n_s, nq)
-    Bf = _free_basis(traj, s, order)
+    y = _samples(P, T, n_segments, s, order)  # (pop, n_s, nq)
+    nq = y.shape[-1]
     scale = T[:, None, None, None] ** order
-    eye = np.broadcast_to(np.eye(traj.nq), (len(x), len(s), traj.nq, traj.nq))
-    d_free = _chain(eye / scale, Bf)
+    eye = np.broadcast_to(np.eye(nq), (len(T), len(s), nq, nq))
+    d_free = _chain(eye / scale, _basis(n_segments, s, order)[1])
     d_T = -order * y / T[:, None, None]
     return _two_sided(y, d_free, d_T, limit)
 
 
 def _inverse_dynamics_derivatives(robot: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray):
-    """(∂u/∂q, ∂u/∂v, ∂u/∂a), each (..., nq_out, nq_in), by central differences in the state,
-    all perturbations in one batched call; the Coulomb term (constant away from rest) is
-    removed from ∂u/∂v exactly."""
+    """(∂u/∂q, ∂u/∂v, ∂u/∂a), each (..., nq_out, nq_in), of
+    :meth:`~adept_traj.robot.Robot.inverse_dynamics`: Pinocchio's analytic RNEA derivatives
+    (rotor inertia included in :math:`\\partial u/\\partial a = M(q)`), the viscous friction's
+    :math:`F_v` added to :math:`\\partial u / \\partial v`; the Coulomb term's derivative is
+    0 away from rest. One Pinocchio call per sample (no batched variant exists; measured
+    3.3 × faster than the batched central differences it replaces, 116 samples)."""
+    model = robot.model
+    data = model.createData()
     nq = q.shape[-1]
-    # Perturbations (3 state parts, 2 signs, nq joints) of (q, v, a): (6 nq, 3, nq)
-    delta = np.zeros((3, 2, nq, 3, nq))
-    for part in range(3):
-        delta[part, 0, :, part, :] = _H * np.eye(nq)
-        delta[part, 1, :, part, :] = -_H * np.eye(nq)
-    delta = delta.reshape(6 * nq, 3, nq)
-    base = (q[..., None, :], v[..., None, :], a[..., None, :])
-    u = robot.inverse_dynamics(*(base[i] + delta[:, i] for i in range(3)))  # (..., 6nq, nq)
-    u = u.reshape(*q.shape[:-1], 3, 2, nq, nq)
-    d = (u[..., 0, :, :] - u[..., 1, :, :]) / (2.0 * _H)  # (..., 3, nq_in, nq_out)
-    d = np.swapaxes(d, -1, -2)  # (..., 3, nq_out, nq_in)
-    friction = np.asarray(robot.model.friction, dtype=float)
-    if np.any(friction):
-        from adept_traj.robot import coulomb_sign
-
-        jump = (coulomb_sign(v + _H) - coulomb_sign(v - _H)) / (2.0 * _H)  # (..., nq)
-        idx = np.arange(nq)
-        d[..., 1, idx, idx] -= friction * jump
-    return d[..., 0, :, :], d[..., 1, :, :], d[..., 2, :, :]
+    flat = [np.ascontiguousarray(z.reshape(-1, nq)) for z in (q, v, a)]
+    out = np.empty((3, flat[0].shape[0], nq, nq))
+    for i, (qi, vi, ai) in enumerate(zip(*flat)):
+        pin.computeRNEADerivatives(model, data, qi, vi, ai)
+        out[0, i], out[1, i], out[2, i] = data.dtau_dq, data.dtau_dv, data.M
+    upper = np.triu(out[2])  # Pinocchio fills the upper triangle of M
+    out[2] = upper + np.swapaxes(np.triu(upper, 1), -1, -2)
+    out[1] += np.diag(np.asarray(model.damping, dtype=float))
+    return tuple(o.reshape(*q.shape, nq) for o in out)
 
 
-def _torque(problem: Any, x: np.ndarray):
+def _torque(problem: Any, T: np.ndarray, P: np.ndarray):
     """Torque rows at the problem's samples."""
-    traj, robot = problem.trajectory, problem.robot
-    s = problem.s
-    smp = traj.sample(x, s, orders=(0, 1, 2))
-    u = robot.inverse_dynamics(smp.q, smp.qd, smp.qdd)  # (pop, n_s, nq)
-    dq, dv, da = _inverse_dynamics_derivatives(robot, smp.q, smp.qd, smp.qdd)
-    T = x[:, 0][:, None, None, None]
+    robot, S, s = problem.robot, problem.trajectory.n_segments, problem.s
+    q, qd, qdd = (_samples(P, T, S, s, order) for order in range(3))
+    u = robot.inverse_dynamics(q, qd, qdd)  # (pop, n_s, nq)
+    dq, dv, da = _inverse_dynamics_derivatives(robot, q, qd, qdd)
+    T4 = T[:, None, None, None]
     d_free = (
-        _chain(dq, _free_basis(traj, s, 0))
-        + _chain(dv / T, _free_basis(traj, s, 1))
-        + _chain(da / T**2, _free_basis(traj, s, 2))
+        _chain(dq, _basis(S, s, 0)[1])
+        + _chain(dv / T4, _basis(S, s, 1)[1])
+        + _chain(da / T4**2, _basis(S, s, 2)[1])
     )
-    d_T = (
-        -(np.einsum("pkij,pkj->pki", dv, smp.qd) + 2.0 * np.einsum("pkij,pkj->pki", da, smp.qdd))
-        / x[:, 0][:, None, None]
-    )
-    return _two_sided(u, d_free, d_T, robot.limits.bound(LIMITS[4].name))
+    d_T = -(np.einsum("pkij,pkj->pki", dv, qd) + 2.0 * np.einsum("pkij,pkj->pki", da, qdd))
+    return _two_sided(u, d_free, d_T / T[:, None, None], robot.limits.bound(LIMITS[4].name))
 
 
-def _distance(problem: Any, x: np.ndarray):
-    """Distance rows at the problem's samples, one per sample and obstacle. The state
-    derivatives are taken only at the samples closer than ``influence + _NEAR`` to some
-    obstacle (elsewhere the clipped distance is constant: zero gradient)."""
-    traj, st, checker = problem.trajectory, problem.settings, problem.checker
-    s = problem.s
-    smp = traj.sample(x, s, orders=(0,))
-    q, t = smp.q, smp.t  # (pop, n_s, nq), (pop, n_s)
-    nq = traj.nq
-    d0 = np.minimum(checker.distances(q, t).distance.min(axis=-2), st.influence)
+def _distance(problem: Any, T: np.ndarray, P: np.ndarray):
+    """Distance rows at the problem's samples, one per sample and obstacle, with coal's
+    witness-point derivatives (:func:`~adept_traj.collision.distance_gradients`: zero
+    where the clipped distance is at ``influence``)."""
+    st, S, s = problem.settings, problem.trajectory.n_segments, problem.s
+    q = _samples(P, T, S, s, 0)
+    grad = distance_gradients(problem.checker, q, T[:, None] * s)
+    d0 = np.minimum(grad.distance, st.influence)  # (pop, n_s, n_obs)
     pop, n_s, n_obs = d0.shape
-    grad_q = np.zeros((pop, n_s, n_obs, nq))
-    grad_t = np.zeros((pop, n_s, n_obs))
-    near = np.flatnonzero((d0 < st.influence + _NEAR).any(axis=-1).ravel())
-    if len(near):
-        # ± each joint, then ± time: (n_near, 2 nq + 2, ·)
-        dq = np.concatenate([_H * np.eye(nq), -_H * np.eye(nq), np.zeros((2, nq))])
-        dt = np.concatenate([np.zeros(2 * nq), [_H, -_H]])
-        qs = q.reshape(-1, nq)[near][:, None, :] + dq
-        ts = t.reshape(-1)[near][:, None] + dt
-        d = np.minimum(checker.distances(qs, ts).distance.min(axis=-2), st.influence)
-        g_q = np.moveaxis((d[:, :nq] - d[:, nq : 2 * nq]) / (2 * _H), 1, -1)
-        grad_q.reshape(-1, n_obs, nq)[near] = g_q
-        grad_t.reshape(-1, n_obs)[near] = (d[:, -2] - d[:, -1]) / (2 * _H)
-    d_free = _chain(grad_q, _free_basis(traj, s, 0))  # (pop, n_s, n_obs, nq·n_free)
-    d_T = grad_t * s[None, :, None]
+    d_free = _chain(grad.dq, _basis(S, s, 0)[1])  # (pop, n_s, n_obs, nq·n_free)
+    d_T = grad.dt * s[None, :, None]
     jac = -np.concatenate([d_T[..., None], d_free], axis=-1) / st.influence
     vals = (st.margin + st.search_buffer - d0) / st.influence
     return vals.reshape(pop, n_s * n_obs), jac.reshape(pop, n_s * n_obs, jac.shape[-1])

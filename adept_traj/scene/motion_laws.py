@@ -72,6 +72,36 @@ class MotionLaw(_ValueObject, ABC):
             attached ball for every real t (a guarantee, not a sampled estimate).
         """
 
+    def point_velocity(self, t: Any, points: Any) -> np.ndarray:
+        """World velocity (..., 3) [m/s] of the points ``points`` (..., 3) [m] (world
+        coordinates at time ``t``) that move rigidly with the frame, at times ``t`` (...)
+        [s] (broadcast against ``points``' leading axes).
+
+        .. math::
+            v(p, t) = \\dot o(t) + \\omega(t) \\times (p - o(t)),
+
+        :math:`o` the frame's origin and :math:`\\omega` its angular velocity. The fixed
+        pose gives 0, the pendulum its closed form; any other law central differences of
+        :meth:`pose` (step 1e-6 s).
+        """
+        pts = as_finite_array(points, "points")
+        if pts.ndim < 1 or pts.shape[-1] != 3:
+            raise InvalidInputError(f"points must have shape (..., 3) [m]; got shape {pts.shape}")
+        try:
+            times = np.broadcast_to(_as_times(t), pts.shape[:-1])
+        except ValueError:
+            raise InvalidInputError(f"t must broadcast to points' shape {pts.shape[:-1]}") from None
+        return self._point_velocity(times, pts)
+
+    def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
+        pose, h = self.pose(t), 1e-6  # by central differences of pose (a generic law)
+        local = np.einsum("...ji,...j->...i", pose[..., :3, :3], points - pose[..., :3, 3])
+        p, m = (
+            np.einsum("...ij,...j->...i", f[..., :3, :3], local) + f[..., :3, 3]
+            for f in (self.pose(t + h), self.pose(t - h))
+        )
+        return (p - m) / (2.0 * h)
+
     @abstractmethod
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
         """Largest speed of any point of a ball attached to the moving frame, at any time.
@@ -129,6 +159,9 @@ class FixedPose(MotionLaw):
         """The attached ball itself, in world coordinates: ((3,) centre [m], radius [m])."""
         p, r = _check_ball(point, radius)
         return self.transform[:3, :3] @ p + self.transform[:3, 3], r
+
+    def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
+        return np.zeros(points.shape)
 
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
         """0 [m/s]: nothing moves (the arguments are checked as for every law)."""
@@ -280,6 +313,24 @@ class PendulumMotion(MotionLaw):
         """Height of the bob above its lowest point, ``(v0² − v²) / (2 g)`` [m]; (...)."""
         v = self.speed(t)
         return (self.v0 * self.v0 - v * v) / (2.0 * self.g)
+
+    def angular_speed(self, t: Any) -> np.ndarray:
+        r"""Swing rate :math:`\dot\varphi(t)` [rad/s] for times ``t`` (...) [s]:
+
+        .. math::
+            \dot\varphi = \frac{-2 a \omega \sin \omega t}{\sqrt{1 - a^2 \cos^2 \omega t}}.
+        """
+        wt = self.omega * _as_times(t)
+        a = min(1.0, self._amplitude_factor)
+        c = np.cos(wt)
+        root = np.sqrt(np.maximum(1.0 - a * a * c * c, np.finfo(float).tiny))
+        return -2.0 * a * self.omega * np.sin(wt) / root
+
+    def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
+        r"""Every point turns about the axis :math:`-e_n` through the pivot at the rate
+        :math:`\dot\varphi`: :math:`v = -\dot\varphi\, e_n \times (p - \text{pivot})`."""
+        omega = -self.angular_speed(t)[..., None] * self.normal_axis
+        return np.cross(omega, points - self.pivot)
 
     def bob_position(self, t: Any) -> np.ndarray:
         """World position of the bob centre [m], (..., 3) for times ``t`` of shape (...) [s]."""
