@@ -18,9 +18,9 @@ from adept_traj.testing.paper_moves import lift_then_lower
 
 class _Reference:
     """Smallest robot–obstacle distance per obstacle by Pinocchio's geometry placements and
-    coal (GJK tolerance 1e-14), one configuration at a time."""
+    coal (GJK tolerance ``tolerance``), one configuration at a time."""
 
-    def __init__(self, problem: TrajectoryProblem) -> None:
+    def __init__(self, problem: TrajectoryProblem, tolerance: float = 1e-14) -> None:
         robot = problem.robot
         self.model, self.data = robot.model, robot.model.createData()
         self.gmodel = robot.collision_model
@@ -28,7 +28,7 @@ class _Reference:
         self.scene = problem.scene
         self.obstacles = [ob.shape.to_coal() for ob in self.scene.obstacles]
         self.request = coal.DistanceRequest()
-        self.request.gjk_tolerance = 1e-14
+        self.request.gjk_tolerance = tolerance
 
     def __call__(self, q: np.ndarray, t: float) -> np.ndarray:
         """(n_obs, n_solids) signed distances [m]."""
@@ -177,3 +177,19 @@ def test_point_velocity_refuses_bad_input(problem) -> None:
         law.point_velocity(np.zeros(3), np.zeros((2, 3)))
     with pytest.raises(InvalidInputError):
         law.point_velocity(np.nan, np.zeros(3))
+
+
+def test_a_failing_tight_gjk_call_falls_back_to_a_looser_tolerance(problem) -> None:
+    """coal 3.0.3's GJK at tolerance 1e-14 fails for this flange–cube pose of the detour
+    scene (−1.8e308, NaN points); the gradient is then taken at the next tolerance and
+    matches central differences (it was NaN)."""
+    scene = Scene.shipped("detour")
+    detour = TrajectoryProblem(problem.robot, scene, scene.start, scene.goal)
+    q = np.array(
+        [-0.2529752057706764, -0.15920972455919985, 0.19942757751768095, 0.14922563773283035]
+    )
+    t = 1.018201431736103
+    grad = distance_gradients(detour.checker, q[None], np.array([t]))
+    assert detour.checker.solid_names[grad.solid[0, 0]] == "link4/flange"
+    dq, _ = _central(_Reference(detour, tolerance=1e-12), q, t, 1e-5)  # 1e-14 fails too
+    np.testing.assert_allclose(grad.dq[0, 0], dq[0], rtol=0, atol=1e-5)

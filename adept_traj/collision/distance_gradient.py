@@ -49,17 +49,22 @@ import coal
 import numpy as np
 
 from adept_traj.collision.checker import CollisionChecker
-from adept_traj.collision.primitives import distance_request
+from adept_traj.collision.primitives import DISTANCE_TOLERANCE, distance_request
 
-__all__ = ["WITNESS_TOLERANCE", "DistanceGradients", "distance_gradients"]
+__all__ = ["WITNESS_TOLERANCES", "DistanceGradients", "distance_gradients"]
 
-#: GJK tolerance of the witness calls. GJK stops when the distance is within its tolerance,
-#: and on curved solids (cylinders, capsules) a distance error ε leaves the witness points
-#: off by about :math:`\sqrt{\varepsilon r}` and the normal by :math:`\sqrt{\varepsilon / r}`:
-#: with the distances' 1e-9 m the gradient of the AdeptOne's outer arm against the
-#: pendulum rod (r = 1 cm) was 1e-4 off (relative); with 1e-14 m, 2e-6, for ≈ 1 µs more
-#: per call.
-WITNESS_TOLERANCE = 1e-14
+#: GJK tolerances of the witness calls, tried in turn. GJK stops when the distance is within
+#: its tolerance, and on curved solids (cylinders, capsules) a distance error ε leaves the
+#: witness points off by about :math:`\\sqrt{\\varepsilon r}` and the normal by
+#: :math:`\\sqrt{\\varepsilon / r}`: with the distances' 1e-9 m the gradient of the
+#: AdeptOne's outer arm against the pendulum rod (r = 1 cm) was 1e-4 off (relative), with
+#: 1e-14 m 2e-6, for ≈ 1 µs more per call. At 1e-14 GJK fails now and then (coal 3.0.3
+#: returned −1.8e308 and NaN points for a cylinder 3 cm from a box): the next one is used.
+WITNESS_TOLERANCES: tuple[float, ...] = (1e-14, 1e-12, DISTANCE_TOLERANCE)
+
+#: Largest difference [m] between a witness call's distance and the checker's for the
+#: witness to be used (EPA's depths from different GJK simplices differ by a few µm).
+_AGREE = 1e-5
 
 
 @dataclass(frozen=True)
@@ -122,7 +127,9 @@ def _distance_gradients(checker: CollisionChecker, q: np.ndarray, t: np.ndarray)
     solid[rows, obstacles] = solids
     if len(rows):
         frames = checker.robot.kinematics.joint_frames(q)
-        p1, p2, normal = _witnesses(checker, frames, t.reshape(-1), rows, solids, obstacles)
+        p1, p2, normal = _witnesses(
+            checker, frames, t.reshape(-1), rows, solids, obstacles, distance[rows, obstacles]
+        )
         dq[rows, obstacles] = _solid_term(checker, frames, rows, solids, p1, normal)
         dt[rows, obstacles] = _obstacle_term(checker, t.reshape(-1), rows, obstacles, p2, normal)
     shape = (*q.shape[:-1], n_obs)
@@ -142,17 +149,21 @@ def _witnesses(
     rows: np.ndarray,
     solids: np.ndarray,
     obstacles: np.ndarray,
+    distance: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Coal's nearest points on the solid and on the obstacle and the normal (m, 3) each,
-    base frame, of the pairs (``rows``, ``solids``, ``obstacles``) (m,)."""
+    base frame, of the pairs (``rows``, ``solids``, ``obstacles``) (m,) whose distances
+    [m] are ``distance`` (m,): the first of :data:`WITNESS_TOLERANCES` whose distance
+    agrees with it to :data:`_AGREE` (all zero, a zero gradient, if none does: not met on
+    the shipped scenes)."""
     broad = checker._broad
     poses = np.empty((len(rows), 4, 4))
     for k in np.unique(solids).tolist():
         sel = np.flatnonzero(solids == k)
         poses[sel] = broad.solid_poses(frames, rows[sel], k)
     obstacle_poses = checker._obstacle_poses(t)
-    out = np.empty((3, len(rows), 3))
-    request, result = _witness_request(), coal.DistanceResult()
+    out = np.zeros((3, len(rows), 3))
+    requests, result = _witness_requests(), coal.DistanceResult()
     tf_solid, tf_obstacle = coal.Transform3s(), coal.Transform3s()
     for i, (n, k, o) in enumerate(zip(rows.tolist(), solids.tolist(), obstacles.tolist())):
         pose = checker._pose_at(obstacle_poses[o], n)
@@ -160,20 +171,24 @@ def _witnesses(
         tf_solid.setTranslation(poses[i, :3, 3])
         tf_obstacle.setRotation(pose[:3, :3])
         tf_obstacle.setTranslation(pose[:3, 3])
-        result.clear()
-        checker._functors[k][o](tf_solid, tf_obstacle, request, result)
-        out[0, i] = result.getNearestPoint1()
-        out[1, i] = result.getNearestPoint2()
-        out[2, i] = result.normal
+        for request in requests:  # GJK may fail at the tightest tolerance: loosen
+            result.clear()
+            d = checker._functors[k][o](tf_solid, tf_obstacle, request, result)
+            if abs(d - distance[i]) <= _AGREE:
+                out[:, i] = result.getNearestPoint1(), result.getNearestPoint2(), result.normal
+                break
     return out[0], out[1], out[2]
 
 
-def _witness_request() -> coal.DistanceRequest:
-    """The package's distance request (EPA as for the distances) with GJK tightened to
-    :data:`WITNESS_TOLERANCE`."""
-    request = distance_request()
-    request.gjk_tolerance = WITNESS_TOLERANCE
-    return request
+def _witness_requests() -> list[coal.DistanceRequest]:
+    """The package's distance request (EPA as for the distances) with GJK's tolerance set
+    to each of :data:`WITNESS_TOLERANCES`."""
+    requests = []
+    for tolerance in WITNESS_TOLERANCES:
+        request = distance_request()
+        request.gjk_tolerance = tolerance
+        requests.append(request)
+    return requests
 
 
 def _solid_term(
