@@ -8,7 +8,8 @@ Run: ``python benchmarks/bench_polish.py [--seeds 1,2,3,4,5] [--algorithms nsga2
    median of 3), and ``plan(problem, algorithm="time-optimal")`` in process (its own
    figures: T, T / T_lb, solve time, certificate). Target: T ≤ 1.001 × 1.0766 s (Drake's,
    SNOPT) in ≤ 1 s wall on one core. Also the straight start alone
-   (``time_optimal(problem, n_starts=1)``).
+   (``time_optimal(problem, n_starts=1)``) and one evaluation of the smooth constraints
+   and their Jacobian (``local_constraints``, what SLSQP calls each iteration).
 2. **Polish inside plan** at the paper budgets (one evaluation process), per seed: the
    fastest certified T / T_lb with and without polish, the hypervolume of both fronts on
    common bounds, and the polish's share of the run's time (the polish timed alone:
@@ -34,6 +35,7 @@ import numpy as np
 from adept_traj import Robot, Scene, TrajectoryProblem, certify, plan
 from adept_traj.analysis import normalised_hypervolume, objective_bounds
 from adept_traj.optimise import minimum_time, time_optimal
+from adept_traj.problem import local_constraints
 
 #: Drake's KinematicTrajectoryOptimization with SNOPT on the paper scene (issue #12) [s].
 DRAKE_T = 1.0766
@@ -87,6 +89,15 @@ def time_optimal_part(problem: TrajectoryProblem) -> None:
     print(
         f"  straight start only: T = {out.x[0]:.5f} s in {statistics.median(times):.2f} s "
         f"(median of 3), {out.n_iterations} SLSQP iterations, certified: {ok}"
+    )
+    calls = []
+    for x in (out.start, out.x) * 10:
+        t0 = time.perf_counter()
+        local_constraints(problem, x)
+        calls.append(time.perf_counter() - t0)
+    print(
+        f"  local_constraints (values and Jacobian, {problem.n_var} variables): "
+        f"{1000 * statistics.median(calls):.1f} ms a call (median of 20)"
     )
 
 
