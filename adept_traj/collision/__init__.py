@@ -1,8 +1,9 @@
 """Robot-obstacle distances over time.
 
 The checker, the conservative broad phase, obstacle pruning, distance tables, closed-form
-point distances and the coal primitives (``distance_request``: the settings every distance
-uses).
+point distances, the distances' derivatives in (q, t) from coal's witness points
+(``distance_gradients``) and the coal primitives (``distance_request``: the settings every
+distance uses).
 """
 
 from __future__ import annotations
@@ -13,7 +14,11 @@ from adept_traj.collision.checker import (
     MinDistances,
     PairDistances,
 )
-from adept_traj.collision.distance_gradient import DistanceGradients, distance_gradients
+from adept_traj.collision.distance_gradient import (
+    WITNESS_TOLERANCES,
+    DistanceGradients,
+    distance_gradients,
+)
 from adept_traj.collision.distance_table import DistanceTable
 from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import (
@@ -32,6 +37,7 @@ from adept_traj.collision.self_collision import SelfCollision
 
 __all__ = [
     "DISTANCE_TOLERANCE",
+    "WITNESS_TOLERANCES",
     "Bounds",
     "BroadPhase",
     "CollisionChecker",
