@@ -266,3 +266,29 @@ def test_a_cycle_location_of_the_wrong_length_names_the_robot_joints(tmp_path: P
         caught.value
     )
     assert "'adept_one_xl' (joint1, joint2, joint3, joint4); got a list of 6" in str(caught.value)
+
+
+def test_compare_seeds_plans_on_the_robot_of_the_options(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """(The seed study planned on the AdeptOne XL whatever the options named.)"""
+    import adept_traj.cli.compare as compare_command
+
+    seen = []
+
+    def fake_study(*args: object, **kwargs: object) -> None:
+        seen.append(kwargs.get("robot"))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(compare_command, "run_seed_study", fake_study)
+    for name in ("planar_2link.urdf", "planar_2link.toml"):
+        shutil.copy(EXAMPLES / name, tmp_path)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(
+        '[robot]\nurdf = "planar_2link.urdf"\nparams = "planar_2link.toml"\n'
+        "[task]\nstart = [0.0, 0.0]\ngoal = [1.0, 1.0]\n"
+    )
+    argv = ["compare", "--seeds", "1", "--scene", str(scene), "--quiet", "--out", str(tmp_path)]
+    assert main([*argv, "--tool-frame", "fore"]) == 130
+    urdf, params = tmp_path / "planar_2link.urdf", tmp_path / "planar_2link.toml"
+    assert seen == [RobotSource(urdf, params, tool_frame="fore")]
