@@ -18,21 +18,25 @@ import adept_traj.viz.server as server
 from adept_traj.cli import main
 from adept_traj.cli.result_robot import check_recorded_robot
 from adept_traj.cycle import read_cycle_file
-from adept_traj.errors import CycleError, RobotMismatchError, SceneError
+from adept_traj.errors import CycleError, RobotMismatchError, RobotModelError, SceneError
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
-from adept_traj.robot import Robot, RobotSource, installed_data_dirs, shipped_file
+from adept_traj.robot import Robot, RobotSource, resolve_package_file, shipped_file
 from adept_traj.scene import Scene, read_robot_files
 
-ROBOTS = next(
-    (
-        d / "example-robot-data" / "robots"
-        for d in installed_data_dirs()
-        if (d / "example-robot-data" / "robots").is_dir()
-    ),
-    None,
-)
+
+def _ur5_urdf() -> Path | None:
+    """The UR5 URDF of example-robot-data, found as a ``package://`` file; ``None``."""
+    try:
+        return resolve_package_file(f"package://example-robot-data/robots/{UR5_PATH}")
+    except RobotModelError:
+        return None
+
+
+UR5_PATH = "ur_description/urdf/ur5_robot.urdf"
+UR5 = _ur5_urdf()
+ROBOTS = UR5.parents[2] if UR5 is not None else None
 needs_robots = pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "data"
 
@@ -126,6 +130,19 @@ def test_show_plays_the_robot_given_and_refuses_another_before_the_server(
     assert len(played) == 1  # refused before the server
 
 
+def _ur5_in_own_package(folder: Path) -> Path:
+    """``folder/ur5.urdf``: the UR5 with meshes in ``package://my_ur/``, a package found
+    only in ``folder/pkgs`` (not installed, not on ROS_PACKAGE_PATH)."""
+    (folder / "pkgs").mkdir()
+    (folder / "pkgs" / "my_ur").symlink_to(ROBOTS / "ur_description")
+    text = UR5.read_text()
+    urdf = folder / "ur5.urdf"
+    urdf.write_text(
+        text.replace("package://example-robot-data/robots/ur_description/", "package://my_ur/")
+    )
+    return urdf
+
+
 @needs_robots
 @pytest.mark.slow
 def test_verify_and_show_find_moved_meshes_with_package_dir_alone(
@@ -133,13 +150,7 @@ def test_verify_and_show_find_moved_meshes_with_package_dir_alone(
 ) -> None:
     """A UR5 whose meshes come from a package only ``package_dirs`` names; the folder moves
     after planning, and ``--package-dir`` alone finds it again."""
-    (tmp_path / "pkgs").mkdir()
-    (tmp_path / "pkgs" / "my_ur").symlink_to(ROBOTS / "ur_description")
-    text = (ROBOTS / "ur_description/urdf/ur5_robot.urdf").read_text()
-    urdf = tmp_path / "ur5.urdf"
-    urdf.write_text(
-        text.replace("package://example-robot-data/robots/ur_description/", "package://my_ur/")
-    )
+    urdf = _ur5_in_own_package(tmp_path)
     robot = Robot.from_urdf(urdf, EXAMPLES / "ur5.toml", package_dirs=[tmp_path / "pkgs"])
     scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, n_knots=6, workers=1)
@@ -184,11 +195,7 @@ to = "right"
 def test_a_ur5_cycle_file_names_its_tool_frame_and_package_folders(tmp_path: Path) -> None:
     shutil.copy(EXAMPLES / "ur5_box.toml", tmp_path)
     shutil.copy(EXAMPLES / "ur5.toml", tmp_path)
-    (tmp_path / "pkgs").mkdir()
-    (tmp_path / "pkgs" / "my_ur").symlink_to(ROBOTS / "ur_description")
-    text = (ROBOTS / "ur_description/urdf/ur5_robot.urdf").read_text()
-    new = text.replace("package://example-robot-data/robots/ur_description/", "package://my_ur/")
-    (tmp_path / "ur5.urdf").write_text(new)
+    _ur5_in_own_package(tmp_path)
     table = (
         '[robot]\nurdf = "ur5.urdf"\nparams = "ur5.toml"\ntool_frame = "wrist_2_link"\n'
         'package_dirs = ["pkgs"]\n'
