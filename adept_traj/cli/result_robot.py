@@ -33,7 +33,7 @@ import argparse
 
 import numpy as np
 
-from adept_traj.cli.robot_options import add_robot_arguments
+from adept_traj.cli.robot_options import add_robot_arguments, options_given
 from adept_traj.errors import RobotMismatchError, RobotModelError
 from adept_traj.results import PlanningResult
 from adept_traj.robot import LIMITS, Robot, RobotSource
@@ -61,13 +61,8 @@ def add_result_robot_arguments(parser: argparse.ArgumentParser) -> None:
 def result_robot(args: argparse.Namespace, result: PlanningResult) -> Robot | None:
     """The robot the options give for ``result`` (module doc), checked against the record;
     ``None`` when no robot option is given (the caller rebuilds the recorded robot)."""
-    urdf = getattr(args, "robot", None)
-    given = {
-        "params": getattr(args, "params", None),
-        "tool_frame": getattr(args, "tool_frame", None),
-        "srdf": getattr(args, "srdf", None),
-        "package_dirs": tuple(getattr(args, "package_dir", None) or ()),
-    }
+    given = options_given(args)
+    urdf = given.pop("urdf")
     if urdf is None and not any(given.values()):
         return None
     recorded = result.robot.source()

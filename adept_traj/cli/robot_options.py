@@ -20,6 +20,7 @@ from adept_traj.scene import SHIPPED_SCENES, read_robot_files
 __all__ = [
     "add_robot_arguments",
     "check_task",
+    "options_given",
     "robot_from_arguments",
     "source_from_arguments",
 ]
@@ -52,7 +53,7 @@ def source_from_arguments(args: argparse.Namespace, scene: str | None = None) ->
     named = RobotSource()
     if scene is not None and scene not in SHIPPED_SCENES:
         named = read_robot_files(scene)
-    return named.overridden(**_options(args))
+    return named.overridden(**options_given(args))
 
 
 def robot_from_arguments(args: argparse.Namespace, scene: str | None = None) -> Robot:
@@ -60,7 +61,7 @@ def robot_from_arguments(args: argparse.Namespace, scene: str | None = None) -> 
     return source_from_arguments(args, scene).load()
 
 
-def _options(args: argparse.Namespace) -> dict[str, Any]:
+def options_given(args: argparse.Namespace) -> dict[str, Any]:
     """The robot options given (``None`` or ``()``: not given), as
     :class:`~adept_traj.robot.RobotSource` fields."""
     return {
