@@ -2,8 +2,10 @@
 [--srdf FILE] [--package-dir DIR ...]``,
 else the scene file's ``[robot]`` table, else the AdeptOne XL.
 
-:func:`add_robot_arguments` declares the options; :func:`robot_from_arguments` loads the
-robot; :func:`check_task` checks a start/goal against the robot's joint count.
+:func:`add_robot_arguments` declares the options; :func:`source_from_arguments` gives
+where the robot loads from (a :class:`~adept_traj.robot.RobotSource`, also handed to the
+workers of a seed study), :func:`robot_from_arguments` loads it; :func:`check_task` checks
+a start/goal against the robot's joint count.
 """
 
 from __future__ import annotations
