@@ -21,6 +21,7 @@ __all__ = [
     "PlanningInterrupted",
     "ResourceLimitError",
     "ResultFormatError",
+    "RobotMismatchError",
     "RobotModelError",
     "SceneError",
     "SceneFileNotFoundError",
@@ -46,6 +47,11 @@ class JointLimitError(InvalidInputError):
 
 class RobotModelError(AdeptTrajError):
     """A robot description (URDF or parameter file) is missing, malformed or unsupported."""
+
+
+class RobotMismatchError(RobotModelError):
+    """A robot given for a saved result (``verify``/``show --robot``) is not the robot the
+    result records: other joints, tool frame, limits or dynamics."""
 
 
 class SceneError(AdeptTrajError):

@@ -33,6 +33,7 @@ from adept_traj.cli.arguments import add_problem_arguments, problem_from_argumen
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import save_figures, summary
+from adept_traj.cli.robot_options import source_from_arguments
 from adept_traj.cycle import (
     parse_seeds,
     run_metrics,
@@ -198,6 +199,7 @@ def _run_study(args: argparse.Namespace) -> int:
             n_gen=args.gens,
             weights=args.weights,
             rate_hz=args.rate,
+            robot=source_from_arguments(args, args.scene),
             workers=args.workers,
             scheduler=args.scheduler,
             resume=args.resume,

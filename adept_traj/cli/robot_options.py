@@ -2,31 +2,41 @@
 [--srdf FILE] [--package-dir DIR ...]``,
 else the scene file's ``[robot]`` table, else the AdeptOne XL.
 
-:func:`add_robot_arguments` declares the options; :func:`robot_from_arguments` loads the
-robot; :func:`check_task` checks a start/goal against the robot's joint count.
+:func:`add_robot_arguments` declares the options; :func:`source_from_arguments` gives
+where the robot loads from (a :class:`~adept_traj.robot.RobotSource`, also handed to the
+workers of a seed study), :func:`robot_from_arguments` loads it; :func:`check_task` checks
+a start/goal against the robot's joint count.
 """
 
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 import numpy as np
 
-from adept_traj.errors import ConfigurationError, InputShapeError
-from adept_traj.robot import Robot
+from adept_traj.errors import InputShapeError
+from adept_traj.robot import Robot, RobotSource
 from adept_traj.scene import SHIPPED_SCENES, read_robot_files
 
-__all__ = ["add_robot_arguments", "check_task", "robot_from_arguments"]
+__all__ = [
+    "add_robot_arguments",
+    "check_task",
+    "options_given",
+    "robot_from_arguments",
+    "source_from_arguments",
+]
 
 
-def add_robot_arguments(parser: argparse.ArgumentParser, flag: str = "--robot") -> None:
-    """Declare ``--robot`` (or ``flag``), ``--params``, ``--tool-frame``, ``--srdf``,
-    ``--package-dir``."""
-    parser.add_argument(
-        flag,
-        dest="robot",
-        help="URDF of the robot (default: the scene file's [robot] urdf, else the AdeptOne XL)",
-    )
+def add_robot_arguments(
+    parser: argparse.ArgumentParser,
+    flag: str = "--robot",
+    help_urdf: str = "URDF of the robot (default: the scene file's [robot] urdf, else the "
+    "AdeptOne XL)",
+) -> None:
+    """Declare ``--robot`` (or ``flag``; its help line ``help_urdf``), ``--params``,
+    ``--tool-frame``, ``--srdf``, ``--package-dir``."""
+    parser.add_argument(flag, dest="robot", help=help_urdf)
     parser.add_argument("--params", help="parameter file (TOML) of the robot")
     parser.add_argument("--tool-frame", help="tool frame name (default: the parameter file's)")
     parser.add_argument("--srdf", help="SRDF: its disable_collisions pairs are not self-checked")
@@ -37,23 +47,32 @@ def add_robot_arguments(parser: argparse.ArgumentParser, flag: str = "--robot") 
     )
 
 
-def robot_from_arguments(args: argparse.Namespace, scene: str | None = None) -> Robot:
-    """The robot of the options: ``--robot`` etc. if given, else the ``[robot]`` table of
-    the scene file ``scene`` (``None`` or a shipped scene's name: none), else the AdeptOne
-    XL. An option given overrides the scene file's value of the same field."""
-    named = {"urdf": None, "params": None, "tool_frame": None, "package_dirs": ()}
+def source_from_arguments(args: argparse.Namespace, scene: str | None = None) -> RobotSource:
+    """Where the robot of the options is loaded from: ``--robot`` etc. if given, else the
+    ``[robot]`` table of the scene file ``scene`` (``None`` or a shipped scene's name:
+    none), else the AdeptOne XL. An option given overrides the scene file's value of the
+    same field; ``--package-dir`` folders are searched before the scene file's."""
+    named = RobotSource()
     if scene is not None and scene not in SHIPPED_SCENES:
         named = read_robot_files(scene)
-    urdf = args.robot if getattr(args, "robot", None) is not None else named["urdf"]
-    params = getattr(args, "params", None) or named["params"]
-    tool_frame = getattr(args, "tool_frame", None) or named["tool_frame"]
-    srdf = getattr(args, "srdf", None)
-    dirs = tuple(getattr(args, "package_dir", None) or ()) + tuple(named["package_dirs"])
-    if urdf is None:
-        if srdf is not None:
-            raise ConfigurationError("--srdf goes with --robot (or the scene file's [robot] urdf)")
-        return Robot.adept_one_xl()
-    return Robot.from_urdf(str(urdf), params, package_dirs=dirs, srdf=srdf, tool_frame=tool_frame)
+    return named.overridden(**options_given(args))
+
+
+def robot_from_arguments(args: argparse.Namespace, scene: str | None = None) -> Robot:
+    """The robot of :func:`source_from_arguments`, loaded."""
+    return source_from_arguments(args, scene).load()
+
+
+def options_given(args: argparse.Namespace) -> dict[str, Any]:
+    """The robot options given (``None`` or ``()``: not given), as
+    :class:`~adept_traj.robot.RobotSource` fields."""
+    return {
+        "urdf": getattr(args, "robot", None),
+        "params": getattr(args, "params", None),
+        "tool_frame": getattr(args, "tool_frame", None),
+        "srdf": getattr(args, "srdf", None),
+        "package_dirs": tuple(getattr(args, "package_dir", None) or ()),
+    }
 
 
 def check_task(robot: Robot, q: object, option: str) -> np.ndarray:

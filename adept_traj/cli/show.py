@@ -5,6 +5,10 @@ of the best trade-off; an uncertified member
 (:func:`~adept_traj.results.certified_members`) is refused unless ``--allow-infeasible``,
 and a member out of range is refused, both before the server starts (exit status 2).
 Without ``--member`` the best trade-off is played, certified or not, as before.
+``--robot URDF [--params TOML] [--srdf FILE] [--tool-frame NAME] [--package-dir DIR]``
+give the robot instead of the recorded files (moved, or meshes elsewhere); it must be the
+recorded robot (:mod:`adept_traj.cli.result_robot`), else exit status 2, before the
+server starts.
 
 Loops until stopped. Ctrl-C (SIGINT) stops the meshcat server and exits with status 0;
 SIGTERM (``kill``, a supervisor, a CI timeout) does the same and exits with status 143
@@ -24,8 +28,9 @@ from types import FrameType
 from typing import NoReturn
 
 from adept_traj.cli import status
+from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.errors import InvalidInputError
-from adept_traj.results import PlanningResult, certified_members, member_index
+from adept_traj.results import PlanningResult, Replay, certified_members, member_index
 
 __all__ = ["add_parser", "run"]
 
@@ -47,6 +52,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         action="store_true",
         help="with --member: play the member even if it is not certified",
     )
+    add_result_robot_arguments(p)
     return p
 
 
@@ -82,8 +88,11 @@ def _play(args: argparse.Namespace) -> NoReturn:
             f"member {index} of the front is not certified (adept-traj front "
             f"{args.folder}); pass --allow-infeasible to play it anyway"
         )
+    robot = result_robot(args, result)
+    replay = None if robot is None else Replay.of(result, result.front.x[index], robot=robot)
     vis = server.show(  # closes its own server if interrupted while starting
         result,
+        replay=replay,
         speed=args.speed,
         show_closest=args.closest,
         open_browser=args.open,

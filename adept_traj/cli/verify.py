@@ -9,6 +9,10 @@ collision checker): re-certification needs it. Exit status (:mod:`adept_traj.cli
 recomputation (:func:`~adept_traj.results.audit`; one ``mismatch:`` line each), whatever
 the verdict.
 
+``--robot URDF [--params TOML] [--srdf FILE] [--tool-frame NAME] [--package-dir DIR]``
+give the robot instead of the recorded files (moved, or meshes elsewhere); it must be the
+recorded robot (:mod:`adept_traj.cli.result_robot`), else exit status 2.
+
 One line per limit kind gives the worst ratio over the joints that have the limit and its
 bound (position: fraction of the range beyond the nearer limit, bound 0; the others:
 ratio to the limit, bound 1); joints without the limit (an infinite one, e.g. no
@@ -26,6 +30,7 @@ import numpy as np
 from adept_traj.analysis import PAPER_WEIGHTS, LimitCheck, certify, check_certificate_memory
 from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
+from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.results import PlanningResult, audit
 from adept_traj.robot import JointLimits
 
@@ -48,6 +53,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="a shipped scene (paper, detour) or the scene TOML file the run was planned on, "
         "compared with the stored scene (default: the shipped scene of the stored name)",
     )
+    add_result_robot_arguments(p)
     return p
 
 
@@ -72,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     scene = None
     if args.scene is not None:
         scene = scene_from_argument(args.scene)
-    problem = result.problem()
+    problem = result.problem(result_robot(args, result))
     try:
         check_certificate_memory(problem, rate, float(result.best_x[0]), option="--rate")
         t0 = time.perf_counter()

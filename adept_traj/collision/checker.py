@@ -377,9 +377,11 @@ class CollisionChecker:
             todo = (flat_d <= self.influence) & ~known
         flat_d[:, self.allowed] = np.inf
         samples, solids, obstacles = np.nonzero(todo)
-        for n, s, o in zip(samples.tolist(), solids.tolist(), obstacles.tolist()):
-            pose = self._broad.solid_poses(frames, n, s)
-            flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+        for c in range(0, len(samples), 8192):  # solid poses in batches (1 MB), not per call
+            cut = [a[c : c + 8192] for a in (samples, solids, obstacles)]
+            poses = self._first_poses(frames, cut[0], cut[1])
+            for pose, n, s, o in zip(poses, *(a.tolist() for a in cut)):
+                flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
         known |= todo
         shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)
         return PairDistances(

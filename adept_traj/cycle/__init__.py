@@ -15,7 +15,6 @@ from adept_traj.cycle.cycle_file import (
     Cycle,
     Location,
     MoveSpec,
-    RobotSource,
     read_cycle_file,
 )
 from adept_traj.cycle.cycle_playback import PLAYBACK_FILE, cycle_html, cycle_playback
@@ -79,7 +78,6 @@ __all__ = [
     "Metric",
     "MoveSpec",
     "MoveTask",
-    "RobotSource",
     "cycle_html",
     "cycle_markdown",
     "cycle_playback",

@@ -23,13 +23,20 @@ from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.errors import CycleError, RobotModelError, UnreachableLocationError
 from adept_traj.files import read_toml
 from adept_traj.optimise import ALGORITHMS
-from adept_traj.robot import ELBOWS, Robot, ScaraGeometry, solve_location
+from adept_traj.robot import (
+    ELBOWS,
+    ROBOT_FILE_KEYS,
+    Robot,
+    RobotSource,
+    ScaraGeometry,
+    solve_location,
+)
 from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy
 from adept_traj.validation import readonly_copy
 
-__all__ = ["MAX_MOVES", "Cycle", "Location", "MoveSpec", "RobotSource", "read_cycle_file"]
+__all__ = ["MAX_MOVES", "Cycle", "Location", "MoveSpec", "read_cycle_file"]
 
 _ERROR = error_factory(CycleError)
 _TOP_KEYS = ("name", "robot", "scene", "repeat", "plan", "location", "move")
@@ -37,21 +44,6 @@ _PLAN_KEYS = ("algorithm", "seed", "pop_size", "n_gen", "weights", "rate_hz")
 _MOVE_KEYS = ("name", "from", "to", "algorithm", "seed", "pop_size", "n_gen", "weights")
 #: Most moves of a cycle file (each is a planning run).
 MAX_MOVES = 1000
-
-
-@dataclass(frozen=True)
-class RobotSource:
-    """Where a worker loads the robot from: the shipped AdeptOne XL (both ``None``) or a
-    URDF [+ parameter file] (absolute paths; they must exist on every worker)."""
-
-    urdf: Path | None = None
-    params: Path | None = None
-
-    def load(self) -> Robot:
-        """The :class:`~adept_traj.robot.Robot`."""
-        if self.urdf is None:
-            return Robot.adept_one_xl()
-        return Robot.from_urdf(self.urdf, self.params)
 
 
 @dataclass(frozen=True)
@@ -136,10 +128,12 @@ def read_cycle_file(path: str | os.PathLike[str]) -> Cycle:
     data = read_toml(p, CycleError, what="cycle file")
     top = Node(data, p, _ERROR).check_keys(_TOP_KEYS)
     folder = p.resolve().parent
-    robot_source = _robot_source(top["robot"], folder)
-    robot = top["robot"].build(robot_source.load) if robot_source.urdf else robot_source.load()
+    robot_node = top["robot"].check_keys(ROBOT_FILE_KEYS) if top["robot"].present else top["robot"]
+    robot_source = RobotSource.from_table(robot_node, folder)
+    robot = robot_node.build(robot_source.load)
     scene = _scene(top["scene"], folder)
-    defaults = top["plan"].check_keys(_PLAN_KEYS) if top["plan"].present else top["plan"]
+    plan_node = top["plan"] if top["plan"].present else Node({}, p, _ERROR)  # all defaults
+    defaults = plan_node.check_keys(_PLAN_KEYS)
     locations = _locations(top["location"], robot)
     moves = _moves(top["move"], locations, defaults)
     return Cycle(
@@ -152,17 +146,6 @@ def read_cycle_file(path: str | os.PathLike[str]) -> Cycle:
         repeat=top["repeat"].integer(minimum=1, maximum=10**6, default=1),
         rate_hz=defaults["rate_hz"].number("[Hz]", minimum=100.0, default=1000.0),
     )
-
-
-def _robot_source(node: Node, folder: Path) -> RobotSource:
-    if not node.present:
-        return RobotSource()
-    node.check_keys(("urdf", "params"))
-    urdf = folder / node["urdf"].string(nonempty=True)
-    params = node["params"].string(nonempty=True, default=None)
-    if not urdf.is_file():
-        raise node["urdf"].error(f"no such file: {urdf}")
-    return RobotSource(urdf=urdf, params=folder / params if params else None)
 
 
 def _scene(node: Node, folder: Path) -> Scene:
@@ -178,6 +161,9 @@ def _locations(node: Node, robot: Robot) -> dict[str, Location]:
         pose_size, pose_text = 4, "x, y, z [m], yaw [rad]"
     except RobotModelError:
         pose_size, pose_text = 6, "x, y, z [m], roll, pitch, yaw [rad]"
+    joints_text = (
+        f"[rad | m], one per joint of robot '{robot.name}' ({', '.join(robot.joint_names)})"
+    )
     out: dict[str, Location] = {}
     entries = node.named_tables()
     if not entries:
@@ -191,7 +177,7 @@ def _locations(node: Node, robot: Robot) -> dict[str, Location]:
         if entry["joints"].present:
             if entry["elbow"].present:
                 raise entry["elbow"].error("only for a 'pose' location")
-            q = entry["joints"].array((robot.nq,), "[rad | m]")
+            q = entry["joints"].array((robot.nq,), joints_text)
             joints = entry["joints"].build(robot.limits.check_position, q, "joints")
             out[name] = Location(name, readonly_copy(joints), None, None)
             continue

@@ -28,13 +28,13 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.cycle.cycle_file import Cycle, MoveSpec, RobotSource
+from adept_traj.cycle.cycle_file import Cycle, MoveSpec
 from adept_traj.errors import CycleError, ResultFormatError
 from adept_traj.files import write_text_atomic
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
-from adept_traj.robot import Robot
+from adept_traj.robot import Robot, RobotSource
 from adept_traj.scene import Scene
 from adept_traj.validation import as_integer
 

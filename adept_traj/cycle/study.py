@@ -32,12 +32,13 @@ from adept_traj.analysis import (
     normalised_hypervolume,
     objective_bounds,
 )
-from adept_traj.cycle.cycle_file import MoveSpec, RobotSource
+from adept_traj.cycle.cycle_file import MoveSpec
 from adept_traj.cycle.runner import MoveTask, run_planning_tasks
 from adept_traj.cycle.summary import fastest_certified
 from adept_traj.errors import ConfigurationError
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult
+from adept_traj.robot import RobotSource
 from adept_traj.scene import Scene
 from adept_traj.validation import as_vector
 

@@ -23,6 +23,7 @@ import numpy as np
 from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
 from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
+from adept_traj.robot import RobotSource
 from adept_traj.robot.robot import Robot, shipped_file
 from adept_traj.validation import (
     as_finite_array,
@@ -127,19 +128,17 @@ class RobotInfo:
         optional = ("package_dirs", "locked_joints", "srdf")
         return {k: v for k, v in out.items() if v or k not in optional}
 
+    def source(self) -> RobotSource:
+        """Where the robot is loaded from (the shipped AdeptOne XL: ``RobotSource()``)."""
+        if self.urdf == SHIPPED_ROBOT:
+            return RobotSource()
+        files = ("params", "tool_frame", "package_dirs", "srdf", "locked_joints")
+        return RobotSource(self.urdf, **{name: getattr(self, name) for name in files})
+
     def load(self) -> Robot:
         """Rebuild the robot (raises :class:`~adept_traj.errors.RobotModelError` when its
         files are gone)."""
-        if self.urdf == SHIPPED_ROBOT:
-            return Robot.adept_one_xl()
-        return Robot.from_urdf(
-            self.urdf,
-            self.params,
-            package_dirs=self.package_dirs,
-            tool_frame=self.tool_frame,
-            locked_joints=self.locked_joints or None,
-            srdf=self.srdf,
-        )
+        return self.source().load()
 
 
 def _is_shipped(robot: Robot) -> bool:

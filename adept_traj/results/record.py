@@ -45,6 +45,7 @@ from adept_traj.results.parts import (
     Timing,
     software_versions,
 )
+from adept_traj.robot import Robot
 from adept_traj.robot.limits import JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import (
@@ -236,18 +237,21 @@ class PlanningResult:
             warning=warning,
         )
 
-    def problem(self) -> TrajectoryProblem:
+    def problem(self, robot: Robot | None = None) -> TrajectoryProblem:
         """Rebuild the whole :class:`TrajectoryProblem` of the run, e.g. to certify the best
         solution again (``certify(result.problem(), result.best_x)``).
 
-        This reloads the robot files (they must still exist), parses the stored scene and
-        builds the problem's collision checker and distance tables; close it when done
-        (``problem.close()``). To view, plot or export the motion, use the lighter
+        This reloads the robot files (they must still exist; or give the ``robot``, e.g.
+        loaded from files that moved: ``adept-traj verify --robot``), parses the stored
+        scene and builds the problem's collision checker and distance tables; close it when
+        done (``problem.close()``). To view, plot or export the motion, use the lighter
         :class:`~adept_traj.results.Replay` (``Replay.of(result)``: robot, scene and spline
         only), as the modules of :mod:`adept_traj.results` do.
         """
+        if robot is not None:
+            check_type(robot, Robot, "robot")
         return TrajectoryProblem(
-            self.robot.load(),
+            self.robot.load() if robot is None else robot,
             Scene.from_dict(self.scene, source="result scene"),
             self.start,
             self.goal,

@@ -61,6 +61,10 @@ from adept_traj.robot.robot import (
     Robot,
     coulomb_sign,
 )
+from adept_traj.robot.robot_source import (
+    ROBOT_FILE_KEYS,
+    RobotSource,
+)
 from adept_traj.robot.urdf_builder import (
     build_urdf,
     link_mass_properties,
@@ -80,6 +84,7 @@ __all__ = [
     "ELBOWS",
     "LIMITS",
     "LIMIT_KINDS",
+    "ROBOT_FILE_KEYS",
     "TASK_ROWS",
     "VELOCITY_AT_REST",
     "BatchKinematics",
@@ -93,6 +98,7 @@ __all__ = [
     "MassProperties",
     "Robot",
     "RobotParameters",
+    "RobotSource",
     "ScaraGeometry",
     "SolidParameters",
     "apply_parameters",

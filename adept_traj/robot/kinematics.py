@@ -73,7 +73,8 @@ class BatchKinematics:
                     "only 1-DoF revolute and prismatic joints (and mimics of them) are supported"
                 )
             # The joint's motion subspace in its own frame: [v; ω] = [axis; 0] or [0; axis].
-            s = pin.getJointJacobian(model, data, i, pin.LOCAL)[:, jm.idx_v]
+            jacobian = pin.getJointJacobian(model, data, i, pin.LOCAL).reshape(6, model.nv)
+            s = jacobian[:, jm.idx_v]  # (a 6 × 1 Jacobian comes back as a vector)
             joints.append(_one_dof_joint(model, i, s))
         self._joints = tuple(joints)
         # Revolute: T = P U Rz(q) U^T with U e_z = axis (pre = P U, post = U^T or None).

@@ -21,6 +21,7 @@ import tomli_w
 
 from adept_traj.errors import SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
+from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.scene import (
     _BOB_SUFFIX,
@@ -75,31 +76,19 @@ def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     return _parse_scene(data, str(p), p.stem or "scene")
 
 
-def read_robot_files(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """The robot a scene file's ``[robot]`` table names: ``{"urdf", "params", "tool_frame",
-    "package_dirs"}`` (each ``None`` or ``()`` when not given; file and folder paths relative
-    to the scene file's folder; ``urdf`` may be a ``package://`` URI). The scene itself
-    does not keep them (a :class:`~adept_traj.scene.Scene` is obstacles and the base pose);
-    the command line loads that robot.
+def read_robot_files(path: str | os.PathLike[str]) -> RobotSource:
+    """The robot a scene file's ``[robot]`` table names
+    (:meth:`~adept_traj.robot.RobotSource.from_table`: file and folder paths relative to
+    the scene file's folder; ``urdf`` may be a ``package://`` URI; no ``urdf``: the shipped
+    AdeptOne XL). The scene itself does not keep them (a :class:`~adept_traj.scene.Scene`
+    is obstacles and the base pose); the command line loads that robot.
 
     Raises the errors of :func:`read_scene_file`.
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
     _parse_scene(data, str(p), p.stem or "scene")  # the whole file is checked
-    robot = Node(data, str(p), _ERROR)["robot"]
-    if not robot.present:
-        return {"urdf": None, "params": None, "tool_frame": None, "package_dirs": ()}
-
-    def here(text: str | None) -> Path | str | None:
-        return text if text is None or text.startswith("package://") else p.parent / text
-
-    return {
-        "urdf": here(robot["urdf"].string(nonempty=True, default=None)),
-        "params": here(robot["params"].string(nonempty=True, default=None)),
-        "tool_frame": robot["tool_frame"].string(nonempty=True, default=None),
-        "package_dirs": tuple(p.parent / d for d in robot["package_dirs"].strings(default=())),
-    }
+    return RobotSource.from_table(Node(data, str(p), _ERROR)["robot"], p.parent)
 
 
 def read_shipped_scene(name: str) -> Scene:
@@ -262,7 +251,7 @@ def _pendulum_dict(
 #: Errors of a scene file: SceneError naming the source (file) and the field path.
 _ERROR = error_factory(SceneError)
 _TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "allowed_contacts")
-_ROBOT_KEYS = ("xyz", "rpy", "urdf", "params", "tool_frame", "package_dirs")
+_ROBOT_KEYS = ("xyz", "rpy", *ROBOT_FILE_KEYS)
 _TASK_KEYS = ("start", "goal")
 _SHAPE_KEYS = {
     "box": ("size", "min", "max"),
