@@ -299,3 +299,14 @@ def test_compare_seeds_plans_on_the_robot_of_the_options(
     assert main([*argv, "--tool-frame", "fore"]) == 130
     urdf, params = tmp_path / "planar_2link.urdf", tmp_path / "planar_2link.toml"
     assert seen == [RobotSource(urdf, params, tool_frame="fore")]
+
+
+@pytest.mark.parametrize("command", ["verify", "show"])
+def test_the_tool_frame_help_of_a_saved_result_names_the_recorded_default(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "tool frame name (default: the recorded one)" in text
+    assert "the parameter file's" not in text

@@ -55,7 +55,11 @@ TORQUE_RTOL = 1e-6
 def add_result_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare ``--robot``, ``--params``, ``--tool-frame``, ``--srdf``, ``--package-dir``
     for a command on a saved result."""
-    add_robot_arguments(parser, help_urdf="URDF of the recorded robot (default: the recorded path)")
+    add_robot_arguments(
+        parser,
+        help_urdf="URDF of the recorded robot (default: the recorded path)",
+        help_tool_frame="tool frame name (default: the recorded one)",
+    )
 
 
 def result_robot(args: argparse.Namespace, result: PlanningResult) -> Robot | None:

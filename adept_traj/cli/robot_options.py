@@ -33,12 +33,13 @@ def add_robot_arguments(
     flag: str = "--robot",
     help_urdf: str = "URDF of the robot (default: the scene file's [robot] urdf, else the "
     "AdeptOne XL)",
+    help_tool_frame: str = "tool frame name (default: the parameter file's)",
 ) -> None:
     """Declare ``--robot`` (or ``flag``; its help line ``help_urdf``), ``--params``,
-    ``--tool-frame``, ``--srdf``, ``--package-dir``."""
+    ``--tool-frame`` (its help line ``help_tool_frame``), ``--srdf``, ``--package-dir``."""
     parser.add_argument(flag, dest="robot", help=help_urdf)
     parser.add_argument("--params", help="parameter file (TOML) of the robot")
-    parser.add_argument("--tool-frame", help="tool frame name (default: the parameter file's)")
+    parser.add_argument("--tool-frame", help=help_tool_frame)
     parser.add_argument("--srdf", help="SRDF: its disable_collisions pairs are not self-checked")
     parser.add_argument(
         "--package-dir",
