@@ -44,6 +44,9 @@ from adept_traj.optimise.polish_step import (
     polish_fastest,
     time_optimal_run,
 )
+from adept_traj.optimise.population import (
+    population_values,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -52,6 +55,9 @@ from adept_traj.optimise.sampling import (
     RampSampling,
     check_population_memory,
     population_bytes,
+)
+from adept_traj.optimise.survival import (
+    RankAndCrowdingSurvival,
 )
 
 __all__ = [
@@ -67,6 +73,7 @@ __all__ = [
     "PlanningInterrupted",
     "PolishOutcome",
     "RampSampling",
+    "RankAndCrowdingSurvival",
     "RunState",
     "check_population_memory",
     "has_checkpoint",
@@ -78,6 +85,7 @@ __all__ = [
     "plan",
     "polish_fastest",
     "population_bytes",
+    "population_values",
     "restore_algorithm",
     "save_checkpoint",
     "time_optimal",

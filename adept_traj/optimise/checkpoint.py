@@ -46,6 +46,7 @@ from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.files import parse_json, read_bytes_bounded, write_atomic
+from adept_traj.optimise.population import population_values
 
 __all__ = [
     "CHECKPOINT_VERSION",
@@ -73,7 +74,7 @@ def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
 
     An attribute that only some members have (NSGA-II ranks only the feasible ones) is
     stored with the mask ``absent.<key>`` (pop,) of the members without it."""
-    out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
+    out = {key: population_values(pop, key) for key in ("X", "F", "G", "CV")}
     out["n_iter"] = np.array(n_iter)
     for key in sorted({key for ind in pop for key in ind.data}):
         values = [ind.data.get(key) for ind in pop]

@@ -27,6 +27,7 @@ import numpy as np
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.errors import ConfigurationError, PlanningInterrupted
 from adept_traj.optimise.checkpoint import load_checkpoint, restore_algorithm, save_checkpoint
+from adept_traj.optimise.population import population_values
 
 __all__ = ["GenerationInfo", "RunState", "optimise"]
 
@@ -147,14 +148,11 @@ def optimise(
                 evaluation_s += time.perf_counter() - t0
             algorithm.tell(infills=infills)
             pop = algorithm.pop
-            cv = pop.get("CV")[:, 0]
-            feasible = cv <= 0.0
-            best_t = float(pop.get("X")[feasible, 0].min()) if feasible.any() else None
-            if feasible.any():
-                F = pop.get("F")[feasible]
-                fronts.append(F[non_dominated(F, maximised=False)])
-            else:
-                fronts.append(np.empty((0, pop.get("F").shape[1])))
+            feasible = population_values(pop, "CV")[:, 0] <= 0.0
+            X, F = population_values(pop, "X"), population_values(pop, "F")
+            best_t = float(X[feasible, 0].min()) if feasible.any() else None
+            F = F[feasible]
+            fronts.append(F[non_dominated(F, maximised=False)] if len(F) else F)
             info = GenerationInfo(
                 generation=len(history) + 1,
                 n_gen=n_gen,
@@ -193,10 +191,10 @@ def optimise(
         ) from None
     pop = algorithm.pop
     return RunState(
-        X=pop.get("X"),
-        F=pop.get("F"),
-        G=pop.get("G"),
-        CV=pop.get("CV")[:, 0],
+        X=population_values(pop, "X"),
+        F=population_values(pop, "F"),
+        G=population_values(pop, "G"),
+        CV=population_values(pop, "CV")[:, 0],
         n_generations=len(history),
         n_evaluations=int(algorithm.evaluator.n_eval),
         total_s=time.perf_counter() - start,
