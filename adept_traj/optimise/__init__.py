@@ -24,6 +24,9 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
+from adept_traj.optimise.front_certificates import (
+    certify_front_members,
+)
 from adept_traj.optimise.loop import (
     GenerationInfo,
     PlanningInterrupted,
@@ -75,6 +78,7 @@ __all__ = [
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "certify_front_members",
     "check_population_memory",
     "has_checkpoint",
     "kinematic_time",
