@@ -50,10 +50,12 @@ from adept_traj.optimise.population import population_values
 
 __all__ = [
     "CHECKPOINT_VERSION",
+    "checkpoint_arrays",
     "has_checkpoint",
     "load_checkpoint",
     "restore_algorithm",
     "save_checkpoint",
+    "write_checkpoint",
 ]
 
 #: Version of the checkpoint file (``meta`` key ``version``); version 1 is still read.
@@ -121,7 +123,8 @@ def save_checkpoint(
     meta: dict[str, Any],
     extra: dict[str, np.ndarray] | None = None,
 ) -> None:
-    """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``.
+    """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``:
+    :func:`write_checkpoint` of :func:`checkpoint_arrays`.
 
     Parameters
     ----------
@@ -136,7 +139,15 @@ def save_checkpoint(
     extra:
         Further numeric arrays of the caller, stored as ``loop.<key>``.
     """
-    folder.mkdir(parents=True, exist_ok=True)
+    write_checkpoint(folder, checkpoint_arrays(algorithm, meta, extra))
+
+
+def checkpoint_arrays(
+    algorithm: Any, meta: dict[str, Any], extra: dict[str, np.ndarray] | None = None
+) -> dict[str, np.ndarray]:
+    """The content of the checkpoint of ``algorithm`` as it is now (after a finished
+    generation), for :func:`write_checkpoint`: new arrays and the metadata as JSON text, so
+    that later generations change nothing in it (parameters as :func:`save_checkpoint`)."""
     arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
     arrays.update({f"loop.{key}": np.asarray(value) for key, value in (extra or {}).items()})
     state = {
@@ -148,6 +159,13 @@ def save_checkpoint(
         **meta,
     }
     arrays["meta"] = np.array(json.dumps(state))
+    return arrays
+
+
+def write_checkpoint(folder: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write the ``arrays`` of :func:`checkpoint_arrays` as ``folder/checkpoint.npz``
+    (``folder`` created if missing), replaced atomically and flushed to disk."""
+    folder.mkdir(parents=True, exist_ok=True)
 
     def write_npz(path: Path) -> None:
         with path.open("wb") as fh:
