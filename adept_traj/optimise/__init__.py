@@ -12,10 +12,12 @@ from adept_traj.optimise.algorithms import (
 )
 from adept_traj.optimise.checkpoint import (
     CHECKPOINT_VERSION,
+    checkpoint_arrays,
     has_checkpoint,
     load_checkpoint,
     restore_algorithm,
     save_checkpoint,
+    write_checkpoint,
 )
 from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
@@ -28,6 +30,7 @@ from adept_traj.optimise.front_certificates import (
     certify_front_members,
 )
 from adept_traj.optimise.loop import (
+    CHECKPOINT_INTERVAL,
     GenerationInfo,
     PlanningInterrupted,
     RunState,
@@ -66,6 +69,7 @@ from adept_traj.optimise.survival import (
 __all__ = [
     "ALGORITHMS",
     "BLOCK_PAIRS",
+    "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
     "TIME_OPTIMAL",
     "AlgorithmSettings",
@@ -80,6 +84,7 @@ __all__ = [
     "RunState",
     "certify_front_members",
     "check_population_memory",
+    "checkpoint_arrays",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -95,4 +100,5 @@ __all__ = [
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",
+    "write_checkpoint",
 ]
