@@ -93,7 +93,7 @@ def test_every_feasible_member_is_certified(
     def fake_certify(problem, x, rate_hz):
         return SimpleNamespace(index=int(x[0]))
 
-    monkeypatch.setattr(planner, "certify_members", fake_members)
+    monkeypatch.setattr(planner, "certify_front_members", fake_members)
     monkeypatch.setattr(planner, "certify", fake_certify)
     front = SimpleNamespace(x=np.arange(4.0)[:, None], feasible=np.array([False, True, True, True]))
     order = np.array([2, 0, 1, 3])

@@ -12,10 +12,12 @@ from adept_traj.optimise.algorithms import (
 )
 from adept_traj.optimise.checkpoint import (
     CHECKPOINT_VERSION,
+    checkpoint_arrays,
     has_checkpoint,
     load_checkpoint,
     restore_algorithm,
     save_checkpoint,
+    write_checkpoint,
 )
 from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
@@ -24,7 +26,11 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
+from adept_traj.optimise.front_certificates import (
+    certify_front_members,
+)
 from adept_traj.optimise.loop import (
+    CHECKPOINT_INTERVAL,
     GenerationInfo,
     PlanningInterrupted,
     RunState,
@@ -44,6 +50,9 @@ from adept_traj.optimise.polish_step import (
     polish_fastest,
     time_optimal_run,
 )
+from adept_traj.optimise.population import (
+    population_values,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -53,10 +62,14 @@ from adept_traj.optimise.sampling import (
     check_population_memory,
     population_bytes,
 )
+from adept_traj.optimise.survival import (
+    RankAndCrowdingSurvival,
+)
 
 __all__ = [
     "ALGORITHMS",
     "BLOCK_PAIRS",
+    "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
     "TIME_OPTIMAL",
     "AlgorithmSettings",
@@ -67,8 +80,11 @@ __all__ = [
     "PlanningInterrupted",
     "PolishOutcome",
     "RampSampling",
+    "RankAndCrowdingSurvival",
     "RunState",
+    "certify_front_members",
     "check_population_memory",
+    "checkpoint_arrays",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -78,9 +94,11 @@ __all__ = [
     "plan",
     "polish_fastest",
     "population_bytes",
+    "population_values",
     "restore_algorithm",
     "save_checkpoint",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",
+    "write_checkpoint",
 ]

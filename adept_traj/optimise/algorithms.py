@@ -14,8 +14,10 @@ parts: DE/rand/1/bin variation (pymoo's DE ``Variant`` with ``selection="rand"``
 ``n_diffs=1``, binomial crossover, fixed F and CR — no self-adaptation, no extra
 mutation) creates NP trial vectors from the current population; the NP parents and NP
 trials are merged and the next population is chosen by non-dominated sorting and crowding
-distance (pymoo's ``RankAndCrowding``, feasibility first), the usual (μ + λ) selection of
-multi-objective DE (Babu & Jehan 2003; Robič & Filipič's DEMO uses the same survival).
+distance (pymoo's ``RankAndCrowding``, feasibility first; for both algorithms its
+equivalent on arrays, :class:`~adept_traj.optimise.RankAndCrowdingSurvival`), the usual
+(μ + λ) selection of multi-objective DE (Babu & Jehan 2003; Robič & Filipič's DEMO uses
+the same survival).
 
 Other names: ``nsga3``, ``unsga3``, ``smsemoa``, ``rvea`` (pymoo's MOEA/D handles no
 constraints, so it is not offered)
@@ -44,6 +46,7 @@ from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.survival import RankAndCrowdingSurvival
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
@@ -158,7 +161,7 @@ def make_algorithm(
 
 
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
-    from pymoo.algorithms.moo.nsga2 import NSGA2, RankAndCrowding
+    from pymoo.algorithms.moo.nsga2 import NSGA2
 
     # pymoo's eliminate_duplicates=True (the default of every algorithm here), its
     # decisions taken in blocks: no (pop, pop) distance matrix.
@@ -173,6 +176,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             sampling=sampling,
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
             mutation=PM(prob=1.0, prob_var=s["mutation_prob_var"], eta=s["mutation_eta"]),
+            survival=RankAndCrowdingSurvival(),
             **dup,
             repair=repair,
         )
@@ -196,7 +200,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             pop_size=pop,
             sampling=sampling,
             mating=variant,
-            survival=RankAndCrowding(),
+            survival=RankAndCrowdingSurvival(),
             n_offsprings=pop,
             **dup,
             output=MultiObjectiveOutput(),

@@ -46,13 +46,16 @@ from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.files import parse_json, read_bytes_bounded, write_atomic
+from adept_traj.optimise.population import population_values
 
 __all__ = [
     "CHECKPOINT_VERSION",
+    "checkpoint_arrays",
     "has_checkpoint",
     "load_checkpoint",
     "restore_algorithm",
     "save_checkpoint",
+    "write_checkpoint",
 ]
 
 #: Version of the checkpoint file (``meta`` key ``version``); version 1 is still read.
@@ -73,7 +76,7 @@ def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
 
     An attribute that only some members have (NSGA-II ranks only the feasible ones) is
     stored with the mask ``absent.<key>`` (pop,) of the members without it."""
-    out = {"X": pop.get("X"), "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV")}
+    out = {key: population_values(pop, key) for key in ("X", "F", "G", "CV")}
     out["n_iter"] = np.array(n_iter)
     for key in sorted({key for ind in pop for key in ind.data}):
         values = [ind.data.get(key) for ind in pop]
@@ -120,7 +123,8 @@ def save_checkpoint(
     meta: dict[str, Any],
     extra: dict[str, np.ndarray] | None = None,
 ) -> None:
-    """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``.
+    """Write the checkpoint of ``algorithm`` (after a finished generation) into ``folder``:
+    :func:`write_checkpoint` of :func:`checkpoint_arrays`.
 
     Parameters
     ----------
@@ -135,7 +139,15 @@ def save_checkpoint(
     extra:
         Further numeric arrays of the caller, stored as ``loop.<key>``.
     """
-    folder.mkdir(parents=True, exist_ok=True)
+    write_checkpoint(folder, checkpoint_arrays(algorithm, meta, extra))
+
+
+def checkpoint_arrays(
+    algorithm: Any, meta: dict[str, Any], extra: dict[str, np.ndarray] | None = None
+) -> dict[str, np.ndarray]:
+    """The content of the checkpoint of ``algorithm`` as it is now (after a finished
+    generation), for :func:`write_checkpoint`: new arrays and the metadata as JSON text, so
+    that later generations change nothing in it (parameters as :func:`save_checkpoint`)."""
     arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
     arrays.update({f"loop.{key}": np.asarray(value) for key, value in (extra or {}).items()})
     state = {
@@ -147,6 +159,13 @@ def save_checkpoint(
         **meta,
     }
     arrays["meta"] = np.array(json.dumps(state))
+    return arrays
+
+
+def write_checkpoint(folder: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write the ``arrays`` of :func:`checkpoint_arrays` as ``folder/checkpoint.npz``
+    (``folder`` created if missing), replaced atomically and flushed to disk."""
+    folder.mkdir(parents=True, exist_ok=True)
 
     def write_npz(path: Path) -> None:
         with path.open("wb") as fh:

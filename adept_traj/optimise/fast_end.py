@@ -44,6 +44,7 @@ import numpy as np
 from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.population import population_values
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.validation import as_integer, as_scalar
@@ -117,8 +118,7 @@ class FastEndSearch:
         feasible members and fresh ramps (immigrants). The replaced children are not
         evaluated: the number of evaluations is the mating's."""
         rng = kwargs.get("random_state")
-        cv = pop.get("CV")
-        feasible = np.flatnonzero(cv[:, 0] <= 0.0) if cv is not None and len(pop) else []
+        feasible = np.flatnonzero(population_values(pop, "CV")[:, 0] <= 0.0) if len(pop) else []
         off = self.mating.do(problem, pop, n_offsprings, **kwargs)
         if rng is None or len(off) == 0:
             return off
@@ -132,7 +132,7 @@ class FastEndSearch:
         keep = np.sort(rng.permutation(len(off))[: len(off) - n_new - n_bump])
         children = self.sampling.ramps(problem, n_new, rng)
         if n_bump:
-            X = pop.get("X")
+            X = population_values(pop, "X")
             fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
             parents = X[fastest[rng.integers(0, len(fastest), size=n_bump)]]
             children = np.concatenate([children, self._perturb(problem, parents, rng)])

@@ -1,16 +1,21 @@
 """The generation loop: ask/tell with timings, progress, checkpoints and exact resume.
 
 :func:`optimise` runs a pymoo algorithm on a problem generation by generation, through
-pymoo's public ask/tell interface only. After every generation it can write a checkpoint
-folder (:mod:`adept_traj.optimise.checkpoint`: ``checkpoint.json`` + ``checkpoint.npz``, no
-pickle): the population with every per-individual attribute the algorithm keeps (F, G, CV,
-rank, crowding, …), the generation and evaluation counters, the state of the algorithm's
-random generator, the feasible front of every generation so far and the timings.
-:func:`optimise` with ``resume=True`` restores all of it, so an interrupted run continues
-**exactly** as an uninterrupted one with the same seed (tested, killed at every
-generation). Ctrl-C (``KeyboardInterrupt``) during a generation leaves the last finished
-generation on disk and raises :class:`PlanningInterrupted` (whose ``checkpoint`` is
-``None`` if no generation was finished yet).
+pymoo's public ask/tell interface only. It can keep a checkpoint folder
+(:mod:`adept_traj.optimise.checkpoint`: ``checkpoint.npz``, no pickle): the population with
+every per-individual attribute the algorithm keeps (F, G, CV, rank, crowding, …), the
+generation and evaluation counters, the state of the algorithm's random generator, the
+feasible front of every generation so far and the timings. The checkpoint of every
+finished generation is made in memory; it is written (and flushed to disk) at most every
+``checkpoint_interval`` seconds, after the last generation, and on Ctrl-C — a write per
+generation cost more than the bookkeeping of pymoo's survival on fast disks, and tens of
+milliseconds each on slow ones. :func:`optimise` with ``resume=True`` restores all of it,
+so an interrupted run continues **exactly** as an uninterrupted one with the same seed
+(tested, killed at every generation): a run killed outright resumes from the last
+checkpoint written and computes the generations after it again, the same ones. Ctrl-C
+(``KeyboardInterrupt``) during a generation writes the last finished generation and raises
+:class:`PlanningInterrupted` (whose ``checkpoint`` is ``None`` if no generation was
+finished yet).
 """
 
 from __future__ import annotations
@@ -26,9 +31,19 @@ import numpy as np
 
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.errors import ConfigurationError, PlanningInterrupted
-from adept_traj.optimise.checkpoint import load_checkpoint, restore_algorithm, save_checkpoint
+from adept_traj.optimise.checkpoint import (
+    checkpoint_arrays,
+    load_checkpoint,
+    restore_algorithm,
+    write_checkpoint,
+)
+from adept_traj.optimise.population import population_values
+from adept_traj.validation import as_scalar
 
-__all__ = ["GenerationInfo", "RunState", "optimise"]
+__all__ = ["CHECKPOINT_INTERVAL", "GenerationInfo", "RunState", "optimise"]
+
+#: Shortest wall time [s] between two checkpoint writes (each one flushed to disk).
+CHECKPOINT_INTERVAL = 1.0
 
 
 @dataclass(frozen=True)
@@ -80,6 +95,7 @@ def optimise(
     resume: bool = False,
     fingerprint: dict[str, Any] | None = None,
     progress: Callable[[GenerationInfo], None] | None = None,
+    checkpoint_interval: float = CHECKPOINT_INTERVAL,
 ) -> RunState:
     """Run ``algorithm`` on ``problem`` for ``n_gen`` generations with ``seed``.
 
@@ -103,6 +119,12 @@ def optimise(
         JSON-ready description of the run, stored in and compared with the checkpoint.
     progress:
         Called after every generation with a :class:`GenerationInfo`.
+    checkpoint_interval:
+        Shortest wall time [s] between two checkpoint writes, ≥ 0 (default
+        :data:`CHECKPOINT_INTERVAL`; 0 writes every generation). The last generation is
+        always written, and on Ctrl-C the last finished one (kept in memory after every
+        generation). A run killed outright resumes from an earlier generation and computes
+        the same later ones again: the same result, at most this much work lost.
 
     Returns
     -------
@@ -119,6 +141,9 @@ def optimise(
     """
     folder = Path(checkpoint) if checkpoint is not None else None
     fingerprint = fingerprint or {}
+    interval = as_scalar(
+        checkpoint_interval, "checkpoint_interval", "[s]", minimum=0.0, error=ConfigurationError
+    )
     algorithm.setup(problem, seed=seed, termination=("n_gen", n_gen), verbose=False)
     spent_total = spent_eval = 0.0
     history: list[dict[str, Any]] = []
@@ -138,6 +163,10 @@ def optimise(
         fronts = _restored_fronts(arrays, len(history))
     start = time.perf_counter() - spent_total
     evaluation_s = spent_eval
+    # The checkpoint of the last finished generation not yet on disk, and when one was
+    # last written.
+    unwritten: dict[str, np.ndarray] | None = None
+    written_at = time.perf_counter()
     try:
         while algorithm.has_next():
             infills = algorithm.ask()
@@ -147,14 +176,11 @@ def optimise(
                 evaluation_s += time.perf_counter() - t0
             algorithm.tell(infills=infills)
             pop = algorithm.pop
-            cv = pop.get("CV")[:, 0]
-            feasible = cv <= 0.0
-            best_t = float(pop.get("X")[feasible, 0].min()) if feasible.any() else None
-            if feasible.any():
-                F = pop.get("F")[feasible]
-                fronts.append(F[non_dominated(F, maximised=False)])
-            else:
-                fronts.append(np.empty((0, pop.get("F").shape[1])))
+            feasible = population_values(pop, "CV")[:, 0] <= 0.0
+            X, F = population_values(pop, "X"), population_values(pop, "F")
+            best_t = float(X[feasible, 0].min()) if feasible.any() else None
+            F = F[feasible]
+            fronts.append(F[non_dominated(F, maximised=False)] if len(F) else F)
             info = GenerationInfo(
                 generation=len(history) + 1,
                 n_gen=n_gen,
@@ -178,10 +204,15 @@ def optimise(
                     "evaluation_s": evaluation_s,
                     "history": history,
                 }
-                save_checkpoint(folder, algorithm, meta, _stored_fronts(fronts))
+                unwritten = checkpoint_arrays(algorithm, meta, _stored_fronts(fronts))
+                if time.perf_counter() - written_at >= interval or not algorithm.has_next():
+                    write_checkpoint(folder, unwritten)
+                    unwritten, written_at = None, time.perf_counter()
             if progress is not None:
                 progress(info)
     except KeyboardInterrupt:
+        if folder is not None and unwritten is not None:
+            write_checkpoint(folder, unwritten)  # the last finished generation
         if folder is None:
             where, saved = " (no checkpoint folder)", None
         elif not history:
@@ -193,10 +224,10 @@ def optimise(
         ) from None
     pop = algorithm.pop
     return RunState(
-        X=pop.get("X"),
-        F=pop.get("F"),
-        G=pop.get("G"),
-        CV=pop.get("CV")[:, 0],
+        X=population_values(pop, "X"),
+        F=population_values(pop, "F"),
+        G=population_values(pop, "G"),
+        CV=population_values(pop, "CV")[:, 0],
         n_generations=len(history),
         n_evaluations=int(algorithm.evaluator.n_eval),
         total_s=time.perf_counter() - start,

@@ -45,7 +45,7 @@ from adept_traj.analysis.indicators import (
     normalised_hypervolume,
     objective_bounds,
 )
-from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
+from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
     optimizer_overhead,
@@ -54,6 +54,7 @@ from adept_traj.analysis.paper_measures import (
 )
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
+from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
 from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_fastest, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
@@ -142,7 +143,8 @@ def _certify_front(
     max_certify: int | None,
 ) -> tuple[MemberCertificate | None, ...]:
     """(n,) the summary of each member's dense certificate with the continuous guarantee
-    (:func:`~adept_traj.analysis.certify_members`), ``None`` for a member not certified.
+    (:func:`~adept_traj.analysis.certify_members`, on the problem's workers:
+    :func:`~adept_traj.optimise.certify_front_members`), ``None`` for a member not certified.
 
     Only members the optimiser marked feasible are certified (a member that violates a
     constraint at the optimiser's samples fails the dense check as well), in the trade-off
@@ -151,7 +153,7 @@ def _certify_front(
     candidates = [int(k) for k in order if front.feasible[k]]
     if max_certify is not None:
         candidates = candidates[:max_certify]
-    return certify_members(problem, front.x, candidates, rate_hz=rate_hz)
+    return certify_front_members(problem, front.x, candidates, rate_hz=rate_hz)
 
 
 def _certified_choice(

@@ -75,6 +75,8 @@ def joint_motion(
     best = index == r.best.index
     dense, limits = member_dense(r, index), r.limits
     t, nq = dense.t, dense.nq
+    from matplotlib.ticker import MaxNLocator
+
     fig = new_figure(4.0 * nq + 1.0, 13.5)
     axes = np.atleast_2d(fig.subplots(len(LIMITS), nq, sharex=True, squeeze=False))
     fig.subplots_adjust(left=0.06, right=0.99, bottom=0.05, top=0.92, wspace=0.32, hspace=0.2)
@@ -117,12 +119,14 @@ def joint_motion(
             ax.set_ylabel(f"{title} [{unit}]", fontsize=9)
             ax.tick_params(labelsize=8)
             ax.grid(alpha=0.3)
+            ax.yaxis.set_major_locator(MaxNLocator(4))  # fewer ticks: each is 4 artists
             if row == 0:
                 joint_type = "revolute" if limits.units[j] == "rad" else "prismatic"
                 ax.set_title(f"{limits.names[j]} ({joint_type})", fontsize=11)
             if row == len(LIMITS) - 1:
                 ax.set_xlabel("time t [s]", fontsize=9)
     ax0 = axes[0, 0]
+    ax0.xaxis.set_major_locator(MaxNLocator(5))  # shared by the columns' time axes
     from matplotlib.lines import Line2D
 
     who = "best trade-off" if best else f"member {index}"

@@ -1,0 +1,87 @@
+r"""NSGA-II's survival (pymoo's rank and crowding) with the bookkeeping done on arrays.
+
+pymoo's :class:`~pymoo.operators.survival.rank_and_crowding.RankAndCrowding` keeps the
+feasible members first (by non-dominated rank, then crowding distance), then the
+infeasible ones by increasing total constraint violation CV. Before ranking, pymoo's
+``Survival.do`` splits the merged parents and offspring (2N members) into feasible and
+infeasible ones with ``Population.get("F", "CV", "FEAS")``: three properties per member,
+each evaluated twice (``hasattr`` then ``getattr``) and ``FEAS`` compares a fresh array
+each time — ≈ 10 µs per member, about as long as the non-dominated sorting itself for
+MODE's 1 000 members.
+
+:class:`RankAndCrowdingSurvival` takes the same decisions from one (2N, 1) array of CV:
+member i is feasible when
+
+.. math::
+    \mathrm{CV}_i \le \varepsilon_{cv}
+
+(pymoo's ``FEAS``, with the individuals' ``cv_eps``, 0 by default); the infeasible ones are
+ordered by ``numpy.argsort`` of their CV as pymoo orders them, the feasible ones go to
+pymoo's own ranking (:meth:`RankAndCrowding._do`, unchanged). Same survivors in the same
+order, same ``rank`` and ``crowding`` data, same draws from the random generator
+(``tests/test_survival.py`` compares both on mixed populations).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pymoo.core.population import Population
+from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
+from pymoo.util import default_random_state
+
+from adept_traj.optimise.population import population_values
+
+__all__ = ["RankAndCrowdingSurvival"]
+
+
+class RankAndCrowdingSurvival(RankAndCrowding):
+    """pymoo's rank-and-crowding survival (NSGA-II's, MODE's here) with the feasibility
+    split on arrays (see the module docstring). Parameters as pymoo's
+    :class:`~pymoo.operators.survival.rank_and_crowding.RankAndCrowding`."""
+
+    @default_random_state
+    def do(
+        self,
+        problem: Any,
+        pop: Population,
+        *args: Any,
+        n_survive: int | None = None,
+        random_state: Any = None,
+        return_indices: bool = False,
+        **kwargs: Any,
+    ) -> Any:
+        """The ``n_survive`` survivors of ``pop`` (all of it by default), as pymoo's
+        ``Survival.do`` chooses them; their indices in ``pop`` if ``return_indices``."""
+        if len(pop) == 0:
+            return pop
+        n_survive = len(pop) if n_survive is None else min(n_survive, len(pop))
+        if not (self.filter_infeasible and problem.has_constraints()):
+            survivors = self._do(
+                problem, pop, *args, n_survive=n_survive, random_state=random_state, **kwargs
+            )
+        else:
+            cv = population_values(pop, "CV")  # (n, 1)
+            eps = np.array([ind.config.get("cv_eps", 0.0) for ind in pop])
+            feasible = np.flatnonzero(cv[:, 0] <= eps)
+            infeasible = np.flatnonzero(~(cv[:, 0] <= eps))
+            infeasible = infeasible[np.argsort(cv[infeasible, 0])]
+            if len(feasible) == 0:
+                survivors = Population()
+            else:
+                survivors = self._do(
+                    problem,
+                    pop[feasible],
+                    *args,
+                    n_survive=min(len(feasible), n_survive),
+                    random_state=random_state,
+                    **kwargs,
+                )
+            n_remaining = n_survive - len(survivors)
+            if n_remaining > 0:
+                survivors = Population.merge(survivors, pop[infeasible[:n_remaining]])
+        if return_indices:
+            where = {ind: k for k, ind in enumerate(pop)}
+            return [where[ind] for ind in survivors]
+        return survivors
