@@ -263,11 +263,10 @@ class CollisionChecker:
         (:mod:`adept_traj.collision.pruning`: their distance is reported as the bound that
         proves it), then search the others (:meth:`_search`)."""
         n_motions = int(np.prod(q.shape[:-2]))
-        far = self._pruning.lower_bounds(
-            self._broad.ball_centres(frames), self._broad.ball_radius, n_motions
-        )
+        centres = self._broad.ball_centres(frames)  # for the pruning and the broad phase
+        far = self._pruning.lower_bounds(centres, self._broad.ball_radius, n_motions)
         keep = self._pruning.kept(far)
-        part = self._restricted(keep)._search(q, t, frames)
+        part = self._restricted(keep)._search(q, t, frames, centres)
         out = [far.copy(), np.full(far.shape, -1), np.full(far.shape, -1)]
         near = far[:, keep] <= self.influence  # else the motion's own bound, as if pruned
         for full, kept in zip(out, (part.distance, part.sample, part.solid)):
@@ -287,15 +286,22 @@ class CollisionChecker:
             view = self._views[key] = restrict_checker(self, keep)
         return view
 
-    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
-        """The branch and bound of :meth:`min_distances` over every obstacle."""
+    def _search(
+        self, q: np.ndarray, t: np.ndarray, frames: np.ndarray, centres: np.ndarray | None = None
+    ) -> MinDistances:
+        """The branch and bound of :meth:`min_distances` over every obstacle (``centres``:
+        the solids' ball centres from :meth:`BroadPhase.ball_centres`, if computed)."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)
-        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
-        lower = np.where(self.allowed, np.inf, bounds.lower)
+        bounds = self._broad.bounds(
+            frames, obstacle_poses, q.reshape(-1, q.shape[-1]), centres=centres
+        )
+        lower, known = bounds.lower, bounds.exact
+        if self.allowed.any():  # else no pass over the whole arrays
+            lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed
         lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
-        known = (bounds.exact | self.allowed).reshape(lower.shape)
+        known = known.reshape(lower.shape)
         best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
         where = np.full(best.shape, -1)
         closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
