@@ -330,16 +330,12 @@ class BroadPhase:
         ``centres`` (3, n_solids, N) [m] may pass the enclosing-ball centres if already
         computed (:meth:`ball_centres` of the same ``frames``)."""
         n = frames.shape[-1]
-        if q is not None and np.shape(q) != (n, self.nq):
-            raise InvalidInputError(
-                f"q must have shape {(n, self.nq)} (one configuration per sample); "
-                f"got {np.shape(q)}"
-            )
-        if centres is not None and np.shape(centres) != (3, self.n_solids, n):
-            raise InvalidInputError(
-                f"centres must have shape {(3, self.n_solids, n)} (ball_centres of frames); "
-                f"got {np.shape(centres)}"
-            )
+        for name, value, shape in (
+            ("q", q, (n, self.nq)),
+            ("centres", centres, (3, self.n_solids, n)),
+        ):
+            if value is not None and np.shape(value) != shape:
+                raise InvalidInputError(f"{name} must have shape {shape}; got {np.shape(value)}")
         # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
         lower = np.empty((self.n_obstacles, self.n_solids, n))
         exact = np.zeros(lower.shape, dtype=bool)
@@ -443,7 +439,11 @@ class BroadPhase:
             - half_extent(*kind_o, n_o)
         )
         gaps[norm[:, 0] == 0.0, 3] = -np.inf  # coincident centres: no centre line, no axis
-        gap = gaps.max(axis=-1)
+        # The largest of the 4 gaps, column by column (a reduction over a trailing axis of
+        # length 4 is several times slower).
+        gap = np.maximum(gaps[:, 0], gaps[:, 1])
+        np.maximum(gap, gaps[:, 2], out=gap)
+        np.maximum(gap, gaps[:, 3], out=gap)
         if "sphere" in (kind_s[0], kind_o[0]):
             # coal 3.0.3 overstates some sphere penetration depths (sphere–cylinder near a
             # cap): a true bound could exceed coal's value, so overlaps are not used here.
