@@ -125,12 +125,14 @@ def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray
     if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
         return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
     delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
-    sq = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]
+    sq = _dot3(delta, delta)
     if isinstance(shape, Sphere):
-        return np.sqrt(sq) - shape.radius
-    axis = np.ascontiguousarray(pose[:, :3, 2].T)  # (3, R)
-    z = axis[0] * delta[0] + axis[1] * delta[1] + axis[2] * delta[2]
-    rho = np.sqrt(np.maximum(sq - z * z, 0.0))
+        sq = np.sqrt(sq, out=sq)
+        sq -= shape.radius
+        return sq
+    z = _dot3(np.ascontiguousarray(pose[:, :3, 2].T)[:, None], delta)  # axis (3, 1, R)
+    rho = np.subtract(sq, np.multiply(z, z), out=sq)
+    rho = np.sqrt(np.maximum(rho, 0.0, out=rho), out=rho)
     if isinstance(shape, Cylinder):  # sqrt(rho² + 0²) is rho exactly: skip it
         return _cylinder_distance(shape, rho, z)
     return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
@@ -143,6 +145,20 @@ def points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
     f = frames.reshape(3, 4, -1)  # (row i, column j, R)
     out = np.empty((3, len(points), f.shape[-1]))
     px, py, pz = (points[:, j, None] for j in range(3))
-    for i in range(3):
-        out[i] = px * f[i, 0] + py * f[i, 1] + pz * f[i, 2] + f[i, 3]
+    term = np.empty(out.shape[1:])
+    for i in range(3):  # px f_i0 + py f_i1 + pz f_i2 + f_i3, in that order, in place
+        np.multiply(px, f[i, 0], out=out[i])
+        out[i] += np.multiply(py, f[i, 1], out=term)
+        out[i] += np.multiply(pz, f[i, 2], out=term)
+        out[i] += f[i, 3]
+    return out
+
+
+def _dot3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`a_0 b_0 + a_1 b_1 + a_2 b_2` (summed in that order) of component-major
+    arrays (3, ...), into one new array."""
+    out = np.multiply(a[0], b[0])
+    term = np.multiply(a[1], b[1])
+    out += term
+    out += np.multiply(a[2], b[2], out=term)
     return out
