@@ -286,9 +286,9 @@ class CollisionChecker:
             view = self._views[key] = restrict_checker(self, keep)
         return view
 
-    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray, balls: Any) -> Any:
+    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray, balls: Any = None) -> Any:
         """The branch and bound of :meth:`min_distances` over every obstacle (``balls``:
-        :meth:`BroadPhase.ball_centres` of ``frames``); a :class:`MinDistances`."""
+        :meth:`BroadPhase.ball_centres` of ``frames``, or None); a :class:`MinDistances`."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)
