@@ -322,16 +322,20 @@ class BroadPhase:
         frames: np.ndarray,
         obstacle_poses: list[np.ndarray],
         q: np.ndarray | None = None,
+        centres: np.ndarray | None = None,
     ) -> Bounds:
         """Lower bounds for joint frames (njoints, 3, 4, N) (component-major) and obstacle
         poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
-        configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too."""
+        configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too.
+        ``centres`` (3, n_solids, N) [m] may pass the enclosing-ball centres if already
+        computed (:meth:`ball_centres` of the same ``frames``)."""
         n = frames.shape[-1]
-        if q is not None and np.shape(q) != (n, self.nq):
-            raise InvalidInputError(
-                f"q must have shape {(n, self.nq)} (one configuration per sample); "
-                f"got {np.shape(q)}"
-            )
+        for name, value, shape in (
+            ("q", q, (n, self.nq)),
+            ("centres", centres, (3, self.n_solids, n)),
+        ):
+            if value is not None and np.shape(value) != shape:
+                raise InvalidInputError(f"{name} must have shape {shape}; got {np.shape(value)}")
         # Internally (n_obstacles, n_solids, N): samples innermost, for fast elementwise work.
         lower = np.empty((self.n_obstacles, self.n_solids, n))
         exact = np.zeros(lower.shape, dtype=bool)
@@ -346,7 +350,8 @@ class BroadPhase:
                 for (k, o), table in self.tables.items():
                     lower[o, k] = table.lower_bound(q[:, table.joint])
                     done[o, k] = True
-            self._ball_bounds(lower, rows, obstacle_poses, done)
+            balls = self.ball_centres(frames) if centres is None else centres
+            self._ball_bounds(lower, balls, obstacle_poses, done)
             close = lower <= self.influence
             close[static] = False
             for o, k in zip(*np.nonzero(close.any(axis=-1))):
@@ -368,22 +373,24 @@ class BroadPhase:
     def _ball_bounds(
         self,
         lower: np.ndarray,
-        frames: dict[int, np.ndarray],
+        balls: np.ndarray,
         obstacle_poses: list[np.ndarray],
         done: np.ndarray,
     ) -> None:
-        """Level 1 in place (``lower`` (n_obstacles, n_solids, N)): enclosing balls against
-        every obstacle, for the pairs not ``done`` (n_obstacles, n_solids) by level 0 and
-        for the samples where a table gave no bound (``-inf``: outside its grid)."""
-        balls = np.empty((3, self.n_solids, lower.shape[-1]))
-        for p, ks in self._by_parent:
-            balls[:, ks] = points_in_joint(frames[p], self._ball_in_joint[ks])
+        """Level 1 in place (``lower`` (n_obstacles, n_solids, N)): enclosing balls (centres
+        ``balls`` (3, n_solids, N)) against every obstacle, for the pairs not ``done``
+        (n_obstacles, n_solids) by level 0 and for the samples where a table gave no bound
+        (``-inf``: outside its grid)."""
         radius = self._ball_radius[:, None]
         for o, shape in enumerate(self.obstacle_shape):
             ks = np.flatnonzero(~done[o])
             if len(ks):
-                lower[o, ks] = obstacle_signed_distance(shape, balls[:, ks], obstacle_poses[o])
-                lower[o, ks] -= radius[ks]
+                # A contiguous run of solids is a view (no gather), the subtraction is in
+                # place on the fresh distances, then one write into ``lower``.
+                run = slice(ks[0], ks[-1] + 1) if ks[-1] - ks[0] == len(ks) - 1 else ks
+                d = obstacle_signed_distance(shape, balls[:, run], obstacle_poses[o])
+                d -= radius[run]
+                lower[o, run] = d
             for k in np.flatnonzero(done[o] & ~self.static[:, o]):
                 gap = np.flatnonzero(np.isneginf(lower[o, k]))
                 if len(gap):
@@ -432,7 +439,11 @@ class BroadPhase:
             - half_extent(*kind_o, n_o)
         )
         gaps[norm[:, 0] == 0.0, 3] = -np.inf  # coincident centres: no centre line, no axis
-        gap = gaps.max(axis=-1)
+        # The largest of the 4 gaps, column by column (a reduction over a trailing axis of
+        # length 4 is several times slower).
+        gap = np.maximum(gaps[:, 0], gaps[:, 1])
+        np.maximum(gap, gaps[:, 2], out=gap)
+        np.maximum(gap, gaps[:, 3], out=gap)
         if "sphere" in (kind_s[0], kind_o[0]):
             # coal 3.0.3 overstates some sphere penetration depths (sphere–cylinder near a
             # cap): a true bound could exceed coal's value, so overlaps are not used here.

@@ -263,11 +263,10 @@ class CollisionChecker:
         (:mod:`adept_traj.collision.pruning`: their distance is reported as the bound that
         proves it), then search the others (:meth:`_search`)."""
         n_motions = int(np.prod(q.shape[:-2]))
-        far = self._pruning.lower_bounds(
-            self._broad.ball_centres(frames), self._broad.ball_radius, n_motions
-        )
+        centres = self._broad.ball_centres(frames)  # for the pruning and the broad phase
+        far = self._pruning.lower_bounds(centres, self._broad.ball_radius, n_motions)
         keep = self._pruning.kept(far)
-        part = self._restricted(keep)._search(q, t, frames)
+        part = self._restricted(keep)._search(q, t, frames, centres)
         out = [far.copy(), np.full(far.shape, -1), np.full(far.shape, -1)]
         near = far[:, keep] <= self.influence  # else the motion's own bound, as if pruned
         for full, kept in zip(out, (part.distance, part.sample, part.solid)):
@@ -287,29 +286,32 @@ class CollisionChecker:
             view = self._views[key] = restrict_checker(self, keep)
         return view
 
-    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
-        """The branch and bound of :meth:`min_distances` over every obstacle."""
+    def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray, balls: Any = None) -> Any:
+        """The branch and bound of :meth:`min_distances` over every obstacle (``balls``:
+        :meth:`BroadPhase.ball_centres` of ``frames``, or None); a :class:`MinDistances`."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)
-        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
-        lower = np.where(self.allowed, np.inf, bounds.lower)
-        lower = lower.reshape(n_motions, n_t * self.n_solids, self.n_obstacles)
-        known = (bounds.exact | self.allowed).reshape(lower.shape)
-        best = lower.min(axis=1)  # (n_motions, n_obs): a bound until improved below
+        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]), balls)
+        lower, known = bounds.lower, bounds.exact
+        if self.allowed.any():  # else no pass over the whole arrays
+            lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed
+        flat = (n_motions, n_t * self.n_solids, self.n_obstacles)
+        lower, known = lower.reshape(flat), known.reshape(flat)
+        smallest = lower.argmin(axis=1)  # (n_motions, n_obs): where each smallest bound is
+        best = np.take_along_axis(lower, smallest[:, None], axis=1)[:, 0]  # bound until improved
         where = np.full(best.shape, -1)
         closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
         # Every pair within influence of such an obstacle is exact already: the argmin is
         # exact when at most influence; above, it may be a level-1 bound (then -1).
-        first = lower[:, :, closed].argmin(axis=1)  # (n_motions, n_closed)
-        is_exact = np.take_along_axis(known[:, :, closed], first[:, None, :], axis=1)[:, 0]
-        where[:, closed] = np.where(is_exact, first, -1)
+        is_exact = np.take_along_axis(known, smallest[:, None, :], axis=1)[:, 0]
+        where[:, closed] = np.where(is_exact, smallest, -1)[:, closed]
         calls = 0
         pm, po = np.nonzero((best <= self.influence) & ~closed)
         # First candidate of every (motion, obstacle) at once: the smallest bound. Most
         # searches end there (the second smallest bound is at least its exact distance).
         rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
-        first = rows.argmin(axis=1)
+        first = smallest[pm, po]  # = rows.argmin(axis=1)
         second = (
             np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
         )

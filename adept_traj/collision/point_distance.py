@@ -51,20 +51,53 @@ def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarr
     if isinstance(shape, Sphere):
         return _norm3(x, y, z) - shape.radius
     if isinstance(shape, Box):
-        hx, hy, hz = (0.5 * float(v) for v in shape.size)
-        ex, ey, ez = np.abs(x) - hx, np.abs(y) - hy, np.abs(z) - hz
-        outside = _norm3(np.maximum(ex, 0.0), np.maximum(ey, 0.0), np.maximum(ez, 0.0))
-        return outside + np.minimum(np.maximum(np.maximum(ex, ey), ez), 0.0)
+        return _box_distance(shape, x, y, z)
     if isinstance(shape, Cylinder):
-        radial = np.sqrt(x * x + y * y) - shape.radius
-        axial = np.abs(z) - 0.5 * shape.length
-        outside = np.hypot(np.maximum(radial, 0.0), np.maximum(axial, 0.0))
-        return outside + np.minimum(np.maximum(radial, axial), 0.0)
+        return _cylinder_distance(shape, np.sqrt(x * x + y * y), z)
     if isinstance(shape, Capsule):
         half = 0.5 * shape.length
         dz = z - np.clip(z, -half, half)
         return _norm3(x, y, dz) - shape.radius
     raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
+
+
+def _box_distance(shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Signed distance [m] of points (x, y, z) (...) in the box's frame; the same
+    operations as the formula of :func:`point_signed_distance`, on few temporaries."""
+    hx, hy, hz = (0.5 * float(v) for v in shape.size)
+    shape_xyz = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z))
+    ex, ey, ez = (np.abs(v, out=np.empty(shape_xyz)) for v in (x, y, z))
+    ex -= hx
+    ey -= hy
+    ez -= hz
+    inside = np.maximum(ex, ey, out=np.empty(shape_xyz))
+    np.maximum(inside, ez, out=inside)
+    np.minimum(inside, 0.0, out=inside)
+    np.maximum(ex, 0.0, out=ex)
+    np.maximum(ey, 0.0, out=ey)
+    np.maximum(ez, 0.0, out=ez)
+    ex *= ex
+    ey *= ey
+    ez *= ez
+    ex += ey
+    ex += ez
+    outside = np.sqrt(ex, out=ex)
+    outside += inside
+    return outside[()]  # a scalar for scalar coordinates
+
+
+def _cylinder_distance(shape: Cylinder, rho: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Signed distance [m] of points at distance ``rho`` (...) [m] from the cylinder's
+    axis and ``z`` (...) [m] along it (from its centre)."""
+    shape_rz = np.broadcast_shapes(np.shape(rho), np.shape(z))
+    radial = np.subtract(rho, shape.radius, out=np.empty(shape_rz))
+    axial = np.abs(z, out=np.empty(shape_rz))
+    axial -= 0.5 * shape.length
+    inside = np.maximum(radial, axial, out=np.empty(shape_rz))
+    np.minimum(inside, 0.0, out=inside)
+    outside = np.hypot(np.maximum(radial, 0.0, out=radial), np.maximum(axial, 0.0, out=axial))
+    outside += inside
+    return outside[()]
 
 
 def _in_obstacle_frame(points: np.ndarray, pose: np.ndarray) -> np.ndarray:
@@ -92,12 +125,16 @@ def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray
     if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
         return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
     delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
-    sq = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]
+    sq = _dot3(delta, delta)
     if isinstance(shape, Sphere):
-        return np.sqrt(sq) - shape.radius
-    axis = np.ascontiguousarray(pose[:, :3, 2].T)  # (3, R)
-    z = axis[0] * delta[0] + axis[1] * delta[1] + axis[2] * delta[2]
-    rho = np.sqrt(np.maximum(sq - z * z, 0.0))
+        sq = np.sqrt(sq, out=sq)
+        sq -= shape.radius
+        return sq
+    z = _dot3(np.ascontiguousarray(pose[:, :3, 2].T)[:, None], delta)  # axis (3, 1, R)
+    rho = np.subtract(sq, np.multiply(z, z), out=sq)
+    rho = np.sqrt(np.maximum(rho, 0.0, out=rho), out=rho)
+    if isinstance(shape, Cylinder):  # sqrt(rho² + 0²) is rho exactly: skip it
+        return _cylinder_distance(shape, rho, z)
     return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
 
 
@@ -108,6 +145,20 @@ def points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
     f = frames.reshape(3, 4, -1)  # (row i, column j, R)
     out = np.empty((3, len(points), f.shape[-1]))
     px, py, pz = (points[:, j, None] for j in range(3))
-    for i in range(3):
-        out[i] = px * f[i, 0] + py * f[i, 1] + pz * f[i, 2] + f[i, 3]
+    term = np.empty(out.shape[1:])
+    for i in range(3):  # px f_i0 + py f_i1 + pz f_i2 + f_i3, in that order, in place
+        np.multiply(px, f[i, 0], out=out[i])
+        out[i] += np.multiply(py, f[i, 1], out=term)
+        out[i] += np.multiply(pz, f[i, 2], out=term)
+        out[i] += f[i, 3]
+    return out
+
+
+def _dot3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`a_0 b_0 + a_1 b_1 + a_2 b_2` (summed in that order) of component-major
+    arrays (3, ...), into one new array."""
+    out = np.multiply(a[0], b[0])
+    term = np.multiply(a[1], b[1])
+    out += term
+    out += np.multiply(a[2], b[2], out=term)
     return out

@@ -1,0 +1,99 @@
+"""CPU time per sample of each piece of one evaluation block of the full problem.
+
+Run: ``python benchmarks/bench_evaluation_pieces.py [--pop 500] [--repeat 7]``.
+
+Evaluates the paper problem's populations (``random``: uniform in the decision bounds;
+``near feasible``: small perturbations of a collision-free move) block by block, as
+:meth:`TrajectoryProblem.evaluate_batch` does (blocks of about 4 096 samples), and times
+each piece of a block separately: spline sampling, RNEA, forward kinematics with the
+manipulability, the spline integrals and exact bounds, the obstacle pruning, the obstacle
+poses, the broad phase, the whole :meth:`CollisionChecker.min_distances` (pruning, poses,
+broad phase, coal and the branch and bound) and the whole block. Figures are **process CPU
+time** (:func:`time.process_time`) in µs per sample (a sample = one configuration of one
+trajectory; 116 per trajectory), the median over ``--repeat`` runs: on a machine shared
+with other jobs, wall time mostly measures the others. The pieces overlap (min_distances
+holds pruning, poses and broad phase), so they do not add up to the block.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from adept_traj import Robot, Scene
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.testing.paper_moves import lift_then_lower  # a hand-made collision-free move
+
+#: Samples per block, as in :meth:`TrajectoryProblem.evaluate_batch`.
+BLOCK_SAMPLES = 4096
+
+
+def pieces(problem: TrajectoryProblem, x: np.ndarray) -> dict[str, float]:
+    """CPU seconds per piece over the blocks of population ``x`` (pop, n_var)."""
+    robot, traj, checker = problem.robot, problem.trajectory, problem.checker
+    broad = checker._broad  # the profile reads the checker's parts
+    spent: dict[str, float] = {}
+
+    def timed(name: str, fn: Callable[[], object]) -> object:
+        start = time.process_time()
+        out = fn()
+        spent[name] = spent.get(name, 0.0) + time.process_time() - start
+        return out
+
+    step = max(1, BLOCK_SAMPLES // len(problem.s))
+    for i in range(0, len(x), step):
+        b = x[i : i + step]
+        smp = timed("spline sampling", lambda b=b: traj.sample(b, problem.s, orders=(0, 1, 2)))
+        timed("RNEA", lambda smp=smp: robot.inverse_dynamics(smp.q, smp.qd, smp.qdd))
+        fk = timed("kinematics + manipulability", lambda smp=smp: robot.forward_kinematics(smp.q))
+        timed("spline integrals", lambda b=b: traj.integrals(b))
+        timed("spline exact bounds", lambda b=b: traj.bounds(b))
+        frames, q = fk.joint_frames, smp.q.reshape(-1, robot.nq)
+        timed(
+            "pruning (ball centres too)",
+            lambda b=b, f=frames: checker._pruning.lower_bounds(
+                broad.ball_centres(f), broad.ball_radius, len(b)
+            ),
+        )
+        poses = timed("obstacle poses", lambda smp=smp: checker._obstacle_poses(smp.t))
+        timed("broad phase", lambda f=frames, p=poses, q=q: broad.bounds(f, p, q))
+        timed(
+            "min_distances (all of it)",
+            lambda smp=smp, f=frames: checker.min_distances(smp.q, smp.t, joint_frames=f),
+        )
+        timed("block (all of it)", lambda b=b: problem._evaluate_block(b))
+    return spent
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--pop", type=int, default=500, help="population size")
+    parser.add_argument("--repeat", type=int, default=7, help="runs (the median is printed)")
+    args = parser.parse_args()
+    robot, scene = Robot.adept_one_xl(), Scene.paper()
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
+    rng = np.random.default_rng(0)
+    span = problem.xu - problem.xl
+    noise = rng.normal(scale=0.01, size=(args.pop, problem.n_var)) * span
+    populations = {
+        "random": problem.xl + span * rng.uniform(size=(args.pop, problem.n_var)),
+        "near feasible": np.clip(lift_then_lower(problem) + noise, problem.xl, problem.xu),
+    }
+    n_samples = args.pop * len(problem.s)
+    print(f"{robot.name}, paper scene, {len(problem.s)} samples per trajectory, CPU µs/sample")
+    for name, x in populations.items():
+        problem.evaluate_batch(x[:5])  # warm-up
+        runs = [pieces(problem, x) for _ in range(args.repeat)]
+        print(name)
+        for piece in runs[0]:
+            median = float(np.median([r[piece] for r in runs]))
+            print(f"  {piece:<30}{median / n_samples * 1e6:7.2f}")
+        block = float(np.median([r["block (all of it)"] for r in runs]))
+        print(f"  {'= evaluations/s on one core':<30}{args.pop / block:7.0f}")
+
+
+if __name__ == "__main__":
+    main()
