@@ -10,9 +10,6 @@ bound is ≤ ``influence`` go to coal (narrow phase, one call per close pair: th
 loop, over close pairs, never over all samples). The other entries hold a lower bound
 greater than ``influence``: every quantity built from distances below ``influence`` (the
 constraint, the clearance penalty) is therefore exact.
-
-Also here: :func:`paper_penalty`, the paper's eqs. (13)–(16) (circumscribing spheres or
-ellipsoids around obstacles, tool points), kept for comparison.
 """
 
 from __future__ import annotations
