@@ -30,6 +30,7 @@ from adept_traj.optimise.loop import (
     RunState,
     optimise,
 )
+from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.planner import (
     plan,
     warn_missing_limits,
@@ -40,8 +41,15 @@ from adept_traj.optimise.polish import (
     time_optimal,
 )
 from adept_traj.optimise.polish_step import (
+    GRADIENT_COST,
+    POLISH_MODES,
+    POLISH_SHARE,
+    SPREAD_MEMBERS,
     TIME_OPTIMAL,
     polish_fastest,
+    polish_members,
+    polish_mode,
+    polish_run,
     time_optimal_run,
 )
 from adept_traj.optimise.repair import (
@@ -58,6 +66,11 @@ __all__ = [
     "ALGORITHMS",
     "BLOCK_PAIRS",
     "CHECKPOINT_VERSION",
+    "GRADIENT_COST",
+    "MAX_EVALUATIONS",
+    "POLISH_MODES",
+    "POLISH_SHARE",
+    "SPREAD_MEMBERS",
     "TIME_OPTIMAL",
     "AlgorithmSettings",
     "BlockedDuplicateElimination",
@@ -69,6 +82,7 @@ __all__ = [
     "RampSampling",
     "RunState",
     "check_population_memory",
+    "epsilon_step",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -77,6 +91,9 @@ __all__ = [
     "optimise",
     "plan",
     "polish_fastest",
+    "polish_members",
+    "polish_mode",
+    "polish_run",
     "population_bytes",
     "restore_algorithm",
     "save_checkpoint",
