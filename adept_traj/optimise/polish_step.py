@@ -236,6 +236,8 @@ def polish_members(
         evaluation_s += outcome.evaluation_s
         if ok:
             kept.append(outcome)
+    if n_evaluations == 0:  # no step ran
+        return state
     counted = dataclasses.replace(
         state,
         n_evaluations=state.n_evaluations + n_evaluations,
