@@ -107,12 +107,11 @@ def test_polish_members_appends_the_dominating_move(problem, members, scale, ste
     assert out.n_evaluations == 100 + step.n_evaluations
     assert out.total_s > state.total_s
     none = polish_members(problem, state, [2], scale, 1000.0, max_evaluations=MAX_EVALUATIONS - 1)
-    assert len(none.X) == len(members) and none.n_evaluations == 100
+    assert len(none.X) == len(members)
+    assert none.n_evaluations == 100
 
 
-def test_front_mode_of_a_small_run_polishes_only_the_fastest(
-    problem, members, monkeypatch
-) -> None:
+def test_front_mode_of_a_small_run_polishes_only_the_fastest(problem, members, monkeypatch) -> None:
     """A quarter of 100 evaluations pays for no member step: "front" leaves the members
     alone (the fastest member's polish, tested in test_polish.py, is left out here)."""
     import adept_traj.optimise.polish_step as polish_step
