@@ -65,13 +65,18 @@ _SIGN = np.where(MAXIMISED, -1.0, 1.0)
 #: Relative tightening of the "not worse" constraints (fraction of the objective's range).
 _TIGHTEN = 1e-7
 
+#: Objectives whose "not worse" constraint is tightened: z1, z2, z5, z6, and z3 when it is
+#: not at its floor 0. Not z4: its minimum is often at the fixed start or goal, where no
+#: move can raise it, and a tightened row would make SLSQP's subproblem infeasible.
+_TIGHTENED = np.array([True, True, True, False, True, True])
+
 #: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.polish`).
 _SLACK = 1e-9
 
 #: Half-width of the box around the start that the solve stays in, as a fraction of each
 #: decision variable's range (xu − xl): a local step (SLSQP's first iterates otherwise
 #: leave the region where its linearisations hold, measured on paper fronts).
-_BOX = 0.01
+_BOX = 0.03
 
 #: The solve stops at the first iteration that ends with at least this many evaluations
 #: (measured on a paper front: the steps that succeed take 9–19 evaluations; a start whose
@@ -185,7 +190,7 @@ def _solve(
     m0 = p0.d.reshape(-1, n_obs).min(axis=0)
     y0 = np.concatenate([x0, [p0.w.min()], m0])
     scale = np.where(span > 0.0, span, np.maximum(np.abs(z0), 1e-12))
-    limit = _SIGN * z0 - np.where((np.arange(6) == 2) & (z0 <= 0.0), 0.0, _TIGHTEN * scale)
+    limit = _SIGN * z0 - np.where(_TIGHTENED & (z0 > 0.0), _TIGHTEN * scale, 0.0)
     rows = np.flatnonzero(no_worse)
     w_scale = max(float(z0[3]), 1e-12)
     half = _BOX * (problem.xu - problem.xl)
