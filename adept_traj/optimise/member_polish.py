@@ -1,46 +1,44 @@
-r"""Gradient-based polish of front members: the best trade-off and ε-constraint steps (SLSQP).
+r"""The ε-constraint polish of a front member: improve one objective, worsen none (SLSQP).
 
-Both steps solve, from a front member :math:`x_0` with objectives :math:`z^0`, a smooth
-problem over :math:`y = [x, s, m_1 … m_{n_{obs}}]`:
+:func:`epsilon_step` solves, from a front member :math:`x_0` with objectives :math:`z^0`,
+a smooth problem over :math:`y = [x, s, m_1 … m_{n_{obs}}]`:
 
 .. math::
-    \min_y \; c^\top \hat z(y) \quad \text{s.t.} \quad g_k(x) \le 0 \ \forall k, \quad
-    w(q_k) \ge s \ \forall k, \quad d_{k,o} \ge m_o \ \forall k, o, \quad
-    \sigma_i \hat z_i(y) \le \sigma_i z^0_i \ \ (i \in E), \quad x_l \le x \le x_u,
-    \quad m_o \le \delta,
+    \min_y \; \frac{\sigma_j \hat z_j(y)}{r_j} \quad \text{s.t.} \quad g_k(x) \le 0 \ \forall k,
+    \quad w(q_k) \ge s \ \forall k, \quad d_{k,o} \ge m_o \ \forall k, o, \quad
+    \sigma_i \hat z_i(y) \le \sigma_i z^0_i \ \ (i \ne j),
+
+    |x - x_0| \le \beta\,(x_u - x_l), \quad x_l \le x \le x_u, \quad m_o \le \delta,
 
 where :math:`g_k` are the smooth per-sample constraints of
 :func:`~adept_traj.problem.local_constraints`, :math:`\hat z = (T, z_2, \sum_o
 \varphi(m_o), s, z_5, z_6)` the objectives with z3 and z4 in **epigraph** form
 (:mod:`adept_traj.problem.objective_gradients`: :math:`w` the manipulability at the samples,
-:math:`d_{k,o}` the distances clipped at δ, :math:`\varphi(d) = \max(0, 1 - d/\delta)^2`;
-at any feasible y, :math:`z_4(x) \ge s` and :math:`z_3(x) \le \sum_o \varphi(m_o)`, with
-equality at the optimum), :math:`\sigma_i = -1` for the maximised z4 and +1 otherwise, and
-E the objectives that must not get worse. Gradients: :func:`~adept_traj.problem.
-objective_gradients`. The answer is made kinematically exact as in
-:func:`~adept_traj.optimise.minimum_time` (T raised to the spline's exact kinematic minimum
-if the velocity samples missed a peak) and evaluated by the problem; the caller certifies it.
+:math:`d_{k,o}` the distances clipped at δ, :math:`\varphi(d) = \max(0, 1 - d/\delta)^2`,
+decreasing; at any feasible y, :math:`z_4(x) \ge s` and :math:`z_3(x) \le \sum_o
+\varphi(m_o)`, with equality at the optimum), :math:`\sigma_i = -1` for the maximised z4
+and +1 otherwise, :math:`r_j` a typical range of objective j and β = 3 % a local box. A
+move that improves :math:`z_j` with these constraints dominates its start.
 
-- :func:`tradeoff_step` minimises the paper's combined objective :math:`f_c` (the one
-  :func:`~adept_traj.analysis.best_tradeoff` ranks by) with its normalisation **frozen** at
-  the front's bounds before the polish, :math:`Z^{\min}, Z^{\max}` (
-  :func:`~adept_traj.analysis.combined_objective`):
+Details, each measured on paper fronts:
 
-  .. math::
-      f_c = \sum_i \hat w_i \, \sigma_i \frac{z_i - Z_i^{\rm best}}{Z^{\max}_i - Z^{\min}_i},
-      \qquad c_i = \frac{\sigma_i \hat w_i}{Z^{\max}_i - Z^{\min}_i},
+- the control points that shape a joint where it is at rest are frozen: z2's Coulomb term
+  jumps when a resting joint starts to move;
+- only the rows that can bind inside the box (by their linear bound) are handed to SLSQP,
+  whose subproblem costs grow with the rows (2 900 on a paper member);
+- the rows :math:`\hat z_i \le z^0_i` are tightened by ``1e-7`` of the range, except z4
+  (its minimum is often at the fixed start or goal, where no move can raise it) and a z3
+  at its floor 0 (exact through the bound :math:`m_o \le \delta`);
+- **the solver does not decide**: after every SLSQP iteration the moves from the best so
+  far towards the iterate (fractions 1, ½, …, 1/32; T raised to the spline's exact
+  kinematic minimum, :func:`~adept_traj.optimise.kinematic_time`) are evaluated by the
+  problem, and the best one that is feasible, worsens no other objective and improves
+  :math:`z_j` is kept (SLSQP's iterates meet the nonlinear rows only to first order); the
+  solve stops after :data:`MAX_EVALUATIONS` constraint-and-Jacobian evaluations. The
+  caller certifies the result.
 
-  a linear function of z. A column with :math:`Z^{\max}_i = Z^{\min}_i` (e.g. z3 = 0 on the
-  whole front) does not enter :math:`f_c`; it must not get worse instead (E = those
-  columns), or the solver would spend it for free.
-- :func:`epsilon_step` improves one objective j, :math:`c = \sigma_j e_j / r_j`, with every
-  other objective not worse (E = all i ≠ j): a result that improves z_j dominates its
-  start. Which j :func:`~adept_traj.optimise.polish_members` chooses is documented there.
-
-Constraints :math:`\hat z_i \le z^0_i` are tightened by ``1e-7`` of the objective's range
-(SLSQP may end a hair outside a constraint), except z3 = 0 (its floor: exact through the
-bound :math:`m_o \le \delta`). SLSQP runs with one BLAS thread (as
-:func:`~adept_traj.optimise.minimum_time`): the same start gives the same move.
+SLSQP runs with one BLAS thread (as :func:`~adept_traj.optimise.minimum_time`): the same
+start gives the same move.
 """
 
 from __future__ import annotations
@@ -112,6 +110,13 @@ def epsilon_step(
         objective is divided by it, the tightening of the others is relative to it.
     max_iter:
         Most SLSQP iterations (≥ 1).
+
+    Returns
+    -------
+    PolishOutcome
+        ``x`` the best kept move (a copy of ``x0`` when none was found);
+        ``n_evaluations`` counts constraint-and-Jacobian evaluations and batches of
+        evaluated moves.
     """
     x0 = _start(problem, x0)
     j = as_integer(objective, "objective", minimum=0, maximum=5, error=ConfigurationError)
