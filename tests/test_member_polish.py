@@ -144,7 +144,7 @@ def test_all_mode_keeps_hypervolume_and_certifies(problem) -> None:
     hypervolume on common bounds at least the unpolished one's."""
     from adept_traj.analysis import normalised_hypervolume, objective_bounds
 
-    options = {"seed": 2, "pop_size": 40, "n_gen": 40}
+    options = {"seed": 2, "pop_size": 24, "n_gen": 30}
     raw = plan(problem, "nsga2", polish="off", **options)
     full = plan(problem, "nsga2", polish="all", **options)
     assert full.algorithm_settings["polish"] == "all"
