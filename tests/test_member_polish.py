@@ -152,3 +152,13 @@ def test_all_mode_keeps_hypervolume_and_certifies(problem) -> None:
     lo, hi = objective_bounds(*fronts)
     assert normalised_hypervolume(fronts[1], lo, hi) >= normalised_hypervolume(fronts[0], lo, hi)
     assert full.front.n_certified == int(np.all(full.front.constraints <= 0.0, axis=1).sum())
+
+
+def test_no_member_step_without_objective_gradients(problem, members, scale) -> None:
+    """A problem whose objectives have no gradients (the paper's z3 penalty) keeps its
+    members: the default polish of plan must not fail there."""
+    paper = TrajectoryProblem(
+        problem.robot, problem.scene, problem.start, problem.goal, z3="paper-sphere"
+    )
+    state = _state(paper, members, 10_000)
+    assert polish_members(paper, state, [0, 1, 2], scale, 1000.0) is state

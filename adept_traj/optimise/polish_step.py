@@ -46,6 +46,7 @@ from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.polish import PolishOutcome, minimum_time, time_optimal
 from adept_traj.problem import from_pymoo, to_pymoo
+from adept_traj.robot.limits import LIMITS
 
 __all__ = [
     "GRADIENT_COST",
@@ -200,8 +201,9 @@ def polish_members(
     Parameters
     ----------
     problem:
-        The :class:`~adept_traj.problem.TrajectoryProblem` (``z3="clearance"``; otherwise
-        ``state`` is returned unchanged).
+        The :class:`~adept_traj.problem.TrajectoryProblem` (``z3="clearance"`` and finite
+        torque limits, which the objective gradients need; otherwise ``state`` is returned
+        unchanged).
     state:
         The run's population (X (pop, n_var), F, G, CV (pop,)).
     members:
@@ -217,7 +219,10 @@ def polish_members(
         :data:`~adept_traj.optimise.member_polish.MAX_EVALUATIONS`) fits in what is left.
     """
     rows = np.asarray(members, dtype=int).ravel()
-    if problem.settings.z3 != "clearance" or len(rows) == 0:
+    torque_limit = problem.robot.limits.bound(LIMITS[4].name)
+    if problem.settings.z3 != "clearance" or not np.all(np.isfinite(torque_limit)):
+        return state  # no objective gradients (objective_gradients refuses)
+    if len(rows) == 0:
         return state
     X = np.asarray(state.X, dtype=float)
     kept, n_evaluations, seconds, evaluation_s = [], 0, 0.0, 0.0
