@@ -104,9 +104,11 @@ def test_minimum_time_from_the_straight_move_reaches_drakes_optimum(problem) -> 
 
 @pytest.fixture(scope="module")
 def small_runs(problem: TrajectoryProblem):
-    """The same small NSGA-II run without and with polish."""
+    """The same small NSGA-II run without and with the polish of the fastest member."""
     options = {"seed": 1, "pop_size": 16, "n_gen": 4}
-    return plan(problem, "nsga2", polish=False, **options), plan(problem, "nsga2", **options)
+    return plan(problem, "nsga2", polish=False, **options), plan(
+        problem, "nsga2", polish="fastest", **options
+    )
 
 
 def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
@@ -123,8 +125,8 @@ def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
     assert expected.x[0] < raw.front.x[:, 0].min()
     assert expected.x[0] == polished.front.x[:, 0].min()
     assert polished.timing.n_evaluations == raw.timing.n_evaluations + expected.n_evaluations
-    assert polished.algorithm_settings["polish"] is True
-    assert raw.algorithm_settings["polish"] is False
+    assert polished.algorithm_settings["polish"] == "fastest"
+    assert raw.algorithm_settings["polish"] == "off"
 
 
 def test_time_optimal_mode_gives_a_certified_result(problem) -> None:

@@ -46,6 +46,7 @@ from adept_traj.cli.report import save_figures, summary
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
     ALGORITHMS,
+    POLISH_MODES,
     TIME_OPTIMAL,
     PlanningInterrupted,
     has_checkpoint,
@@ -63,6 +64,7 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 _SAVED = (
     "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
     "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
+    "polish",
     "robot", "params", "tool_frame", "srdf", "package_dir",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
@@ -80,10 +82,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "fastest move by multi-start SLSQP, no evolutionary search)",
     )
     p.add_argument(
-        "--no-polish",
-        action="store_true",
-        help="do not polish the fastest member by SLSQP after the evolutionary search",
+        "--polish",
+        choices=POLISH_MODES,
+        default="front",
+        help="gradient-based polish after the evolutionary search: off, fastest (the "
+        "fastest member, SLSQP), front (default: also the best trade-off and members "
+        "spread over the front, within a quarter of the search's evaluations), all (every "
+        "front member)",
     )
+    p.add_argument("--no-polish", action="store_true", help="the same as --polish off")
     p.add_argument("--pop", type=int, help="population size (default: the paper's)")
     p.add_argument("--gens", type=int, help="generations (default: the paper's, 100)")
     p.add_argument("--out", type=str, help="result folder")
@@ -213,6 +220,8 @@ def run(args: argparse.Namespace) -> int:
             folder, overwrite=args.overwrite, html=not opts.no_html, figures=not opts.no_plots
         )
     as_integer(opts.seed, "--seed", minimum=0, error=ConfigurationError)
+    if opts.no_polish and opts.polish != "off" and args.polish is not None:
+        raise ConfigurationError(f"--no-polish conflicts with --polish {opts.polish}")
     if opts.algorithm != TIME_OPTIMAL:
         make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
     problem = problem_from_arguments(opts)
@@ -246,7 +255,7 @@ def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, res
                 resume=resume and has_checkpoint(checkpoint),
                 progress=progress,
                 rate_hz=opts.rate,
-                polish=not opts.no_polish,
+                polish="off" if opts.no_polish else opts.polish,
             )
         return _finish(result, problem, folder, opts)
     except PlanningInterrupted as exc:

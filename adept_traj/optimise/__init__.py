@@ -36,6 +36,7 @@ from adept_traj.optimise.loop import (
     RunState,
     optimise,
 )
+from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.planner import (
     plan,
     warn_missing_limits,
@@ -46,8 +47,15 @@ from adept_traj.optimise.polish import (
     time_optimal,
 )
 from adept_traj.optimise.polish_step import (
+    GRADIENT_COST,
+    POLISH_MODES,
+    POLISH_SHARE,
+    SPREAD_MEMBERS,
     TIME_OPTIMAL,
     polish_fastest,
+    polish_members,
+    polish_mode,
+    polish_run,
     time_optimal_run,
 )
 from adept_traj.optimise.population import (
@@ -71,6 +79,11 @@ __all__ = [
     "BLOCK_PAIRS",
     "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
+    "GRADIENT_COST",
+    "MAX_EVALUATIONS",
+    "POLISH_MODES",
+    "POLISH_SHARE",
+    "SPREAD_MEMBERS",
     "TIME_OPTIMAL",
     "AlgorithmSettings",
     "BlockedDuplicateElimination",
@@ -85,6 +98,7 @@ __all__ = [
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
+    "epsilon_step",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -93,6 +107,9 @@ __all__ = [
     "optimise",
     "plan",
     "polish_fastest",
+    "polish_members",
+    "polish_mode",
+    "polish_run",
     "population_bytes",
     "population_values",
     "restore_algorithm",

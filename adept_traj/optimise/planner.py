@@ -17,11 +17,14 @@ Steps:
    trade-off order (the best trade-off when it passes), with its exact certificate; if
    none passes, the trade-off choice with its failing certificate. A front of
    least-infeasible members thus costs one certificate.
-5. **Polish** (default; before steps 2–4): the fastest feasible member of the final
-   population is polished by SLSQP (:func:`~adept_traj.optimise.polish_fastest`); a
-   polished move that passes its certificate joins the population, so it replaces the
-   members it dominates in the front. ``algorithm="time-optimal"`` replaces step 1 and this
-   one by :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
+5. **Polish** (default; before steps 2–4; :func:`~adept_traj.optimise.polish_run`): the
+   fastest feasible member of the final population is polished by SLSQP
+   (:func:`~adept_traj.optimise.polish_fastest`), then (``polish="front"``, the default)
+   the best trade-off and a few members spread over the front by an ε-constraint step
+   (:func:`~adept_traj.optimise.polish_members`); a polished move that passes its
+   certificate joins the population, so it replaces the members it dominates in the
+   front. ``algorithm="time-optimal"`` replaces step 1 and this one by
+   :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
 6. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
@@ -56,7 +59,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_fastest, time_optimal_run
+from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, polish_run, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
@@ -69,7 +72,7 @@ from adept_traj.results.record import (
     Timing,
 )
 from adept_traj.robot import JointLimits
-from adept_traj.validation import as_integer, check_type
+from adept_traj.validation import as_integer
 
 __all__ = ["plan", "warn_missing_limits"]
 
@@ -200,7 +203,7 @@ def plan(
     progress: Callable[[GenerationInfo], None] | None = None,
     rate_hz: float = 1000.0,
     max_certify: int | None = None,
-    polish: bool = True,
+    polish: bool | str = True,
     **params: Any,
 ) -> PlanningResult:
     """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name), or find one
@@ -218,9 +221,13 @@ def plan(
     max_certify: most front members certified (in the trade-off order, among those the
         optimiser marked feasible; ``None``: all). A member not certified is reported with
         ``feasible = False``.
-    polish: after the evolutionary search, polish its fastest feasible member by SLSQP
-        (:func:`~adept_traj.optimise.polish_fastest`; its time and evaluations are counted
-        in ``result.timing``). Default True; ignored by ``"time-optimal"``.
+    polish: the polish after the evolutionary search
+        (:data:`~adept_traj.optimise.POLISH_MODES`): ``"off"`` (or False), ``"fastest"``
+        (the fastest feasible member by SLSQP), ``"front"`` (or True, the default: also
+        the best trade-off and :data:`~adept_traj.optimise.SPREAD_MEMBERS` members spread
+        over the front, by an ε-constraint step) or ``"all"`` (every front member); its
+        time and evaluations are counted in ``result.timing``, its name is recorded as
+        ``result.algorithm_settings["polish"]``. Ignored by ``"time-optimal"``.
 
     With ``algorithm="time-optimal"`` the parameters ``pop_size``, ``n_gen``,
     ``checkpoint``, ``resume`` and ``progress`` are not used; ``params`` may give
@@ -236,7 +243,7 @@ def plan(
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
-    check_type(polish, bool, "polish")
+    polish = polish_mode(polish)
     warn_missing_limits(problem.robot.name, problem.robot.limits)
     if algorithm == TIME_OPTIMAL:
         state, settings_dict = time_optimal_run(problem, seed, **params)
@@ -256,8 +263,7 @@ def plan(
         )
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
-        if polish:
-            state = polish_fastest(problem, state, rate_hz)
+        state = polish_run(problem, state, rate_hz, polish, weights)
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)

@@ -3,7 +3,8 @@
 The B-spline trajectory (``bspline``; its per-segment arithmetic in ``spline_segments``),
 the kinematic lower bound of the travel time (``time_bound``), the objective table, pymoo's
 sign convention and the paper's penalty (``objectives``), smooth per-sample constraints
-with their Jacobians for local solvers (``gradients``), :class:`TrajectoryProblem`
+with their Jacobians for local solvers (``gradients``), the objectives' gradients
+(``objective_gradients``), :class:`TrajectoryProblem`
 (``trajectory_problem``) with its :class:`Evaluation` (``evaluation``), its parallel
 evaluator (``evaluator``) and its plain-loop reference (``reference``).
 """
@@ -14,6 +15,7 @@ from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
 from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, local_constraints
+from adept_traj.problem.objective_gradients import ObjectiveGradients, objective_gradients
 from adept_traj.problem.objectives import (
     MAXIMISED,
     OBJECTIVE_NAMES,
@@ -41,6 +43,7 @@ __all__ = [
     "KinematicBound",
     "LocalConstraints",
     "Objective",
+    "ObjectiveGradients",
     "ParallelEvaluator",
     "ProblemSettings",
     "TrajectoryBounds",
@@ -51,6 +54,7 @@ __all__ = [
     "from_pymoo",
     "kinematic_lower_bound",
     "local_constraints",
+    "objective_gradients",
     "paper_penalty",
     "to_pymoo",
 ]
