@@ -13,7 +13,8 @@ optimiser's coarse Gauss–Legendre samples:
 - the exact signed distance of **every** robot solid to **every** obstacle at every sample,
   moving obstacles at their pose at that instant (``CollisionChecker.distances(...,
   exact=True)``: coal for each pair, the closed form for sphere obstacles; no broad-phase
-  bound stands in for a distance).
+  bound stands in for a distance); with self-collision on, the distance between the
+  robot's own solids too (:mod:`~adept_traj.analysis.self_distance`, part of the verdict).
 
 Each limit kind is summarised per joint by a :class:`LimitCheck`:
 
@@ -58,6 +59,7 @@ import numpy as np
 
 from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, continuous_distance
 from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
+from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.analysis.limit_check import (
     DEFAULT_TOLERANCE,
     LimitCheck,
@@ -116,6 +118,8 @@ class Certificate:
         not computed; ``inf``: no obstacle).
     torque_guarantee: how the torque was checked, e.g. ``"sampled at 1000 Hz, refined to
         8000 Hz near the limit"`` (``None``: not recorded, e.g. a result saved before).
+    self_distance: the robot's distance to itself (:class:`SelfDistance`; ``None``:
+        self-collision off), part of the verdict.
     """
 
     x: np.ndarray
@@ -134,8 +138,11 @@ class Certificate:
     guarantee: str | None = None
     distance_bound: float | None = None
     torque_guarantee: str | None = None
+    self_distance: SelfDistance | None = None
 
     def __post_init__(self) -> None:
+        if self.self_distance is not None:
+            check_type(self.self_distance, SelfDistance, "self_distance")
         x = readonly_copy(as_finite_array(self.x, "x"))
         if x.ndim != 1 or x.size < 1 or not x[0] > 0:
             raise InvalidInputError(f"x must have shape (n_var,) with T = x[0] > 0; got {x!r}")
@@ -163,10 +170,9 @@ class Certificate:
                 raise InvalidInputError(f"closest_pair must be (solid, obstacle); got {pair!r}")
             object.__setattr__(self, "closest_pair", pair)
         object.__setattr__(self, "violations", tuple(str(v) for v in self.violations))
-        if self.guarantee is not None:
-            object.__setattr__(self, "guarantee", str(self.guarantee))
-        if self.torque_guarantee is not None:
-            object.__setattr__(self, "torque_guarantee", str(self.torque_guarantee))
+        for name in ("guarantee", "torque_guarantee"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, str(getattr(self, name)))
         if self.distance_bound is not None:
             bound = float(self.distance_bound)
             if math.isnan(bound):
@@ -196,8 +202,9 @@ class Certificate:
 
     @property
     def distance_ok(self) -> bool:
-        """The smallest distance is at least the margin."""
-        return self.min_distance >= self.margin
+        """The smallest distance, and self-distance, is at least the margin."""
+        own = self.self_distance
+        return self.min_distance >= self.margin and (own is None or own.ok(self.margin))
 
     @property
     def feasible(self) -> bool:
@@ -206,8 +213,9 @@ class Certificate:
 
     @property
     def certified(self) -> bool:
-        """:attr:`feasible` with the ``"continuous"`` distance guarantee."""
-        return self.feasible and self.guarantee == CONTINUOUS
+        """:attr:`feasible` with the ``"continuous"`` distance (and self-distance) guarantee."""
+        own = self.self_distance
+        return self.feasible and self.guarantee == CONTINUOUS == (own or self).guarantee
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -371,6 +379,8 @@ def certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
+    if (own := problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)):
+        violations.extend(own.violations(margin))
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(
         x=xa,
@@ -384,5 +394,6 @@ def certify(
         guarantee=guarantee,
         distance_bound=bound,
         torque_guarantee=torque_guarantee,
+        self_distance=own,
         **checks,
     )

@@ -14,6 +14,7 @@ from adept_traj.collision.checker import (
     PairDistances,
 )
 from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.lever_arms import pair_lever_arms, solid_lever_arms
 from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import (
     DISTANCE_TOLERANCE,
@@ -27,7 +28,7 @@ from adept_traj.collision.pruning import (
     restrict_checker,
     sweep_clearance,
 )
-from adept_traj.collision.self_collision import SelfCollision
+from adept_traj.collision.self_collision import SelfCollision, SelfDistances
 
 __all__ = [
     "DISTANCE_TOLERANCE",
@@ -39,11 +40,14 @@ __all__ = [
     "ObstaclePruning",
     "PairDistances",
     "SelfCollision",
+    "SelfDistances",
     "coal_kind",
     "distance_request",
+    "pair_lever_arms",
     "point_signed_distance",
     "restrict_broad_phase",
     "restrict_checker",
     "shape_of",
+    "solid_lever_arms",
     "sweep_clearance",
 ]

@@ -2,34 +2,65 @@
 
 :class:`SelfCollision` checks every pair of collision solids except
 
-- solids on the same joint body or on **adjacent** bodies (one joint's parent is the
-  other's: they touch at the joint by design);
+- solids on the same joint body or on **adjacent** bodies: one body is the other's nearest
+  ancestor that carries a solid (bodies without a solid are skipped, as MoveIt's collision
+  matrix does: the AdeptOne XL's quill, on the body after the solid-less ``link3``, runs
+  through its outer arm by design);
 - the link pairs listed in an SRDF's ``<disable_collisions link1=… link2=…/>`` (the MoveIt
   convention; e.g. ``srdf/ur5.srdf`` of example-robot-data) or given as ``disabled``.
 
 Meshes are the convex hulls of :mod:`adept_traj.robot.collision_meshes`, so a reported
 distance is never larger than the true one (and at most the two hulls' gaps smaller).
-Distances above ``influence`` may be reported as a lower bound (the distance between the
-solids' enclosing balls), which keeps coal calls to the pairs that are close.
 
-Scope: this is a query (:meth:`SelfCollision.distances`, :meth:`SelfCollision.min_distance`)
-for checking configurations and motions; the planner's constraints and the certificate do
-not include self-collision yet (docs/your-robot.md).
+Distances above ``influence`` may be reported as a lower bound greater than it: the broad
+phase bounds each pair from the solids' enclosing balls, then, where that bound is at most
+``influence``, from their covering spheres (:func:`~adept_traj.collision.primitives.covering_spheres`,
+numpy, batched); only the pairs still within ``influence`` go to coal (one call per close
+pair and sample: the only Python loop). :meth:`SelfCollision.min_distances` finds the
+smallest distance over a whole motion by branch and bound, as
+:meth:`~adept_traj.collision.CollisionChecker.min_distances` does for obstacles. The
+planner's distance constraint and the certificate use them when self-collision is on
+(:class:`~adept_traj.problem.ProblemSettings`, ``docs/problem.md``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 
 import coal
 import numpy as np
 
-from adept_traj.collision.primitives import distance_request, enclosing_ball
-from adept_traj.errors import RobotModelError
-from adept_traj.robot import Robot
+from adept_traj.collision.lever_arms import pair_lever_arms
+from adept_traj.collision.point_distance import points_in_joint
+from adept_traj.collision.primitives import covering_spheres, distance_request, enclosing_ball
+from adept_traj.errors import InputShapeError, RobotModelError
+from adept_traj.robot import Robot, solid_frames
 from adept_traj.validation import as_batch, as_scalar
 
-__all__ = ["SelfCollision"]
+__all__ = ["SelfCollision", "SelfDistances"]
+
+
+@dataclass(frozen=True)
+class SelfDistances:
+    """Smallest self-distance over each motion (:meth:`SelfCollision.min_distances`).
+
+    Attributes
+    ----------
+    distance:
+        (...) smallest signed distance [m] over the motion's samples and the checked pairs;
+        exact when ≤ ``influence``, else a lower bound greater than it (``inf``: no pair).
+    sample, pair:
+        (...) int, the sample and the pair index where the smallest exact distance was found
+        (-1 if the distance is only a lower bound above ``influence``).
+    n_narrow:
+        Number of coal distance calls made.
+    """
+
+    distance: np.ndarray
+    sample: np.ndarray
+    pair: np.ndarray
+    n_narrow: int
 
 
 class SelfCollision:
@@ -65,7 +96,6 @@ class SelfCollision:
         model = robot.model
         self.links = tuple(model.frames[g.parentFrame].name for g in objects)
         given = [tuple(p) for p in disabled]
-        pairs = given + list(robot.disabled_pairs)
         known = set(self.links)
         unknown = sorted({n for pair in given for n in pair if n not in known})
         if unknown:  # (an SRDF may name links without solids: those pairs are moot)
@@ -73,14 +103,21 @@ class SelfCollision:
                 f"robot '{robot.name}': disabled pair link(s) {unknown} have no collision "
                 f"solid; links with solids are {sorted(known)}"
             )
-        off = {frozenset(p) for p in pairs}
-        joints = [g.parentJoint for g in objects]
-        parent = model.parents
+        off = {frozenset(p) for p in given + list(robot.disabled_pairs)}
+        #: The disabled ``(link1, link2)`` pairs that name two links with solids (sorted).
+        self.disabled = tuple(
+            sorted(tuple(sorted(p)) for p in off if len(p) == 2 and p <= known)  # type: ignore[misc]
+        )
+        self._parents, self._local = solid_frames(robot.collision_model)
+        self._by_parent = [
+            (int(p), np.flatnonzero(self._parents == p)) for p in np.unique(self._parents)
+        ]
+        near = _solid_parents(model.parents, set(self._parents.tolist()))
         chosen = []
         for a in range(len(objects)):
             for b in range(a + 1, len(objects)):
-                ja, jb = joints[a], joints[b]
-                if ja == jb or parent[ja] == jb or parent[jb] == ja:
+                ja, jb = int(self._parents[a]), int(self._parents[b])
+                if ja == jb or near[ja] == jb or near[jb] == ja:
                     continue
                 if frozenset((self.links[a], self.links[b])) in off:
                     continue
@@ -90,47 +127,191 @@ class SelfCollision:
         self.solid_names = tuple(g.name for g in objects)
         self._geoms = [g.geometry for g in objects]
         balls = [enclosing_ball(g) for g in self._geoms]
-        self._centres = np.array([c for c, _ in balls]).reshape(-1, 3)
+        rot, shift = self._local[:, :3, :3], self._local[:, :3, 3]
+        centres = np.array([c for c, _ in balls]).reshape(-1, 3)
+        self._ball_in_joint = np.einsum("kij,kj->ki", rot, centres) + shift
         self._radii = np.array([r for _, r in balls])
+        covers = [covering_spheres(g) for g in self._geoms]
+        self._cover_in_joint = [c @ rot[k].T + shift[k] for k, (c, _) in enumerate(covers)]
+        self._cover_radii = [r for _, r in covers]
         self._request = distance_request()
+        #: (n_pairs, nq) joint-space Lipschitz factors of each pair's distance.
+        self._rho = pair_lever_arms(robot, self.pairs)
+
+    @property
+    def n_pairs(self) -> int:
+        """Number of checked pairs."""
+        return len(self.pairs)
 
     @property
     def pair_names(self) -> tuple[tuple[str, str], ...]:
         """``(solid a, solid b)`` names of the checked pairs."""
         return tuple((self.solid_names[a], self.solid_names[b]) for a, b in self.pairs)
 
-    def distances(self, q: object) -> np.ndarray:
+    def distances(self, q: object, *, exact: bool = False) -> np.ndarray:
         """Signed distances (..., n_pairs) [m] of the checked pairs for configurations
         ``q`` (..., nq) [rad | m]: exact (coal, negative = penetration depth) where at most
-        :attr:`influence`, else a lower bound greater than it."""
+        :attr:`influence` (everywhere with ``exact=True``), else a lower bound greater than
+        it."""
         qa = as_batch(q, "q", self.robot.nq, "[rad | m]")
-        return self._distances(qa)
+        frames = self.robot.kinematics.joint_frames(qa)
+        flat = qa.reshape(-1, qa.shape[-1])
+        return self._distances(frames, flat, exact).reshape(*qa.shape[:-1], self.n_pairs)
 
     def min_distance(self, q: object) -> np.ndarray:
         """Smallest self-distance (...) [m] over the checked pairs (``inf`` when none)."""
         d = self.distances(q)
         return d.min(axis=-1, initial=np.inf)
 
-    def _distances(self, q: np.ndarray) -> np.ndarray:
-        poses = self.robot.geometry_poses(q).reshape(-1, len(self.solid_names), 4, 4)
-        n, k = poses.shape[0], len(self.pairs)
-        out = np.empty((n, k))
-        if k == 0:
-            return out.reshape(*q.shape[:-1], 0)
-        a, b = self.pairs[:, 0], self.pairs[:, 1]
-        centres = np.einsum("nsij,sj->nsi", poses[..., :3, :3], self._centres) + poses[..., :3, 3]
-        gap = np.linalg.norm(centres[:, a] - centres[:, b], axis=-1)
-        out[:] = gap - self._radii[a] - self._radii[b]  # a lower bound (balls contain solids)
-        result = coal.DistanceResult()
-        tf_a, tf_b = coal.Transform3s(), coal.Transform3s()
-        for i, p in zip(*np.nonzero(out <= self.influence)):
-            sa, sb = self.pairs[p]
-            tf_a.setRotation(poses[i, sa, :3, :3])
-            tf_a.setTranslation(poses[i, sa, :3, 3])
-            tf_b.setRotation(poses[i, sb, :3, :3])
-            tf_b.setTranslation(poses[i, sb, :3, 3])
-            result.clear()
-            out[i, p] = coal.distance(
-                self._geoms[sa], tf_a, self._geoms[sb], tf_b, self._request, result
+    def min_distances(self, q: object, joint_frames: np.ndarray | None = None) -> SelfDistances:
+        """Per motion, the smallest self-distance over all samples and pairs.
+
+        ``q`` (..., n_t, nq) [rad | m]: the leading axes ``...`` are motions. Candidates
+        (sample, pair) within ``influence`` are computed by coal in increasing order of their
+        broad-phase bound until the best exact distance is below the next bound.
+        ``joint_frames`` (njoints, 3, 4, N), N = ∏ q.shape[:-1], may pass the robot's joint
+        frames (:attr:`~adept_traj.robot.ForwardKinematics.joint_frames`) if computed.
+        """
+        qa = as_batch(q, "q", self.robot.nq, "[rad | m]")
+        if qa.ndim < 2:
+            raise InputShapeError(f"q must have shape (..., n_t, {self.robot.nq}); got {qa.shape}")
+        if joint_frames is None:
+            joint_frames = self.robot.kinematics.joint_frames(qa)
+        expected = (self.robot.model.njoints, 3, 4, int(np.prod(qa.shape[:-1])))
+        if np.shape(joint_frames) != expected:
+            raise InputShapeError(
+                f"joint_frames must have shape {expected} for q of shape {qa.shape}; "
+                f"got {np.shape(joint_frames)}"
             )
-        return out.reshape(*q.shape[:-1], k)
+        batch, n_t = qa.shape[:-2], qa.shape[-2]
+        found = self._min_distances(joint_frames, qa.reshape(-1, n_t, qa.shape[-1]), n_t)
+        return SelfDistances(
+            distance=found.distance.reshape(batch),
+            sample=found.sample.reshape(batch),
+            pair=found.pair.reshape(batch),
+            n_narrow=found.n_narrow,
+        )
+
+    # ------------------------------------------------------------------ private hooks
+    def _bounds(self, frames: np.ndarray) -> np.ndarray:
+        """Lower bounds (N, n_pairs) [m]: enclosing balls, then covering spheres where the
+        ball bound is at most :attr:`influence`."""
+        n = frames.shape[-1]
+        out = np.empty((n, self.n_pairs))
+        if not self.n_pairs:
+            return out
+        flat = frames.reshape(frames.shape[0], 12, n)
+        balls = np.empty((3, len(self._radii), n))
+        for p, ks in self._by_parent:
+            balls[:, ks] = points_in_joint(flat[p], self._ball_in_joint[ks])
+        a, b = self.pairs[:, 0], self.pairs[:, 1]
+        gap = np.sqrt(((balls[:, a] - balls[:, b]) ** 2).sum(axis=0))  # (n_pairs, N)
+        out[:] = (gap - (self._radii[a] + self._radii[b])[:, None]).T
+        close = out <= self.influence
+        covers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # solid: (centres, where)
+        for s in np.unique(self.pairs[close.any(axis=0)]).tolist():
+            rows = np.flatnonzero(close[:, (self.pairs == s).any(axis=1)].any(axis=1))
+            where = np.zeros(n, dtype=int)
+            where[rows] = np.arange(len(rows))
+            frame = flat[self._parents[s]][:, rows]
+            covers[s] = (points_in_joint(frame, self._cover_in_joint[s]), where)
+        for p, (sa, sb) in enumerate(self.pairs.tolist()):
+            rows = np.flatnonzero(close[:, p])
+            if len(rows) == 0:
+                continue
+            (ca, wa), (cb, wb) = covers[sa], covers[sb]
+            ca, cb = ca[:, :, wa[rows]], cb[:, :, wb[rows]]
+            d = np.sqrt(((ca[:, :, None] - cb[:, None]) ** 2).sum(axis=0))  # (ka, kb, R)
+            d -= (self._cover_radii[sa][:, None] + self._cover_radii[sb][None])[..., None]
+            out[rows, p] = d.min(axis=(0, 1))
+        return out
+
+    def _pose(self, frames: np.ndarray, n: int, s: int) -> coal.Transform3s:
+        """Pose of solid ``s`` at flat sample ``n`` of the joint frames (njoints, 3, 4, N)."""
+        top = frames[self._parents[s], :, :, n] @ self._local[s]
+        return coal.Transform3s(top[:, :3], top[:, 3])
+
+    def _narrow(self, frames: np.ndarray, n: int, p: int) -> float:
+        """Exact signed distance [m] of pair ``p`` at flat sample ``n`` (coal)."""
+        sa, sb = self.pairs[p]
+        return coal.distance(
+            self._geoms[sa],
+            self._pose(frames, n, sa),
+            self._geoms[sb],
+            self._pose(frames, n, sb),
+            self._request,
+            coal.DistanceResult(),
+        )
+
+    def _distances(self, frames: np.ndarray, q: np.ndarray, exact: bool) -> np.ndarray:
+        """Distances (N, n_pairs) [m] at the flat samples of ``q`` (N, nq): coal for every
+        pair (``exact``) or, per pair, for the closest candidate within :attr:`influence`
+        first, whose exact value lifts the other candidates' bounds by the joint-space
+        Lipschitz bound of :mod:`adept_traj.collision.lever_arms` (a candidate lifted above
+        :attr:`influence` keeps that bound)."""
+        out = self._bounds(frames)
+        if exact:
+            for n, p in np.ndindex(out.shape):
+                out[n, p] = self._narrow(frames, n, p)
+            return out
+        for p in range(self.n_pairs):
+            todo = np.flatnonzero(out[:, p] <= self.influence)
+            while len(todo):
+                c = int(todo[np.argmin(out[todo, p])])
+                out[c, p] = d = self._narrow(frames, c, p)
+                todo = todo[todo != c]
+                lift = d - np.abs(q[todo] - q[c]) @ self._rho[p]
+                out[todo, p] = np.maximum(out[todo, p], lift)
+                todo = todo[out[todo, p] <= self.influence]
+        return out
+
+    def _min_distances(self, frames: np.ndarray, q: np.ndarray, n_t: int) -> SelfDistances:
+        """Branch and bound of :meth:`min_distances` for ``q`` (n_motions, n_t, nq)."""
+        n_motions, k = len(q), self.n_pairs
+        bounds = self._bounds(frames).reshape(n_motions, n_t * k)
+        best = bounds.min(axis=1, initial=np.inf)
+        where = np.full(n_motions, -1)
+        calls = 0
+        for m in np.flatnonzero(best <= self.influence).tolist():
+            row = bounds[m]
+            cand = np.flatnonzero(row <= self.influence)
+            low = row[cand]
+            value, floor = np.inf, row.min(initial=np.inf, where=row > self.influence)
+            while len(cand):
+                i = int(np.argmin(low))
+                if low[i] >= value:  # every bound is a valid lower bound: prune
+                    break
+                c = int(cand[i])
+                d = self._narrow(frames, m * n_t + c // k, c % k)
+                calls += 1
+                if d < value:
+                    value, where[m] = d, c
+                keep = np.arange(len(cand)) != i
+                cand, low = cand[keep], low[keep]
+                same = np.flatnonzero(cand % k == c % k)
+                gap = np.abs(q[m, cand[same] // k] - q[m, c // k]) @ self._rho[c % k]
+                low[same] = np.maximum(low[same], d - gap)
+                far = low > self.influence
+                floor = min(floor, low.min(initial=np.inf, where=far))
+                cand, low = cand[~far], low[~far]
+            if value > self.influence:  # only a lower bound above influence is known
+                value, where[m] = min(value, floor), -1
+            best[m] = value
+        return SelfDistances(
+            distance=best,
+            sample=np.where(where >= 0, where // max(k, 1), -1),
+            pair=np.where(where >= 0, where % max(k, 1), -1),
+            n_narrow=calls,
+        )
+
+
+def _solid_parents(parents: list[int], with_solids: set[int]) -> list[int]:
+    """Per joint (njoints,), its nearest strict ancestor joint carrying a solid (0: the
+    base, also when no ancestor has one)."""
+    out = [0] * len(parents)
+    for j in range(1, len(parents)):
+        a = int(parents[j])
+        while a > 0 and a not in with_solids:
+            a = int(parents[a])
+        out[j] = a
+    return out

@@ -1,0 +1,129 @@
+r"""The robot's distance to itself in the certificate: :class:`SelfDistance`.
+
+When the problem checks self-collision (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`,
+``ProblemSettings.self_collision``), :func:`~adept_traj.analysis.certify` computes the
+signed distance of every checked pair of robot solids (adjacent and disabled pairs left
+out, :class:`~adept_traj.collision.SelfCollision`) at every dense sample, and bounds it
+between the samples as for the obstacles
+(:func:`~adept_traj.analysis.continuous.continuous_self_distance`): both solids of a pair
+move, but a joint moving both moves them rigidly together, so the rate of change of the
+pair's distance :math:`d_{ab}` is bounded by the joints that move exactly one of them,
+
+.. math::
+    |\dot d_{ab}| \le \sum_{j \in J_a \setminus J_b} r_{aj} |\dot q_j|
+                   + \sum_{j \in J_b \setminus J_a} r_{bj} |\dot q_j|,
+
+with the lever arms :math:`r_{sj}` [m] of :func:`~adept_traj.collision.solid_lever_arms`.
+The self-distance must reach the same safety margin as the obstacle distance: the margin
+covers what the model leaves out (the convex hulls of the meshes, calibration,
+tracking error), which is the same for a link near another link as near an obstacle.
+It enters the verdict (:attr:`Certificate.feasible <adept_traj.analysis.Certificate.feasible>`,
+:attr:`~adept_traj.analysis.Certificate.certified`), not the dense trajectory's
+``min_distance`` series (robot–obstacle only).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from adept_traj.analysis.continuous import CONTINUOUS, continuous_self_distance
+from adept_traj.errors import InvalidInputError
+from adept_traj.problem.trajectory_problem import TrajectoryProblem
+
+__all__ = ["SelfDistance", "self_distance"]
+
+
+@dataclass(frozen=True)
+class SelfDistance:
+    """The smallest distance between two of the robot's own checked solids over a motion.
+
+    Attributes
+    ----------
+    min_distance: smallest signed distance [m] over the samples and checked pairs
+        (negative: penetration depth; ``inf``: no checked pair); exact when ``exact``,
+        else a lower bound (above the check's influence distance).
+    exact: whether :attr:`min_distance` is the exact smallest distance.
+    t_min_distance: its time [s] (``None``: no checked pair or only a bound is known).
+    pair: ``(solid a, solid b)`` names at that instant (``None``: as for the time).
+    guarantee: ``"continuous"`` (the bound holds at every instant) or ``"sampled at N Hz"``.
+    distance_bound: lower bound [m] of the self-distance at every instant of [0, T]
+        (``None``: not computed; ``inf``: no checked pair).
+    """
+
+    min_distance: float
+    exact: bool
+    t_min_distance: float | None
+    pair: tuple[str, str] | None
+    guarantee: str
+    distance_bound: float | None
+
+    def __post_init__(self) -> None:
+        d = float(self.min_distance)
+        if math.isnan(d) or d == -math.inf:
+            raise InvalidInputError(f"self min_distance must be a number or +inf; got {d!r}")
+        object.__setattr__(self, "min_distance", d)
+        if self.t_min_distance is not None:
+            object.__setattr__(self, "t_min_distance", float(self.t_min_distance))
+        if self.pair is not None:
+            pair = tuple(str(n) for n in self.pair)
+            if len(pair) != 2:
+                raise InvalidInputError(f"self pair must be (solid a, solid b); got {pair!r}")
+            object.__setattr__(self, "pair", pair)
+        if self.distance_bound is not None:
+            bound = float(self.distance_bound)
+            if math.isnan(bound):
+                raise InvalidInputError("self distance_bound must be a number or ±inf; got nan")
+            object.__setattr__(self, "distance_bound", bound)
+
+    def ok(self, margin: float) -> bool:
+        """The smallest self-distance is at least ``margin`` [m]."""
+        return self.min_distance >= margin
+
+    def violations(self, margin: float) -> tuple[str, ...]:
+        """The certificate's message when the self-distance is below ``margin`` [m], e.g.
+        ``"self-distance: -0.0123 m < margin 0.01 m at t = 0.512 s (forearm – base)"``."""
+        if self.ok(margin) or self.pair is None:
+            return ()
+        return (
+            f"self-distance: {self.min_distance:.4g} m < margin {margin:.4g} m at "
+            f"t = {self.t_min_distance:.3f} s ({self.pair[0]} – {self.pair[1]})",
+        )
+
+
+def self_distance(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    continuous: bool,
+    max_depth: int,
+) -> SelfDistance:
+    """The :class:`SelfDistance` of ``x`` (n_var,) sampled at ``t`` (n,) [s] with
+    configurations ``q`` and speeds ``qd`` (n, nq), for :func:`~adept_traj.analysis.certify`
+    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on).
+
+    The distances are exact at or below the check's influence distance and lower bounds
+    above it (:meth:`~adept_traj.collision.SelfCollision.distances`), whatever
+    ``certify``'s ``exact``: the verdict and the continuous bound need no more."""
+    check = problem.self_check
+    if check is None:
+        raise InvalidInputError("the problem's self-collision check is off")
+    grid_hz = (len(t) - 1) / float(x[0])
+    if not check.n_pairs:
+        return SelfDistance(math.inf, True, None, None, CONTINUOUS, math.inf)
+    d = check.distances(q)  # (n, n_pairs)
+    if continuous:
+        found = continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth, exact=False)
+        best, t_best, p = found.min_distance, found.t_min_distance, found.pair[0]
+        guarantee, bound = found.guarantee, found.lower_bound
+    else:
+        k, p = np.unravel_index(int(np.argmin(d)), d.shape)
+        best, t_best = float(d[k, p]), float(t[k])
+        guarantee, bound = f"sampled at {grid_hz:g} Hz", None
+    known = best <= check.influence
+    names = check.pair_names[int(p)] if known else None
+    return SelfDistance(best, known, t_best if known else None, names, guarantee, bound)
