@@ -59,7 +59,6 @@ import numpy as np
 
 from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, continuous_distance
 from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
-from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.analysis.limit_check import (
     DEFAULT_TOLERANCE,
     LimitCheck,
@@ -69,6 +68,7 @@ from adept_traj.analysis.limit_check import (
     _ratio_check,
     _refined_torque_check,
 )
+from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -379,7 +379,7 @@ def certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    if (own := problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)):
+    if own := problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth):
         violations.extend(own.violations(margin))
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

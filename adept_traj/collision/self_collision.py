@@ -1,4 +1,4 @@
-"""Self-collision: signed distances between the robot's own links, batched over configurations.
+r"""Self-collision: signed distances between the robot's own links, batched over configurations.
 
 :class:`SelfCollision` checks every pair of collision solids except
 
@@ -12,12 +12,16 @@
 Meshes are the convex hulls of :mod:`adept_traj.robot.collision_meshes`, so a reported
 distance is never larger than the true one (and at most the two hulls' gaps smaller).
 
-Distances above ``influence`` may be reported as a lower bound greater than it: the broad
-phase bounds each pair from the solids' enclosing balls, then, where that bound is at most
-``influence``, from their covering spheres (:func:`~adept_traj.collision.primitives.covering_spheres`,
-numpy, batched); only the pairs still within ``influence`` go to coal (one call per close
-pair and sample: the only Python loop). :meth:`SelfCollision.min_distances` finds the
-smallest distance over a whole motion by branch and bound, as
+Distances above ``influence`` may be reported as a lower bound greater than it. The broad
+phase (numpy, batched) bounds each pair from the solids' enclosing balls, then, where that
+bound is at most ``influence``, from their covering spheres
+(:func:`~adept_traj.collision.primitives.covering_spheres`); only the pairs still within
+``influence`` go to coal (one call per close pair and sample: the only Python loop), the
+closest first: an exact distance :math:`d_{ab}(q_c)` lifts the bound of the pair's other
+samples to :math:`d_{ab}(q_c) - \sum_j \rho_{abj} |q_j - q_{c,j}|`
+(:func:`~adept_traj.collision.pair_lever_arms`), and a sample lifted above ``influence``
+needs no call. :meth:`SelfCollision.min_distances` finds the smallest distance over a
+whole motion by branch and bound, as
 :meth:`~adept_traj.collision.CollisionChecker.min_distances` does for obstacles. The
 planner's distance constraint and the certificate use them when self-collision is on
 (:class:`~adept_traj.problem.ProblemSettings`, ``docs/problem.md``).

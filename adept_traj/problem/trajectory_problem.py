@@ -208,7 +208,8 @@ class TrajectoryProblem(Problem):
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
         self.robot, self.scene = robot, scene
         self_check = SelfCollision(robot, settings.disabled_pairs, influence=settings.influence)
-        on = bool(self_check.n_pairs) if settings.self_collision is None else settings.self_collision
+        on = settings.self_collision
+        on = bool(self_check.n_pairs) if on is None else on
         #: The robot–robot distances (``None``: self-collision off).
         self.self_check = self_check if on else None
         self.settings = settings = replace(

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis import SelfDistance
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
 from adept_traj.analysis.member_certificate import MemberCertificate
-from adept_traj.analysis import SelfDistance
 from adept_traj.errors import InvalidInputError
 from adept_traj.results.parts import Front
 from adept_traj.robot.limits import LIMIT_KINDS, LIMITS
