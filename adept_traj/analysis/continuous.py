@@ -52,7 +52,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from adept_traj.collision import pair_lever_arms
 from adept_traj.collision import solid_lever_arms as lever_arms
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -178,22 +177,22 @@ def continuous_self_distance(
     pairs: np.ndarray,
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
-    exact: bool = True,
 ) -> DistanceGuarantee:
     """:func:`continuous_distance` for the robot's own solid pairs
     (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
-    (n, n_pairs) [m] are the self-distances at ``t``; the Lipschitz constant of pair
-    :math:`(a, b)` counts only the joints that move one of its solids
-    (:func:`~adept_traj.collision.pair_lever_arms`), nothing moves otherwise (no obstacle
-    speed). The returned ``pair`` is ``(pair index, 0)``."""
+    (n, n_pairs) [m] are the self-distances at ``t`` (or lower bounds of them); the
+    Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
+    solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
+    obstacle speed). The midpoints' distances are exact below the margin, lower bounds
+    above it. The returned ``pair`` is ``(pair index, 0)``."""
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
-        return check.distances(q, exact=exact)[..., None]
+        return check.distances(q, exact_below=problem.settings.margin)[..., None]
 
-    arms, speeds = pair_lever_arms(problem.robot, check.pairs), np.zeros(1)
+    arms, speeds = check.lever_arms, np.zeros(1)
     return _bisect(problem, x, t, qd, pairs[..., None], rate_hz, max_depth, arms, speeds, distances)
 
 

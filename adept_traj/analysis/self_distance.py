@@ -33,7 +33,10 @@ from adept_traj.analysis.continuous import CONTINUOUS, continuous_self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 
-__all__ = ["SelfDistance", "self_distance"]
+__all__ = ["MIN_SEARCH", "SelfDistance", "self_distance"]
+
+#: Most exact distances computed to make the smallest self-distance of a certificate exact.
+MIN_SEARCH = 64
 
 
 @dataclass(frozen=True)
@@ -44,10 +47,10 @@ class SelfDistance:
     ----------
     min_distance: smallest signed distance [m] over the samples and checked pairs
         (negative: penetration depth; ``inf``: no checked pair); exact when ``exact``,
-        else a lower bound (above the check's influence distance).
+        else a lower bound of the smallest distance (above the margin).
     exact: whether :attr:`min_distance` is the exact smallest distance.
-    t_min_distance: its time [s] (``None``: no checked pair or only a bound is known).
-    pair: ``(solid a, solid b)`` names at that instant (``None``: as for the time).
+    t_min_distance: its time [s] (``None``: no checked pair).
+    pair: ``(solid a, solid b)`` names at that instant (``None``: no checked pair).
     guarantee: ``"continuous"`` (the bound holds at every instant) or ``"sampled at N Hz"``.
     distance_bound: lower bound [m] of the self-distance at every instant of [0, T]
         (``None``: not computed; ``inf``: no checked pair).
@@ -106,24 +109,39 @@ def self_distance(
     configurations ``q`` and speeds ``qd`` (n, nq), for :func:`~adept_traj.analysis.certify`
     (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on).
 
-    The distances are exact at or below the check's influence distance and lower bounds
-    above it (:meth:`~adept_traj.collision.SelfCollision.distances`), whatever
-    ``certify``'s ``exact``: the verdict and the continuous bound need no more."""
+    The distances at the samples are exact where below the margin and lower bounds
+    above it (:meth:`~adept_traj.collision.SelfCollision.distances` with ``exact_below``:
+    the verdict and the continuous bound need no more, and a pair touching by design is
+    not computed at every sample). The smallest is then made exact by branch and bound:
+    the smallest bound is replaced by its exact distance, which lifts the pair's other
+    bounds by the joint-space Lipschitz bound, until the smallest value is exact or above
+    the check's influence distance, at most :data:`MIN_SEARCH` times (else it is reported
+    as a bound, ``exact=False``), whatever ``certify``'s ``exact``.
+    """
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
     grid_hz = (len(t) - 1) / float(x[0])
     if not check.n_pairs:
         return SelfDistance(math.inf, True, None, None, CONTINUOUS, math.inf)
-    d = check.distances(q)  # (n, n_pairs)
-    if continuous:
-        found = continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth, exact=False)
-        best, t_best, p = found.min_distance, found.t_min_distance, found.pair[0]
-        guarantee, bound = found.guarantee, found.lower_bound
-    else:
+    margin = float(problem.settings.margin)
+    d = check.distances(q, exact_below=margin)  # (n, n_pairs)
+    known = d <= margin
+    rho = check.lever_arms  # (n_pairs, nq) [m/rad | 1]
+    for _ in range(MIN_SEARCH):
         k, p = np.unravel_index(int(np.argmin(d)), d.shape)
-        best, t_best = float(d[k, p]), float(t[k])
-        guarantee, bound = f"sampled at {grid_hz:g} Hz", None
-    known = best <= check.influence
-    names = check.pair_names[int(p)] if known else None
-    return SelfDistance(best, known, t_best if known else None, names, guarantee, bound)
+        if known[k, p] or d[k, p] > check.influence:
+            break
+        exact_kp = float(check.pair_distance(q[k], int(p)))
+        np.maximum(d[:, p], exact_kp - np.abs(q - q[k]) @ rho[p], out=d[:, p])  # lift
+        d[k, p], known[k, p] = exact_kp, True
+    k, p = np.unravel_index(int(np.argmin(d)), d.shape)
+    best, t_best, exact = float(d[k, p]), float(t[k]), bool(known[k, p])
+    guarantee, bound = f"sampled at {grid_hz:g} Hz", None
+    if continuous:
+        between = continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth)
+        guarantee, bound = between.guarantee, between.lower_bound
+        if between.min_distance < best:  # (exact: below the margin) between the samples
+            best, t_best, p = between.min_distance, between.t_min_distance, between.pair[0]
+            exact = best <= margin
+    return SelfDistance(best, exact, t_best, check.pair_names[p], guarantee, bound)

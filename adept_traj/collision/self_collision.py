@@ -35,12 +35,13 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
+from adept_traj.collision.capsules import enclosing_capsule, segment_distance
 from adept_traj.collision.lever_arms import pair_lever_arms
 from adept_traj.collision.point_distance import points_in_joint
-from adept_traj.collision.primitives import covering_spheres, distance_request, enclosing_ball
+from adept_traj.collision.primitives import distance_request, enclosing_ball
 from adept_traj.errors import InputShapeError, RobotModelError
 from adept_traj.robot import Robot, solid_frames
-from adept_traj.validation import as_batch, as_scalar
+from adept_traj.validation import as_batch, as_integer, as_scalar
 
 __all__ = ["SelfCollision", "SelfDistances"]
 
@@ -130,14 +131,15 @@ class SelfCollision:
         self.pairs = np.array(chosen, dtype=int).reshape(-1, 2)
         self.solid_names = tuple(g.name for g in objects)
         self._geoms = [g.geometry for g in objects]
-        balls = [enclosing_ball(g) for g in self._geoms]
         rot, shift = self._local[:, :3, :3], self._local[:, :3, 3]
-        centres = np.array([c for c, _ in balls]).reshape(-1, 3)
-        self._ball_in_joint = np.einsum("kij,kj->ki", rot, centres) + shift
-        self._radii = np.array([r for _, r in balls])
-        covers = [covering_spheres(g) for g in self._geoms]
-        self._cover_in_joint = [c @ rot[k].T + shift[k] for k, (c, _) in enumerate(covers)]
-        self._cover_radii = [r for _, r in covers]
+        #: Radii (n_solids,) [m] of the balls around the solids' local bounding boxes, centred
+        #: at the middle of their capsules (:mod:`adept_traj.collision.capsules`).
+        self._radii = np.array([enclosing_ball(g)[1] for g in self._geoms])
+        capsules = [enclosing_capsule(g) for g in self._geoms]
+        ends = np.array([[c[0], c[1]] for c in capsules]).reshape(-1, 2, 3)
+        #: Capsule ends (n_solids, 2, 3) in the parent joint frames and radii (n_solids,).
+        self._capsule_in_joint = np.einsum("kij,kej->kei", rot, ends) + shift[:, None]
+        self._capsule_radii = np.array([c[2] for c in capsules])
         self._request = distance_request()
         #: (n_pairs, nq) joint-space Lipschitz factors of each pair's distance.
         self._rho = pair_lever_arms(robot, self.pairs)
@@ -148,19 +150,39 @@ class SelfCollision:
         return len(self.pairs)
 
     @property
+    def lever_arms(self) -> np.ndarray:
+        """(n_pairs, nq) factors :math:`\\rho_{abj}` of the checked pairs
+        (:func:`~adept_traj.collision.pair_lever_arms`): a pair's distance changes at most
+        at :math:`\\sum_j \\rho_{abj} |\\dot q_j|` [m/s]."""
+        return self._rho.copy()
+
+    @property
     def pair_names(self) -> tuple[tuple[str, str], ...]:
         """``(solid a, solid b)`` names of the checked pairs."""
         return tuple((self.solid_names[a], self.solid_names[b]) for a, b in self.pairs)
 
-    def distances(self, q: object, *, exact: bool = False) -> np.ndarray:
+    def distances(
+        self, q: object, *, exact: bool = False, exact_below: float | None = None
+    ) -> np.ndarray:
         """Signed distances (..., n_pairs) [m] of the checked pairs for configurations
-        ``q`` (..., nq) [rad | m]: exact (coal, negative = penetration depth) where at most
-        :attr:`influence` (everywhere with ``exact=True``), else a lower bound greater than
-        it."""
+        ``q`` (..., nq) [rad | m] within the joint limits: exact (coal, negative =
+        penetration depth) where at most ``exact_below`` [m] (default :attr:`influence`;
+        everywhere with ``exact=True``), else a lower bound greater than it."""
         qa = as_batch(q, "q", self.robot.nq, "[rad | m]")
+        below = self.influence if exact_below is None else as_scalar(exact_below, "exact_below")
         frames = self.robot.kinematics.joint_frames(qa)
         flat = qa.reshape(-1, qa.shape[-1])
-        return self._distances(frames, flat, exact).reshape(*qa.shape[:-1], self.n_pairs)
+        out = self._distances(frames, flat, np.inf if exact else below)
+        return out.reshape(*qa.shape[:-1], self.n_pairs)
+
+    def pair_distance(self, q: object, pair: int) -> np.ndarray:
+        """Exact signed distances (...) [m] (coal) of checked pair ``pair`` (an index of
+        :attr:`pairs`) at configurations ``q`` (..., nq) [rad | m]."""
+        qa = as_batch(q, "q", self.robot.nq, "[rad | m]")
+        p = as_integer(pair, "pair", minimum=0, maximum=self.n_pairs - 1)
+        frames = self.robot.kinematics.joint_frames(qa)
+        out = [self._narrow(frames, n, p) for n in range(frames.shape[-1])]
+        return np.array(out).reshape(qa.shape[:-1])
 
     def min_distance(self, q: object) -> np.ndarray:
         """Smallest self-distance (...) [m] over the checked pairs (``inf`` when none)."""
@@ -198,36 +220,27 @@ class SelfCollision:
 
     # ------------------------------------------------------------------ private hooks
     def _bounds(self, frames: np.ndarray) -> np.ndarray:
-        """Lower bounds (N, n_pairs) [m]: enclosing balls, then covering spheres where the
-        ball bound is at most :attr:`influence`."""
-        n = frames.shape[-1]
-        out = np.empty((n, self.n_pairs))
-        if not self.n_pairs:
+        """Lower bounds (N, n_pairs) [m] for joint frames (njoints, 3, 4, N): enclosing
+        balls, then enclosing capsules where those are at most :attr:`influence`."""
+        n, k = frames.shape[-1], self.n_pairs
+        out = np.empty((n, k))
+        if not k:
             return out
         flat = frames.reshape(frames.shape[0], 12, n)
-        balls = np.empty((3, len(self._radii), n))
+        ends = np.empty((3, len(self._radii), 2, n))  # capsule ends; their middle: ball centre
         for p, ks in self._by_parent:
-            balls[:, ks] = points_in_joint(flat[p], self._ball_in_joint[ks])
-        a, b = self.pairs[:, 0], self.pairs[:, 1]
-        gap = np.sqrt(((balls[:, a] - balls[:, b]) ** 2).sum(axis=0))  # (n_pairs, N)
-        out[:] = (gap - (self._radii[a] + self._radii[b])[:, None]).T
-        close = out <= self.influence
-        covers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # solid: (centres, where)
-        for s in np.unique(self.pairs[close.any(axis=0)]).tolist():
-            rows = np.flatnonzero(close[:, (self.pairs == s).any(axis=1)].any(axis=1))
-            where = np.zeros(n, dtype=int)
-            where[rows] = np.arange(len(rows))
-            frame = flat[self._parents[s]][:, rows]
-            covers[s] = (points_in_joint(frame, self._cover_in_joint[s]), where)
+            points = points_in_joint(flat[p], self._capsule_in_joint[ks].reshape(-1, 3))
+            ends[:, ks] = points.reshape(3, len(ks), 2, n)
         for p, (sa, sb) in enumerate(self.pairs.tolist()):
-            rows = np.flatnonzero(close[:, p])
-            if len(rows) == 0:
-                continue
-            (ca, wa), (cb, wb) = covers[sa], covers[sb]
-            ca, cb = ca[:, :, wa[rows]], cb[:, :, wb[rows]]
-            d = np.sqrt(((ca[:, :, None] - cb[:, None]) ** 2).sum(axis=0))  # (ka, kb, R)
-            d -= (self._cover_radii[sa][:, None] + self._cover_radii[sb][None])[..., None]
-            out[rows, p] = d.min(axis=(0, 1))
+            gap = 0.5 * (ends[:, sa, 0] + ends[:, sa, 1] - ends[:, sb, 0] - ends[:, sb, 1])
+            out[:, p] = np.sqrt((gap * gap).sum(axis=0)) - (self._radii[sa] + self._radii[sb])
+            close = out[:, p] <= self.influence
+            rows = np.flatnonzero(close) if close.mean() < 0.5 else slice(None)  # (no copy)
+            if close.any():
+                a, b = ends[:, sa][..., rows], ends[:, sb][..., rows]
+                gap = segment_distance(a[:, 0], a[:, 1], b[:, 0], b[:, 1])
+                bound = gap - (self._capsule_radii[sa] + self._capsule_radii[sb])
+                out[rows, p] = np.maximum(out[rows, p], bound)
         return out
 
     def _pose(self, frames: np.ndarray, n: int, s: int) -> coal.Transform3s:
@@ -247,26 +260,26 @@ class SelfCollision:
             coal.DistanceResult(),
         )
 
-    def _distances(self, frames: np.ndarray, q: np.ndarray, exact: bool) -> np.ndarray:
+    def _distances(self, frames: np.ndarray, q: np.ndarray, below: float) -> np.ndarray:
         """Distances (N, n_pairs) [m] at the flat samples of ``q`` (N, nq): coal for every
-        pair (``exact``) or, per pair, for the closest candidate within :attr:`influence`
+        pair (``below = inf``) or, per pair, for the closest candidate at most ``below``
         first, whose exact value lifts the other candidates' bounds by the joint-space
         Lipschitz bound of :mod:`adept_traj.collision.lever_arms` (a candidate lifted above
-        :attr:`influence` keeps that bound)."""
+        ``below`` keeps that bound)."""
         out = self._bounds(frames)
-        if exact:
+        if below == np.inf:
             for n, p in np.ndindex(out.shape):
                 out[n, p] = self._narrow(frames, n, p)
             return out
         for p in range(self.n_pairs):
-            todo = np.flatnonzero(out[:, p] <= self.influence)
+            todo = np.flatnonzero(out[:, p] <= below)
             while len(todo):
                 c = int(todo[np.argmin(out[todo, p])])
                 out[c, p] = d = self._narrow(frames, c, p)
                 todo = todo[todo != c]
                 lift = d - np.abs(q[todo] - q[c]) @ self._rho[p]
                 out[todo, p] = np.maximum(out[todo, p], lift)
-                todo = todo[out[todo, p] <= self.influence]
+                todo = todo[out[todo, p] <= below]
         return out
 
     def _min_distances(self, frames: np.ndarray, q: np.ndarray, n_t: int) -> SelfDistances:
