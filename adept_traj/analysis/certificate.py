@@ -214,8 +214,8 @@ class Certificate:
     @property
     def certified(self) -> bool:
         """:attr:`feasible` with the ``"continuous"`` distance (and self-distance) guarantee."""
-        own = self.self_distance
-        return self.feasible and self.guarantee == CONTINUOUS == (own or self).guarantee
+        own_ok = self.self_distance is None or self.self_distance.guarantee == CONTINUOUS
+        return self.feasible and self.guarantee == CONTINUOUS and own_ok
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -379,8 +379,8 @@ def certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    if own := problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth):
-        violations.extend(own.violations(margin))
+    own = problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)
+    violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(
         x=xa,
