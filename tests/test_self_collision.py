@@ -24,14 +24,8 @@ from adept_traj.robot import Robot, installed_data_dirs
 from adept_traj.scene import Box, FixedPose, Obstacle, Scene
 from adept_traj.testing.paper_moves import lift_then_lower, single_result
 
-ROBOTS = next(
-    (
-        d / "example-robot-data" / "robots"
-        for d in installed_data_dirs()
-        if (d / "example-robot-data" / "robots").is_dir()
-    ),
-    None,
-)
+_FOUND = [d / "example-robot-data/robots" for d in installed_data_dirs()]
+ROBOTS = next((d for d in _FOUND if d.is_dir()), None)
 needs_ur5 = pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
 PARAMS = "examples/data/ur5.toml"
 HOME = np.array([0.0, -1.57, 0.0, -1.57, 0.0, 0.0])

@@ -68,7 +68,7 @@ from adept_traj.analysis.limit_check import (
     _ratio_check,
     _refined_torque_check,
 )
-from adept_traj.analysis.self_distance import SelfDistance, self_distance
+from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -158,26 +158,13 @@ class Certificate:
                 raise InvalidInputError(
                     f"{kind} has {check.dense.size} joints, the dense trajectory {self.dense.nq}"
                 )
-        d = float(self.min_distance)
-        if math.isnan(d) or d == -math.inf:
-            raise InvalidInputError(f"min_distance must be a number or +inf; got {d!r}")
-        object.__setattr__(self, "min_distance", d)
-        if self.t_min_distance is not None:
-            object.__setattr__(self, "t_min_distance", float(self.t_min_distance))
-        if self.closest_pair is not None:
-            pair = tuple(str(n) for n in self.closest_pair)
-            if len(pair) != 2:
-                raise InvalidInputError(f"closest_pair must be (solid, obstacle); got {pair!r}")
-            object.__setattr__(self, "closest_pair", pair)
+        _normalise_distance(
+            self, "min_distance", "t_min_distance", "closest_pair", "distance_bound"
+        )
         object.__setattr__(self, "violations", tuple(str(v) for v in self.violations))
         for name in ("guarantee", "torque_guarantee"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, str(getattr(self, name)))
-        if self.distance_bound is not None:
-            bound = float(self.distance_bound)
-            if math.isnan(bound):
-                raise InvalidInputError("distance_bound must be a number or ±inf; got nan")
-            object.__setattr__(self, "distance_bound", bound)
 
     # ------------------------------------------------------------------ summaries
     @property

@@ -64,22 +64,7 @@ class SelfDistance:
     distance_bound: float | None
 
     def __post_init__(self) -> None:
-        d = float(self.min_distance)
-        if math.isnan(d) or d == -math.inf:
-            raise InvalidInputError(f"self min_distance must be a number or +inf; got {d!r}")
-        object.__setattr__(self, "min_distance", d)
-        if self.t_min_distance is not None:
-            object.__setattr__(self, "t_min_distance", float(self.t_min_distance))
-        if self.pair is not None:
-            pair = tuple(str(n) for n in self.pair)
-            if len(pair) != 2:
-                raise InvalidInputError(f"self pair must be (solid a, solid b); got {pair!r}")
-            object.__setattr__(self, "pair", pair)
-        if self.distance_bound is not None:
-            bound = float(self.distance_bound)
-            if math.isnan(bound):
-                raise InvalidInputError("self distance_bound must be a number or ±inf; got nan")
-            object.__setattr__(self, "distance_bound", bound)
+        _normalise_distance(self, "min_distance", "t_min_distance", "pair", "distance_bound")
 
     def ok(self, margin: float) -> bool:
         """The smallest self-distance is at least ``margin`` [m]."""
@@ -94,6 +79,29 @@ class SelfDistance:
             f"self-distance: {self.min_distance:.4g} m < margin {margin:.4g} m at "
             f"t = {self.t_min_distance:.3f} s ({self.pair[0]} – {self.pair[1]})",
         )
+
+
+def _normalise_distance(record: object, value: str, when: str, pair: str, bound: str) -> None:
+    """Check and convert, in place, the distance fields of a frozen dataclass ``record``
+    (a :class:`SelfDistance` or a :class:`~adept_traj.analysis.Certificate`): the
+    distance ``value`` [m] a number or +inf, its time ``when`` [s] and ``pair`` of two
+    names (or ``None``), the lower bound ``bound`` [m] a number (or ``None``)."""
+    d = float(getattr(record, value))
+    if math.isnan(d) or d == -math.inf:
+        raise InvalidInputError(f"{value} must be a number or +inf; got {d!r}")
+    object.__setattr__(record, value, d)
+    if getattr(record, when) is not None:
+        object.__setattr__(record, when, float(getattr(record, when)))
+    if getattr(record, pair) is not None:
+        names = tuple(str(n) for n in getattr(record, pair))
+        if len(names) != 2:
+            raise InvalidInputError(f"{pair} must be a pair of names; got {names!r}")
+        object.__setattr__(record, pair, names)
+    if getattr(record, bound) is not None:
+        low = float(getattr(record, bound))
+        if math.isnan(low):
+            raise InvalidInputError(f"{bound} must be a number or ±inf; got nan")
+        object.__setattr__(record, bound, low)
 
 
 def self_distance(
