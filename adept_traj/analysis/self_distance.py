@@ -49,8 +49,9 @@ class SelfDistance:
         (negative: penetration depth; ``inf``: no checked pair); exact when ``exact``,
         else a lower bound of the smallest distance (above the margin).
     exact: whether :attr:`min_distance` is the exact smallest distance.
-    t_min_distance: its time [s] (``None``: no checked pair).
-    pair: ``(solid a, solid b)`` names at that instant (``None``: no checked pair).
+    t_min_distance: its time [s] (of the smallest bound when not ``exact``; ``None``: no
+        checked pair).
+    pair: ``(solid a, solid b)`` names there (``None``: no checked pair).
     guarantee: ``"continuous"`` (the bound holds at every instant) or ``"sampled at N Hz"``.
     distance_bound: lower bound [m] of the self-distance at every instant of [0, T]
         (``None``: not computed; ``inf``: no checked pair).
