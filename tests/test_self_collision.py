@@ -17,7 +17,12 @@ import pytest
 
 from adept_traj.analysis import certify, certify_members
 from adept_traj.cli import main
-from adept_traj.collision import SelfCollision, pair_lever_arms
+from adept_traj.collision import (
+    SelfCollision,
+    enclosing_capsule,
+    pair_lever_arms,
+    segment_distance,
+)
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot, installed_data_dirs
@@ -215,3 +220,30 @@ def test_the_result_records_self_collision_and_verify_rebuilds_it(
     assert "self_collision" not in text
     assert "self_distance" not in text
     assert PlanningResult.load(tmp_path / "off").problem().self_check is None
+
+
+# ---------------------------------------------------------------------------- capsules
+def test_segment_distance_matches_dense_sampling_of_both_segments() -> None:
+    rng = np.random.default_rng(7)
+    ends = rng.normal(size=(4, 3, 50))
+    ends[2] = ends[0] + 1e-3 * rng.normal(size=(3, 50))  # some nearly degenerate cases
+    got = segment_distance(*ends)
+    s = np.linspace(0.0, 1.0, 401)
+    for k in range(50):
+        a = ends[0][:, k, None] + s * (ends[1][:, k] - ends[0][:, k])[:, None]  # (3, 401)
+        b = ends[2][:, k, None] + s * (ends[3][:, k] - ends[2][:, k])[:, None]
+        brute = np.sqrt(((a[:, :, None] - b[:, None]) ** 2).sum(axis=0)).min()
+        step = np.linalg.norm(ends[1][:, k] - ends[0][:, k]) + np.linalg.norm(
+            ends[3][:, k] - ends[2][:, k]
+        )
+        assert brute - step / 400 - 1e-12 <= got[k] <= brute + 1e-12
+
+
+def test_the_enclosing_capsule_contains_the_solid_box() -> None:
+    box = coal.Box(0.4, 0.1, 0.06)
+    a0, a1, radius = enclosing_capsule(box)
+    corners = np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T * [0.2, 0.05, 0.03]
+    gap = segment_distance(*(np.repeat(p[:, None], 8, axis=1) for p in (a0, a1)),
+                           corners.T, corners.T)  # fmt: skip
+    assert np.all(gap <= radius + 1e-12)
+    assert radius == pytest.approx(0.5 * np.hypot(0.1, 0.06))

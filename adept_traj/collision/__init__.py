@@ -8,6 +8,7 @@ uses).
 from __future__ import annotations
 
 from adept_traj.collision.broad_phase import Bounds, BroadPhase
+from adept_traj.collision.capsules import enclosing_capsule, segment_distance
 from adept_traj.collision.checker import (
     CollisionChecker,
     MinDistances,
@@ -43,10 +44,12 @@ __all__ = [
     "SelfDistances",
     "coal_kind",
     "distance_request",
+    "enclosing_capsule",
     "pair_lever_arms",
     "point_signed_distance",
     "restrict_broad_phase",
     "restrict_checker",
+    "segment_distance",
     "shape_of",
     "solid_lever_arms",
     "sweep_clearance",
