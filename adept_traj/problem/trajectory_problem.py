@@ -105,8 +105,10 @@ class ProblemSettings:
         Check the robot's own links against each other (the pairs of
         :class:`~adept_traj.collision.SelfCollision`) in the distance constraint and the
         certificate, with the same margin. ``None`` (default): on when the robot has a
-        checked pair. The problem's :attr:`~TrajectoryProblem.settings` hold the resolved
-        ``True``/``False``.
+        checked pair and its disabled pairs are known (an SRDF,
+        ``Robot.from_urdf(..., srdf=...)``, or ``disabled_pairs`` given): without them,
+        links that touch by design would make ordinary moves infeasible. The problem's
+        :attr:`~TrajectoryProblem.settings` hold the resolved ``True``/``False``.
     disabled_pairs:
         ``(link1, link2)`` pairs left out of the self-collision check besides the robot's
         SRDF pairs. The problem's settings hold every disabled pair naming two links with
@@ -208,8 +210,8 @@ class TrajectoryProblem(Problem):
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
         self.robot, self.scene = robot, scene
         self_check = SelfCollision(robot, settings.disabled_pairs, influence=settings.influence)
-        on = settings.self_collision
-        on = bool(self_check.n_pairs) if on is None else on
+        on, known = settings.self_collision, robot.srdf_path is not None or settings.disabled_pairs
+        on = bool(self_check.n_pairs and known) if on is None else on
         #: The robot–robot distances (``None``: self-collision off).
         self.self_check = self_check if on else None
         self.settings = settings = replace(
