@@ -148,6 +148,10 @@ def test_distances_and_the_motion_minimum_match_coal_called_directly(ur5: Robot)
     np.testing.assert_allclose(found.distance, ref.min(axis=(1, 2)), atol=1e-6)
     m = int(np.argmin(found.distance))
     assert ref[m, found.sample[m], found.pair[m]] == pytest.approx(found.distance[m], abs=1e-6)
+    low = ref.min(axis=(1, 2)) - 1e-3  # just below each motion's minimum: bounds above it
+    capped = check.min_distances(q, below=low)
+    assert np.all(capped.distance > low)
+    assert np.all(capped.distance <= ref.min(axis=(1, 2)) + 1e-9)
 
 
 @needs_ur5
@@ -160,7 +164,14 @@ def test_a_move_folding_into_itself_is_refused_and_not_certified(ur5: Robot) -> 
     x = on.trajectory.straight_line(on.xu[0])
     assert off.evaluate_batch(x).constraints[-1] <= 0.0
     assert certify(off, x, 100.0).certified
-    assert on.evaluate_batch(x).constraints[-1] > 0.0
+    g = on.evaluate_batch(x).constraints[-1]
+    st = on.settings
+    q = on.trajectory.sample(x, on.s).q
+    own = _reference(ur5, q, on.self_check.pair_names).min()
+    obstacle = off.evaluate_batch(x).min_distance.min()
+    expected = (st.margin + st.search_buffer - min(own, obstacle, st.influence)) / st.influence
+    assert g == pytest.approx(expected, abs=1e-9)
+    assert g > 0.0
     cert = certify(on, x, 100.0)
     assert not cert.feasible
     assert not cert.certified

@@ -41,7 +41,7 @@ from adept_traj.collision.point_distance import points_in_joint
 from adept_traj.collision.primitives import distance_request, enclosing_ball
 from adept_traj.errors import InputShapeError, RobotModelError
 from adept_traj.robot import Robot, solid_frames
-from adept_traj.validation import as_batch, as_integer, as_scalar
+from adept_traj.validation import as_batch, as_finite_array, as_integer, as_scalar
 
 __all__ = ["SelfCollision", "SelfDistances"]
 
@@ -189,12 +189,17 @@ class SelfCollision:
         d = self.distances(q)
         return d.min(axis=-1, initial=np.inf)
 
-    def min_distances(self, q: object, joint_frames: np.ndarray | None = None) -> SelfDistances:
+    def min_distances(
+        self, q: object, joint_frames: np.ndarray | None = None, below: object = None
+    ) -> SelfDistances:
         """Per motion, the smallest self-distance over all samples and pairs.
 
         ``q`` (..., n_t, nq) [rad | m]: the leading axes ``...`` are motions. Candidates
-        (sample, pair) within ``influence`` are computed by coal in increasing order of their
-        broad-phase bound until the best exact distance is below the next bound.
+        (sample, pair) within ``below`` (...) [m] (default :attr:`influence`; at most it)
+        are computed by coal in increasing order of their broad-phase bound until the best
+        exact distance is below the next bound: the result is exact where at most
+        ``below``, else a lower bound above it (the planner passes the motion's obstacle
+        distance: a self-distance above it does not change the constraint).
         ``joint_frames`` (njoints, 3, 4, N), N = ∏ q.shape[:-1], may pass the robot's joint
         frames (:attr:`~adept_traj.robot.ForwardKinematics.joint_frames`) if computed.
         """
@@ -210,7 +215,12 @@ class SelfCollision:
                 f"got {np.shape(joint_frames)}"
             )
         batch, n_t = qa.shape[:-2], qa.shape[-2]
-        found = self._min_distances(joint_frames, qa.reshape(-1, n_t, qa.shape[-1]), n_t)
+        limit = np.full(batch, self.influence) if below is None else as_finite_array(below, "below")
+        try:
+            limit = np.minimum(np.broadcast_to(limit, batch), self.influence).reshape(-1)
+        except ValueError:
+            raise InputShapeError(f"below must broadcast to {batch}; got {limit.shape}") from None
+        found = self._min_distances(joint_frames, qa.reshape(-1, n_t, qa.shape[-1]), limit)
         return SelfDistances(
             distance=found.distance.reshape(batch),
             sample=found.sample.reshape(batch),
@@ -282,18 +292,19 @@ class SelfCollision:
                 todo = todo[out[todo, p] <= below]
         return out
 
-    def _min_distances(self, frames: np.ndarray, q: np.ndarray, n_t: int) -> SelfDistances:
-        """Branch and bound of :meth:`min_distances` for ``q`` (n_motions, n_t, nq)."""
-        n_motions, k = len(q), self.n_pairs
+    def _min_distances(self, frames: np.ndarray, q: np.ndarray, below: np.ndarray) -> SelfDistances:
+        """Branch and bound of :meth:`min_distances` for ``q`` (n_motions, n_t, nq) and
+        ``below`` (n_motions,) [m]."""
+        (n_motions, n_t, _), k = q.shape, self.n_pairs
         bounds = self._bounds(frames).reshape(n_motions, n_t * k)
         best = bounds.min(axis=1, initial=np.inf)
         where = np.full(n_motions, -1)
         calls = 0
-        for m in np.flatnonzero(best <= self.influence).tolist():
-            row = bounds[m]
-            cand = np.flatnonzero(row <= self.influence)
+        for m in np.flatnonzero(best <= below).tolist():
+            row, limit = bounds[m], below[m]
+            cand = np.flatnonzero(row <= limit)
             low = row[cand]
-            value, floor = np.inf, row.min(initial=np.inf, where=row > self.influence)
+            value, floor = np.inf, row.min(initial=np.inf, where=row > limit)
             while len(cand):
                 i = int(np.argmin(low))
                 if low[i] >= value:  # every bound is a valid lower bound: prune
@@ -308,10 +319,10 @@ class SelfCollision:
                 same = np.flatnonzero(cand % k == c % k)
                 gap = np.abs(q[m, cand[same] // k] - q[m, c // k]) @ self._rho[c % k]
                 low[same] = np.maximum(low[same], d - gap)
-                far = low > self.influence
+                far = low > limit
                 floor = min(floor, low.min(initial=np.inf, where=far))
                 cand, low = cand[~far], low[~far]
-            if value > self.influence:  # only a lower bound above influence is known
+            if value > limit:  # only a lower bound above the limit is known
                 value, where[m] = min(value, floor), -1
             best[m] = value
         return SelfDistances(

@@ -334,7 +334,7 @@ class TrajectoryProblem(Problem):
         closest = mind.distance.min(axis=-1, initial=np.inf)
         n_narrow = mind.n_narrow
         if self.self_check is not None:  # robot–robot pairs: the distance constraint only
-            own = self.self_check.min_distances(smp.q, joint_frames=fk.joint_frames)
+            own = self.self_check.min_distances(smp.q, fk.joint_frames, below=closest)
             closest, n_narrow = np.minimum(closest, own.distance), n_narrow + own.n_narrow
         g = self._constraints(
             bounds.q_min,
