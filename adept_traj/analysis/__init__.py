@@ -14,6 +14,7 @@ from adept_traj.analysis.continuous import (
     DEFAULT_MAX_DEPTH,
     DistanceGuarantee,
     continuous_distance,
+    continuous_self_distance,
     obstacle_speeds,
     solid_lever_arms,
 )
@@ -48,6 +49,7 @@ from adept_traj.analysis.paper_measures import (
     ratio_non_dominated,
     spread,
 )
+from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
@@ -65,6 +67,7 @@ __all__ = [
     "DistanceGuarantee",
     "LimitCheck",
     "MemberCertificate",
+    "SelfDistance",
     "algorithm_effort",
     "average_fitness",
     "best_tradeoff",
@@ -74,6 +77,7 @@ __all__ = [
     "check_certificate_memory",
     "combined_objective",
     "continuous_distance",
+    "continuous_self_distance",
     "dense_samples",
     "hypervolume",
     "igd",
@@ -85,6 +89,7 @@ __all__ = [
     "obstacle_speeds",
     "optimizer_overhead",
     "ratio_non_dominated",
+    "self_distance",
     "solid_lever_arms",
     "spread",
     "to_unit_minimisation",

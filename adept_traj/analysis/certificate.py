@@ -13,7 +13,8 @@ optimiser's coarse Gauss–Legendre samples:
 - the exact signed distance of **every** robot solid to **every** obstacle at every sample,
   moving obstacles at their pose at that instant (``CollisionChecker.distances(...,
   exact=True)``: coal for each pair, the closed form for sphere obstacles; no broad-phase
-  bound stands in for a distance).
+  bound stands in for a distance); with self-collision on, the distance between the
+  robot's own solids too (:mod:`~adept_traj.analysis.self_distance`, part of the verdict).
 
 Each limit kind is summarised per joint by a :class:`LimitCheck`:
 
@@ -67,6 +68,7 @@ from adept_traj.analysis.limit_check import (
     _ratio_check,
     _refined_torque_check,
 )
+from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -116,6 +118,8 @@ class Certificate:
         not computed; ``inf``: no obstacle).
     torque_guarantee: how the torque was checked, e.g. ``"sampled at 1000 Hz, refined to
         8000 Hz near the limit"`` (``None``: not recorded, e.g. a result saved before).
+    self_distance: the robot's distance to itself (:class:`SelfDistance`; ``None``:
+        self-collision off), part of the verdict.
     """
 
     x: np.ndarray
@@ -134,8 +138,11 @@ class Certificate:
     guarantee: str | None = None
     distance_bound: float | None = None
     torque_guarantee: str | None = None
+    self_distance: SelfDistance | None = None
 
     def __post_init__(self) -> None:
+        if self.self_distance is not None:
+            check_type(self.self_distance, SelfDistance, "self_distance")
         x = readonly_copy(as_finite_array(self.x, "x"))
         if x.ndim != 1 or x.size < 1 or not x[0] > 0:
             raise InvalidInputError(f"x must have shape (n_var,) with T = x[0] > 0; got {x!r}")
@@ -151,27 +158,13 @@ class Certificate:
                 raise InvalidInputError(
                     f"{kind} has {check.dense.size} joints, the dense trajectory {self.dense.nq}"
                 )
-        d = float(self.min_distance)
-        if math.isnan(d) or d == -math.inf:
-            raise InvalidInputError(f"min_distance must be a number or +inf; got {d!r}")
-        object.__setattr__(self, "min_distance", d)
-        if self.t_min_distance is not None:
-            object.__setattr__(self, "t_min_distance", float(self.t_min_distance))
-        if self.closest_pair is not None:
-            pair = tuple(str(n) for n in self.closest_pair)
-            if len(pair) != 2:
-                raise InvalidInputError(f"closest_pair must be (solid, obstacle); got {pair!r}")
-            object.__setattr__(self, "closest_pair", pair)
+        _normalise_distance(
+            self, "min_distance", "t_min_distance", "closest_pair", "distance_bound"
+        )
         object.__setattr__(self, "violations", tuple(str(v) for v in self.violations))
-        if self.guarantee is not None:
-            object.__setattr__(self, "guarantee", str(self.guarantee))
-        if self.torque_guarantee is not None:
-            object.__setattr__(self, "torque_guarantee", str(self.torque_guarantee))
-        if self.distance_bound is not None:
-            bound = float(self.distance_bound)
-            if math.isnan(bound):
-                raise InvalidInputError("distance_bound must be a number or ±inf; got nan")
-            object.__setattr__(self, "distance_bound", bound)
+        for name in ("guarantee", "torque_guarantee"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, str(getattr(self, name)))
 
     # ------------------------------------------------------------------ summaries
     @property
@@ -196,8 +189,9 @@ class Certificate:
 
     @property
     def distance_ok(self) -> bool:
-        """The smallest distance is at least the margin."""
-        return self.min_distance >= self.margin
+        """The smallest distance, and self-distance, is at least the margin."""
+        own = self.self_distance
+        return self.min_distance >= self.margin and (own is None or own.ok(self.margin))
 
     @property
     def feasible(self) -> bool:
@@ -206,8 +200,9 @@ class Certificate:
 
     @property
     def certified(self) -> bool:
-        """:attr:`feasible` with the ``"continuous"`` distance guarantee."""
-        return self.feasible and self.guarantee == CONTINUOUS
+        """:attr:`feasible` with the ``"continuous"`` distance (and self-distance) guarantee."""
+        own_ok = self.self_distance is None or self.self_distance.guarantee == CONTINUOUS
+        return self.feasible and self.guarantee == CONTINUOUS and own_ok
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -371,6 +366,8 @@ def certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
+    own = problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)
+    violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(
         x=xa,
@@ -384,5 +381,6 @@ def certify(
         guarantee=guarantee,
         distance_bound=bound,
         torque_guarantee=torque_guarantee,
+        self_distance=own,
         **checks,
     )

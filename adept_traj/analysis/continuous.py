@@ -47,19 +47,21 @@ violation found between the uniform samples.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from adept_traj.collision.primitives import enclosing_ball
+from adept_traj.collision import solid_lever_arms as lever_arms
+from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
-from adept_traj.robot.robot import solid_frames
 
 __all__ = [
     "CONTINUOUS",
     "DEFAULT_MAX_DEPTH",
     "DistanceGuarantee",
     "continuous_distance",
+    "continuous_self_distance",
     "obstacle_speeds",
     "solid_lever_arms",
 ]
@@ -96,29 +98,12 @@ class DistanceGuarantee:
 
 
 def solid_lever_arms(problem: TrajectoryProblem) -> np.ndarray:
-    r"""(n_solids, nq) factors :math:`r_{sj}`: solid ``s`` moves at most
-    :math:`\sum_j r_{sj} |\dot q_j|` [m/s]; [m] for a revolute joint (bound on the distance
-    of its points from the joint origin), 1 for a prismatic joint, 0 for a joint that does
-    not move the solid (see the module docstring)."""
-    robot = problem.robot
-    kin, model = robot.kinematics, robot.model
-    parents, local = solid_frames(robot.collision_model)
-    lim = robot.limits
-    out = np.zeros((len(parents), robot.nq))
-    for s, geometry in enumerate(robot.collision_model.geometryObjects):
-        centre, radius = enclosing_ball(geometry.geometry)
-        reach = float(np.linalg.norm(local[s, :3, :3] @ centre + local[s, :3, 3])) + radius
-        frame = int(parents[s])
-        while frame > 0:  # walk from the solid's joint to the root, growing the reach
-            k = model.joints[frame].idx_q
-            if kin.revolute[frame - 1]:
-                out[s, k] = reach
-            else:
-                out[s, k] = 1.0
-                reach += max(abs(float(lim.lower[k])), abs(float(lim.upper[k])))
-            reach += float(np.linalg.norm(model.jointPlacements[frame].translation))
-            frame = int(kin.parents[frame - 1])
-    return out
+    r"""(n_solids, nq) factors :math:`r_{sj}` of the problem's robot: solid ``s`` moves at
+    most :math:`\sum_j r_{sj} |\dot q_j|` [m/s]; [m] for a revolute joint (bound on the
+    distance of its points from the joint origin), 1 for a prismatic joint, 0 for a joint
+    that does not move the solid (see the module docstring;
+    :func:`adept_traj.collision.solid_lever_arms`)."""
+    return lever_arms(problem.robot)
 
 
 def obstacle_speeds(problem: TrajectoryProblem) -> np.ndarray:
@@ -175,9 +160,58 @@ def continuous_distance(
     Returns:
         :class:`DistanceGuarantee`.
     """
+    checker = problem.checker
+
+    def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
+        return checker.distances(q[None], t_m[None], exact=exact).distance[0]
+
+    arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
+    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances)
+
+
+def continuous_self_distance(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    qd: np.ndarray,
+    pairs: np.ndarray,
+    rate_hz: float,
+    max_depth: int = DEFAULT_MAX_DEPTH,
+) -> DistanceGuarantee:
+    """:func:`continuous_distance` for the robot's own solid pairs
+    (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
+    (n, n_pairs) [m] are the self-distances at ``t`` (or lower bounds of them); the
+    Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
+    solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
+    obstacle speed). The midpoints' distances are exact below the margin, lower bounds
+    above it. The returned ``pair`` is ``(pair index, 0)``."""
+    check = problem.self_check
+    if check is None:
+        raise InvalidInputError("the problem's self-collision check is off")
+
+    def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
+        return check.distances(q, exact_below=problem.settings.margin)[..., None]
+
+    arms, speeds = check.lever_arms, np.zeros(1)
+    return _bisect(problem, x, t, qd, pairs[..., None], rate_hz, max_depth, arms, speeds, distances)
+
+
+def _bisect(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    qd: np.ndarray,
+    pairs: np.ndarray,
+    rate_hz: float,
+    max_depth: int,
+    arms: np.ndarray,
+    speeds: np.ndarray,
+    distances: Callable[[np.ndarray, np.ndarray], np.ndarray],
+) -> DistanceGuarantee:
+    """The refinement of :func:`continuous_distance` for distances ``pairs`` (n, ns, no) at
+    ``t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,); ``distances(q, t)`` gives
+    them (m, ns, no) at configurations (m, nq) and times (m,) [s]."""
     margin = float(problem.settings.margin)
-    arms = solid_lever_arms(problem)
-    speeds = obstacle_speeds(problem)
     acc = problem.trajectory.bounds(x).qdd_abs_max
     T = float(x[0])
     k, s, o = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
@@ -207,7 +241,7 @@ def continuous_distance(
         t_a, t_b, d_a, d_b, v_a, v_b = (a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b))
         t_m = 0.5 * (t_a + t_b)
         smp = problem.trajectory.sample(x, t_m / T, orders=(0, 1))
-        d_m = problem.checker.distances(smp.q[None], t_m[None], exact=exact).distance[0]
+        d_m = distances(smp.q, t_m)
         n_refined += len(t_m)
         k, s, o = np.unravel_index(int(np.argmin(d_m)), d_m.shape)
         if d_m[k, s, o] < best[0]:

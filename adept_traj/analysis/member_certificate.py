@@ -14,7 +14,9 @@ A front member's full :class:`~adept_traj.analysis.Certificate` holds its dense 
   of the joint range beyond the nearer limit (≤ 0 inside), the others as the ratio to the
   limit (≤ 1 within);
 - the smallest distance [m], when [s] and between which solid and obstacle, and the lower
-  bound of the distance at every instant.
+  bound of the distance at every instant;
+- with self-collision on, the same for the robot's own solids
+  (:class:`~adept_traj.analysis.SelfDistance`: part of ``feasible``).
 
 Every member is certified by :func:`certify_members` on the same problem with the
 influence distance lowered to ``margin + 0.01 m`` (``certify(..., exact=False)``): a pair
@@ -37,6 +39,7 @@ import numpy as np
 
 from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
 from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE
+from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
@@ -72,6 +75,7 @@ class MemberCertificate:
     distance_bound: lower bound [m] of the distance at every instant of [0, T]
         (``None``: not computed; ``inf``: no obstacle).
     violations: every violated limit, as in the certificate.
+    self_distance: the robot's distance to itself (``None``: self-collision off).
     """
 
     feasible: bool
@@ -86,9 +90,12 @@ class MemberCertificate:
     closest_pair: tuple[str, str] | None
     distance_bound: float | None
     violations: tuple[str, ...]
+    self_distance: SelfDistance | None = None
 
     def __post_init__(self) -> None:
         check_type(self.feasible, bool, "feasible")
+        if self.self_distance is not None:
+            check_type(self.self_distance, SelfDistance, "self_distance")
         check_type(self.min_distance_exact, bool, "min_distance_exact")
         for name in ("worst", "worst_joint", "t_worst"):
             values = tuple(getattr(self, name))
@@ -125,6 +132,7 @@ class MemberCertificate:
             closest_pair=certificate.closest_pair,
             distance_bound=certificate.distance_bound,
             violations=certificate.violations,
+            self_distance=certificate.self_distance,
         )
 
     def worst_of(self, kind: str) -> float:

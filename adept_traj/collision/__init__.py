@@ -9,6 +9,7 @@ distance uses).
 from __future__ import annotations
 
 from adept_traj.collision.broad_phase import Bounds, BroadPhase
+from adept_traj.collision.capsules import enclosing_capsule, segment_distance
 from adept_traj.collision.checker import (
     CollisionChecker,
     MinDistances,
@@ -20,6 +21,7 @@ from adept_traj.collision.distance_gradient import (
     distance_gradients,
 )
 from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.lever_arms import pair_lever_arms, solid_lever_arms
 from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import (
     DISTANCE_TOLERANCE,
@@ -33,7 +35,7 @@ from adept_traj.collision.pruning import (
     restrict_checker,
     sweep_clearance,
 )
-from adept_traj.collision.self_collision import SelfCollision
+from adept_traj.collision.self_collision import SelfCollision, SelfDistances
 
 __all__ = [
     "DISTANCE_TOLERANCE",
@@ -47,12 +49,17 @@ __all__ = [
     "ObstaclePruning",
     "PairDistances",
     "SelfCollision",
+    "SelfDistances",
     "coal_kind",
     "distance_gradients",
     "distance_request",
+    "enclosing_capsule",
+    "pair_lever_arms",
     "point_signed_distance",
     "restrict_broad_phase",
     "restrict_checker",
+    "segment_distance",
     "shape_of",
+    "solid_lever_arms",
     "sweep_clearance",
 ]

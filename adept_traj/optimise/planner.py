@@ -80,6 +80,10 @@ __all__ = ["plan", "warn_missing_limits"]
 _LEAST_INFEASIBLE = 10
 
 
+#: Problem settings left out of a checkpoint's fingerprint at these values.
+_UNSET = {"search_buffer": 0.0, "self_collision": False, "disabled_pairs": ()}
+
+
 def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[str, Any]:
     """What a checkpoint must match to be resumed by this run."""
     return json.loads(
@@ -87,12 +91,13 @@ def _fingerprint(problem: TrajectoryProblem, settings: Any, seed: int) -> dict[s
             {
                 "start": problem.start.tolist(),
                 "goal": problem.goal.tolist(),
-                # workers change nothing in the results; a zero search_buffer is left out
-                # so that checkpoints written before the field existed still resume.
+                # workers change nothing in the results; a zero search_buffer, self-collision
+                # off and no disabled pairs are left out so that checkpoints written before
+                # those fields existed still resume.
                 "problem_settings": {
                     k: v
                     for k, v in problem.settings.__dict__.items()
-                    if k != "workers" and not (k == "search_buffer" and v == 0.0)
+                    if k != "workers" and not (k in _UNSET and v == _UNSET[k])
                 },
                 "scene": problem.scene.to_dict(),
                 "robot": problem.robot.name,

@@ -44,13 +44,13 @@ from __future__ import annotations
 import copy
 import multiprocessing
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from pymoo.core.problem import Problem
 
-from adept_traj.collision.checker import CollisionChecker
+from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
@@ -101,6 +101,19 @@ class ProblemSettings:
         results are identical to the serial evaluation. The workers are forked when first
         needed and hold a snapshot of the problem (later edits of ``robot.model`` are not
         seen by them); :meth:`TrajectoryProblem.close` stops them.
+    self_collision:
+        Check the robot's own links against each other (the pairs of
+        :class:`~adept_traj.collision.SelfCollision`) in the distance constraint and the
+        certificate, with the same margin. ``None`` (default): on when the robot has a
+        checked pair and its disabled pairs are known (an SRDF,
+        ``Robot.from_urdf(..., srdf=...)``, or ``disabled_pairs`` given): without them,
+        links that touch by design would make ordinary moves infeasible. The problem's
+        :attr:`~TrajectoryProblem.settings` hold the resolved ``True``/``False``.
+    disabled_pairs:
+        ``(link1, link2)`` pairs left out of the self-collision check besides the robot's
+        SRDF pairs. The problem's settings hold every disabled pair naming two links with
+        solids (these and the SRDF's, sorted), so that a saved result rebuilds the same
+        check.
     """
 
     n_knots: int = 20
@@ -111,6 +124,8 @@ class ProblemSettings:
     z3: str = "clearance"
     workers: int = 1
     search_buffer: float = 0.002
+    self_collision: bool | None = None
+    disabled_pairs: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
@@ -127,6 +142,17 @@ class ProblemSettings:
                 f"need 0 ≤ search_buffer ≤ influence − margin = "
                 f"{self.influence - self.margin:.4g} [m]; got search_buffer={self.search_buffer}"
             )
+        if self.self_collision is not None and not isinstance(self.self_collision, bool):
+            raise ConfigurationError(
+                f"self_collision must be True, False or None; got {self.self_collision!r}"
+            )
+        try:
+            pairs = tuple((str(a), str(b)) for a, b in self.disabled_pairs)
+        except (TypeError, ValueError):
+            raise ConfigurationError(
+                f"disabled_pairs must be (link1, link2) pairs; got {self.disabled_pairs!r}"
+            ) from None
+        object.__setattr__(self, "disabled_pairs", pairs)
         for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
             value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
             object.__setattr__(self, name, value)
@@ -182,7 +208,15 @@ class TrajectoryProblem(Problem):
                 settings = ProblemSettings(**values)
             except TypeError as exc:
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
-        self.robot, self.scene, self.settings = robot, scene, settings
+        self.robot, self.scene = robot, scene
+        self_check = SelfCollision(robot, settings.disabled_pairs, influence=settings.influence)
+        on, known = settings.self_collision, robot.srdf_path is not None or settings.disabled_pairs
+        on = bool(self_check.n_pairs and known) if on is None else on
+        #: The robot–robot distances (``None``: self-collision off).
+        self.self_check = self_check if on else None
+        self.settings = settings = replace(
+            settings, self_collision=on, disabled_pairs=self_check.disabled if on else ()
+        )
         lim = robot.limits
         if robot.task_rows is None:
             raise RobotModelError(
@@ -297,17 +331,22 @@ class TrajectoryProblem(Problem):
         mind = self.checker.min_distances(smp.q, smp.t, joint_frames=fk.joint_frames)
         z3 = self._z3(mind.distance, smp, fk.tool_pose)
         f = np.stack([T, z2, z3, z4, integ.z5, integ.z6], axis=-1)
+        closest = mind.distance.min(axis=-1, initial=np.inf)
+        n_narrow = mind.n_narrow
+        if self.self_check is not None:  # robot–robot pairs: the distance constraint only
+            own = self.self_check.min_distances(smp.q, fk.joint_frames, below=closest)
+            closest, n_narrow = np.minimum(closest, own.distance), n_narrow + own.n_narrow
         g = self._constraints(
             bounds.q_min,
             bounds.q_max,
             [bounds.qd_abs_max, bounds.qdd_abs_max, bounds.qddd_abs_max, np.abs(u).max(axis=1)],
-            mind.distance.min(axis=-1, initial=np.inf),
+            closest,
         )
         return Evaluation(
             objectives=f,
             constraints=g,
             min_distance=np.minimum(mind.distance, st.influence),
-            n_narrow=mind.n_narrow,
+            n_narrow=n_narrow,
         )
 
     def _z3(self, min_dist: np.ndarray, smp: Any, tool_pose: np.ndarray) -> np.ndarray:

@@ -17,7 +17,8 @@ field of ``result.json``:
   when the front has a member feasible at the samples, that every member is and none
   dominates another (how ``plan`` builds it);
 - the certificate (dense trajectory t, q, qd, qdd, qddd, tau, min_distance; every limit
-  check, the minimum distance, its time and pair, the violations, the verdict) against a
+  check, the minimum distance, its time and pair, the self-distance when self-collision is
+  on, the violations, the verdict) against a
   fresh :func:`~adept_traj.analysis.certify` at the stored rate and tolerance;
 - ``best.F_avg`` and ``best.f_c`` against :func:`~adept_traj.analysis.best_tradeoff` of the
   stored front with ``weights`` (not stored: ``plan``'s are the paper's unless changed),
@@ -273,6 +274,18 @@ class _Auditor(MismatchLog):
         self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
         self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
         self.optional(f"{path}.distance_bound", stored.distance_bound, now.distance_bound)
+        self.self_distance(f"{path}.self_distance", stored.self_distance, now.self_distance)
+
+    def self_distance(self, path: str, stored: Any, now: Any) -> None:
+        """Compare two :class:`~adept_traj.analysis.SelfDistance` (or ``None``: off)."""
+        if stored is None or now is None:
+            self.value(path, stored, now)
+            return
+        for field in ("exact", "pair", "guarantee"):
+            self.value(f"{path}.{field}", getattr(stored, field), getattr(now, field))
+        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
+        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
+        self.optional(f"{path}.distance_bound", stored.distance_bound, now.distance_bound)
 
     def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
         self.value(f"{path}.feasible", stored.feasible, now.feasible)
@@ -282,6 +295,7 @@ class _Auditor(MismatchLog):
         self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
         self.value(f"{path}.closest_pair", stored.closest_pair, now.closest_pair)
         self.value(f"{path}.violations", list(stored.violations), list(now.violations))
+        self.self_distance(f"{path}.self_distance", stored.self_distance, now.self_distance)
         for old, new in zip(stored.checks, now.checks, strict=True):
             for name in ("dense", "t_worst"):
                 self.numbers(f"{path}.{old.kind}.{name}", getattr(old, name), getattr(new, name))

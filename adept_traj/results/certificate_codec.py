@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis import SelfDistance
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
 from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.errors import InvalidInputError
@@ -47,7 +48,38 @@ def _member_certificate(front: Front, i: int) -> dict[str, Any]:
     }
     if m.distance_bound is not None:
         out["distance_bound"] = _float(m.distance_bound)  # null: +inf (no obstacle)
+    if m.self_distance is not None:  # optional key (self-collision on)
+        out["self_distance"] = _encode_self_distance(m.self_distance)
     return {"certificate": out}
+
+
+def _encode_self_distance(d: SelfDistance) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "min_distance": _float(d.min_distance),  # null: +inf (no checked pair)
+        "exact": d.exact,
+        "t_min_distance": d.t_min_distance,
+        "pair": None if d.pair is None else list(d.pair),
+        "guarantee": d.guarantee,
+    }
+    if d.distance_bound is not None:
+        out["distance_bound"] = _float(d.distance_bound)
+    return out
+
+
+def _decode_self_distance(node: Node) -> SelfDistance | None:
+    """The ``self_distance`` object (absent: self-collision off, or a file written before)."""
+    if not node.present:
+        return None
+    pair, bound = node["pair"], node["distance_bound"]
+    return node.build(
+        SelfDistance,
+        min_distance=node["min_distance"].number(null=math.inf),
+        exact=node["exact"].boolean(),
+        t_min_distance=node["t_min_distance"].number(null=None),
+        pair=None if pair.value is None else pair.strings(),
+        guarantee=node["guarantee"].string(nonempty=True),
+        distance_bound=bound.number(null=math.inf) if bound.present else None,
+    )
 
 
 def _encode_certificate(c: Certificate) -> dict[str, Any]:
@@ -68,6 +100,8 @@ def _encode_certificate(c: Certificate) -> dict[str, Any]:
         out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
     if c.torque_guarantee is not None:
         out["torque_guarantee"] = c.torque_guarantee
+    if c.self_distance is not None:
+        out["self_distance"] = _encode_self_distance(c.self_distance)
     for check in c.checks:
         out[check.kind] = {
             "limit": check.symbol,
@@ -124,6 +158,7 @@ def _decode_member_certificate(node: Node) -> MemberCertificate | None:
             node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
         ),
         violations=node["violations"].strings(),
+        self_distance=_decode_self_distance(node["self_distance"]),
     )
 
 
@@ -162,5 +197,6 @@ def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
             node["distance_bound"].number(null=math.inf) if node["distance_bound"].present else None
         ),
         torque_guarantee=node["torque_guarantee"].string(nonempty=True, default=None),
+        self_distance=_decode_self_distance(node["self_distance"]),
         **checks,
     )

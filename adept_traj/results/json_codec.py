@@ -70,11 +70,13 @@ def _read_json(path: Path) -> PlanningResult:
 
 # ============================================================================ encoding
 def _problem_settings(settings: ProblemSettings) -> dict[str, Any]:
-    """The settings as stored: a zero ``search_buffer`` is left out, so that files written
-    before the field existed are written back unchanged (absent reads back as 0)."""
+    """The settings as stored: a zero ``search_buffer``, ``self_collision`` off and no
+    ``disabled_pairs`` are left out, so that files written before the fields existed are
+    written back unchanged (absent reads back as 0, off and none)."""
     out = dataclasses.asdict(settings)
-    if out["search_buffer"] == 0.0:
-        del out["search_buffer"]
+    for key, default in (("search_buffer", 0.0), ("self_collision", False), ("disabled_pairs", ())):
+        if out[key] == default or out[key] is None:
+            del out[key]
     return out
 
 
@@ -194,6 +196,7 @@ def _decode(top: Node) -> PlanningResult:
     ps = top["problem_settings"].check_keys([f.name for f in dataclasses.fields(ProblemSettings)])
     settings = {k: tuple(v) if isinstance(v, list) else v for k, v in ps.table().items()}
     settings.setdefault("search_buffer", 0.0)  # absent: written before the field (no buffer)
+    settings.setdefault("self_collision", False)  # absent: off (or written before the field)
     scene = top["scene"]
     scene.build(Scene.from_dict, scene.table(), source=f"{top.file} (scene)")
     lim = top["limits"]
