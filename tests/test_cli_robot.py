@@ -310,3 +310,19 @@ def test_the_tool_frame_help_of_a_saved_result_names_the_recorded_default(
     text = " ".join(capsys.readouterr().out.split())
     assert "tool frame name (default: the recorded one)" in text
     assert "the parameter file's" not in text
+
+
+def test_the_ur5_example_scene_names_its_srdf_as_a_package_uri_and_turns_self_collision_on() -> (
+    None
+):
+    source = read_robot_files(EXAMPLES / "ur5_box.toml")
+    assert str(source.srdf).startswith("package://example-robot-data/")
+    robot = source.load()
+    expected = ROBOTS / "ur_description" / "srdf" / "ur5.srdf"
+    assert robot.srdf_path.resolve() == expected.resolve()
+    assert {"base_link", "shoulder_link"} in [set(pair) for pair in robot.disabled_pairs]
+    scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, n_knots=6)
+    assert problem.self_check is not None
+    assert problem.self_check.n_pairs > 0
+    problem.close()

@@ -166,8 +166,9 @@ class Robot:
             Folders searched first for ``package://`` meshes (then ``ROS_PACKAGE_PATH``,
             then installed robot data; :mod:`adept_traj.robot.package_paths`).
         srdf:
-            Optional SRDF: its ``disable_collisions`` link pairs are left out of the
-            self-collision check (:class:`~adept_traj.collision.SelfCollision`).
+            Optional SRDF (a path or a ``package://`` URI): its ``disable_collisions`` link
+            pairs are left out of the self-collision check
+            (:class:`~adept_traj.collision.SelfCollision`).
         tool_frame:
             Tool frame name; default: the parameter file's ``tool_frame``, else the last
             frame of the model. An unknown name is refused with the list of frames.
@@ -217,7 +218,7 @@ class Robot:
             package_dirs=dirs,
             locked_joints=locked_joints,
             mesh_hulls=hulls,
-            srdf_path=None if srdf is None else Path(srdf),
+            srdf_path=None if srdf is None else resolve_package_file(str(srdf), package_dirs),
         )
 
     # ------------------------------------------------------------------ basic facts

@@ -51,7 +51,8 @@ class RobotSource:
     params: the parameter file (TOML), or ``None``.
     tool_frame: the tool frame's name, or ``None`` (the parameter file's, else the last).
     package_dirs: folders searched first for ``package://`` files.
-    srdf: the SRDF (its ``disable_collisions`` pairs), or ``None``.
+    srdf: the SRDF's path or ``package://`` URI (its ``disable_collisions`` pairs), or
+        ``None``.
     locked_joints: ``(name, value)`` pairs of joints fixed at a value [rad | m] (a mapping
         is accepted and stored as pairs).
     """
@@ -94,7 +95,7 @@ class RobotSource:
 
         def path(key: str) -> str | Path | None:
             text = node[key].string(nonempty=True, default=None)
-            if text is None or (key == "urdf" and text.startswith(_URI)):
+            if text is None or (key in ("urdf", "srdf") and text.startswith(_URI)):
                 return text
             if not (base / text).is_file():
                 raise node[key].error(f"no such file: {base / text}")
