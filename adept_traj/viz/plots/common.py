@@ -178,8 +178,9 @@ def save_figure(fig: Figure, path: Path) -> Path:
     a crash or Ctrl-C); return ``path``.
 
     zlib level 1 (:data:`PNG_COMPRESSION`): about 0.02 s less per figure than matplotlib's
-    default level 6 (a quarter of the encoding time) for files up to a quarter larger. No ``Software`` entry (matplotlib's
-    version): the same figure gives the same bytes with any matplotlib release.
+    default level 6 (a quarter of the encoding time) for files up to a quarter larger.
+    No ``Software`` entry (matplotlib's version): the same figure gives the same
+    bytes with any matplotlib release.
     """
     return write_atomic(
         path,
