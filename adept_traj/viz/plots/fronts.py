@@ -1,9 +1,8 @@
 """The final fronts as a scatter matrix of the objectives z1…z6 (the paper's Figs. 5–6).
 
-The 36 panels are drawn on ONE matplotlib ``Axes`` (hidden), each panel a square cell of
-it with its own scale: an ``Axes`` costs about 25 ms to make and draw, so 36 of them were
-most of the figure's time. Each result is then three scatters (feasible, infeasible, best
-trade-off) over all the panels, the histograms one filled and one outlined collection.
+The 36 panels are cells of one hidden ``Axes`` (:mod:`adept_traj.viz.plots.panels`): each
+result is three scatters (feasible, infeasible, best trade-off) over all the panels, its
+histograms one filled and one outlined collection.
 """
 
 from __future__ import annotations
@@ -27,6 +26,7 @@ from adept_traj.viz.plots.common import (
     png_path,
     save_figure,
 )
+from adept_traj.viz.plots.panels import hidden_axes, shifted, tick_labels
 
 __all__ = ["pareto_matrix"]
 
@@ -80,11 +80,8 @@ def pareto_matrix(
     peak = max(float(c.max()) for c in counts.values())
 
     fig = new_figure(_SIZE, _SIZE)
-    left, bottom, right, top = _BOX
-    ax = fig.add_axes((left, bottom, right - left, top - bottom))
-    ax.set_axis_off()
-    ax.set(xlim=(0.0, m - 1 + _SIDE), ylim=(0.0, m - 1 + _SIDE))
-    _panels(fig, ax, limits)
+    ax = hidden_axes(fig, _BOX, m - 1 + _SIDE, m - 1 + _SIDE)
+    _panels(ax, limits)
     rows, cols = np.nonzero(~np.eye(m, dtype=bool))  # the off-diagonal panels (i, j)
     diag = np.arange(m)
     for k, (key, r) in enumerate(res.items()):
@@ -144,15 +141,13 @@ def _to_panel(values: np.ndarray, limits: np.ndarray) -> np.ndarray:
     return _SIDE * (values - limits[:, 0]) / (limits[:, 1] - limits[:, 0])
 
 
-def _panels(fig: Any, ax: Any, limits: np.ndarray) -> None:
+def _panels(ax: Any, limits: np.ndarray) -> None:
     """The frames of the m × m panels (the diagonal shaded, named z1…z6) and the ticks,
     tick labels and axis labels of the bottom row (x) and the left column (y): three
     ticks per objective (``MaxNLocator(3)``), labels as matplotlib's ``ScalarFormatter``
     writes them (scientific outside 10⁻² … 10³, the factor at the axis' end)."""
     from matplotlib.collections import LineCollection, PatchCollection
     from matplotlib.patches import Rectangle
-    from matplotlib.ticker import MaxNLocator, ScalarFormatter
-    from matplotlib.transforms import offset_copy
 
     m = len(limits)
     boxes = [Rectangle((j, m - 1 - i), _SIDE, _SIDE) for i in range(m) for j in range(m)]
@@ -160,23 +155,11 @@ def _panels(fig: Any, ax: Any, limits: np.ndarray) -> None:
     ax.add_collection(PatchCollection(boxes, facecolors=shade, edgecolors="none", zorder=0))
     frames = PatchCollection(boxes, facecolors="none", edgecolors="black", lw=0.8, zorder=2.5)
     ax.add_collection(frames)
-
-    def shifted(dx: float, dy: float) -> Any:  # data coordinates shifted by points
-        return offset_copy(ax.transData, fig=fig, x=dx, y=dy, units="points")
-
-    below, left_of = shifted(0.0, -3.5), shifted(-3.5, 0.0)
+    below, left_of = shifted(ax, 0.0, -3.5), shifted(ax, -3.5, 0.0)
     ticks = []
     for j in range(m):
         lo, hi = limits[j]
-        locs = MaxNLocator(3).tick_values(lo, hi)
-        locs = locs[(locs >= lo) & (locs <= hi)]
-        fmt = ScalarFormatter(useMathText=True)
-        fmt.set_powerlimits((-2, 3))
-        fmt.create_dummy_axis()
-        fmt.axis.set_view_interval(lo, hi)
-        fmt.axis.set_data_interval(lo, hi)
-        texts = fmt.format_ticks(locs)
-        offset = fmt.get_offset()
+        locs, texts, offset = tick_labels(lo, hi, 3, math_text=True, power_limits=(-2, 3))
         pos = _SIDE * (locs - lo) / (hi - lo)
         # x ticks under panel (m - 1, j), y ticks left of panel (j, 0)
         for p, text in zip(pos, texts):
@@ -186,14 +169,15 @@ def _panels(fig: Any, ax: Any, limits: np.ndarray) -> None:
             ax.text(0.0, m - 1 - j + p, text, transform=left_of, fontsize=7, ha="right",
                     va="center")  # fmt: skip
         if offset:
-            ax.text(j + _SIDE, 0.0, offset, transform=shifted(0.0, -13.0), fontsize=7,
+            ax.text(j + _SIDE, 0.0, offset, transform=shifted(ax, 0.0, -13.0), fontsize=7,
                     ha="right", va="top")  # fmt: skip
-            ax.text(0.0, m - 1 - j + _SIDE, offset, transform=shifted(0.0, 2.0), fontsize=7,
-                    ha="left", va="bottom")  # fmt: skip
-        ax.text(j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shifted(0.0, -14.0),
+            ax.text(0.0, m - 1 - j + _SIDE, offset, transform=shifted(ax, 0.0, 2.0),
+                    fontsize=7, ha="left", va="bottom")  # fmt: skip
+        ax.text(j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shifted(ax, 0.0, -14.0),
                 fontsize=9, ha="center", va="top")  # fmt: skip
-        ax.text(0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j], transform=shifted(-30.0, 0.0),
-                fontsize=9, ha="right", va="center", rotation=90)  # fmt: skip
+        ax.text(0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j],
+                transform=shifted(ax, -30.0, 0.0), fontsize=9, ha="right", va="center",
+                rotation=90)  # fmt: skip
         ax.text(j + 0.04 * _SIDE, m - 1 - j + 0.93 * _SIDE, f"z{j + 1}", fontsize=10,
                 fontweight="bold", va="top")  # fmt: skip
     ax.add_collection(LineCollection(ticks, colors="black", lw=0.8))
