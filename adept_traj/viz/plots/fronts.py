@@ -159,7 +159,7 @@ def _panels(ax: Any, limits: np.ndarray) -> None:
     ticks = []
     for j in range(m):
         lo, hi = limits[j]
-        locs, texts, offset = tick_labels(lo, hi, 3, math_text=True, power_limits=(-2, 3))
+        locs, texts, offset = tick_labels(lo, hi, 3, power_of_ten=True, power_limits=(-2, 3))
         pos = _SIDE * (locs - lo) / (hi - lo)
         # x ticks under panel (m - 1, j), y ticks left of panel (j, 0)
         for p, text in zip(pos, texts):
