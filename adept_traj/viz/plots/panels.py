@@ -8,13 +8,14 @@ collection over all the cells, and only the tick labels that are seen as text.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
 
 __all__ = ["hidden_axes", "shifted", "tick_labels"]
 
-_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+_SUPERSCRIPT = str.maketrans("-−0123456789", "⁻⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 
 def hidden_axes(fig: Any, box: tuple[float, float, float, float], width: float,
@@ -68,7 +69,8 @@ def tick_labels(
     fmt.create_dummy_axis()
     fmt.axis.set_view_interval(lo, hi)
     fmt.axis.set_data_interval(lo, hi)
-    labels = fmt.format_ticks(locs)
-    if power_of_ten and fmt.orderOfMagnitude and not fmt.offset:
-        return locs, labels, "×10" + str(fmt.orderOfMagnitude).translate(_SUPERSCRIPT)
-    return locs, labels, fmt.get_offset()
+    labels, offset = fmt.format_ticks(locs), fmt.get_offset()
+    factor = re.fullmatch("1e([-−]?[0-9]+)", offset)  # a factor alone, no offset
+    if power_of_ten and factor:
+        return locs, labels, "×10" + factor.group(1).translate(_SUPERSCRIPT)
+    return locs, labels, offset
