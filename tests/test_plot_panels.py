@@ -1,4 +1,4 @@
-"""adept_traj.viz.plots.panels: the ticks of a panel drawn on a shared hidden Axes are those
+"""adept_traj.viz.plots._panels: the ticks of a panel drawn on a shared hidden Axes are those
 a matplotlib axis of the same range places and labels (the reference: a real Axes)."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator, ScalarFormatter
 
-from adept_traj.viz.plots.panels import hidden_axes, tick_labels
+from adept_traj.viz.plots._panels import hidden_axes, tick_labels
 
 assert matplotlib  # imported for its presence
 

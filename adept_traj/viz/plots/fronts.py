@@ -1,6 +1,6 @@
 """The final fronts as a scatter matrix of the objectives z1…z6 (the paper's Figs. 5–6).
 
-The 36 panels are cells of one hidden ``Axes`` (:mod:`adept_traj.viz.plots.panels`): each
+The 36 panels are cells of one hidden ``Axes`` (``adept_traj.viz.plots._panels``): each
 result is three scatters (feasible, infeasible, best trade-off) over all the panels, its
 histograms one filled and one outlined collection.
 """
@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.results import PlanningResult
+from adept_traj.viz.plots._panels import hidden_axes, shifted, tick_labels
 from adept_traj.viz.plots.common import (
     COLOURS,
     MARKERS,
@@ -26,7 +27,6 @@ from adept_traj.viz.plots.common import (
     png_path,
     save_figure,
 )
-from adept_traj.viz.plots.panels import hidden_axes, shifted, tick_labels
 
 __all__ = ["pareto_matrix"]
 
@@ -81,7 +81,7 @@ def pareto_matrix(
 
     fig = new_figure(_SIZE, _SIZE)
     ax = hidden_axes(fig, _BOX, m - 1 + _SIDE, m - 1 + _SIDE)
-    _panels(ax, limits)
+    _frames_and_ticks(ax, limits)
     rows, cols = np.nonzero(~np.eye(m, dtype=bool))  # the off-diagonal panels (i, j)
     diag = np.arange(m)
     for k, (key, r) in enumerate(res.items()):
@@ -141,7 +141,7 @@ def _to_panel(values: np.ndarray, limits: np.ndarray) -> np.ndarray:
     return _SIDE * (values - limits[:, 0]) / (limits[:, 1] - limits[:, 0])
 
 
-def _panels(ax: Any, limits: np.ndarray) -> None:
+def _frames_and_ticks(ax: Any, limits: np.ndarray) -> None:
     """The frames of the m × m panels (the diagonal shaded, named z1…z6) and the ticks,
     tick labels and axis labels of the bottom row (x) and the left column (y): three
     ticks per objective (``MaxNLocator(3)``), labels as matplotlib's ``ScalarFormatter``

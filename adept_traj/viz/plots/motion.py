@@ -14,6 +14,7 @@ import numpy as np
 from adept_traj.results import PlanningResult, certified_members, member_dense, member_index
 from adept_traj.robot import LIMITS
 from adept_traj.viz.inputs import as_result
+from adept_traj.viz.plots._panels import hidden_axes, shifted, tick_labels
 from adept_traj.viz.plots.common import (
     display_name,
     new_figure,
@@ -23,13 +24,12 @@ from adept_traj.viz.plots.common import (
     status,
     violations_line,
 )
-from adept_traj.viz.plots.panels import hidden_axes, shifted, tick_labels
 
 __all__ = ["joint_motion"]
 
 #: Row title of each limit kind (torque rows also hold the prismatic joint's force).
 _TITLES = {"torque": "torque / force"}
-#: Panels are unit cells of one hidden Axes (:mod:`.panels`), apart by these gaps [cell],
+#: Panels are unit cells of one hidden Axes (``_panels``), apart by these gaps [cell],
 #: inside this box of the figure (left, bottom, right, top).
 _GAP_X, _GAP_Y = 0.32, 0.2
 _PITCH_X, _PITCH_Y = 1.0 + _GAP_X, 1.0 + _GAP_Y
@@ -141,6 +141,7 @@ def joint_motion(
                 ax.text(
                     x0, y0 + 1.0, offset, transform=shifted(ax, 0.0, 2.0), fontsize=8, va="bottom"
                 )
+            # the label left of the widest tick label (about 0.62 em a character) [points]
             width = 7.0 + 0.62 * 8 * max((len(s) for s in y_texts), default=0) + 4.0
             ax.text(x0, y0 + 0.5, f"{title} [{unit}]", transform=shifted(ax, -width, 0.0),
                     fontsize=9, ha="right", va="center", rotation=90)  # fmt: skip
