@@ -267,3 +267,19 @@ def test_wireframes_outline_the_solids() -> None:
     np.testing.assert_allclose(cyl[:, 2].min(), 2.7)
     np.testing.assert_allclose(cyl[:, 2].max(), 3.3)
     assert wireframes.wireframe("mesh", (), pose) == []
+
+
+def test_figures_are_the_same_bytes_every_time(
+    results: dict[str, PlanningResult], figures: dict[str, Path], tmp_path: Path
+) -> None:
+    """Drawn again in this process (save_all drew them on two), the same bytes; no
+    matplotlib version in the file (a Software entry would change with each release)."""
+    again = {
+        "pareto_matrix.png": plots.pareto_matrix(results, tmp_path / "p.png"),
+        "joint_motion_nsga2.png": plots.joint_motion(results["nsga2"], tmp_path / "j.png"),
+    }
+    for name, path in again.items():
+        data = path.read_bytes()
+        assert data == figures[name].read_bytes(), name
+        assert b"Software" not in data
+        assert b"atplotlib" not in data

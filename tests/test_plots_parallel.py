@@ -57,8 +57,8 @@ def test_two_processes_write_the_files_of_one(
     assert set(_writers(one).values()) == {os.getpid()}
     writers = _writers(two)
     assert len(set(writers.values())) == 2  # this process and one forked process
-    # the heaviest two (joint motion, Pareto matrix) are drawn by different processes
-    assert writers["joint_motion_nsga2.png"] != writers["pareto_matrix.png"]
+    # the heaviest two (tool path, joint motion) are drawn by different processes
+    assert writers["tool_path_nsga2.png"] != writers["joint_motion_nsga2.png"]
 
 
 def test_a_figure_whose_process_fails_is_drawn_again_here(

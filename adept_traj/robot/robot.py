@@ -166,9 +166,8 @@ class Robot:
             Folders searched first for ``package://`` meshes (then ``ROS_PACKAGE_PATH``,
             then installed robot data; :mod:`adept_traj.robot.package_paths`).
         srdf:
-            Optional SRDF (a path or a ``package://`` URI): its ``disable_collisions`` link
-            pairs are left out of the self-collision check
-            (:class:`~adept_traj.collision.SelfCollision`).
+            Optional SRDF (path or ``package://`` URI): its ``disable_collisions`` pairs
+            are left out of the self-collision check (:class:`~adept_traj.collision.SelfCollision`).
         tool_frame:
             Tool frame name; default: the parameter file's ``tool_frame``, else the last
             frame of the model. An unknown name is refused with the list of frames.

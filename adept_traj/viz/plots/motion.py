@@ -14,9 +14,11 @@ import numpy as np
 from adept_traj.results import PlanningResult, certified_members, member_dense, member_index
 from adept_traj.robot import LIMITS
 from adept_traj.viz.inputs import as_result
+from adept_traj.viz.plots._panels import hidden_axes, shifted, tick_labels
 from adept_traj.viz.plots.common import (
     display_name,
     new_figure,
+    padded,
     png_path,
     save_figure,
     status,
@@ -27,6 +29,11 @@ __all__ = ["joint_motion"]
 
 #: Row title of each limit kind (torque rows also hold the prismatic joint's force).
 _TITLES = {"torque": "torque / force"}
+#: Panels are unit cells of one hidden Axes (``_panels``), apart by these gaps [cell],
+#: inside this box of the figure (left, bottom, right, top).
+_GAP_X, _GAP_Y = 0.32, 0.2
+_PITCH_X, _PITCH_Y = 1.0 + _GAP_X, 1.0 + _GAP_Y
+_BOX = (0.06, 0.05, 0.99, 0.92)
 
 
 def _limit_lines(limits: Any, kind: str, j: int) -> list[float]:
@@ -36,6 +43,23 @@ def _limit_lines(limits: Any, kind: str, j: int) -> list[float]:
         v = float(limits.bound(kind)[j])
         values = [-v, v]
     return [v for v in values if math.isfinite(v)]
+
+
+def _note(limits: Any, kind: str, j: int, values: np.ndarray) -> str:
+    """A panel's note: the peak of ``values`` (n,) as a percentage of its limit, or for
+    positions the smallest margin to a limit as a percentage of the range ("" if the limit
+    is infinite)."""
+    if kind == "position":
+        span = float(limits.upper[j] - limits.lower[j])
+        margin = min(float(limits.upper[j] - values.max()), float(values.min() - limits.lower[j]))
+        return (
+            f"margin {100 * margin / span:.0f} % of range"
+            if math.isfinite(span) and span > 0
+            else ""
+        )
+    lim = float(limits.bound(kind)[j])
+    peak = float(np.abs(values).max())
+    return f"peak {100 * peak / lim:.0f} % of limit" if math.isfinite(lim) else ""
 
 
 def joint_motion(
@@ -75,59 +99,90 @@ def joint_motion(
     best = index == r.best.index
     dense, limits = member_dense(r, index), r.limits
     t, nq = dense.t, dense.nq
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.collections import LineCollection, PatchCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Rectangle
 
     fig = new_figure(4.0 * nq + 1.0, 13.5)
-    axes = np.atleast_2d(fig.subplots(len(LIMITS), nq, sharex=True, squeeze=False))
-    fig.subplots_adjust(left=0.06, right=0.99, bottom=0.05, top=0.92, wspace=0.32, hspace=0.2)
+    n_rows = len(LIMITS)
+    ax = hidden_axes(fig, _BOX, nq * _PITCH_X - _GAP_X, n_rows * _PITCH_Y - _GAP_Y)
+    t0, t1 = float(t[0]), float(t[-1])
+    x_locs, x_texts, _ = tick_labels(t0, t1, 5)  # the columns share the time axis
+    x_pos = (x_locs - t0) / (t1 - t0)
+    u = (t - t0) / (t1 - t0)  # (n,) time in cell units
+    curves, limit_lines, grid, boxes = [], [], [], []
+    x_ticks: list[tuple[float, float]] = []
+    y_ticks: list[tuple[float, float]] = []
     for row, kind in enumerate(LIMITS):
         data = getattr(dense, kind.quantity)
         title, units = _TITLES.get(kind.name, kind.name), kind.units
+        y0 = (n_rows - 1 - row) * _PITCH_Y
         for j in range(nq):
-            ax = axes[row, j]
+            x0 = j * _PITCH_X
+            boxes.append(Rectangle((x0, y0), 1.0, 1.0))
             unit = units[0] if limits.units[j] == "rad" else units[1]
-            ax.plot(t, data[:, j], color="tab:blue", lw=1.3)
             lines = _limit_lines(limits, kind.name, j)
-            for v in lines:
-                ax.axhline(v, color="tab:red", ls="--", lw=1.0)
-            if kind.name == "position":
-                span = float(limits.upper[j] - limits.lower[j])
-                margin = min(
-                    float(limits.upper[j] - data[:, j].max()),
-                    float(data[:, j].min() - limits.lower[j]),
+            lo, hi = padded(min(data[:, j].min(), *lines), max(data[:, j].max(), *lines), 0.05)
+            curves.append(np.column_stack([x0 + u, y0 + (data[:, j] - lo) / (hi - lo)]))
+            limit_lines += [
+                [(x0, y0 + (v - lo) / (hi - lo)), (x0 + 1.0, y0 + (v - lo) / (hi - lo))]
+                for v in lines
+            ]
+            y_locs, y_texts, offset = tick_labels(lo, hi, 4)
+            y_pos = y0 + (y_locs - lo) / (hi - lo)
+            grid += [[(x0, y), (x0 + 1.0, y)] for y in y_pos]
+            grid += [[(x0 + x, y0), (x0 + x, y0 + 1.0)] for x in x_pos]
+            x_ticks += [(x0 + x, y0) for x in x_pos]
+            y_ticks += [(x0, y) for y in y_pos]
+            for y, text in zip(y_pos, y_texts):
+                ax.text(x0, y, text, transform=shifted(ax, -7.0, 0.0), fontsize=8, ha="right",
+                        va="center")  # fmt: skip
+            if offset:
+                ax.text(
+                    x0, y0 + 1.0, offset, transform=shifted(ax, 0.0, 2.0), fontsize=8, va="bottom"
                 )
-                note = (
-                    f"margin {100 * margin / span:.0f} % of range"
-                    if math.isfinite(span) and span > 0
-                    else ""
-                )
-            else:
-                lim = float(limits.bound(kind.name)[j])
-                peak = float(np.abs(data[:, j]).max())
-                note = f"peak {100 * peak / lim:.0f} % of limit" if math.isfinite(lim) else ""
+            # the label left of the widest tick label (about 0.62 em a character) [points]
+            width = 7.0 + 0.62 * 8 * max((len(s) for s in y_texts), default=0) + 4.0
+            ax.text(x0, y0 + 0.5, f"{title} [{unit}]", transform=shifted(ax, -width, 0.0),
+                    fontsize=9, ha="right", va="center", rotation=90)  # fmt: skip
+            note = _note(limits, kind.name, j, data[:, j])
             if note:
                 ax.text(
-                    0.98,
-                    0.04,
+                    x0 + 0.98,
+                    y0 + 0.04,
                     note,
-                    transform=ax.transAxes,
                     ha="right",
                     va="bottom",
                     fontsize=8,
                     bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 1},
+                    zorder=3,
                 )
-            ax.set_ylabel(f"{title} [{unit}]", fontsize=9)
-            ax.tick_params(labelsize=8)
-            ax.grid(alpha=0.3)
-            ax.yaxis.set_major_locator(MaxNLocator(4))  # fewer ticks: each is 4 artists
             if row == 0:
                 joint_type = "revolute" if limits.units[j] == "rad" else "prismatic"
-                ax.set_title(f"{limits.names[j]} ({joint_type})", fontsize=11)
-            if row == len(LIMITS) - 1:
-                ax.set_xlabel("time t [s]", fontsize=9)
-    ax0 = axes[0, 0]
-    ax0.xaxis.set_major_locator(MaxNLocator(5))  # shared by the columns' time axes
-    from matplotlib.lines import Line2D
+                ax.text(
+                    x0 + 0.5,
+                    y0 + 1.0,
+                    f"{limits.names[j]} ({joint_type})",
+                    transform=shifted(ax, 0.0, 6.0),
+                    fontsize=11,
+                    ha="center",
+                    va="bottom",
+                )
+            if row == n_rows - 1:
+                for x, text in zip(x_pos, x_texts):
+                    ax.text(x0 + x, y0, text, transform=shifted(ax, 0.0, -7.0), fontsize=8,
+                            ha="center", va="top")  # fmt: skip
+                ax.text(x0 + 0.5, y0, "time t [s]", transform=shifted(ax, 0.0, -19.0),
+                        fontsize=9, ha="center", va="top")  # fmt: skip
+    ax.add_collection(LineCollection(grid, colors="#b0b0b0", alpha=0.3, lw=0.8, zorder=1.5))
+    ax.add_collection(LineCollection(curves, colors="tab:blue", lw=1.3, zorder=2))
+    ax.add_collection(LineCollection(limit_lines, colors="tab:red", linestyles="--", lw=1.0,
+                                     zorder=2))  # fmt: skip
+    ax.add_collection(PatchCollection(boxes, facecolors="none", edgecolors="black", lw=0.8,
+                                      zorder=2.5))  # fmt: skip
+    for ticks, marker in ((x_ticks, 3), (y_ticks, 0)):  # TICKDOWN, TICKLEFT: 3.5 pt long
+        xs, ys = np.array(ticks).T
+        ax.plot(xs, ys, ls="", marker=marker, ms=3.5, mew=0.8, color="black", clip_on=False)
 
     who = "best trade-off" if best else f"member {index}"
 
@@ -141,7 +196,6 @@ def joint_motion(
         fontsize=9,
         bbox_to_anchor=(0.99, 0.965),
     )
-    ax0.set_xlim(float(t[0]), float(t[-1]))
     if best:
         what, T = "the best trade-off", float(r.best_objectives[0])
         verdict = f"{status(r)} at {r.certificate.rate_hz:g} Hz"
