@@ -129,8 +129,13 @@ def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
     assert raw.algorithm_settings["polish"] == "off"
 
 
-def test_time_optimal_mode_gives_a_certified_result(problem) -> None:
-    result = plan(problem, "time-optimal", seed=1, n_starts=2)
+@pytest.fixture(scope="module")
+def time_optimal_result(problem: TrajectoryProblem):
+    return plan(problem, "time-optimal", seed=1, n_starts=2)
+
+
+def test_time_optimal_mode_gives_a_certified_result(time_optimal_result) -> None:
+    result = time_optimal_result
     assert result.algorithm == "time-optimal"
     assert result.feasible
     assert result.front.n_certified == len(result.front.x)
