@@ -57,6 +57,8 @@ _DISTANCE = CONSTRAINT_KINDS.index("distance")
 #: the detour scene, of 400 ramps × (1, 1.25, 1.5, 2, 2.5) only ramps at 1 × were feasible).
 _DETOUR_RAMPS = 2000
 _DETOUR_SPEEDS = (1.0,)
+#: Most batches of detour ramps drawn (a feasible ramp is rare: 0–3 in 2 000 there).
+_DETOUR_BATCHES = 3
 
 #: Extra distance buffers [m] of the solves from detour starts, tried in turn until the
 #: move passes its certificate (a fast move cuts corners between the samples: measured on
@@ -174,18 +176,22 @@ def time_optimal(
 
 def _detour_starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
     """(k, n_var), k ≤ ``n_starts``: the fastest feasible moves, one per ramp, among
-    :data:`_DETOUR_RAMPS` seeded ramps each at :data:`_DETOUR_SPEEDS` × its kinematic
-    minimum T (one batched evaluation by the problem); fastest first."""
-    rng = np.random.default_rng([seed, 1])  # not the ramps of _starts
-    ramps = RampSampling().ramps(problem, _DETOUR_RAMPS, rng)
+    batches of :data:`_DETOUR_RAMPS` seeded ramps each at :data:`_DETOUR_SPEEDS` × its
+    kinematic minimum T (one batched evaluation by the problem each), fastest first; up to
+    :data:`_DETOUR_BATCHES` batches, until one holds a feasible move (k = 0: none did)."""
     speeds = np.asarray(_DETOUR_SPEEDS)
-    x = np.repeat(ramps, len(speeds), axis=0)
-    t = np.repeat(kinematic_time(problem, ramps), len(speeds)) * np.tile(speeds, len(ramps))
-    x[:, 0] = np.clip(t * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
-    ok = np.all(problem.evaluate_batch(x).constraints <= 0.0, axis=1).reshape(len(ramps), -1)
-    rows = np.flatnonzero(ok.any(axis=1))
-    rows = rows * len(speeds) + np.argmax(ok[rows], axis=1)  # each ramp's fastest feasible
-    return x[rows[np.argsort(x[rows, 0], kind="stable")][:n_starts]]
+    for batch in range(_DETOUR_BATCHES):
+        rng = np.random.default_rng([seed, 1 + batch])  # not the ramps of _starts
+        ramps = RampSampling().ramps(problem, _DETOUR_RAMPS, rng)
+        x = np.repeat(ramps, len(speeds), axis=0)
+        t = np.repeat(kinematic_time(problem, ramps), len(speeds)) * np.tile(speeds, len(ramps))
+        x[:, 0] = np.clip(t * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
+        ok = np.all(problem.evaluate_batch(x).constraints <= 0.0, axis=1).reshape(len(ramps), -1)
+        rows = np.flatnonzero(ok.any(axis=1))
+        if len(rows):
+            rows = rows * len(speeds) + np.argmax(ok[rows], axis=1)  # each ramp's fastest
+            return x[rows[np.argsort(x[rows, 0], kind="stable")][:n_starts]]
+    return np.empty((0, problem.n_var))
 
 
 def _detour(problem: Any, x0: np.ndarray, options: dict[str, Any]) -> PolishOutcome:
