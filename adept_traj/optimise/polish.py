@@ -21,7 +21,10 @@ feasibility.
 :func:`time_optimal` runs :func:`minimum_time` from several starts — the straight move and
 the ``n_starts − 1`` kinematically fastest of 8 × (``n_starts`` − 1) ramps of
 :class:`~adept_traj.optimise.RampSampling` drawn from a generator seeded by ``seed``, each
-at its kinematic minimum T — and returns every outcome. Everything
+at its kinematic minimum T — and returns every outcome. When none of them ends feasible
+(the straight move blocked, as on the detour scene), it adds the outcomes of detour
+starts: the fastest evaluator-feasible of batches of seeded ramps, solved with extra
+distance buffers until the move passes its certificate (``docs/engine.md``). Everything
 is deterministic: the same problem and seed give the same vectors.
 """
 
@@ -151,7 +154,8 @@ def time_optimal(
 ) -> list[PolishOutcome]:
     """:func:`minimum_time` from the straight move and the ``n_starts − 1`` kinematically
     fastest of ``8 (n_starts − 1)`` seeded ramps (each at its kinematic minimum T); one
-    outcome per start, in start order.
+    outcome per start, in start order; when none is feasible, followed by the outcomes of
+    at most ``n_starts`` detour starts (module docstring).
 
     Parameters
     ----------
