@@ -81,6 +81,8 @@ def test_front_lists_every_member_of_a_v1_result(capsys: pytest.CaptureFixture[s
         "F_avg [-]",
         "certified",
         "clearance [m]",
+        "T/T_lb [-]",
+        "T/T_best [-]",
     ]
     n = len(raw["front"])
     assert [int(r[1]) for r in rows] == list(range(n))

@@ -129,8 +129,13 @@ def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
     assert raw.algorithm_settings["polish"] == "off"
 
 
-def test_time_optimal_mode_gives_a_certified_result(problem) -> None:
-    result = plan(problem, "time-optimal", seed=1, n_starts=2)
+@pytest.fixture(scope="module")
+def time_optimal_result(problem: TrajectoryProblem):
+    return plan(problem, "time-optimal", seed=1, n_starts=2)
+
+
+def test_time_optimal_mode_gives_a_certified_result(time_optimal_result) -> None:
+    result = time_optimal_result
     assert result.algorithm == "time-optimal"
     assert result.feasible
     assert result.front.n_certified == len(result.front.x)
@@ -151,3 +156,32 @@ def test_a_scene_without_obstacles_has_no_distance_rows(problem) -> None:
     np.testing.assert_array_equal(lc.jacobian, with_obstacles.jacobian[:, keep])
     outcome = minimum_time(empty, x[0], max_iter=5)
     assert outcome.x[0] < x[0, 0]
+
+
+def test_minimum_time_keeps_the_fastest_point_inside_when_slsqp_ends_outside(problem) -> None:
+    """One SLSQP iteration from a feasible detour ends outside the constraints: the
+    fastest visited point inside them is returned (here the start), evaluated."""
+    x0 = lift_then_lower(problem)
+    assert np.all(problem.evaluate_batch(x0).constraints <= 0.0)
+    out = minimum_time(problem, x0, max_iter=1)
+    assert out.feasible
+    assert out.x[0] <= x0[0]
+    assert np.all(problem.evaluate_batch(out.x).constraints <= 0.0)
+
+
+def test_minimum_time_buffer_keeps_the_samples_farther(problem) -> None:
+    """With ``buffer`` b every sample of the answer clears margin + search buffer + b (the
+    distance rows of local_constraints, scaled by the influence distance); b < 0 refused."""
+    x0 = problem.trajectory.straight_line(problem.xl[0])
+    b = 0.003
+    out = minimum_time(problem, x0, max_iter=30, buffer=b)
+    assert out.feasible
+    lc = local_constraints(problem, out.x)
+    rows = lc.kind == CONSTRAINT_KINDS.index("distance")
+    assert np.all(lc.values[0, rows] <= -b / problem.settings.influence + 1e-6)
+    plain = minimum_time(problem, x0, max_iter=30)
+    assert np.any(
+        local_constraints(problem, plain.x).values[0, rows] > -b / problem.settings.influence
+    )
+    with pytest.raises(ConfigurationError, match="buffer"):
+        minimum_time(problem, x0, buffer=-0.001)

@@ -12,6 +12,9 @@ version-1 file, which holds the best trade-off's only). A clearance shown as ``â
 lower bound: the member stays farther than ``margin + 0.01 m`` from everything, where its
 certificate keeps the broad phase's bounds (:mod:`adept_traj.analysis.member_certificate`).
 The best trade-off (``result.best.index``) is marked ``*``; its clearance is always exact.
+The last two columns are the member's gaps: ``T`` over the kinematic lower bound
+(``result.lower_bound.T_min``) and over T_best (``result.metrics.t_best``, the best T the
+local solver reached in the run; ``-``: not computed).
 
 ``certified`` is ``front.feasible`` when :func:`~adept_traj.plan` certified every member
 (``front.n_certified`` set). A result saved before that (``n_certified`` absent, e.g.
@@ -52,6 +55,8 @@ COLUMNS: dict[str, str] = {
     "F_avg": "-",
     "certified": "",
     "clearance": "m",
+    "T/T_lb": "-",
+    "T/T_best": "-",
 }
 
 
@@ -92,6 +97,9 @@ def _columns(result: PlanningResult, weights: list[float]) -> dict[str, np.ndarr
     cols.update(f_c=choice.f_c, F_avg=choice.F_avg, certified=certified, clearance=clearance)
     exact[result.best.index] = True
     cols["clearance_exact"] = exact
+    t_lb, t_best = float(result.lower_bound.T_min), result.metrics.t_best
+    cols["T/T_lb"] = front.x[:, 0] / t_lb if t_lb > 0 else np.full(n, np.nan)
+    cols["T/T_best"] = front.x[:, 0] / t_best if t_best else np.full(n, np.nan)
     return cols
 
 
@@ -100,7 +108,7 @@ def _cell(name: str, value: float | bool, exact: bool = True) -> str:
         return str(int(value))
     if name == "certified":
         return "yes" if value else "no"
-    if name == "clearance" and np.isnan(value):
+    if name in ("clearance", "T/T_lb", "T/T_best") and np.isnan(value):
         return "-"
     if name == "clearance" and not exact:
         return f"â‰¥{float(value):.6g}"

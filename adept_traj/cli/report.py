@@ -7,12 +7,22 @@ from pathlib import Path
 
 from adept_traj.results import PlanningResult, Replay
 
-__all__ = ["save_figures", "summary"]
+__all__ = ["save_figures", "summary", "t_best_text"]
+
+
+def t_best_text(result: PlanningResult) -> str:
+    """``"T_best 1.077 s by polish, gap 1.06x"`` (the best trade-off's z1 over
+    ``metrics.t_best`` [s]) or ``"T_best not computed"``."""
+    m = result.metrics
+    if m.t_best is None:
+        return "T_best not computed"
+    return f"T_best {m.t_best:.4f} s by {m.t_best_source}, gap {result.gap_best:.3f}x"
 
 
 def summary(result: PlanningResult, folder: Path) -> str:
     """A few lines on a finished run: evaluations, time and evaluation workers, the best
-    trade-off's objectives z1 [s] … z6 and its gap to the kinematic lower bound, how many
+    trade-off's objectives z1 [s] … z6 and its gaps to the kinematic lower bound and to
+    T_best (``metrics.t_best``, the best T the local solver reached; "not computed"), how many
     front members are certified, its dense certificate and the guarantee it gives
     (violations listed), the result's warning and where it was saved."""
     z = result.best_objectives
@@ -29,8 +39,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
         f"{workers} worker{'s' if workers != 1 else ''}); "
         f"front of {len(front)}{certified}",
         f"best trade-off: T = {z[0]:.3f} s (lower bound {result.lower_bound.T_min:.3f} s, "
-        f"gap {result.gap:.2f}x), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, z4 = {z[3]:.4g} m², "
-        f"z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
+        f"gap {result.gap:.2f}x; {t_best_text(result)}), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, "
+        f"z4 = {z[3]:.4g} m², z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
         f"verified at {cert.rate_hz:g} Hz: {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m; "
         f"distance: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'}; "

@@ -250,6 +250,7 @@ def plan(
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     polish = polish_mode(polish)
     warn_missing_limits(problem.robot.name, problem.robot.limits)
+    n_searched: int | None = 0  # population rows made by the search (the rest by the local solver)
     if algorithm == TIME_OPTIMAL:
         state, settings_dict = time_optimal_run(problem, seed, **params)
         name = TIME_OPTIMAL
@@ -268,6 +269,7 @@ def plan(
         )
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
+        n_searched = len(state.X) if polish != "off" else None
         state = polish_run(problem, state, rate_hz, polish, weights)
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
@@ -308,6 +310,7 @@ def plan(
         ae=algorithm_effort(state.total_s, state.n_evaluations),
         hv=normalised_hypervolume(front.objectives, lo, hi) if feasible.any() else None,
         hv_reference_point=np.full(6, DEFAULT_HV_REFERENCE) if feasible.any() else None,
+        **_t_best(front, rows, n_searched, name),
     )
     return PlanningResult.from_problem(
         problem,
@@ -329,3 +332,17 @@ def plan(
         history=_history(state, front.objectives if feasible.any() else None),
         warning=warning,
     )
+
+
+def _t_best(front: Front, rows: np.ndarray, n_searched: int | None, name: str) -> dict[str, Any]:
+    """``t_best`` [s] and ``t_best_source`` of :class:`~adept_traj.results.Metrics`: the z1
+    of the front's fastest certified member when the local solver made it (its population
+    row ``rows[k]`` ≥ ``n_searched``; ``n_searched`` None: no polish), else nothing."""
+    ok = np.flatnonzero(front.feasible)
+    if n_searched is None or len(ok) == 0:
+        return {}
+    k = ok[np.argmin(front.objectives[ok, 0])]
+    if rows[k] < n_searched:
+        return {}
+    source = "time-optimal" if name == TIME_OPTIMAL else "polish"
+    return {"t_best": float(front.objectives[k, 0]), "t_best_source": source}

@@ -21,22 +21,27 @@ feasibility.
 :func:`time_optimal` runs :func:`minimum_time` from several starts — the straight move and
 the ``n_starts − 1`` kinematically fastest of 8 × (``n_starts`` − 1) ramps of
 :class:`~adept_traj.optimise.RampSampling` drawn from a generator seeded by ``seed``, each
-at its kinematic minimum T — and returns every outcome. Everything
+at its kinematic minimum T — and returns every outcome. When none of them ends feasible
+(the straight move blocked, as on the detour scene), it adds the outcomes of detour
+starts: the fastest evaluator-feasible of batches of seeded ramps, solved with extra
+distance buffers until the move passes its certificate (``docs/engine.md``). Everything
 is deterministic: the same problem and seed give the same vectors.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis.member_certificate import certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
-from adept_traj.problem import local_constraints
+from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
 from adept_traj.validation import as_integer, as_scalar, as_vector
 
 __all__ = ["PolishOutcome", "minimum_time", "time_optimal"]
@@ -46,6 +51,22 @@ _SLACK = 1e-9
 
 #: Ramps drawn per ramp start of :func:`time_optimal` (the fastest ones are used).
 _RAMPS_PER_START = 8
+
+#: Index of the distance rows in :data:`~adept_traj.problem.CONSTRAINT_KINDS`.
+_DISTANCE = CONSTRAINT_KINDS.index("distance")
+
+#: Detour starts of :func:`time_optimal`: ramps drawn, and the multiples of each ramp's
+#: kinematic minimum T at which they are evaluated (one batch of 2 000 moves, ≈ 1.5 s; on
+#: the detour scene, of 400 ramps × (1, 1.25, 1.5, 2, 2.5) only ramps at 1 × were feasible).
+_DETOUR_RAMPS = 2000
+_DETOUR_SPEEDS = (1.0,)
+#: Most batches of detour ramps drawn (a feasible ramp is rare: 0–3 in 2 000 there).
+_DETOUR_BATCHES = 3
+
+#: Extra distance buffers [m] of the solves from detour starts, tried in turn until the
+#: move passes its certificate (a fast move cuts corners between the samples: measured on
+#: the detour scene, 0.4 mm past the 2 mm search buffer at T = 1.12 s).
+_DETOUR_BUFFERS = (0.005, 0.01)
 
 
 @dataclass(frozen=True)
@@ -87,7 +108,7 @@ class PolishOutcome:
 
 
 def minimum_time(
-    problem: Any, x0: Any, *, max_iter: int = 100, tol: float = 1e-10
+    problem: Any, x0: Any, *, max_iter: int = 100, tol: float = 1e-10, buffer: float = 0.0
 ) -> PolishOutcome:
     """The fastest move near ``x0`` (n_var,) subject to every constraint (see the module
     docstring).
@@ -102,10 +123,19 @@ def minimum_time(
         Most SLSQP iterations (≥ 1).
     tol:
         SLSQP's ``ftol`` on the travel time [s] (> 0).
+    buffer:
+        Distance [m] (≥ 0) the solve adds to the problem's margin and search buffer in its
+        distance rows (the final evaluation uses the problem's own): room for the corners
+        a fast move cuts between the samples.
+
+    When SLSQP ends outside the constraints (from a detour its iterates may cross an
+    obstacle and stop there), the fastest point it visited inside every per-sample
+    constraint is returned instead, evaluated (the start when it was inside).
     """
     x0 = as_vector(x0, "x0", problem.n_var)
     max_iter = as_integer(max_iter, "max_iter", minimum=1, error=ConfigurationError)
     tol = as_scalar(tol, "tol", minimum=0.0, error=ConfigurationError)
+    buffer = as_scalar(buffer, "buffer", "m", minimum=0.0, error=ConfigurationError)
     if tol <= 0.0:
         raise ConfigurationError(f"tol must be > 0 [s]; got {tol}")
     if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
@@ -116,7 +146,7 @@ def minimum_time(
     # count, and SLSQP amplifies the last-bit differences (a move polished in a Dask worker,
     # single-threaded, differed from the same move polished here at 1e-13 s).
     with threadpool_limits(limits=1, user_api="blas"):
-        return _minimum_time(problem, x0, max_iter, tol)
+        return _minimum_time(problem, x0, max_iter, tol, buffer)
 
 
 def time_optimal(
@@ -124,7 +154,8 @@ def time_optimal(
 ) -> list[PolishOutcome]:
     """:func:`minimum_time` from the straight move and the ``n_starts − 1`` kinematically
     fastest of ``8 (n_starts − 1)`` seeded ramps (each at its kinematic minimum T); one
-    outcome per start, in start order.
+    outcome per start, in start order; when none is feasible, followed by the outcomes of
+    at most ``n_starts`` detour starts (module docstring).
 
     Parameters
     ----------
@@ -139,7 +170,54 @@ def time_optimal(
     """
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
-    return [minimum_time(problem, x, **options) for x in _starts(problem, seed, n_starts)]
+    outcomes = [minimum_time(problem, x, **options) for x in _starts(problem, seed, n_starts)]
+    if any(o.feasible for o in outcomes):
+        return outcomes
+    return outcomes + [
+        _detour(problem, x, options) for x in _detour_starts(problem, seed, n_starts)
+    ]
+
+
+def _detour_starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
+    """(k, n_var), k ≤ ``n_starts``: the fastest feasible moves, one per ramp, among
+    batches of :data:`_DETOUR_RAMPS` seeded ramps each at :data:`_DETOUR_SPEEDS` × its
+    kinematic minimum T (one batched evaluation by the problem each), fastest first; up to
+    :data:`_DETOUR_BATCHES` batches, until one holds a feasible move (k = 0: none did)."""
+    speeds = np.asarray(_DETOUR_SPEEDS)
+    for batch in range(_DETOUR_BATCHES):
+        rng = np.random.default_rng([seed, 1 + batch])  # not the ramps of _starts
+        ramps = RampSampling().ramps(problem, _DETOUR_RAMPS, rng)
+        x = np.repeat(ramps, len(speeds), axis=0)
+        t = np.repeat(kinematic_time(problem, ramps), len(speeds)) * np.tile(speeds, len(ramps))
+        x[:, 0] = np.clip(t * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
+        ok = np.all(problem.evaluate_batch(x).constraints <= 0.0, axis=1).reshape(len(ramps), -1)
+        rows = np.flatnonzero(ok.any(axis=1))
+        if len(rows):
+            rows = rows * len(speeds) + np.argmax(ok[rows], axis=1)  # each ramp's fastest
+            return x[rows[np.argsort(x[rows, 0], kind="stable")][:n_starts]]
+    return np.empty((0, problem.n_var))
+
+
+def _detour(problem: Any, x0: np.ndarray, options: dict[str, Any]) -> PolishOutcome:
+    """:func:`minimum_time` from the feasible detour ``x0`` with the extra distance buffers
+    of :data:`_DETOUR_BUFFERS` in turn, until the move passes its certificate (1 kHz,
+    :func:`~adept_traj.analysis.certify_members`); the last outcome otherwise. The
+    evaluations and time of every solve are counted in the outcome."""
+    spent = [0, 0.0, 0.0]  # evaluations, seconds, evaluation seconds of earlier solves
+    for buffer in _DETOUR_BUFFERS:
+        outcome = minimum_time(problem, x0, buffer=buffer, **options)
+        tic = time.perf_counter()
+        ok = outcome.feasible and certify_members(problem, outcome.x[None])[0].feasible
+        outcome = dataclasses.replace(
+            outcome,
+            n_evaluations=outcome.n_evaluations + spent[0],
+            seconds=outcome.seconds + spent[1] + time.perf_counter() - tic,
+            evaluation_s=outcome.evaluation_s + spent[2],
+        )
+        if ok:
+            break
+        spent = [outcome.n_evaluations, outcome.seconds, outcome.evaluation_s]
+    return outcome
 
 
 def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
@@ -160,7 +238,9 @@ def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
     return x
 
 
-def _minimum_time(problem: Any, x0: np.ndarray, max_iter: int, tol: float) -> PolishOutcome:
+def _minimum_time(
+    problem: Any, x0: np.ndarray, max_iter: int, tol: float, buffer: float
+) -> PolishOutcome:
     from scipy.optimize import minimize  # lazy: scipy.optimize is heavy
 
     started = time.perf_counter()
@@ -171,13 +251,17 @@ def _minimum_time(problem: Any, x0: np.ndarray, max_iter: int, tol: float) -> Po
         if key not in cache:
             cache.clear()
             tic = time.perf_counter()
-            lc = local_constraints(problem, np.clip(x, problem.xl, problem.xu))
-            cache[key] = (lc.values[0], lc.jacobian[0])
+            xc = np.clip(x, problem.xl, problem.xu)
+            lc = local_constraints(problem, xc)
+            cache[key] = (lc.values[0] + extra * (lc.kind == _DISTANCE), lc.jacobian[0])
             counter[0] += 1
             spent[0] += time.perf_counter() - tic
+            if np.all(lc.values[0] <= 0.0) and (safe[0] is None or xc[0] < safe[0][0]):
+                safe[0] = xc  # the fastest point found within the problem's constraints
         return cache[key]
 
-    counter, spent = [0], [0.0]
+    counter, spent, safe = [0], [0.0], [None]
+    extra = buffer / problem.settings.influence  # distance rows are scaled by influence
     grad = np.zeros(problem.n_var)
     grad[0] = 1.0
     res = minimize(
@@ -195,11 +279,14 @@ def _minimum_time(problem: Any, x0: np.ndarray, max_iter: int, tol: float) -> Po
         ],
         options={"maxiter": max_iter, "ftol": tol},
     )
-    x = np.clip(res.x, problem.xl, problem.xu)
-    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
-    x[0] = min(max(x[0], t_kin), problem.xu[0])
-    ev = problem.evaluate_batch(x)
+    x, ev = _evaluated(problem, res.x)
     spent[0] += ev.seconds
+    if np.any(ev.constraints > 0.0) and safe[0] is not None:
+        # SLSQP ended outside (from a detour its iterates cross an obstacle and stop there):
+        # the fastest point it visited inside every per-sample constraint instead.
+        x, ev = _evaluated(problem, safe[0])
+        counter[0] += 1
+        spent[0] += ev.seconds
     return PolishOutcome(
         x=x,
         objectives=ev.objectives,
@@ -212,3 +299,12 @@ def _minimum_time(problem: Any, x0: np.ndarray, max_iter: int, tol: float) -> Po
         evaluation_s=spent[0],
         message=str(res.message),
     )
+
+
+def _evaluated(problem: Any, x: np.ndarray) -> tuple[np.ndarray, Any]:
+    """``x`` (n_var,) clipped to the bounds with T raised to its kinematic minimum, and its
+    evaluation by the problem."""
+    x = np.clip(x, problem.xl, problem.xu)
+    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
+    x[0] = min(max(x[0], t_kin), problem.xu[0])
+    return x, problem.evaluate_batch(x)

@@ -25,7 +25,8 @@ field of ``result.json``:
   and ``best.index`` against ``plan``'s rule (the trade-off order; when the choice is not
   the first, the members before it must fail certification: they are certified again);
 - the metrics SSM, OO, AE, HV and the HV reference point, recomputed as ``plan`` does from
-  the stored front and timing.
+  the stored front and timing; T_best, when stored, as the z1 of the fastest certified
+  member, and its source as the algorithm's (``"time-optimal"`` or ``"polish"``).
 
 Numbers agree when equal or within a relative tolerance :data:`AUDIT_RTOL` of the field's
 magnitude (per column of a matrix, i.e. per quantity and joint):
@@ -360,3 +361,8 @@ class _Auditor(MismatchLog):
             self.value("metrics.HV_reference_point", m.hv_reference_point, ref)
         else:
             self.numbers("metrics.HV_reference_point", m.hv_reference_point, ref)
+        if m.t_best is not None:  # None: not computed (which rows the solver made is not stored)
+            ok = r.front.feasible
+            self.optional("metrics.T_best", m.t_best, float(F[ok, 0].min()) if ok.any() else None)
+            source = "time-optimal" if r.algorithm == "time-optimal" else "polish"
+            self.value("metrics.T_best_source", m.t_best_source, source)

@@ -38,6 +38,7 @@ from adept_traj.results.certificate_codec import (
 )
 from adept_traj.results.parts import (
     METRIC_NAMES,
+    T_BEST_SOURCES,
     BestSolution,
     Front,
     GenerationRecord,
@@ -85,6 +86,8 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     metrics: dict[str, Any] = {key: getattr(r.metrics, name) for name, key in _JSON_METRICS.items()}
     ref = r.metrics.hv_reference_point
     metrics["HV_reference_point"] = None if ref is None else _floats(ref)
+    if r.metrics.t_best is not None:  # absent: not computed (and in results before it)
+        metrics["T_best"], metrics["T_best_source"] = r.metrics.t_best, r.metrics.t_best_source
     history = None if r.history is None else [dataclasses.asdict(rec) for rec in r.history]
     out: dict[str, Any] = {
         "format": FORMAT,
@@ -244,6 +247,8 @@ def _decode(top: Node) -> PlanningResult:
         Metrics,
         **{name: md[key].number(null=None) for name, key in _JSON_METRICS.items()},
         hv_reference_point=md["HV_reference_point"].array((len(OBJECTIVE_NAMES),), nullable=True),
+        t_best=md["T_best"].number("s", default=None),
+        t_best_source=md["T_best_source"].string(choices=T_BEST_SOURCES, default=None),
     )
     timing = td.build(
         Timing,

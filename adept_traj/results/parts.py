@@ -25,13 +25,7 @@ from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
 from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
 from adept_traj.robot import RobotSource
 from adept_traj.robot.robot import Robot, shipped_file
-from adept_traj.validation import (
-    as_finite_array,
-    as_integer,
-    as_scalar,
-    deep_equal,
-    readonly_copy,
-)
+from adept_traj.validation import as_finite_array, as_integer, as_scalar, deep_equal, readonly_copy
 
 __all__ = [
     "SHIPPED_ROBOT",
@@ -48,6 +42,8 @@ __all__ = [
 SHIPPED_ROBOT = "adept_one_xl"
 #: Field names of :class:`Metrics` that hold a number (or ``None``).
 METRIC_NAMES = ("ssm", "rni", "oo", "ae", "hv")
+#: Sources of :attr:`Metrics.t_best`: the fastest member's polish, the time-optimal mode.
+T_BEST_SOURCES = ("polish", "time-optimal")
 
 
 def _optional_scalar(value: Any, name: str, unit: str = "", minimum: float = -math.inf) -> Any:
@@ -302,8 +298,10 @@ class Metrics:
     ----------
     ssm, rni, oo, ae: the paper's spacing (SSM), ratio of non-dominated individuals (RNI),
         optimiser overhead (OO) and algorithm effort (AE), as the engine defines them.
-    hv: hypervolume of the normalised front w.r.t. ``hv_reference_point``.
-    hv_reference_point: (6,) the reference point, or ``None``.
+    hv, hv_reference_point: hypervolume of the normalised front w.r.t. the (6,) reference point.
+    t_best, t_best_source: T_best [s], the z1 of the front's fastest certified member when
+        the local solver made it, and that solver (:data:`T_BEST_SOURCES`); ``None``: not
+        computed (no polish, or no polished move is the fastest certified member).
     """
 
     ssm: float | None = None
@@ -312,10 +310,16 @@ class Metrics:
     ae: float | None = None
     hv: float | None = None
     hv_reference_point: np.ndarray | None = None
+    t_best: float | None = None
+    t_best_source: str | None = None
 
     def __post_init__(self) -> None:
         for name in METRIC_NAMES:
             object.__setattr__(self, name, _metric(getattr(self, name), f"metrics.{name}"))
+        t_best, src = _optional_scalar(self.t_best, "metrics.t_best", "s"), self.t_best_source
+        object.__setattr__(self, "t_best", t_best)
+        if (t_best is None) != (src is None) or src not in (None, *T_BEST_SOURCES):
+            raise InvalidInputError(f"metrics.t_best_source {src!r}: {T_BEST_SOURCES} with t_best")
         if self.hv_reference_point is not None:
             ref = readonly_copy(as_finite_array(self.hv_reference_point, "hv_reference_point"))
             if ref.ndim != 1:

@@ -301,6 +301,13 @@ class PlanningResult:
         t_min = float(self.lower_bound.T_min)
         return float(self.best_objectives[0]) / t_min if t_min > 0 else None
 
+    @property
+    def gap_best(self) -> float | None:
+        """Best travel time over the best T the parametrisation reached in the run,
+        ``z1 / metrics.t_best`` (≥ 1); ``None`` when T_best was not computed."""
+        t_best = self.metrics.t_best
+        return float(self.best_objectives[0]) / t_best if t_best else None
+
     def __eq__(self, other: object) -> bool:
         return deep_equal(self, other) if type(other) is type(self) else NotImplemented
 
