@@ -23,7 +23,7 @@ from adept_traj.cli import main
 from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import RobotModelError, SceneError
 from adept_traj.optimise import plan
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import CONSTRAINT_KINDS, TrajectoryProblem, local_constraints
 from adept_traj.results import PlanningResult, RobotInfo
 from adept_traj.robot import Robot, installed_data_dirs
 from adept_traj.scene import Box, FixedPose, Obstacle, Scene, Sphere
@@ -398,3 +398,27 @@ def test_the_robot_command_reports_self_collision_with_an_srdf(
     line = capsys.readouterr().out.splitlines()[-1]
     assert line.startswith("  self-collision: min distance -0.")
     assert main(["robot", "--srdf", str(srdf)]) == 2  # the AdeptOne XL: no --robot
+
+
+def test_the_panda_torque_rows_have_a_jacobian_despite_its_mimic_finger() -> None:
+    """Pinocchio's RNEA derivatives refuse mimic joints: the Panda's torque rows take
+    central differences in the state; checked against central differences through x."""
+    robot = Robot.from_urdf(PANDA)
+    start = np.clip(np.zeros(robot.nq), robot.limits.lower + 0.3, robot.limits.upper - 0.3)
+    start[-1] = 0.02
+    goal = start + np.r_[1.0, -0.5, 0.4, 0.3, -0.2, 0.4, 0.5, 0.0]
+    problem = TrajectoryProblem(robot, Scene(), start, goal, n_knots=6)
+    x = 0.5 * (problem.xl + problem.xu)
+    x[0] = 2.0 * problem.xl[0]
+    lc = local_constraints(problem, x)
+    torque = lc.kind == CONSTRAINT_KINDS.index("torque")
+    assert torque.sum() > 0
+    h = 1e-5
+    for c in (0, 3, problem.n_var - 2):
+        e = np.zeros(problem.n_var)
+        e[c] = h
+        fd = (
+            local_constraints(problem, x + e).values[0]
+            - local_constraints(problem, x - e).values[0]
+        ) / (2 * h)
+        np.testing.assert_allclose(lc.jacobian[0, torque, c], fd[torque], rtol=1e-4, atol=1e-6)
