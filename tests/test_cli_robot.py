@@ -326,3 +326,31 @@ def test_the_ur5_example_scene_names_its_srdf_as_a_package_uri_and_turns_self_co
     assert problem.self_check is not None
     assert problem.self_check.n_pairs > 0
     problem.close()
+
+
+def test_a_parameter_file_disables_link_pairs_and_turns_self_collision_on(tmp_path: Path) -> None:
+    params = tmp_path / "ur5.toml"
+    params.write_text(
+        'disable_collisions = [["forearm_link", "wrist_3_link"]]\n'
+        + (EXAMPLES / "ur5.toml").read_text()
+    )
+    robot = Robot.from_urdf(UR5, params)
+    assert robot.disabled_pairs == (("forearm_link", "wrist_3_link"),)
+    scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
+    problem = TrajectoryProblem(robot, scene, scene.start, scene.goal, n_knots=6)
+    check = problem.self_check
+    assert check is not None
+    links = {frozenset(pair) for pair in check.disabled}
+    assert frozenset(("forearm_link", "wrist_3_link")) in links
+    checked = {frozenset(check.links[i] for i in pair) for pair in check.pairs.tolist()}
+    assert frozenset(("forearm_link", "wrist_3_link")) not in checked
+    assert frozenset(("upper_arm_link", "wrist_3_link")) in checked
+    problem.close()
+    params.write_text('disable_collisions = [["forearm_link", "no_such_link"]]\n')
+    with pytest.raises(
+        RobotModelError, match=r"disable_collisions names link\(s\) \['no_such_link'\]"
+    ):
+        Robot.from_urdf(UR5, params)
+    params.write_text('disable_collisions = [["forearm_link", "base_link", "tool0"]]\n')
+    with pytest.raises(RobotModelError, match="must hold \\[link1, link2\\] pairs of link names"):
+        Robot.from_urdf(UR5, params)

@@ -235,17 +235,7 @@ class CollisionChecker:
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
-    def _narrow_at(
-        self, frames: np.ndarray, obstacle_poses: list[np.ndarray], base: int, c: int, o: int
-    ) -> float:
-        """Coal distance of candidate ``c`` (= sample · n_solids + solid) of the motion whose
-        first sample is ``base`` in the flattened arrays, to obstacle ``o``."""
-        k, s = divmod(c, self.n_solids)
-        n = base + k
-        pose = self._broad.solid_poses(frames, n, s)
-        return self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
-
-    def _first_poses(
+    def _poses_at_samples(
         self, frames: np.ndarray, samples: np.ndarray, solids: np.ndarray
     ) -> np.ndarray:
         """Poses (n, 4, 4) of ``solids`` (n,) at flat ``samples`` (n,), batched per solid."""
@@ -315,7 +305,7 @@ class CollisionChecker:
         # Poses of the first candidates (solid and obstacle), formed together.
         first_sample = pm * n_t + first // self.n_solids
         first_solid = first % self.n_solids
-        solid_at = self._first_poses(frames, first_sample, first_solid)
+        solid_at = self._poses_at_samples(frames, first_sample, first_solid)
         for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
             bounds_mo = rows[i]
             if known[m, c0, o]:
@@ -327,14 +317,20 @@ class CollisionChecker:
             where[m, o] = c0
             if second[i] < value and second[i] <= self.influence:
                 near = np.flatnonzero(bounds_mo <= self.influence)
-                for c in near[np.argsort(bounds_mo[near], kind="stable")][1:]:
+                order = near[np.argsort(bounds_mo[near], kind="stable")][1:]
+                order = order[bounds_mo[order] < value]  # the loop stops before the others
+                todo = order[~known[m, order, o]]  # their solid poses, formed together
+                n_of, s_of = m * n_t + todo // self.n_solids, todo % self.n_solids
+                poses, j = self._poses_at_samples(frames, n_of, s_of), 0
+                for c in order.tolist():
                     if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune
                         break
                     if known[m, c, o]:
                         d = float(bounds_mo[c])
                     else:
-                        d = self._narrow_at(frames, obstacle_poses, m * n_t, int(c), o)
-                        calls += 1
+                        pose_o = self._pose_at(obstacle_poses[o], int(n_of[j]))
+                        d = self._narrow(poses[j], pose_o, int(s_of[j]), o)
+                        j, calls = j + 1, calls + 1
                     if d < value:
                         value, where[m, o] = d, c
             if value > self.influence:
@@ -378,7 +374,7 @@ class CollisionChecker:
         samples, solids, obstacles = np.nonzero(todo)
         for c in range(0, len(samples), 8192):  # solid poses in batches (1 MB), not per call
             cut = [a[c : c + 8192] for a in (samples, solids, obstacles)]
-            poses = self._first_poses(frames, cut[0], cut[1])
+            poses = self._poses_at_samples(frames, cut[0], cut[1])
             for pose, n, s, o in zip(poses, *(a.tolist() for a in cut)):
                 flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
         known |= todo

@@ -210,7 +210,8 @@ class TrajectoryProblem(Problem):
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
         self.robot, self.scene = robot, scene
         self_check = SelfCollision(robot, settings.disabled_pairs, influence=settings.influence)
-        on, known = settings.self_collision, robot.srdf_path is not None or settings.disabled_pairs
+        known = robot.srdf_path is not None or robot.disabled_pairs or settings.disabled_pairs
+        on = settings.self_collision
         on = bool(self_check.n_pairs and known) if on is None else on
         #: The robot–robot distances (``None``: self-collision off).
         self.self_check = self_check if on else None

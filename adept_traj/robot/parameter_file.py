@@ -3,10 +3,12 @@
 A parameter file is TOML (see ``urdf/adept_one_xl.toml`` and ``docs/robot-model.md``). For a
 robot loaded from any URDF it may give, per joint, the acceleration and jerk limits, the
 rotor inertia and gear ratio (their product ``rotor_inertia · gear_ratio²`` becomes
-Pinocchio's ``model.armature``) and Coulomb/viscous friction; at the top level the tool frame
-and the rows of the square task Jacobian. Values given here override the URDF's. The
-AdeptOne XL file additionally describes the whole chain (joint origins, link solids and
-masses), from which :mod:`adept_traj.robot.urdf_builder` writes the shipped URDF.
+Pinocchio's ``model.armature``) and Coulomb/viscous friction; at the top level the tool frame,
+the rows of the square task Jacobian and ``disable_collisions = [["link1", "link2"], …]``:
+link pairs left out of the self-collision check (as an SRDF's ``disable_collisions``).
+Values given here override the URDF's. The AdeptOne XL file additionally describes the
+whole chain (joint origins, link solids and masses), from which
+:mod:`adept_traj.robot.urdf_builder` writes the shipped URDF.
 
 Units: SI — [m], [rad], [s], [kg], [kg·m²], [N], [N·m].
 """
@@ -40,7 +42,16 @@ _SHAPES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radiu
 #: Errors of a parameter file: RobotModelError naming the file and the field path.
 _ERROR = error_factory(RobotModelError)
 
-_TOP_KEYS = ("name", "base_link", "tool_frame", "task_rows", "joint", "link", "frame")
+_TOP_KEYS = (
+    "name",
+    "base_link",
+    "tool_frame",
+    "task_rows",
+    "disable_collisions",
+    "joint",
+    "link",
+    "frame",
+)
 _SOLID_KEYS = ("name", "shape", "xyz", "rpy", "mass", "rgba")
 _FRAME_KEYS = ("name", "parent", "xyz", "rpy")
 #: The numbers of a [[joint]] table: key -> (unit, minimum, strictly above the minimum).
@@ -140,6 +151,7 @@ class RobotParameters:
     base_link: str | None = None
     tool_frame: str | None = None
     task_rows: tuple[str, ...] | None = None
+    disabled_pairs: tuple[tuple[str, str], ...] = ()
     joints: tuple[JointParameters, ...] = ()
     links: tuple[LinkParameters, ...] = ()
     frames: tuple[FrameParameters, ...] = ()
@@ -153,6 +165,10 @@ class RobotParameters:
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> RobotParameters:
         """Validate a parsed parameter mapping (same schema as the TOML file)."""
         top = Node(data, source, _ERROR).check_keys(_TOP_KEYS)
+        off = top["disable_collisions"]
+        pairs = tuple(tuple(n.strings(min_items=2)) for n in off.items(default=[]))
+        if any(len(pair) != 2 for pair in pairs):
+            raise off.error("must hold [link1, link2] pairs of link names")
         params = cls(
             source=source,
             name=top["name"].string(nonempty=True, default=None),
@@ -161,6 +177,7 @@ class RobotParameters:
             task_rows=top["task_rows"].strings(
                 choices=TASK_ROWS, distinct=True, min_items=1, default=None
             ),
+            disabled_pairs=pairs,
             joints=tuple(_joint(name, node) for name, node in top["joint"].named_tables()),
             links=tuple(_link(name, node) for name, node in top["link"].named_tables()),
             frames=tuple(_frame(name, node) for name, node in top["frame"].named_tables()),

@@ -36,12 +36,7 @@ from adept_traj.robot.urdf_loading import (
 )
 from adept_traj.validation import as_batch
 
-__all__ = [
-    "VELOCITY_AT_REST",
-    "ForwardKinematics",
-    "Robot",
-    "coulomb_sign",
-]
+__all__ = ["VELOCITY_AT_REST", "ForwardKinematics", "Robot", "coulomb_sign"]
 
 #: Joint speeds with ``|v| ≤ VELOCITY_AT_REST`` [rad/s | m/s] count as rest for Coulomb
 #: friction (sign 0): a joint held still must not flip ±F_c on rounding noise (1e-17).
@@ -81,6 +76,8 @@ class Robot:
         Joints fixed at a value [rad | m] (name → value), removed from q.
     srdf_path : pathlib.Path or None
         The SRDF given (its ``disable_collisions`` pairs: :attr:`disabled_pairs`).
+    disabled_pairs : tuple of (str, str)
+        Link pairs left out of self-collision: the SRDF's, then the parameter file's.
     mesh_hulls : tuple of HullReport
         The collision meshes replaced by their convex hulls (see
         :mod:`adept_traj.robot.collision_meshes`).
@@ -102,6 +99,7 @@ class Robot:
         locked_joints: Mapping[str, float] | None = None,
         mesh_hulls: tuple[HullReport, ...] = (),
         srdf_path: Path | None = None,
+        disabled_pairs: Sequence[tuple[str, str]] = (),
     ) -> None:  # the keyword-only arguments: see the class attributes
         self.model = model
         self.collision_model = collision_model
@@ -114,7 +112,8 @@ class Robot:
         self.locked_joints = dict(locked_joints or {})
         self.mesh_hulls = tuple(mesh_hulls)
         self.srdf_path = srdf_path  # its pairs are excluded from self-collision checks
-        self.disabled_pairs = () if srdf_path is None else read_srdf_disabled_pairs(srdf_path)
+        srdf_pairs = () if srdf_path is None else read_srdf_disabled_pairs(srdf_path)
+        self.disabled_pairs = srdf_pairs + tuple((str(a), str(b)) for a, b in disabled_pairs)
         if not model.existFrame(tool_frame):
             frames = [f.name for f in model.frames]
             raise RobotModelError(f"robot '{name}': no frame '{tool_frame}'; frames are {frames}")
@@ -218,6 +217,7 @@ class Robot:
             locked_joints=locked_joints,
             mesh_hulls=hulls,
             srdf_path=None if srdf is None else resolve_package_file(str(srdf), package_dirs),
+            disabled_pairs=params.disabled_pairs if params is not None else (),
         )
 
     # ------------------------------------------------------------------ basic facts

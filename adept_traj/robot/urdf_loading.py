@@ -238,6 +238,13 @@ def _write_parameters(
         raise RobotModelError(
             f"{params.source}: joint(s) {unknown} are not in {path}; its joints are {sorted(known)}"
         )
+    links = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
+    unknown = sorted({n for pair in params.disabled_pairs for n in pair if n not in links})
+    if unknown:
+        raise RobotModelError(
+            f"{params.source}: disable_collisions names link(s) {unknown} not in {path}; its "
+            f"links are {sorted(links)}"
+        )
     for j in params.joints:
         k = model.joints[model.getJointId(j.name)].idx_q
         targets = {
