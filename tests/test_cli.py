@@ -140,6 +140,7 @@ def test_console_script_runs_in_a_subprocess() -> None:
     assert "joint4" in result.stdout
 
 
+@pytest.mark.slow  # ~3 s: the default tier's budget
 def test_show_serves_on_localhost_and_stops_on_ctrl_c(tmp_path: Path) -> None:
     import signal
 

@@ -15,7 +15,12 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
     ("script", "args", "expect"),
     [
         ("robot_dynamics.py", [], "kinematic lower bound on T: 1.073 s"),
-        ("plan_paper.py", ["--gens", "2", "--small"], "mode: 39 evaluations"),
+        pytest.param(
+            "plan_paper.py",
+            ["--gens", "2", "--small"],
+            "mode: 39 evaluations",
+            marks=pytest.mark.slow,  # ~3.5 s: the default tier's budget
+        ),
         ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
         ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
         ("ur5_around_a_box.py", ["--gens", "2", "--pop", "12"], "certified feasible"),

@@ -27,6 +27,7 @@ def _front(folder: Path) -> tuple[np.ndarray, int]:
     return np.hstack([result.front.x, result.front.objectives]), workers
 
 
+@pytest.mark.slow  # ~3.5 s: the default tier's budget
 def test_plan_defaults_to_the_available_cores_with_the_serial_front(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
