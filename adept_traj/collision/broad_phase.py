@@ -224,16 +224,18 @@ class BroadPhase:
             )
         )
 
-    def solid_poses(self, frames: np.ndarray, rows: np.ndarray | int, k: int) -> np.ndarray:
-        """Poses (R, 4, 4) of solid ``k`` at the samples ``rows`` of the joint frames
-        ``frames`` (njoints, 3, 4, N); one pose (4, 4) for a single sample index."""
-        parent, local = frames[self.parents[k]], self.local[k]
-        if np.ndim(rows) == 0:
-            pose = np.empty((4, 4))
-            pose[:3] = parent[:, :, int(rows)] @ local
-        else:
+    def solid_poses(self, frames: np.ndarray, rows: np.ndarray, k: int | np.ndarray) -> np.ndarray:
+        """Poses (R, 4, 4) at the samples ``rows`` (R,) of the joint frames ``frames``
+        (njoints, 3, 4, N) of solid ``k``, or of solid ``k[i]`` at ``rows[i]`` for ``k`` (R,)
+        (formed in one batch per solid)."""
+        if np.ndim(k):
             pose = np.empty((len(rows), 4, 4))
-            pose[:, :3] = compose(parent[..., rows], local).transpose(2, 0, 1)
+            for s in np.unique(k).tolist():
+                sel = np.flatnonzero(k == s)
+                pose[sel] = self.solid_poses(frames, rows[sel], s)
+            return pose
+        pose = np.empty((len(rows), 4, 4))
+        pose[:, :3] = compose(frames[self.parents[k]][..., rows], self.local[k]).transpose(2, 0, 1)
         pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
         return pose
 

@@ -235,16 +235,6 @@ class CollisionChecker:
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 
-    def _poses_at_samples(
-        self, frames: np.ndarray, samples: np.ndarray, solids: np.ndarray
-    ) -> np.ndarray:
-        """Poses (n, 4, 4) of ``solids`` (n,) at flat ``samples`` (n,), batched per solid."""
-        poses = np.empty((len(samples), 4, 4))
-        for k in np.unique(solids).tolist():
-            sel = np.flatnonzero(solids == k)
-            poses[sel] = self._broad.solid_poses(frames, samples[sel], k)
-        return poses
-
     def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
         """Leave out the fixed obstacles that no motion comes within ``influence`` of
         (:mod:`adept_traj.collision.pruning`: their distance is reported as the bound that
@@ -305,7 +295,7 @@ class CollisionChecker:
         # Poses of the first candidates (solid and obstacle), formed together.
         first_sample = pm * n_t + first // self.n_solids
         first_solid = first % self.n_solids
-        solid_at = self._poses_at_samples(frames, first_sample, first_solid)
+        solid_at = self._broad.solid_poses(frames, first_sample, first_solid)
         for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
             bounds_mo = rows[i]
             if known[m, c0, o]:
@@ -321,7 +311,7 @@ class CollisionChecker:
                 order = order[bounds_mo[order] < value]  # the loop stops before the others
                 todo = order[~known[m, order, o]]  # their solid poses, formed together
                 n_of, s_of = m * n_t + todo // self.n_solids, todo % self.n_solids
-                poses, j = self._poses_at_samples(frames, n_of, s_of), 0
+                poses, j = self._broad.solid_poses(frames, n_of, s_of), 0
                 for c in order.tolist():
                     if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune
                         break
@@ -374,7 +364,7 @@ class CollisionChecker:
         samples, solids, obstacles = np.nonzero(todo)
         for c in range(0, len(samples), 8192):  # solid poses in batches (1 MB), not per call
             cut = [a[c : c + 8192] for a in (samples, solids, obstacles)]
-            poses = self._poses_at_samples(frames, cut[0], cut[1])
+            poses = self._broad.solid_poses(frames, cut[0], cut[1])
             for pose, n, s, o in zip(poses, *(a.tolist() for a in cut)):
                 flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
         known |= todo

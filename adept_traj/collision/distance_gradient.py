@@ -156,11 +156,7 @@ def _witnesses(
     [m] are ``distance`` (m,): the first of :data:`WITNESS_TOLERANCES` whose distance
     agrees with it to :data:`_AGREE` (all zero, a zero gradient, if none does: not met on
     the shipped scenes)."""
-    broad = checker._broad
-    poses = np.empty((len(rows), 4, 4))
-    for k in np.unique(solids).tolist():
-        sel = np.flatnonzero(solids == k)
-        poses[sel] = broad.solid_poses(frames, rows[sel], k)
+    poses = checker._broad.solid_poses(frames, rows, solids)
     obstacle_poses = checker._obstacle_poses(t)
     out = np.zeros((3, len(rows), 3))
     requests, result = _witness_requests(), coal.DistanceResult()
