@@ -87,9 +87,7 @@ def search_pairs(
         return best, where, 0
     rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
     first = smallest[pm, po]  # = rows.argmin(axis=1)
-    second = (
-        np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
-    )
+    second = np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
     # 1. The first candidates, their poses (solid and obstacle) formed together.
     value = rows[np.arange(len(pm)), first]  # exact already where known
     todo = np.flatnonzero(~known[pm, first, po])
