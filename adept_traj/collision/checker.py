@@ -25,6 +25,7 @@ from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.robot.kinematics import stack_times
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import as_finite_array
@@ -224,7 +225,7 @@ class CollisionChecker:
             key = id(ob.motion)
             if key not in laws:
                 laws[key] = _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
-            poses.append(_right(laws[key], ob.offset))  # = to_base @ ob.pose(t)
+            poses.append(stack_times(laws[key], ob.offset))  # = to_base @ ob.pose(t)
         return poses
 
     @staticmethod
@@ -333,8 +334,3 @@ def _left(a: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """``a @ poses`` for a constant (4, 4) ``a`` and poses (N, 4, 4), as one GEMM (numpy's
     stacked product of small matrices is several times slower)."""
     return (poses.transpose(0, 2, 1).reshape(-1, 4) @ a.T).reshape(-1, 4, 4).transpose(0, 2, 1)
-
-
-def _right(poses: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``poses @ b`` for poses (N, 4, 4) and a constant (4, 4) ``b``, as one GEMM."""
-    return (poses.reshape(-1, 4) @ b).reshape(poses.shape)
