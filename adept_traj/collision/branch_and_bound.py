@@ -13,9 +13,8 @@ all pairs together:
 
 1. the first candidate of each pair (the smallest bound, the first one on ties): its
    solid pose is formed for all pairs in one batch and coal is called once per pair;
-2. the pairs whose second smallest bound is below that first value and at most
-   ``influence``: their remaining candidates (bound at most ``influence`` and below the
-   first value) are sorted by bound (ties by index) for all pairs in one
+2. the pairs with other candidates whose bound is below that first value and at most
+   ``influence``: these candidates are sorted by bound (ties by index) for all pairs in one
    :func:`numpy.lexsort`, their solid poses formed in one batch; then each pair walks its
    sorted candidates until a bound reaches its best value (the only Python loop, over
    the candidates computed);
@@ -87,7 +86,6 @@ def search_pairs(
         return best, where, 0
     rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
     first = smallest[pm, po]  # = rows.argmin(axis=1)
-    second = np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
     # 1. The first candidates, their poses (solid and obstacle) formed together.
     value = rows[np.arange(len(pm)), first]  # exact already where known
     todo = np.flatnonzero(~known[pm, first, po])
@@ -97,10 +95,15 @@ def search_pairs(
         first[todo] % ns, po[todo],
     )  # fmt: skip
     found = first.copy()
-    # 2. The pairs whose next candidate may still be smaller.
-    need = np.flatnonzero((second < value) & (second <= influence))
+    # 2. The pairs with another candidate whose bound is below the first value and at most
+    # influence (their second smallest bound is).
+    mask = (rows <= influence) & (rows < value[:, None])
+    mask[np.arange(len(pm)), first] = False  # the first candidate, done
+    need = np.flatnonzero(mask.any(axis=1))
     if len(need):
-        calls += _walk(checker, frames, obstacle_poses, known, rows, pm, po, need, value, found)
+        calls += _walk(
+            checker, frames, obstacle_poses, known, rows, mask, pm, po, need, value, found
+        )
     where[pm, po] = found
     # 3. Not exact: candidates with a bound in (influence, value) were not computed; the
     # smallest of value and those bounds is a lower bound above influence.
@@ -138,19 +141,20 @@ def _walk(
     obstacle_poses: list[np.ndarray],
     known: np.ndarray,
     rows: np.ndarray,
+    mask: np.ndarray,
     pm: np.ndarray,
     po: np.ndarray,
     need: np.ndarray,
     value: np.ndarray,
     found: np.ndarray,
 ) -> int:
-    """Step 2 of the module doc for the pairs ``need``: updates ``value`` and ``found``
-    (candidate of the best value) in place; returns the number of coal calls."""
+    """Step 2 of the module doc for the pairs ``need`` (``mask`` (n_pairs, n_candidates):
+    the candidates left, bound at most ``influence`` and below the first value): updates
+    ``value`` and ``found`` (candidate of the best value) in place; returns the number of
+    coal calls."""
     ns, n_t = checker.n_solids, rows.shape[1] // checker.n_solids
     sub = rows[need]
-    mask = (sub <= checker.influence) & (sub < value[need, None])
-    mask[np.arange(len(need)), found[need]] = False  # the first candidate, done
-    pair, cand = np.nonzero(mask)
+    pair, cand = np.nonzero(mask[need])
     bound = sub[pair, cand]
     order = np.lexsort((cand, bound, pair))  # by pair, then bound, then index
     pair, cand, bound = pair[order], cand[order], bound[order]
