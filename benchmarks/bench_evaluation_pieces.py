@@ -13,11 +13,22 @@ time** (:func:`time.process_time`) in µs per sample (a sample = one configurati
 trajectory; 116 per trajectory), the median over ``--repeat`` runs: on a machine shared
 with other jobs, wall time mostly measures the others. The pieces overlap (min_distances
 holds pruning, poses and broad phase), so they do not add up to the block.
+
+``--against DIR`` compares this tree's code with the code of another checkout ``DIR``
+(e.g. ``git worktree add /tmp/base main``) in **paired runs**: each pair evaluates the
+populations whole (:meth:`TrajectoryProblem.evaluate_batch`, one core) in one process
+of this code and one of ``DIR``'s, alternately, and prints the process CPU time per
+sample of each and the median over pairs of the ratio (this / other): the pairs see the
+same load, so the ratio is what moves least.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 
@@ -68,22 +79,82 @@ def pieces(problem: TrajectoryProblem, x: np.ndarray) -> dict[str, float]:
     return spent
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--pop", type=int, default=500, help="population size")
-    parser.add_argument("--repeat", type=int, default=7, help="runs (the median is printed)")
-    args = parser.parse_args()
+def _problem_and_populations(pop: int) -> tuple[TrajectoryProblem, dict[str, np.ndarray]]:
+    """The paper problem and its seeded ``random``, ``near straight`` (collides) and
+    ``near feasible`` populations of ``pop`` trajectories."""
     robot, scene = Robot.adept_one_xl(), Scene.paper()
     problem = TrajectoryProblem(robot, scene, scene.start, scene.goal)
     rng = np.random.default_rng(0)
     span = problem.xu - problem.xl
-    noise = rng.normal(scale=0.01, size=(args.pop, problem.n_var)) * span
+    noise = rng.normal(scale=0.01, size=(pop, problem.n_var)) * span
     populations = {
-        "random": problem.xl + span * rng.uniform(size=(args.pop, problem.n_var)),
+        "random": problem.xl + span * rng.uniform(size=(pop, problem.n_var)),
+        "near straight": np.clip(
+            problem.trajectory.straight_line(1.6) + noise, problem.xl, problem.xu
+        ),
         "near feasible": np.clip(lift_then_lower(problem) + noise, problem.xl, problem.xu),
     }
+    return problem, populations
+
+
+def _whole(pop: int, repeat: int) -> None:
+    """Child of ``--against``: print, as JSON, the median CPU seconds per sample of
+    ``evaluate_batch`` on each population (``repeat`` runs)."""
+    problem, populations = _problem_and_populations(pop)
+    problem.evaluate_batch(populations["random"][:5])  # warm-up
+    out = {}
+    for name, x in populations.items():
+        runs = []
+        for _ in range(repeat):
+            start = time.process_time()
+            problem.evaluate_batch(x)
+            runs.append(time.process_time() - start)
+        out[name] = float(np.median(runs)) / (pop * len(problem.s))
+    print(json.dumps(out))
+
+
+def _paired(other: str, pairs: int, pop: int, repeat: int) -> None:
+    """Alternate processes of this code and of ``other``'s; print both and the ratios."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    trees = {"this": here, "other": os.path.abspath(other)}
+    runs: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
+    for i in range(pairs):
+        for label in ("this", "other") if i % 2 == 0 else ("other", "this"):
+            env = {**os.environ, "PYTHONPATH": trees[label]}
+            cmd = [sys.executable, __file__, "--whole", "--pop", str(pop), "--repeat", str(repeat)]
+            done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+            runs[label].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    print(f"paired runs: {pairs} pairs, population {pop}, CPU µs/sample (median), this vs {other}")
+    print(f"{'population':<15}{'this':>8}{'other':>8}{'this/other':>12}  (pair ratios)")
+    for name in runs["this"][0]:
+        mine = [r[name] * 1e6 for r in runs["this"]]
+        theirs = [r[name] * 1e6 for r in runs["other"]]
+        ratios = [a / b for a, b in zip(mine, theirs)]
+        shown = ", ".join(f"{r:.2f}" for r in ratios)
+        print(
+            f"{name:<15}{np.median(mine):8.2f}{np.median(theirs):8.2f}"
+            f"{np.median(ratios):12.3f}  ({shown})"
+        )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--pop", type=int, default=500, help="population size")
+    parser.add_argument("--repeat", type=int, default=7, help="runs (the median is printed)")
+    parser.add_argument("--against", metavar="DIR", help="paired runs against DIR's code")
+    parser.add_argument("--pairs", type=int, default=6, help="pairs of runs for --against")
+    parser.add_argument("--whole", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.whole:
+        return _whole(args.pop, args.repeat)
+    if args.against:
+        return _paired(args.against, args.pairs, args.pop, args.repeat)
+    problem, populations = _problem_and_populations(args.pop)
+    del populations["near straight"]  # the per-piece table: two populations
     n_samples = args.pop * len(problem.s)
-    print(f"{robot.name}, paper scene, {len(problem.s)} samples per trajectory, CPU µs/sample")
+    print(
+        f"{problem.robot.name}, paper scene, {len(problem.s)} samples per trajectory, CPU µs/sample"
+    )
     for name, x in populations.items():
         problem.evaluate_batch(x[:5])  # warm-up
         runs = [pieces(problem, x) for _ in range(args.repeat)]

@@ -12,7 +12,7 @@ import pytest
 
 from adept_traj.collision import BroadPhase, point_signed_distance
 from adept_traj.errors import InvalidInputError
-from adept_traj.robot import Robot
+from adept_traj.robot import Robot, stack_times
 from adept_traj.scene import Box, Cylinder, Scene
 
 BOX = Box((0.4, 0.6, 1.0))
@@ -119,3 +119,14 @@ def test_ball_level_is_the_ball_distance(paper_frames: tuple, gap: bool) -> None
             else:  # the pendulum's bob
                 d = np.linalg.norm(local, axis=-1) - shape.radius
             np.testing.assert_allclose(lower[o, k], d - broad.ball_radius[k], atol=1e-12)
+
+
+def test_stack_times_is_the_stacked_product() -> None:
+    """One GEMM over the rows of a stack of matrices times one matrix: the sums written out
+    (einsum), within rounding; shapes (..., m, k) @ (k, n) → (..., m, n)."""
+    rng = np.random.default_rng(5)
+    stack = rng.normal(size=(7, 5, 4, 3))
+    b = rng.normal(size=(4, 4))[:3, 1:]  # a non-contiguous view, as a pose's rotation block
+    out = stack_times(stack, b)
+    assert out.shape == (7, 5, 4, 3)
+    np.testing.assert_allclose(out, np.einsum("...ik,kj->...ij", stack, b), rtol=0, atol=1e-14)

@@ -1,13 +1,14 @@
 """Robot-obstacle distances over time.
 
-The checker, the conservative broad phase, obstacle pruning, distance tables, closed-form
-point distances, the distances' derivatives in (q, t) from coal's witness points
-(``distance_gradients``) and the coal primitives (``distance_request``: the settings every
-distance uses).
+The checker, the conservative broad phase, the branch and bound (``search_pairs``), obstacle
+pruning, distance tables, closed-form point distances, the distances' derivatives in (q, t)
+from coal's witness points (``distance_gradients``) and the coal primitives
+(``distance_request``: the settings every distance uses).
 """
 
 from __future__ import annotations
 
+from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import Bounds, BroadPhase
 from adept_traj.collision.capsules import enclosing_capsule, segment_distance
 from adept_traj.collision.checker import (
@@ -58,6 +59,7 @@ __all__ = [
     "point_signed_distance",
     "restrict_broad_phase",
     "restrict_checker",
+    "search_pairs",
     "segment_distance",
     "shape_of",
     "solid_lever_arms",

@@ -71,7 +71,7 @@ from adept_traj.collision.primitives import (
 )
 from adept_traj.collision.pruning import sweep_clearance
 from adept_traj.errors import InvalidInputError
-from adept_traj.robot.kinematics import compose
+from adept_traj.robot.kinematics import compose, stack_times
 from adept_traj.robot.robot import Robot, solid_frames
 from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Sphere
@@ -433,7 +433,7 @@ class BroadPhase:
         towards = np.divide(delta, norm, out=np.zeros_like(delta), where=norm > 0)
         axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
         n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (R, 4, 3)
-        n_o = axes @ rot_o  # axes in the obstacle frame
+        n_o = stack_times(axes, po[:3, :3]) if po.ndim == 2 else axes @ rot_o  # obstacle frame
         gaps = (
             np.abs(np.einsum("nai,ni->na", axes, delta))
             - _ROUNDING

@@ -20,10 +20,12 @@ from typing import Any
 import coal
 import numpy as np
 
+from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.robot.kinematics import stack_times
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import as_finite_array
@@ -125,6 +127,11 @@ class CollisionChecker:
         self._result = coal.DistanceResult()
         self._tf = (coal.Transform3s(), coal.Transform3s())
         self._pruning = ObstaclePruning(scene, self.influence)
+        #: The base pose of each fixed obstacle (None: moving), formed once.
+        self._to_base = to_base = scene.base_from_world
+        self._fixed_poses = [
+            None if ob.is_moving else to_base @ ob.pose(0.0) for ob in scene.obstacles
+        ]
         self._views: dict[tuple[int, ...], CollisionChecker] = {}  # by obstacles kept
 
     @property
@@ -207,18 +214,18 @@ class CollisionChecker:
     def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
         """Obstacle poses in the robot base frame at the flattened times ``t``: per obstacle
         one (4, 4) pose if it is fixed, else (N, 4, 4) with N = ``t.size``."""
-        to_base = self.scene.base_from_world
+        to_base = self._to_base
         flat_t = t.reshape(-1)
         laws: dict[int, np.ndarray] = {}  # a pendulum's rod and bob share one motion law
         poses = []
-        for ob in self.scene.obstacles:
-            if not ob.is_moving:
-                poses.append(to_base @ ob.pose(0.0))
+        for ob, fixed in zip(self.scene.obstacles, self._fixed_poses):
+            if fixed is not None:
+                poses.append(fixed)
                 continue
             key = id(ob.motion)
             if key not in laws:
                 laws[key] = _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
-            poses.append(_right(laws[key], ob.offset))  # = to_base @ ob.pose(t)
+            poses.append(stack_times(laws[key], ob.offset))  # = to_base @ ob.pose(t)
         return poses
 
     @staticmethod
@@ -264,71 +271,20 @@ class CollisionChecker:
         return view
 
     def _search(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray, balls: Any = None) -> Any:
-        """The branch and bound of :meth:`min_distances` over every obstacle (``balls``:
+        """The branch and bound of :meth:`min_distances` over every obstacle
+        (:func:`~adept_traj.collision.branch_and_bound.search_pairs`; ``balls``:
         :meth:`BroadPhase.ball_centres` of ``frames``, or None); a :class:`MinDistances`."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
         obstacle_poses = self._obstacle_poses(t)
-        bounds = self._broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]), balls)
+        q_flat = q.reshape(-1, q.shape[-1])
+        bounds = self._broad.bounds(frames, obstacle_poses, q_flat, balls)
         lower, known = bounds.lower, bounds.exact
         if self.allowed.any():  # else no pass over the whole arrays
             lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed
         flat = (n_motions, n_t * self.n_solids, self.n_obstacles)
         lower, known = lower.reshape(flat), known.reshape(flat)
-        smallest = lower.argmin(axis=1)  # (n_motions, n_obs): where each smallest bound is
-        best = np.take_along_axis(lower, smallest[:, None], axis=1)[:, 0]  # bound until improved
-        where = np.full(best.shape, -1)
-        closed = self._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
-        # Every pair within influence of such an obstacle is exact already: the argmin is
-        # exact when at most influence; above, it may be a level-1 bound (then -1).
-        is_exact = np.take_along_axis(known, smallest[:, None, :], axis=1)[:, 0]
-        where[:, closed] = np.where(is_exact, smallest, -1)[:, closed]
-        calls = 0
-        pm, po = np.nonzero((best <= self.influence) & ~closed)
-        # First candidate of every (motion, obstacle) at once: the smallest bound. Most
-        # searches end there (the second smallest bound is at least its exact distance).
-        rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
-        first = smallest[pm, po]  # = rows.argmin(axis=1)
-        second = (
-            np.partition(rows, 1, axis=1)[:, 1] if rows.shape[1] > 1 else np.full(len(pm), np.inf)
-        )
-        # Poses of the first candidates (solid and obstacle), formed together.
-        first_sample = pm * n_t + first // self.n_solids
-        first_solid = first % self.n_solids
-        solid_at = self._broad.solid_poses(frames, first_sample, first_solid)
-        for i, (m, o, c0) in enumerate(zip(pm.tolist(), po.tolist(), first.tolist())):
-            bounds_mo = rows[i]
-            if known[m, c0, o]:
-                value = float(bounds_mo[c0])  # exact already
-            else:
-                pose_o = self._pose_at(obstacle_poses[o], int(first_sample[i]))
-                value = self._narrow(solid_at[i], pose_o, int(first_solid[i]), o)
-                calls += 1
-            where[m, o] = c0
-            if second[i] < value and second[i] <= self.influence:
-                near = np.flatnonzero(bounds_mo <= self.influence)
-                order = near[np.argsort(bounds_mo[near], kind="stable")][1:]
-                order = order[bounds_mo[order] < value]  # the loop stops before the others
-                todo = order[~known[m, order, o]]  # their solid poses, formed together
-                n_of, s_of = m * n_t + todo // self.n_solids, todo % self.n_solids
-                poses, j = self._broad.solid_poses(frames, n_of, s_of), 0
-                for c in order.tolist():
-                    if bounds_mo[c] >= value:  # every bound is a valid lower bound: prune
-                        break
-                    if known[m, c, o]:
-                        d = float(bounds_mo[c])
-                    else:
-                        pose_o = self._pose_at(obstacle_poses[o], int(n_of[j]))
-                        d = self._narrow(poses[j], pose_o, int(s_of[j]), o)
-                        j, calls = j + 1, calls + 1
-                    if d < value:
-                        value, where[m, o] = d, c
-            if value > self.influence:
-                # Not exact: candidates with a bound in (influence, value) were not computed;
-                # the smallest of value and those bounds is a lower bound above influence.
-                value = min(value, bounds_mo.min(initial=np.inf, where=bounds_mo > self.influence))
-                where[m, o] = -1  # only a bound is known
-            best[m, o] = value
+        best, where, calls = search_pairs(self, frames, lower, known, obstacle_poses, n_t)
         sample = np.where(where >= 0, where // self.n_solids, -1)
         solid = np.where(where >= 0, where % self.n_solids, -1)
         shape = (*batch, self.n_obstacles)
@@ -378,8 +334,3 @@ def _left(a: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """``a @ poses`` for a constant (4, 4) ``a`` and poses (N, 4, 4), as one GEMM (numpy's
     stacked product of small matrices is several times slower)."""
     return (poses.transpose(0, 2, 1).reshape(-1, 4) @ a.T).reshape(-1, 4, 4).transpose(0, 2, 1)
-
-
-def _right(poses: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``poses @ b`` for poses (N, 4, 4) and a constant (4, 4) ``b``, as one GEMM."""
-    return (poses.reshape(-1, 4) @ b).reshape(poses.shape)

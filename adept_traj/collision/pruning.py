@@ -141,6 +141,7 @@ def restrict_checker(checker: CollisionChecker, obstacles: np.ndarray) -> Collis
         allowed_contacts=contacts,
     )
     view.allowed = checker.allowed[:, keep]
+    view._fixed_poses = [checker._fixed_poses[o] for o in keep]
     view._views = {}
     return view
 

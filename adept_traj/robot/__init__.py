@@ -31,6 +31,7 @@ from adept_traj.robot.kinematics import (
     BatchKinematics,
     compose,
     frames_to_poses,
+    stack_times,
 )
 from adept_traj.robot.limits import (
     LIMIT_KINDS,
@@ -128,4 +129,5 @@ __all__ = [
     "solid_inertia",
     "solve_location",
     "sphere_inertia",
+    "stack_times",
 ]

@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from adept_traj.errors import RobotModelError
 
-__all__ = ["BatchKinematics", "compose", "frames_to_poses"]
+__all__ = ["BatchKinematics", "compose", "frames_to_poses", "stack_times"]
 
 
 @dataclass(frozen=True)
@@ -233,6 +233,13 @@ def compose(frames: np.ndarray, transform: np.ndarray) -> np.ndarray:
     """Component-major frames (3, 4, N) times a constant homogeneous ``transform`` (4, 4):
     row r of the product is :math:`T^\\top` applied to row r, one GEMM over the samples."""
     return np.matmul(transform.T, frames)
+
+
+def stack_times(stack: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``stack @ b`` for a stack of matrices (..., m, k) and one constant matrix (k, n),
+    as one GEMM over all the rows (numpy's stacked product calls BLAS once per matrix,
+    which dominates for small ones); (..., m, n)."""
+    return (stack.reshape(-1, stack.shape[-1]) @ b).reshape(*stack.shape[:-1], b.shape[-1])
 
 
 def frames_to_poses(frames: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
