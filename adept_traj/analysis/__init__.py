@@ -42,6 +42,7 @@ from adept_traj.analysis.member_certificate import (
     FRONT_INFLUENCE_ABOVE_MARGIN,
     MemberCertificate,
     certify_members,
+    certifying_problem,
 )
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
@@ -74,6 +75,7 @@ __all__ = [
     "certificate_bytes",
     "certify",
     "certify_members",
+    "certifying_problem",
     "check_certificate_memory",
     "combined_objective",
     "continuous_distance",

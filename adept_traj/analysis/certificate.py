@@ -317,6 +317,7 @@ def certify(
     t, q, qd, qdd, qddd = smp.t, smp.q, smp.qd, smp.qdd, smp.qddd
     tau = robot.inverse_dynamics(q, qd, qdd)
     bounds = problem.trajectory.bounds(xa)
+    acc = bounds.qdd_abs_max  # (nq,) the exact largest |q̈|, for the continuous bounds
 
     checker = problem.checker
     if checker.n_obstacles and checker.n_solids:
@@ -324,7 +325,9 @@ def certify(
         per_sample = pairs.min(axis=(1, 2))
         grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact)
+            found = continuous_distance(
+                problem, xa, t, qd, pairs, grid_hz, depth, exact, acceleration_bound=acc
+            )
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
@@ -366,7 +369,9 @@ def certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)
+    own = problem.self_check and self_distance(
+        problem, xa, t, q, qd, continuous, depth, acceleration_bound=acc
+    )
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

@@ -20,7 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
+from adept_traj.analysis.member_certificate import (
+    MemberCertificate,
+    certify_members,
+    certifying_problem,
+)
 from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
@@ -67,6 +71,7 @@ def certify_front_members(
     n_proc = min(as_integer(n_proc, "workers", minimum=1), len(rows))
     if n_proc <= 1 or "fork" not in multiprocessing.get_all_start_methods():
         return certify_members(problem, xs, rows, rate_hz=rate)
+    certifying_problem(problem)  # made once here: the forked processes inherit it
     shares = [rows[i::n_proc] for i in range(n_proc)]
     pool = multiprocessing.get_context("fork").Pool(
         n_proc, initializer=_start, initargs=(problem, xs, rate)
