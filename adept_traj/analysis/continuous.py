@@ -150,7 +150,11 @@ def _interval_bounds(
     qd_bar = 0.5 * (np.abs(qd_a) + np.abs(qd_b) + acc * h[:, None])  # (m, nq)
     v = qd_bar @ arms.T  # (m, ns)
     lipschitz = v[:, :, None] + speeds[None, None, :]
-    return 0.5 * (d_a + d_b - lipschitz * h[:, None, None])
+    lipschitz *= h[:, None, None]
+    low = d_a + d_b
+    low -= lipschitz
+    low *= 0.5  # the same operations in the same order as ½(d_a + d_b − L h), in place
+    return low
 
 
 def continuous_distance(
@@ -259,16 +263,18 @@ def _bisect(
     k, s, o = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
     best = (float(pairs[k, s, o]), float(t[k]), (int(s), int(o)))
     t_a, t_b, d_a, d_b, v_a, v_b = t[:-1], t[1:], pairs[:-1], pairs[1:], qd[:-1], qd[1:]
+    at_sample = pairs.reshape(len(pairs), -1).min(axis=1)  # (n,) smallest over the pairs
+    m_a, m_b = at_sample[:-1], at_sample[1:]  # of each interval's ends
     lower = math.inf
     depth = n_refined = 0
     while len(t_a):
         low = _interval_bounds(d_a, d_b, v_a, v_b, t_b - t_a, arms, acc, speeds)
-        per = low.min(axis=(1, 2))
+        per = low.reshape(len(low), -1).min(axis=1)
         ok = per >= margin
         if ok.any():
             lower = min(lower, float(per[ok].min()))
         # Refine the intervals that miss the margin with both ends clear of it.
-        ends_clear = (d_a.min(axis=(1, 2)) >= margin) & (d_b.min(axis=(1, 2)) >= margin)
+        ends_clear = (m_a >= margin) & (m_b >= margin)
         todo = ~ok & ends_clear
         stuck = ~ok & ~ends_clear
         if stuck.any():
@@ -280,7 +286,9 @@ def _bisect(
         if not todo.any():
             break
         depth += 1
-        t_a, t_b, d_a, d_b, v_a, v_b = (a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b))
+        t_a, t_b, d_a, d_b, v_a, v_b, m_a, m_b = (
+            a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b, m_a, m_b)
+        )
         t_m = 0.5 * (t_a + t_b)
         smp = problem.trajectory.sample(x, t_m / T, orders=(0, 1))
         d_m = distances(smp.q, t_m)
@@ -290,6 +298,8 @@ def _bisect(
             best = (float(d_m[k, s, o]), float(t_m[k]), (int(s), int(o)))
         t_a, t_b = np.concatenate([t_a, t_m]), np.concatenate([t_m, t_b])
         d_a, d_b = np.concatenate([d_a, d_m]), np.concatenate([d_m, d_b])
+        at_m = d_m.reshape(len(d_m), -1).min(axis=1)
+        m_a, m_b = np.concatenate([m_a, at_m]), np.concatenate([at_m, m_b])
         v_a, v_b = np.concatenate([v_a, smp.qd]), np.concatenate([smp.qd, v_b])
     finest = f"sampled at {rate_hz * 2**depth:g} Hz"
     guarantee = CONTINUOUS if lower >= margin else finest
