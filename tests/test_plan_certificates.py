@@ -9,24 +9,24 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem, plan
-from adept_traj.analysis import certify_members, member_certificate
+from adept_traj.analysis import MemberCertificate, certify_members
 
 
 @pytest.fixture(scope="module")
 def counted_run(problem: TrajectoryProblem):
     """A small NSGA-II run with the polish of its fastest member (one process), and how
-    often each move was certified by ``certify(..., exact=False)`` (the members'
-    certificates; the reported solution's exact one is not counted)."""
+    often each move's certificate was summarised (``MemberCertificate.of``: every member
+    certificate, the polish's and the front's; the reported solution's exact certificate
+    is not summarised)."""
     calls: Counter[bytes] = Counter()
-    real = member_certificate.certify
+    real = MemberCertificate.of
 
-    def counting(problem, x, *args, **kwargs):
-        if kwargs.get("exact") is False:
-            calls[np.asarray(x, dtype=float).tobytes()] += 1
-        return real(problem, x, *args, **kwargs)
+    def counting(cls, certificate, *args, **kwargs):
+        calls[certificate.x.tobytes()] += 1
+        return real(certificate, *args, **kwargs)
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(member_certificate, "certify", counting)
+        patch.setattr(MemberCertificate, "of", classmethod(counting))
         result = plan(problem, "nsga2", seed=1, pop_size=16, n_gen=4, polish="fastest")
     return result, calls
 

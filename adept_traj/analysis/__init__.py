@@ -27,7 +27,12 @@ from adept_traj.analysis.decision import (
     normalise,
     objective_weights,
 )
-from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
+from adept_traj.analysis.dense_trajectory import (
+    BATCH_SAMPLES,
+    DenseStates,
+    DenseTrajectory,
+    dense_samples,
+)
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     hypervolume,
@@ -54,6 +59,7 @@ from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
+    "BATCH_SAMPLES",
     "CONTINUOUS",
     "DEFAULT_HV_REFERENCE",
     "DEFAULT_MAX_DEPTH",
@@ -64,6 +70,7 @@ __all__ = [
     "PAPER_WEIGHTS",
     "BestTradeoff",
     "Certificate",
+    "DenseStates",
     "DenseTrajectory",
     "DistanceGuarantee",
     "LimitCheck",

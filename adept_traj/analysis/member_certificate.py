@@ -38,8 +38,15 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
-from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE
+from adept_traj.analysis.certificate import (
+    DEFAULT_RATE_HZ,
+    Certificate,
+    _certify,
+    check_certificate_memory,
+)
+from adept_traj.analysis.continuous import DEFAULT_MAX_DEPTH
+from adept_traj.analysis.dense_trajectory import BATCH_SAMPLES, _dense_states, dense_samples
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, _limits
 from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
@@ -190,11 +197,36 @@ def certify_members(
     out: list[MemberCertificate | None] = [None] * len(xs)
     if not rows:
         return tuple(out)
+    bad = [k for k in rows if not xs[k, 0] > 0.0]
+    if bad:
+        raise InvalidInputError(
+            f"x[{bad[0]}, 0] (travel time T [s]) must be > 0; got {xs[bad[0], 0]!r}"
+        )
     fast, influence = certifying_problem(problem)
-    for k in rows:
-        certificate = certify(fast, xs[k], rate_hz=rate, tolerance=tol, exact=False)
-        out[k] = MemberCertificate.of(certificate, influence)
+    _limits(fast.robot.limits)
+    for k in rows:  # every member's memory before any is sampled
+        check_certificate_memory(fast, rate, float(xs[k, 0]))
+    for group in _batches(xs, rows, rate):
+        states = _dense_states(fast, xs[group], rate, False)
+        for k, dense in zip(group, states):
+            certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+            out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
+
+
+def _batches(xs: np.ndarray, rows: list[int], rate_hz: float) -> list[list[int]]:
+    """``rows`` in order, cut into runs whose dense samples at ``rate_hz`` [Hz] add up to at
+    most :data:`~adept_traj.analysis.dense_trajectory.BATCH_SAMPLES` (a longer move alone)."""
+    batches: list[list[int]] = []
+    total = BATCH_SAMPLES + 1
+    for k in rows:
+        n = dense_samples(float(xs[k, 0]), rate_hz)
+        if total + n > BATCH_SAMPLES:
+            batches.append([])
+            total = 0
+        batches[-1].append(k)
+        total += n
+    return batches
 
 
 #: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
