@@ -29,8 +29,10 @@ from adept_traj.analysis.decision import (
 )
 from adept_traj.analysis.dense_trajectory import (
     BATCH_SAMPLES,
+    BATCH_VALUES,
     DenseStates,
     DenseTrajectory,
+    batch_samples,
     dense_samples,
 )
 from adept_traj.analysis.indicators import (
@@ -60,6 +62,7 @@ from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-export
 
 __all__ = [
     "BATCH_SAMPLES",
+    "BATCH_VALUES",
     "CONTINUOUS",
     "DEFAULT_HV_REFERENCE",
     "DEFAULT_MAX_DEPTH",
@@ -78,6 +81,7 @@ __all__ = [
     "SelfDistance",
     "algorithm_effort",
     "average_fitness",
+    "batch_samples",
     "best_tradeoff",
     "certificate_bytes",
     "certify",

@@ -6,7 +6,7 @@ ends included) and :class:`DenseTrajectory` holds the states, torques and smalle
 distances at those samples (built by :func:`~adept_traj.analysis.certificate.certify`).
 
 The states, torques and distances of several moves are formed together (one inverse
-dynamics call and one distance call for up to :data:`BATCH_SAMPLES` samples of several
+dynamics call and one distance call for up to :func:`batch_samples` samples of several
 moves, :func:`~adept_traj.analysis.certify_members`): every sample's values depend on that
 sample alone, so a move's values are those of its own call (tested bit for bit).
 """
@@ -25,14 +25,35 @@ from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_finite_array, as_scalar, deep_equal, readonly_copy
 
-__all__ = ["BATCH_SAMPLES", "DenseStates", "DenseTrajectory", "dense_samples"]
+__all__ = [
+    "BATCH_SAMPLES",
+    "BATCH_VALUES",
+    "DenseStates",
+    "DenseTrajectory",
+    "batch_samples",
+    "dense_samples",
+]
 
-#: Most dense samples of several moves formed in one batch by
+#: Most dense samples of the several moves formed in one batch by
 #: :func:`~adept_traj.analysis.certify_members` (a move with more is formed alone): the
 #: per-call work of the inverse dynamics and the distances is shared, and the batch's
-#: arrays stay in the CPU cache (measured on the paper front: about 6 000 samples, 3–4
-#: moves at 1 kHz, were the fastest; 14 000 were slower than one move at a time).
+#: arrays stay in the CPU cache. Measured on the paper front (42 solid–obstacle pairs):
+#: about 6 000 samples (3–4 moves at 1 kHz) were the fastest, 6 % faster than one move at
+#: a time; 12 000 were 1.7× slower.
 BATCH_SAMPLES = 6144
+
+#: Most solid–obstacle distances (samples × pairs, 2 MiB of them) of one batch: a scene
+#: with many obstacles batches fewer samples (:func:`batch_samples`).
+BATCH_VALUES = 2**18
+
+
+def batch_samples(problem: TrajectoryProblem) -> int:
+    """Most dense samples of one batch for ``problem``: :data:`BATCH_SAMPLES`, or fewer so
+    that the batch holds at most :data:`BATCH_VALUES` solid–obstacle distances (6 144 for
+    the paper's 7 solids and 6 obstacles, 187 for 7 solids and 200 obstacles)."""
+    pairs = problem.checker.n_solids * problem.checker.n_obstacles
+    return max(1, min(BATCH_SAMPLES, BATCH_VALUES // max(1, pairs)))
+
 
 #: A move's dense states: (the spline samples :class:`~adept_traj.problem.TrajectorySamples`
 #: ``t`` (n,) [s], ``q, qd, qdd, qddd`` (n, nq); the torques ``tau`` (n, nq) [N·m | N]; the

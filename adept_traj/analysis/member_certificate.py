@@ -45,7 +45,7 @@ from adept_traj.analysis.certificate import (
     check_certificate_memory,
 )
 from adept_traj.analysis.continuous import DEFAULT_MAX_DEPTH
-from adept_traj.analysis.dense_trajectory import BATCH_SAMPLES, _dense_states, dense_samples
+from adept_traj.analysis.dense_trajectory import _dense_states, batch_samples, dense_samples
 from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, _limits
 from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
@@ -206,7 +206,7 @@ def certify_members(
     _limits(fast.robot.limits)
     for k in rows:  # every member's memory before any is sampled
         check_certificate_memory(fast, rate, float(xs[k, 0]))
-    for group in _batches(xs, rows, rate):
+    for group in _batches(xs, rows, rate, batch_samples(fast)):
         states = _dense_states(fast, xs[group], rate, False)
         for k, dense in zip(group, states):
             certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
@@ -214,14 +214,15 @@ def certify_members(
     return tuple(out)
 
 
-def _batches(xs: np.ndarray, rows: list[int], rate_hz: float) -> list[list[int]]:
+def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list[list[int]]:
     """``rows`` in order, cut into runs whose dense samples at ``rate_hz`` [Hz] add up to at
-    most :data:`~adept_traj.analysis.dense_trajectory.BATCH_SAMPLES` (a longer move alone)."""
+    most ``most`` (:func:`~adept_traj.analysis.dense_trajectory.batch_samples`; a longer move
+    alone)."""
     batches: list[list[int]] = []
-    total = BATCH_SAMPLES + 1
+    total = most + 1
     for k in rows:
         n = dense_samples(float(xs[k, 0]), rate_hz)
-        if total + n > BATCH_SAMPLES:
+        if total + n > most:
             batches.append([])
             total = 0
         batches[-1].append(k)
