@@ -246,8 +246,9 @@ def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, f
     paper-front certificates: 0.85 s instead of 1.6 s with the default 0.05 m).
 
     Made once per ``problem`` and kept while ``problem`` lives (the same object is returned
-    again; it evaluates in one process). A caller about to fork certifying processes calls
-    it first, so that they share it.
+    again; it evaluates in one process and, like ``problem`` itself, is not for use from
+    several threads at once). A caller about to fork certifying processes calls it first,
+    so that they share it.
     """
     check_type(problem, TrajectoryProblem, "problem")
     made = _CERTIFYING.get(problem)

@@ -1,7 +1,8 @@
 """The front members' certificates on the problem's worker processes.
 
-:func:`~adept_traj.analysis.certify_members` certifies one member after the other (about
-14 ms each on the paper scene: 1.4 s for NSGA-II's 100 members, 7 s for MODE's 500).
+:func:`~adept_traj.analysis.certify_members` certifies one batch of members after the
+other (about 8–9 ms of CPU a member on the paper scene on a loaded machine: 0.9 s for
+NSGA-II's 100 members, 4.3 s for MODE's 500).
 :func:`certify_front_members` gives each of ``workers`` forked processes every
 ``workers``-th member (the trade-off order interleaved, so that each gets as many of the
 costly and the cheap ones), each process calls
