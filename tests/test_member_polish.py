@@ -116,7 +116,7 @@ def test_front_mode_of_a_small_run_polishes_only_the_fastest(problem, members, m
     alone (the fastest member's polish, tested in test_polish.py, is left out here)."""
     import adept_traj.optimise.polish_step as polish_step
 
-    monkeypatch.setattr(polish_step, "polish_fastest", lambda problem, state, rate: state)
+    monkeypatch.setattr(polish_step, "_polish_fastest", lambda problem, state, rate, made: state)
     state = _state(problem, members, 100)
     out = polish_run(problem, state, 1000.0, "front", PAPER_WEIGHTS)
     assert out is state

@@ -27,7 +27,14 @@ from adept_traj.analysis.decision import (
     normalise,
     objective_weights,
 )
-from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
+from adept_traj.analysis.dense_trajectory import (
+    BATCH_SAMPLES,
+    BATCH_VALUES,
+    DenseStates,
+    DenseTrajectory,
+    batch_samples,
+    dense_samples,
+)
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     hypervolume,
@@ -42,6 +49,7 @@ from adept_traj.analysis.member_certificate import (
     FRONT_INFLUENCE_ABOVE_MARGIN,
     MemberCertificate,
     certify_members,
+    certifying_problem,
 )
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
@@ -53,6 +61,8 @@ from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
+    "BATCH_SAMPLES",
+    "BATCH_VALUES",
     "CONTINUOUS",
     "DEFAULT_HV_REFERENCE",
     "DEFAULT_MAX_DEPTH",
@@ -63,6 +73,7 @@ __all__ = [
     "PAPER_WEIGHTS",
     "BestTradeoff",
     "Certificate",
+    "DenseStates",
     "DenseTrajectory",
     "DistanceGuarantee",
     "LimitCheck",
@@ -70,10 +81,12 @@ __all__ = [
     "SelfDistance",
     "algorithm_effort",
     "average_fitness",
+    "batch_samples",
     "best_tradeoff",
     "certificate_bytes",
     "certify",
     "certify_members",
+    "certifying_problem",
     "check_certificate_memory",
     "combined_objective",
     "continuous_distance",

@@ -58,15 +58,17 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, continuous_distance
-from adept_traj.analysis.dense_trajectory import DenseTrajectory, dense_samples
+from adept_traj.analysis.dense_trajectory import (
+    DenseStates,
+    DenseTrajectory,
+    _dense_states,
+    dense_samples,
+)
 from adept_traj.analysis.limit_check import (
     DEFAULT_TOLERANCE,
     LimitCheck,
-    _check,
-    _limit_messages,
+    _limit_checks,
     _limits,
-    _ratio_check,
-    _refined_torque_check,
 )
 from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, self_distance
 from adept_traj.errors import InvalidInputError
@@ -307,24 +309,38 @@ def certify(
     check_type(continuous, bool, "continuous")
     depth = as_integer(max_depth, "max_depth", minimum=0)
     check_type(exact, bool, "exact")
-    robot, lim = problem.robot, problem.robot.limits
-    span = _limits(lim)
+    _limits(problem.robot.limits)
     check_certificate_memory(problem, rate, T)
+    states = _dense_states(problem, xa[None], rate, exact)[0]
+    return _certify(problem, xa, rate, tol, continuous, depth, exact, states)
 
-    n = dense_samples(T, rate)
-    s = np.linspace(0.0, 1.0, n)
-    smp = problem.trajectory.sample(xa, s)
+
+def _certify(
+    problem: TrajectoryProblem,
+    xa: np.ndarray,
+    rate: float,
+    tol: float,
+    continuous: bool,
+    depth: int,
+    exact: bool,
+    states: DenseStates,
+) -> Certificate:
+    """:func:`certify` of the checked ``xa`` (n_var,) from its dense ``states``."""
+    T = float(xa[0])
+    smp, tau, pairs = states
+    n = len(smp.t)
     t, q, qd, qdd, qddd = smp.t, smp.q, smp.qd, smp.qdd, smp.qddd
-    tau = robot.inverse_dynamics(q, qd, qdd)
     bounds = problem.trajectory.bounds(xa)
+    acc = bounds.qdd_abs_max  # (nq,) the exact largest |q̈|, for the continuous bounds
 
     checker = problem.checker
-    if checker.n_obstacles and checker.n_solids:
-        pairs = checker.distances(q[None], t[None], exact=exact).distance[0]  # (n, ns, no)
+    if pairs is not None:  # (n, ns, no)
         per_sample = pairs.min(axis=(1, 2))
         grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact)
+            found = continuous_distance(
+                problem, xa, t, qd, pairs, grid_hz, depth, exact, acceleration_bound=acc
+            )
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
@@ -340,33 +356,18 @@ def certify(
         min_d, t_min_d, pair = math.inf, None, None
         guarantee, bound = CONTINUOUS, math.inf
 
-    excess = np.maximum(q - lim.upper, lim.lower - q) / span  # (n, nq)
-    exact_excess = np.maximum(bounds.q_max - lim.upper, lim.lower - bounds.q_min) / span
-    checks = {
-        "position": _check("position", excess, exact_excess, t, tol),
-        "velocity": _ratio_check("velocity", qd, bounds.qd_abs_max, lim.velocity, t, tol),
-        "acceleration": _ratio_check(
-            "acceleration", qdd, bounds.qdd_abs_max, lim.acceleration, t, tol
-        ),
-        "jerk": _ratio_check("jerk", qddd, bounds.qddd_abs_max, lim.jerk, t, tol),
-    }
-    if continuous:
-        checks["torque"], torque_guarantee = _refined_torque_check(problem, xa, t, tau, tol)
-    else:
-        checks["torque"] = _ratio_check("torque", tau, None, lim.torque, t, tol)
-        torque_guarantee = f"sampled at {(n - 1) / T:g} Hz"
-    violations = [
-        message
-        for kind in LIMIT_KINDS
-        for message in _limit_messages(checks[kind], lim.names, lim.lower, lim.upper)
-    ]
+    checks, torque_guarantee, violations = _limit_checks(
+        problem, xa, smp, tau, bounds, tol, continuous
+    )
     margin = float(problem.settings.margin)
     if min_d < margin and pair is not None:
         violations.append(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and self_distance(problem, xa, t, q, qd, continuous, depth)
+    own = problem.self_check and self_distance(
+        problem, xa, t, q, qd, continuous, depth, acceleration_bound=acc
+    )
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

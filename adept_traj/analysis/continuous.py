@@ -47,6 +47,7 @@ violation found between the uniform samples.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -115,6 +116,25 @@ def obstacle_speeds(problem: TrajectoryProblem) -> np.ndarray:
     ).reshape(len(obstacles))
 
 
+#: (lever arms (n_solids, nq), obstacle speeds (n_obstacles,)) of each problem, read-only:
+#: they depend on the robot and the scene alone, and a front certifies hundreds of moves of
+#: one problem (computing them took ≈ 1 ms per certificate).
+_RATES: weakref.WeakKeyDictionary[TrajectoryProblem, tuple[np.ndarray, np.ndarray]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _rates(problem: TrajectoryProblem) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`solid_lever_arms` and :func:`obstacle_speeds` of ``problem``, computed once
+    per problem (read-only arrays)."""
+    rates = _RATES.get(problem)
+    if rates is None:
+        arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
+        arms.flags.writeable = speeds.flags.writeable = False
+        rates = _RATES[problem] = (arms, speeds)
+    return rates
+
+
 def _interval_bounds(
     d_a: np.ndarray,
     d_b: np.ndarray,
@@ -130,7 +150,11 @@ def _interval_bounds(
     qd_bar = 0.5 * (np.abs(qd_a) + np.abs(qd_b) + acc * h[:, None])  # (m, nq)
     v = qd_bar @ arms.T  # (m, ns)
     lipschitz = v[:, :, None] + speeds[None, None, :]
-    return 0.5 * (d_a + d_b - lipschitz * h[:, None, None])
+    lipschitz *= h[:, None, None]
+    low = d_a + d_b
+    low -= lipschitz
+    low *= 0.5  # the same operations in the same order as ½(d_a + d_b − L h), in place
+    return low
 
 
 def continuous_distance(
@@ -142,6 +166,8 @@ def continuous_distance(
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
     exact: bool = True,
+    *,
+    acceleration_bound: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """Lower-bound the distance between the samples and refine where needed.
 
@@ -156,6 +182,10 @@ def continuous_distance(
         exact: distances at the midpoints exact for every pair (``False``: lower bounds
             above the checker's influence distance, as
             :meth:`~adept_traj.collision.CollisionChecker.distances`).
+        acceleration_bound: (nq,) the spline's exact :math:`\\max_t |\\ddot q_j|`
+            [rad/s² | m/s²] if the caller has it
+            (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``.qdd_abs_max``);
+            ``None``: computed here.
 
     Returns:
         :class:`DistanceGuarantee`.
@@ -165,8 +195,9 @@ def continuous_distance(
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
         return checker.distances(q[None], t_m[None], exact=exact).distance[0]
 
-    arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
-    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances)
+    arms, speeds = _rates(problem)
+    acc = _acceleration_bound(problem, x, acceleration_bound)
+    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
 
 
 def continuous_self_distance(
@@ -177,6 +208,8 @@ def continuous_self_distance(
     pairs: np.ndarray,
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
+    *,
+    acceleration_bound: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """:func:`continuous_distance` for the robot's own solid pairs
     (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
@@ -184,7 +217,8 @@ def continuous_self_distance(
     Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
     solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
     obstacle speed). The midpoints' distances are exact below the margin, lower bounds
-    above it. The returned ``pair`` is ``(pair index, 0)``."""
+    above it. The returned ``pair`` is ``(pair index, 0)``. ``acceleration_bound`` as for
+    :func:`continuous_distance`."""
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
@@ -193,7 +227,18 @@ def continuous_self_distance(
         return check.distances(q, exact_below=problem.settings.margin)[..., None]
 
     arms, speeds = check.lever_arms, np.zeros(1)
-    return _bisect(problem, x, t, qd, pairs[..., None], rate_hz, max_depth, arms, speeds, distances)
+    acc = _acceleration_bound(problem, x, acceleration_bound)
+    pairs = pairs[..., None]
+    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
+
+
+def _acceleration_bound(
+    problem: TrajectoryProblem, x: np.ndarray, given: np.ndarray | None
+) -> np.ndarray:
+    """(nq,) the spline's exact largest |q̈| [rad/s² | m/s²]: ``given``, else computed."""
+    if given is not None:
+        return np.asarray(given, dtype=float)
+    return problem.trajectory.bounds(x).qdd_abs_max
 
 
 def _bisect(
@@ -207,26 +252,29 @@ def _bisect(
     arms: np.ndarray,
     speeds: np.ndarray,
     distances: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    acc: np.ndarray,
 ) -> DistanceGuarantee:
     """The refinement of :func:`continuous_distance` for distances ``pairs`` (n, ns, no) at
-    ``t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,); ``distances(q, t)`` gives
-    them (m, ns, no) at configurations (m, nq) and times (m,) [s]."""
+    ``t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,), the exact acceleration
+    bound ``acc`` (nq,); ``distances(q, t)`` gives them (m, ns, no) at configurations
+    (m, nq) and times (m,) [s]."""
     margin = float(problem.settings.margin)
-    acc = problem.trajectory.bounds(x).qdd_abs_max
     T = float(x[0])
     k, s, o = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
     best = (float(pairs[k, s, o]), float(t[k]), (int(s), int(o)))
     t_a, t_b, d_a, d_b, v_a, v_b = t[:-1], t[1:], pairs[:-1], pairs[1:], qd[:-1], qd[1:]
+    at_sample = pairs.reshape(len(pairs), -1).min(axis=1)  # (n,) smallest over the pairs
+    m_a, m_b = at_sample[:-1], at_sample[1:]  # of each interval's ends
     lower = math.inf
     depth = n_refined = 0
     while len(t_a):
         low = _interval_bounds(d_a, d_b, v_a, v_b, t_b - t_a, arms, acc, speeds)
-        per = low.min(axis=(1, 2))
+        per = low.reshape(len(low), -1).min(axis=1)
         ok = per >= margin
         if ok.any():
             lower = min(lower, float(per[ok].min()))
         # Refine the intervals that miss the margin with both ends clear of it.
-        ends_clear = (d_a.min(axis=(1, 2)) >= margin) & (d_b.min(axis=(1, 2)) >= margin)
+        ends_clear = (m_a >= margin) & (m_b >= margin)
         todo = ~ok & ends_clear
         stuck = ~ok & ~ends_clear
         if stuck.any():
@@ -238,7 +286,9 @@ def _bisect(
         if not todo.any():
             break
         depth += 1
-        t_a, t_b, d_a, d_b, v_a, v_b = (a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b))
+        t_a, t_b, d_a, d_b, v_a, v_b, m_a, m_b = (
+            a[todo] for a in (t_a, t_b, d_a, d_b, v_a, v_b, m_a, m_b)
+        )
         t_m = 0.5 * (t_a + t_b)
         smp = problem.trajectory.sample(x, t_m / T, orders=(0, 1))
         d_m = distances(smp.q, t_m)
@@ -248,6 +298,8 @@ def _bisect(
             best = (float(d_m[k, s, o]), float(t_m[k]), (int(s), int(o)))
         t_a, t_b = np.concatenate([t_a, t_m]), np.concatenate([t_m, t_b])
         d_a, d_b = np.concatenate([d_a, d_m]), np.concatenate([d_m, d_b])
+        at_m = d_m.reshape(len(d_m), -1).min(axis=1)
+        m_a, m_b = np.concatenate([m_a, at_m]), np.concatenate([at_m, m_b])
         v_a, v_b = np.concatenate([v_a, smp.qd]), np.concatenate([smp.qd, v_b])
     finest = f"sampled at {rate_hz * 2**depth:g} Hz"
     guarantee = CONTINUOUS if lower >= margin else finest

@@ -227,3 +227,44 @@ def _refined_torque_check(
     else:
         label = f"sampled at {grid_hz:g} Hz, below {TORQUE_REFINE_FRACTION:g} × UC"
     return check, label
+
+
+def _limit_checks(
+    problem: Any,
+    x: np.ndarray,
+    smp: Any,
+    tau: np.ndarray,
+    bounds: Any,
+    tol: float,
+    continuous: bool,
+) -> tuple[dict[str, LimitCheck], str, list[str]]:
+    """The five :class:`LimitCheck` of the certificate of ``x`` (n_var,) by kind, the
+    torque's guarantee label and the messages of the violated limits, from the dense spline
+    samples ``smp`` (``t`` (n,)
+    [s], ``q, qd, qdd, qddd`` (n, nq)), the torques ``tau`` (n, nq) [N·m | N] and the
+    spline's exact extrema ``bounds`` (:meth:`~adept_traj.problem.BSplineTrajectory.bounds`);
+    ``continuous``: the torque refined near its limit (:func:`_refined_torque_check`)."""
+    lim = problem.robot.limits
+    span = _limits(lim)
+    t, q, n = smp.t, smp.q, len(smp.t)
+    excess = np.maximum(q - lim.upper, lim.lower - q) / span  # (n, nq)
+    exact_excess = np.maximum(bounds.q_max - lim.upper, lim.lower - bounds.q_min) / span
+    checks = {
+        "position": _check("position", excess, exact_excess, t, tol),
+        "velocity": _ratio_check("velocity", smp.qd, bounds.qd_abs_max, lim.velocity, t, tol),
+        "acceleration": _ratio_check(
+            "acceleration", smp.qdd, bounds.qdd_abs_max, lim.acceleration, t, tol
+        ),
+        "jerk": _ratio_check("jerk", smp.qddd, bounds.qddd_abs_max, lim.jerk, t, tol),
+    }
+    if continuous:
+        checks["torque"], torque_guarantee = _refined_torque_check(problem, x, t, tau, tol)
+    else:
+        checks["torque"] = _ratio_check("torque", tau, None, lim.torque, t, tol)
+        torque_guarantee = f"sampled at {(n - 1) / float(x[0]):g} Hz"
+    violations = [
+        message
+        for kind in LIMIT_KINDS
+        for message in _limit_messages(checks[kind], lim.names, lim.lower, lim.upper)
+    ]
+    return checks, torque_guarantee, violations

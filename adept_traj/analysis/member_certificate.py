@@ -31,21 +31,34 @@ compares it field by field.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import DEFAULT_RATE_HZ, Certificate, certify
-from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE
+from adept_traj.analysis.certificate import (
+    DEFAULT_RATE_HZ,
+    Certificate,
+    _certify,
+    check_certificate_memory,
+)
+from adept_traj.analysis.continuous import DEFAULT_MAX_DEPTH
+from adept_traj.analysis.dense_trajectory import _dense_states, batch_samples, dense_samples
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, _limits
 from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
 from adept_traj.validation import as_batch, as_integer, as_scalar, check_type, deep_equal
 
-__all__ = ["FRONT_INFLUENCE_ABOVE_MARGIN", "MemberCertificate", "certify_members"]
+__all__ = [
+    "FRONT_INFLUENCE_ABOVE_MARGIN",
+    "MemberCertificate",
+    "certify_members",
+    "certifying_problem",
+]
 
 #: Influence distance above the margin [m] of the front's certificates: the distances at
 #: or below ``margin + FRONT_INFLUENCE_ABOVE_MARGIN`` are exact, those above lower bounds.
@@ -184,18 +197,70 @@ def certify_members(
     out: list[MemberCertificate | None] = [None] * len(xs)
     if not rows:
         return tuple(out)
-    fast, influence = _certifying_problem(problem)
-    for k in rows:
-        certificate = certify(fast, xs[k], rate_hz=rate, tolerance=tol, exact=False)
-        out[k] = MemberCertificate.of(certificate, influence)
+    bad = [k for k in rows if not xs[k, 0] > 0.0]
+    if bad:
+        raise InvalidInputError(
+            f"x[{bad[0]}, 0] (travel time T [s]) must be > 0; got {xs[bad[0], 0]!r}"
+        )
+    fast, influence = certifying_problem(problem)
+    _limits(fast.robot.limits)
+    for k in rows:  # every member's memory before any is sampled
+        check_certificate_memory(fast, rate, float(xs[k, 0]))
+    for group in _batches(xs, rows, rate, batch_samples(fast)):
+        states = _dense_states(fast, xs[group], rate, False)
+        for k, dense in zip(group, states):
+            certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+            out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
 
 
+def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list[list[int]]:
+    """``rows`` in order, cut into runs whose dense samples at ``rate_hz`` [Hz] add up to at
+    most ``most`` (:func:`~adept_traj.analysis.dense_trajectory.batch_samples`; a longer move
+    alone)."""
+    batches: list[list[int]] = []
+    total = most + 1
+    for k in rows:
+        n = dense_samples(float(xs[k, 0]), rate_hz)
+        if total + n > most:
+            batches.append([])
+            total = 0
+        batches[-1].append(k)
+        total += n
+    return batches
+
+
+#: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
+#: itself, not held here, so that the key can die) and its influence [m], made once: it
+#: takes ≈ 0.1 s (the broad phase's distance tables), as much as seven certificates, and
+#: the polish certifies its moves one call at a time.
+_CERTIFYING: weakref.WeakKeyDictionary[Any, tuple[TrajectoryProblem | None, float]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
+    """The problem :func:`certify_members` certifies on, and its influence distance [m]:
+    ``problem`` with the influence lowered to ``margin +`` :data:`FRONT_INFLUENCE_ABOVE_MARGIN`
+    (never raised; a pair whose broad-phase bound exceeds it needs no coal call; 100
+    paper-front certificates: 0.85 s instead of 1.6 s with the default 0.05 m).
+
+    Made once per ``problem`` and kept while ``problem`` lives (the same object is returned
+    again; it evaluates in one process and, like ``problem`` itself, is not for use from
+    several threads at once). A caller about to fork certifying processes calls it first,
+    so that they share it.
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    made = _CERTIFYING.get(problem)
+    if made is None:
+        fast, influence = _certifying_problem(problem)
+        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence)
+    fast, influence = made
+    return (problem if fast is None else fast), influence
+
+
 def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
-    """The problem with the influence distance lowered to ``margin + 0.01 m`` (never
-    raised), and that influence [m]: a pair whose broad-phase bound exceeds it needs no
-    coal call. 100 paper-front certificates: 0.85 s instead of 1.6 s with the default
-    0.05 m."""
+    """:func:`certifying_problem`, made."""
     st = problem.settings
     influence = min(st.influence, st.margin + FRONT_INFLUENCE_ABOVE_MARGIN)
     if influence == st.influence:

@@ -113,10 +113,14 @@ def self_distance(
     qd: np.ndarray,
     continuous: bool,
     max_depth: int,
+    *,
+    acceleration_bound: np.ndarray | None = None,
 ) -> SelfDistance:
     """The :class:`SelfDistance` of ``x`` (n_var,) sampled at ``t`` (n,) [s] with
     configurations ``q`` and speeds ``qd`` (n, nq), for :func:`~adept_traj.analysis.certify`
-    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on).
+    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on);
+    ``acceleration_bound`` (nq,) [rad/s² | m/s²]: the spline's exact largest :math:`|\\ddot q|`
+    if the caller has it (``None``: computed).
 
     The distances at the samples are exact where below the margin and lower bounds
     above it (:meth:`~adept_traj.collision.SelfCollision.distances` with ``exact_below``:
@@ -148,7 +152,9 @@ def self_distance(
     best, t_best, exact = float(d[k, p]), float(t[k]), bool(known[k, p])
     guarantee, bound = f"sampled at {grid_hz:g} Hz", None
     if continuous:
-        between = continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth)
+        between = continuous_self_distance(
+            problem, x, t, qd, d, grid_hz, max_depth, acceleration_bound=acceleration_bound
+        )
         guarantee, bound = between.guarantee, between.lower_bound
         if between.min_distance < best:  # (exact: below the margin) between the samples
             best, t_best, p = between.min_distance, between.t_min_distance, between.pair[0]

@@ -23,7 +23,8 @@ Steps:
    the best trade-off and a few members spread over the front by an ε-constraint step
    (:func:`~adept_traj.optimise.polish_members`); a polished move that passes its
    certificate joins the population, so it replaces the members it dominates in the
-   front. ``algorithm="time-optimal"`` replaces step 1 and this one by
+   front; its certificate's summary is that member's in step 4 (no move is certified
+   twice). ``algorithm="time-optimal"`` replaces step 1 and this one by
    :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
 6. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
@@ -34,7 +35,7 @@ from __future__ import annotations
 
 import json
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -59,7 +60,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, polish_run, time_optimal_run
+from adept_traj.optimise.polish_step import TIME_OPTIMAL, _polish_run, polish_mode, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
@@ -149,6 +150,7 @@ def _certify_front(
     order: np.ndarray,
     rate_hz: float,
     max_certify: int | None,
+    known: Mapping[bytes, MemberCertificate] | None = None,
 ) -> tuple[MemberCertificate | None, ...]:
     """(n,) the summary of each member's dense certificate with the continuous guarantee
     (:func:`~adept_traj.analysis.certify_members`, on the problem's workers:
@@ -156,12 +158,20 @@ def _certify_front(
 
     Only members the optimiser marked feasible are certified (a member that violates a
     constraint at the optimiser's samples fails the dense check as well), in the trade-off
-    ``order`` (n,), at most ``max_certify`` of them (``None``: all).
+    ``order`` (n,), at most ``max_certify`` of them (``None``: all). A member whose
+    ``x.tobytes()`` is in ``known`` (the polish's summaries, made the same way) keeps that
+    summary instead of being certified again.
     """
     candidates = [int(k) for k in order if front.feasible[k]]
     if max_certify is not None:
         candidates = candidates[:max_certify]
-    return certify_front_members(problem, front.x, candidates, rate_hz=rate_hz)
+    known = {} if known is None else known
+    reused = {k: known[front.x[k].tobytes()] for k in candidates if front.x[k].tobytes() in known}
+    todo = [k for k in candidates if k not in reused]
+    out = list(certify_front_members(problem, front.x, todo, rate_hz=rate_hz))
+    for k, summary in reused.items():
+        out[k] = summary
+    return tuple(out)
 
 
 def _certified_choice(
@@ -251,6 +261,7 @@ def plan(
     polish = polish_mode(polish)
     warn_missing_limits(problem.robot.name, problem.robot.limits)
     n_searched: int | None = 0  # population rows made by the search (the rest by the local solver)
+    polished: dict[bytes, MemberCertificate] = {}  # the polish's certificates, by x.tobytes()
     if algorithm == TIME_OPTIMAL:
         state, settings_dict = time_optimal_run(problem, seed, **params)
         name = TIME_OPTIMAL
@@ -270,7 +281,7 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        state = polish_run(problem, state, rate_hz, polish, weights)
+        state, polished = _polish_run(problem, state, rate_hz, polish, weights)
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)
@@ -291,7 +302,7 @@ def plan(
         feasible=feasible[rows],
     )
     choice = best_tradeoff(front.objectives, weights)
-    summaries = _certify_front(problem, front, choice.order, rate_hz, max_certify)
+    summaries = _certify_front(problem, front, choice.order, rate_hz, max_certify, polished)
     certified = np.array([s is not None and s.feasible for s in summaries], dtype=bool)
     front = Front(
         x=front.x,

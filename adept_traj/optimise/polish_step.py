@@ -40,7 +40,7 @@ import numpy as np
 
 from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
-from adept_traj.analysis.member_certificate import certify_members
+from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
@@ -103,6 +103,14 @@ def polish_fastest(problem: Any, state: RunState, rate_hz: float) -> RunState:
         Rate [Hz] of the certificate (made as for the front's members,
         :func:`~adept_traj.analysis.certify_members`).
     """
+    return _polish_fastest(problem, state, rate_hz, {})
+
+
+def _polish_fastest(
+    problem: Any, state: RunState, rate_hz: float, certified: dict[bytes, MemberCertificate]
+) -> RunState:
+    """:func:`polish_fastest`, adding the summary of the certificate it made (if any) to
+    ``certified`` under the move's ``x.tobytes()``."""
     X = np.asarray(state.X, dtype=float)
     feasible = np.flatnonzero(np.all(np.asarray(state.G) <= 0.0, axis=1))
     if len(feasible) == 0:
@@ -113,7 +121,7 @@ def polish_fastest(problem: Any, state: RunState, rate_hz: float) -> RunState:
     keep = (
         outcome.feasible
         and outcome.x[0] < X[start, 0]
-        and certify_members(problem, outcome.x[None], rate_hz=rate_hz)[0].feasible
+        and _certified(problem, outcome.x, rate_hz, certified)
     )
     spent = outcome.seconds + time.perf_counter() - tic
     counted = dataclasses.replace(
@@ -142,18 +150,40 @@ def polish_mode(polish: Any) -> str:
 def polish_run(problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any) -> RunState:
     """``state`` after the polish ``mode`` (:data:`POLISH_MODES`, see the module docstring)
     with the f_c ``weights`` (6,) of the run."""
+    return _polish_run(problem, state, rate_hz, mode, weights)[0]
+
+
+def _polish_run(
+    problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any
+) -> tuple[RunState, dict[bytes, MemberCertificate]]:
+    """:func:`polish_run`, and the summaries of the certificates it made, by the polished
+    move's ``x.tobytes()`` (:func:`~adept_traj.analysis.certify_members` at ``rate_hz``
+    with its default tolerance: what :func:`~adept_traj.plan` makes for a front member, so
+    that ``plan`` certifies no polished move twice)."""
     mode = polish_mode(mode)
+    certified: dict[bytes, MemberCertificate] = {}
     if mode == "off":
-        return state
+        return state, certified
     members, scale = _chosen_members(state, mode, weights)
     budget = None
     if mode == "front":
         budget = int(POLISH_SHARE * state.n_evaluations / GRADIENT_COST)
     before = state.n_evaluations
-    state = polish_fastest(problem, state, rate_hz)
+    state = _polish_fastest(problem, state, rate_hz, certified)
     if budget is not None:
         budget -= state.n_evaluations - before
-    return polish_members(problem, state, members, scale, rate_hz, max_evaluations=budget)
+    state = _polish_members(problem, state, members, scale, rate_hz, budget, certified)
+    return state, certified
+
+
+def _certified(
+    problem: Any, x: np.ndarray, rate_hz: float, certified: dict[bytes, MemberCertificate]
+) -> bool:
+    """Whether the move ``x`` (n_var,) passes its certificate; its summary is added to
+    ``certified``."""
+    summary = certify_members(problem, x[None], rate_hz=rate_hz)[0]
+    certified[x.tobytes()] = summary
+    return summary.feasible
 
 
 def _chosen_members(state: RunState, mode: str, weights: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -218,6 +248,20 @@ def polish_members(
         is polished only while a whole step (at most
         :data:`~adept_traj.optimise.member_polish.MAX_EVALUATIONS`) fits in what is left.
     """
+    return _polish_members(problem, state, members, scale, rate_hz, max_evaluations, {})
+
+
+def _polish_members(
+    problem: Any,
+    state: RunState,
+    members: Any,
+    scale: Any,
+    rate_hz: float,
+    max_evaluations: int | None,
+    certified: dict[bytes, MemberCertificate],
+) -> RunState:
+    """:func:`polish_members`, adding the summaries of the certificates it made to
+    ``certified`` under each move's ``x.tobytes()``."""
     rows = np.asarray(members, dtype=int).ravel()
     torque_limit = problem.robot.limits.bound(LIMITS[4].name)
     if problem.settings.z3 != "clearance" or not np.all(np.isfinite(torque_limit)):
@@ -234,7 +278,7 @@ def polish_members(
         ok = (
             outcome.feasible
             and outcome.x[0] < X[k, 0]
-            and certify_members(problem, outcome.x[None], rate_hz=rate_hz)[0].feasible
+            and _certified(problem, outcome.x, rate_hz, certified)
         )
         seconds += outcome.seconds + time.perf_counter() - tic
         n_evaluations += outcome.n_evaluations
