@@ -79,7 +79,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--algorithm",
         default="nsga2",
         help=f"one of {', '.join(ALGORITHMS)} (default nsga2), or {TIME_OPTIMAL} (one "
-        "fastest move by multi-start SLSQP, no evolutionary search)",
+        "fastest move by multi-start SLSQP, no evolutionary search; with --weights the move "
+        "of least weighted sum of z1..z6, scaled by the straight move's values)",
     )
     p.add_argument(
         "--polish",
@@ -112,7 +113,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     # An option left out is None, so that --resume tells it from one given (even with its
     # default value); the defaults fill it in for a new run.
-    p.set_defaults(plan_defaults={k: p.get_default(k) for k in _SAVED}, **dict.fromkeys(_SAVED))
+    defaults = {k: p.get_default(k) for k in _SAVED}
+    # Without --weights: the paper's weights of f_c, and the time-optimal mode stays min T.
+    defaults["weights"] = None
+    p.set_defaults(plan_defaults=defaults, **dict.fromkeys(_SAVED))
     return p
 
 
