@@ -33,7 +33,8 @@ def test_values_are_the_documented_sum(problem) -> None:
     z_ref = problem.evaluate_batch(straight).objectives
     np.testing.assert_array_equal(ws.weights, [0.5, 0.25, 0.0, 0.25, 0.0, 0.0])
     np.testing.assert_array_equal(ws.scale[[0, 1, 3, 4, 5]], z_ref[[0, 1, 3, 4, 5]])
-    assert ws.scale[0] == problem.lower_bound.T_min and ws.scale[2] == 1.0
+    assert ws.scale[0] == problem.lower_bound.T_min
+    assert ws.scale[2] == 1.0
     z = problem.evaluate_batch(lift_then_lower(problem)).objectives
     by_hand = 0.5 * z[0] / z_ref[0] + 0.25 * z[1] / z_ref[1] - 0.25 * z[3] / z_ref[3]
     assert ws.values(z) == pytest.approx(by_hand, rel=1e-12)
@@ -147,7 +148,8 @@ def test_plan_weighted_mode_round_trips_verifies_and_repeats(problem, tmp_path) 
     ws = WeightedSum.from_settings(first.algorithm_settings)
     f = ws.values(first.front.objectives)
     certified = np.flatnonzero(first.front.feasible)
-    assert first.feasible and first.best.index == certified[np.argmin(f[certified])]
+    assert first.feasible
+    assert first.best.index == certified[np.argmin(f[certified])]
     fastest = certified[np.argmin(first.front.objectives[certified, 0])]
     assert f[first.best.index] < f[fastest]
     assert first.best_objectives[0] > first.front.objectives[fastest, 0]

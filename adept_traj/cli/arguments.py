@@ -87,8 +87,8 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     """The problem the options describe, on the robot of
     :func:`~adept_traj.cli.robot_options.robot_from_arguments` (default: the AdeptOne XL).
 
-    ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights`` must be six
-    finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
+    ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights``, when given, must
+    be six finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
 
     Raises
     ------

@@ -24,7 +24,9 @@ Steps:
    (:func:`~adept_traj.optimise.polish_members`); a polished move that passes its
    certificate joins the population, so it replaces the members it dominates in the
    front. ``algorithm="time-optimal"`` replaces step 1 and this one by
-   :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
+   :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP), or, with
+   ``weights``, by :func:`~adept_traj.optimise.weighted_run` (the weighted-sum mode: the
+   certified member of least :math:`f_w` is reported instead of the trade-off choice).
 6. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
