@@ -45,9 +45,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from adept_traj.analysis.decision import objective_weights
-from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.problem import MAXIMISED, objective_gradients
-from adept_traj.robot.limits import LIMITS
+from adept_traj.errors import InvalidInputError
+from adept_traj.problem import MAXIMISED, check_differentiable, objective_gradients
 from adept_traj.validation import as_batch, as_vector, readonly_copy
 
 __all__ = ["WEIGHTED_SUM_REFERENCE", "WeightedSum", "weighted_sum"]
@@ -142,17 +141,7 @@ def weighted_sum(problem: Any, weights: ArrayLike) -> WeightedSum:
     have no gradients (``z3`` other than ``"clearance"``, an infinite torque limit)
     :class:`~adept_traj.errors.ConfigurationError`."""
     w = objective_weights(weights, len(_SIGN))
-    if problem.settings.z3 != "clearance":
-        raise ConfigurationError(
-            f"the weighted-sum mode needs z3='clearance' (its gradient); this problem has "
-            f"z3={problem.settings.z3!r}"
-        )
-    torque = problem.robot.limits.bound(LIMITS[4].name)
-    if not np.all(np.isfinite(torque)):
-        raise ConfigurationError(
-            f"the weighted-sum mode needs finite torque limits [N·m | N] (the z2 gradient); "
-            f"got {torque.tolist()}"
-        )
+    check_differentiable(problem)
     straight = problem.trajectory.straight_line(problem.lower_bound.T_min)
     z = problem.evaluate_batch(straight[None]).objectives[0]
     r = np.abs(z)
