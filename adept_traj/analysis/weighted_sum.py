@@ -28,7 +28,7 @@ stored problem. The paper's Table 3 bounds exist only for its own scene and robo
 minimum-T move's values would depend on which local optimum the solver found (three
 distinct ones on the paper scene, with z2 from 3 408 to 3 791 J). With these scales a unit
 of :math:`f_w` is "the straight move's value of every objective": on the paper scene the
-minimum-T move has :math:`z_1/r_1 = 1.004`, :math:`z_2/r_2 = 1.50`.
+minimum-T moves have :math:`z_1/r_1 = 1.0036` and :math:`z_2/r_2` from 1.14 to 1.27.
 
 :meth:`WeightedSum.to_dict` gives the weights and scales as stored in a result
 (``result.algorithm_settings["weighted_sum"]``), :meth:`WeightedSum.from_settings` reads
