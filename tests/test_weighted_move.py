@@ -165,3 +165,23 @@ def test_plan_weighted_mode_round_trips_verifies_and_repeats(problem, tmp_path) 
     path.write_text(json.dumps(doc))
     found = audit(PlanningResult.load(tmp_path / "r"), problem=problem)
     assert any("weighted_sum.scale" in m.field for m in found.mismatches)
+
+
+@pytest.mark.slow
+def test_cli_weights_turn_the_time_optimal_mode_into_the_weighted_sum(tmp_path, capsys) -> None:
+    """``--algorithm time-optimal`` without ``--weights`` stays minimum T; with them the
+    summary prints f_w, the result stores the weights, and ``verify`` passes."""
+    from adept_traj.cli.app import main
+
+    quiet = ["--no-html", "--no-plots", "--quiet", "--workers", "1"]
+    assert main(["plan", "--algorithm", "time-optimal", "--out", str(tmp_path / "t"), *quiet]) == 0
+    plain = PlanningResult.load(tmp_path / "t")
+    assert "weighted_sum" not in plain.algorithm_settings
+    assert "weighted sum" not in capsys.readouterr().out
+    args = ["--weights", "0,1,0,0,0,0", "--out", str(tmp_path / "w"), *quiet]
+    assert main(["plan", "--algorithm", "time-optimal", *args]) == 0
+    assert "weighted sum f_w = " in capsys.readouterr().out
+    weighted = PlanningResult.load(tmp_path / "w")
+    assert weighted.algorithm_settings["weighted_sum"]["weights"] == list(ENERGY)
+    assert weighted.best_objectives[0] > plain.best_objectives[0]
+    assert main(["verify", str(tmp_path / "w")]) == 0

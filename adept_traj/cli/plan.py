@@ -113,10 +113,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     # An option left out is None, so that --resume tells it from one given (even with its
     # default value); the defaults fill it in for a new run.
-    defaults = {k: p.get_default(k) for k in _SAVED}
-    # Without --weights: the paper's weights of f_c, and the time-optimal mode stays min T.
-    defaults["weights"] = None
-    p.set_defaults(plan_defaults=defaults, **dict.fromkeys(_SAVED))
+    p.set_defaults(plan_defaults={k: p.get_default(k) for k in _SAVED}, **dict.fromkeys(_SAVED))
     return p
 
 
@@ -191,6 +188,8 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
         if out is None:
             raise ConfigurationError("give --out DIR (or --resume DIR)")
         folder, options = out, {**args.plan_defaults, **given}
+        if options["algorithm"] == TIME_OPTIMAL and "weights" not in given:
+            options["weights"] = None  # minimum T (saved so: a restart stays minimum T)
         for key in ("scene", "ros", "robot", "params", "srdf", "package_dir"):
             options[key] = _comparable(key, options[key])
     else:
