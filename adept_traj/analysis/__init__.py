@@ -58,6 +58,7 @@ from adept_traj.analysis.paper_measures import (
     spread,
 )
 from adept_traj.analysis.self_distance import SelfDistance, self_distance
+from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
@@ -71,6 +72,7 @@ __all__ = [
     "FRONT_INFLUENCE_ABOVE_MARGIN",
     "LIMIT_KINDS",
     "PAPER_WEIGHTS",
+    "WEIGHTED_SUM_REFERENCE",
     "BestTradeoff",
     "Certificate",
     "DenseStates",
@@ -79,6 +81,7 @@ __all__ = [
     "LimitCheck",
     "MemberCertificate",
     "SelfDistance",
+    "WeightedSum",
     "algorithm_effort",
     "average_fitness",
     "batch_samples",
@@ -106,4 +109,5 @@ __all__ = [
     "solid_lever_arms",
     "spread",
     "to_unit_minimisation",
+    "weighted_sum",
 ]

@@ -54,7 +54,11 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: the scene's)")
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     parser.add_argument(
-        "--weights", type=floats, default=list(PAPER_WEIGHTS), help="w1,...,w6 for f_c"
+        "--weights",
+        type=floats,
+        default=list(PAPER_WEIGHTS),
+        help="w1,...,w6 for f_c (default: the paper's); with plan --algorithm time-optimal, "
+        "the weights of the weighted sum it minimises",
     )
     parser.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
@@ -83,8 +87,8 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     """The problem the options describe, on the robot of
     :func:`~adept_traj.cli.robot_options.robot_from_arguments` (default: the AdeptOne XL).
 
-    ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights`` must be six
-    finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
+    ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights``, when given, must
+    be six finite numbers ≥ 0, not all 0; ``--rate`` is checked by :func:`check_rate`.
 
     Raises
     ------
@@ -100,13 +104,14 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
         raise ConfigurationError(
             f"scene '{scene.name}' has no [task] start/goal: give --start and --goal"
         )
-    weights = np.asarray(args.weights, dtype=float)
-    if weights.shape != (6,) or not np.all(np.isfinite(weights)) or (weights < 0).any():
-        raise InvalidInputError(
-            f"--weights must be 6 finite numbers ≥ 0; got {','.join(map(str, args.weights))}"
-        )
-    if weights.sum() <= 0:
-        raise InvalidInputError("--weights must not all be 0")
+    if args.weights is not None:  # None: plan's default (the paper's weights of f_c)
+        weights = np.asarray(args.weights, dtype=float)
+        if weights.shape != (6,) or not np.all(np.isfinite(weights)) or (weights < 0).any():
+            raise InvalidInputError(
+                f"--weights must be 6 finite numbers ≥ 0; got {','.join(map(str, args.weights))}"
+            )
+        if weights.sum() <= 0:
+            raise InvalidInputError("--weights must not all be 0")
     check_rate(args.rate)
     robot = robot_from_arguments(args, args.scene)
     start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")

@@ -79,7 +79,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--algorithm",
         default="nsga2",
         help=f"one of {', '.join(ALGORITHMS)} (default nsga2), or {TIME_OPTIMAL} (one "
-        "fastest move by multi-start SLSQP, no evolutionary search)",
+        "fastest move by multi-start SLSQP, no evolutionary search; with --weights the move "
+        "of least weighted sum of z1..z6, scaled by the straight move's values)",
     )
     p.add_argument(
         "--polish",
@@ -187,6 +188,8 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
         if out is None:
             raise ConfigurationError("give --out DIR (or --resume DIR)")
         folder, options = out, {**args.plan_defaults, **given}
+        if options["algorithm"] == TIME_OPTIMAL and "weights" not in given:
+            options["weights"] = None  # minimum T (saved so: a restart stays minimum T)
         for key in ("scene", "ros", "robot", "params", "srdf", "package_dir"):
             options[key] = _comparable(key, options[key])
     else:

@@ -5,9 +5,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
+from adept_traj.analysis import WeightedSum
 from adept_traj.results import PlanningResult, Replay
 
-__all__ = ["save_figures", "summary", "t_best_text"]
+__all__ = ["save_figures", "summary", "t_best_text", "weighted_sum_text"]
 
 
 def t_best_text(result: PlanningResult) -> str:
@@ -17,6 +20,27 @@ def t_best_text(result: PlanningResult) -> str:
     if m.t_best is None:
         return "T_best not computed"
     return f"T_best {m.t_best:.4f} s by {m.t_best_source}, gap {result.gap_best:.3f}x"
+
+
+def weighted_sum_text(result: PlanningResult) -> list[str]:
+    """``["weighted sum f_w = … (…)"]`` for a result of the weighted-sum mode (its
+    ``algorithm_settings["weighted_sum"]``): the best member's :math:`f_w` and that of the
+    fastest certified member (the minimum-T move), with the weights; ``[]`` otherwise."""
+    weighted = WeightedSum.from_settings(result.algorithm_settings)
+    if weighted is None:
+        return []
+    f = weighted.values(result.front.objectives)
+    ok = np.flatnonzero(result.front.feasible)
+    weights = ",".join(f"{w:.4g}" for w in weighted.weights)
+    fastest = (
+        f"; fastest certified member {f[ok[np.argmin(result.front.objectives[ok, 0])]]:.6f}"
+        if len(ok)
+        else ""
+    )
+    return [
+        f"weighted sum f_w = {f[result.best.index]:.6f} (weights {weights}, scales of the "
+        f"{weighted.reference}{fastest})"
+    ]
 
 
 def summary(result: PlanningResult, folder: Path) -> str:
@@ -46,6 +70,7 @@ def summary(result: PlanningResult, folder: Path) -> str:
         f"distance: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'}; "
         f"torque: {cert.torque_guarantee or f'sampled at {cert.rate_hz:g} Hz'})",
     ]
+    lines += weighted_sum_text(result)
     lines += [f"  violation: {v}" for v in cert.violations]
     if result.warning:
         lines.append(f"warning: {result.warning}")

@@ -73,6 +73,14 @@ from adept_traj.optimise.sampling import (
 from adept_traj.optimise.survival import (
     RankAndCrowdingSurvival,
 )
+from adept_traj.optimise.weighted_move import (
+    MAX_EVALUATIONS_PER_START,
+    STEP_EVALUATIONS,
+    STOP_DECREASE,
+    WEIGHTED_BOX,
+    weighted_descent,
+    weighted_run,
+)
 
 __all__ = [
     "ALGORITHMS",
@@ -81,10 +89,14 @@ __all__ = [
     "CHECKPOINT_VERSION",
     "GRADIENT_COST",
     "MAX_EVALUATIONS",
+    "MAX_EVALUATIONS_PER_START",
     "POLISH_MODES",
     "POLISH_SHARE",
     "SPREAD_MEMBERS",
+    "STEP_EVALUATIONS",
+    "STOP_DECREASE",
     "TIME_OPTIMAL",
+    "WEIGHTED_BOX",
     "AlgorithmSettings",
     "BlockedDuplicateElimination",
     "FastEndSearch",
@@ -117,5 +129,7 @@ __all__ = [
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",
+    "weighted_descent",
+    "weighted_run",
     "write_checkpoint",
 ]

@@ -142,11 +142,11 @@ def _start(problem: Any, x0: Any) -> np.ndarray:
     return x0
 
 
-def _threads_limited(problem: Any, x0: np.ndarray, *args: Any) -> PolishOutcome:
+def _threads_limited(problem: Any, x0: np.ndarray, *args: Any, **options: Any) -> PolishOutcome:
     from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
 
     with threadpool_limits(limits=1, user_api="blas"):
-        return _solve(problem, x0, *args)
+        return _solve(problem, x0, *args, **options)
 
 
 class _Pieces:
@@ -169,6 +169,9 @@ def _solve(
     no_worse: np.ndarray,
     span: np.ndarray,
     max_iter: int,
+    *,
+    box: float = _BOX,
+    max_evaluations: int = MAX_EVALUATIONS,
 ) -> PolishOutcome:
     from scipy.optimize import minimize  # lazy: scipy.optimize is heavy
 
@@ -198,7 +201,7 @@ def _solve(
     limit = _SIGN * z0 - np.where(_TIGHTENED & (z0 > 0.0), _TIGHTEN * scale, 0.0)
     rows = np.flatnonzero(no_worse)
     w_scale = max(float(z0[3]), 1e-12)
-    half = _BOX * (problem.xu - problem.xl)
+    half = box * (problem.xu - problem.xl)
     half[_at_rest(problem, x0)] = 0.0
     lower, upper = np.maximum(problem.xl, x0 - half), np.minimum(problem.xu, x0 + half)
     on_g, on_w, on_d = _rows_in_reach(p0, half, st.influence)
@@ -264,7 +267,7 @@ def _solve(
         if ok.any():
             k = np.flatnonzero(ok)[np.argmin(z[ok] @ cost)]
             best[:] = [x[k], z[k], (ev.objectives[k], ev.constraints[k])]
-        if counter[0] >= MAX_EVALUATIONS:
+        if counter[0] >= max_evaluations:
             raise StopIteration  # scipy ends the solve (its callback protocol)
 
     res = minimize(

@@ -25,7 +25,9 @@ Steps:
    certificate joins the population, so it replaces the members it dominates in the
    front; its certificate's summary is that member's in step 4 (no move is certified
    twice). ``algorithm="time-optimal"`` replaces step 1 and this one by
-   :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP).
+   :func:`~adept_traj.optimise.time_optimal_run` (multi-start SLSQP), or, with
+   ``weights``, by :func:`~adept_traj.optimise.weighted_run` (the weighted-sum mode: the
+   certified member of least :math:`f_w` is reported instead of the trade-off choice).
 6. **Metrics**: SSM (spread of the front), RNI (non-dominated share of the final
    population), OO and AE (from measured times), HV of the front normalised on its own
    objective bounds (reference point 1.1; see ``docs/decision-and-metrics.md``).
@@ -42,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis.certificate import Certificate, certify
-from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff
+from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff, objective_weights
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
     non_dominated,
@@ -56,12 +58,14 @@ from adept_traj.analysis.paper_measures import (
     ratio_non_dominated,
     spread,
 )
+from adept_traj.analysis.weighted_sum import WeightedSum
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
 from adept_traj.optimise.polish_step import TIME_OPTIMAL, _polish_run, polish_mode, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
+from adept_traj.optimise.weighted_move import weighted_run
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
     NO_FEASIBLE_WARNING,
@@ -212,7 +216,7 @@ def plan(
     *,
     pop_size: int | None = None,
     n_gen: int | None = None,
-    weights: Sequence[float] = PAPER_WEIGHTS,
+    weights: Sequence[float] | None = None,
     checkpoint: str | Path | None = None,
     resume: bool = False,
     progress: Callable[[GenerationInfo], None] | None = None,
@@ -229,7 +233,9 @@ def plan(
     problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
     algorithm, pop_size, n_gen, params: see :func:`~adept_traj.optimise.make_algorithm`.
     seed: random seed (the same seed gives the same front).
-    weights: the six weights of f_c (default: the paper's).
+    weights: the six weights of f_c (``None``, the default: the paper's,
+        :data:`~adept_traj.analysis.PAPER_WEIGHTS`); with ``"time-optimal"``, given
+        weights turn the mode into the weighted-sum mode (below).
     checkpoint, resume: checkpoint folder and whether to resume from it.
     progress: called after every generation.
     rate_hz: rate of the dense verification (≥ 1000 Hz recommended).
@@ -247,6 +253,11 @@ def plan(
     With ``algorithm="time-optimal"`` the parameters ``pop_size``, ``n_gen``,
     ``checkpoint``, ``resume`` and ``progress`` are not used; ``params`` may give
     ``n_starts`` and ``max_iter`` (:func:`~adept_traj.optimise.time_optimal_run`).
+    With ``weights`` it minimises instead the weighted sum :math:`f_w` of the six objectives
+    with the fixed normalisation of :func:`~adept_traj.analysis.weighted_sum`, from the
+    minimum-T moves (:func:`~adept_traj.optimise.weighted_run`; ``params`` may also give
+    ``max_evaluations``), and reports the certified front member of lowest :math:`f_w`
+    (the weights and scales in ``result.algorithm_settings["weighted_sum"]``).
 
     Returns
     -------
@@ -259,10 +270,17 @@ def plan(
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     polish = polish_mode(polish)
+    weighted = None  # the weighted sum of the weighted-sum mode
+    if weights is not None:
+        objective_weights(weights, 6)  # bad weights refused before any long work
     warn_missing_limits(problem.robot.name, problem.robot.limits)
     n_searched: int | None = 0  # population rows made by the search (the rest by the local solver)
     polished: dict[bytes, MemberCertificate] = {}  # the polish's certificates, by x.tobytes()
-    if algorithm == TIME_OPTIMAL:
+    if algorithm == TIME_OPTIMAL and weights is not None:
+        state, settings_dict = weighted_run(problem, seed, weights, **params)
+        weighted = WeightedSum.from_settings(settings_dict)
+        name = TIME_OPTIMAL
+    elif algorithm == TIME_OPTIMAL:
         state, settings_dict = time_optimal_run(problem, seed, **params)
         name = TIME_OPTIMAL
     else:
@@ -281,7 +299,7 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        state, polished = _polish_run(problem, state, rate_hz, polish, weights)
+        state, polished = _polish_run(problem, state, rate_hz, polish, _weights(weights))
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)
@@ -301,8 +319,9 @@ def plan(
         constraints=constraints[rows],
         feasible=feasible[rows],
     )
-    choice = best_tradeoff(front.objectives, weights)
-    summaries = _certify_front(problem, front, choice.order, rate_hz, max_certify, polished)
+    choice = best_tradeoff(front.objectives, _weights(weights))
+    order = choice.order if weighted is None else weighted.order(front.objectives)
+    summaries = _certify_front(problem, front, order, rate_hz, max_certify, polished)
     certified = np.array([s is not None and s.feasible for s in summaries], dtype=bool)
     front = Front(
         x=front.x,
@@ -312,7 +331,7 @@ def plan(
         n_certified=int(certified.sum()),
         certificates=summaries,
     )
-    certificate, index = _certified_choice(problem, front, choice.order, rate_hz)
+    certificate, index = _certified_choice(problem, front, order, rate_hz)
     lo, hi = objective_bounds(front.objectives)
     metrics = Metrics(
         ssm=spread(front.objectives) if len(rows) > 1 else None,
@@ -343,6 +362,11 @@ def plan(
         history=_history(state, front.objectives if feasible.any() else None),
         warning=warning,
     )
+
+
+def _weights(weights: Sequence[float] | None) -> Sequence[float]:
+    """The weights of f_c: the given ones, else the paper's."""
+    return PAPER_WEIGHTS if weights is None else weights
 
 
 def _t_best(front: Front, rows: np.ndarray, n_searched: int | None, name: str) -> dict[str, Any]:

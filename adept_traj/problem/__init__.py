@@ -15,7 +15,11 @@ from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
 from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, local_constraints
-from adept_traj.problem.objective_gradients import ObjectiveGradients, objective_gradients
+from adept_traj.problem.objective_gradients import (
+    ObjectiveGradients,
+    check_differentiable,
+    objective_gradients,
+)
 from adept_traj.problem.objectives import (
     MAXIMISED,
     OBJECTIVE_NAMES,
@@ -51,6 +55,7 @@ __all__ = [
     "TrajectoryProblem",
     "TrajectorySamples",
     "available_cores",
+    "check_differentiable",
     "from_pymoo",
     "kinematic_lower_bound",
     "local_constraints",

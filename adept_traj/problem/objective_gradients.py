@@ -59,7 +59,7 @@ from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, loc
 from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_batch, check_type
 
-__all__ = ["ObjectiveGradients", "objective_gradients"]
+__all__ = ["ObjectiveGradients", "check_differentiable", "objective_gradients"]
 
 #: Central-difference step in the joint positions [rad | m] for ∂|det J|/∂q.
 _H = 1e-6
@@ -119,6 +119,22 @@ def objective_gradients(
         With a leading population axis of 1 for a single vector.
     """
     xa = np.atleast_2d(as_batch(x, "x", problem.n_var))
+    check_differentiable(problem)
+    if local is None:
+        local = local_constraints(problem, xa)
+    else:
+        check_type(local, LocalConstraints, "local")
+        if local.values.shape[0] != len(xa):
+            raise ConfigurationError(
+                f"local has {local.values.shape[0]} vectors but x has {len(xa)}"
+            )
+    return _objective_gradients(problem, xa, local)
+
+
+def check_differentiable(problem: Any) -> None:
+    """Refuse (:class:`~adept_traj.errors.ConfigurationError`) a problem whose objectives
+    have no gradients here: ``z3`` other than ``"clearance"`` (the paper's penalties are not
+    differentiated) or an infinite torque limit (z2's gradient uses the torque rows)."""
     if problem.settings.z3 != "clearance":
         raise ConfigurationError(
             f"objective gradients need z3='clearance'; this problem has z3="
@@ -129,15 +145,6 @@ def objective_gradients(
         raise ConfigurationError(
             f"the z2 gradient needs finite torque limits [N·m | N]; got {torque_limit}"
         )
-    if local is None:
-        local = local_constraints(problem, xa)
-    else:
-        check_type(local, LocalConstraints, "local")
-        if local.values.shape[0] != len(xa):
-            raise ConfigurationError(
-                f"local has {local.values.shape[0]} vectors but x has {len(xa)}"
-            )
-    return _objective_gradients(problem, xa, local)
 
 
 def _objective_gradients(

@@ -24,6 +24,10 @@ field of ``result.json``:
   stored front with ``weights`` (not stored: ``plan``'s are the paper's unless changed),
   and ``best.index`` against ``plan``'s rule (the trade-off order; when the choice is not
   the first, the members before it must fail certification: they are certified again);
+- for a result of the weighted-sum mode (``algorithm_settings["weighted_sum"]``): its
+  stored weights replace ``weights``, ``best.index`` follows the order of increasing
+  :math:`f_w` (:meth:`~adept_traj.analysis.WeightedSum.order`), and the stored scales
+  against :func:`~adept_traj.analysis.weighted_sum` of the rebuilt problem;
 - the metrics SSM, OO, AE, HV and the HV reference point, recomputed as ``plan`` does from
   the stored front and timing; T_best, when stored, as the z1 of the fastest certified
   member, and its source as the algorithm's (``"time-optimal"`` or ``"polish"``).
@@ -57,6 +61,7 @@ from adept_traj.analysis import (
     DEFAULT_HV_REFERENCE,
     PAPER_WEIGHTS,
     Certificate,
+    WeightedSum,
     algorithm_effort,
     best_tradeoff,
     certify,
@@ -67,6 +72,7 @@ from adept_traj.analysis import (
     objective_weights,
     optimizer_overhead,
     spread,
+    weighted_sum,
 )
 from adept_traj.problem import OBJECTIVE_NAMES, TrajectoryProblem
 from adept_traj.results.mismatches import Mismatch, MismatchLog, close
@@ -123,7 +129,8 @@ def audit(
     Parameters
     ----------
     result: the loaded result.
-    weights: (6,) the weights of f_c given to ``plan`` (default: the paper's).
+    weights: (6,) the weights of f_c given to ``plan`` (default: the paper's; a result of
+        the weighted-sum mode uses its stored ones).
     scene: the scene the run was planned on, to compare the stored one with; default: the
         shipped scene of the stored scene's name (``adept_traj.scene.SHIPPED_SCENES``),
         else none.
@@ -137,6 +144,9 @@ def audit(
     """
     check_type(result, PlanningResult, "result")
     w = objective_weights(weights, len(OBJECTIVE_NAMES))
+    weighted = WeightedSum.from_settings(result.algorithm_settings)
+    if weighted is not None:
+        w = weighted.weights
     if scene is not None:
         check_type(scene, Scene, "scene")
     elif result.scene.get("name") in SHIPPED_SCENES:
@@ -156,6 +166,7 @@ class _Auditor(MismatchLog):
     ) -> None:
         super().__init__()
         self.r, self.p, self.weights, self.scene = result, problem, weights, scene
+        self.weighted = WeightedSum.from_settings(result.algorithm_settings)
         self.not_checked = list(NOT_RECOMPUTABLE)
 
     def run(self) -> Audit:
@@ -170,6 +181,7 @@ class _Auditor(MismatchLog):
         )
         self.certificate("certificate", self.r.certificate, certificate)
         self.best(certificate)
+        self.weighted_sum()
         self.metrics()
         return Audit(
             tuple(self.mismatches),
@@ -318,8 +330,19 @@ class _Auditor(MismatchLog):
         self.count(1, 1)
         if r.best.f_c is not None and not close(r.best.f_c, float(choice.f_c[i])):
             self.add("best.f_c", r.best.f_c, float(choice.f_c[i]), f"with weights {weights}")
-        expected = self.expected_index(choice.order, certificate)
+        order = choice.order if self.weighted is None else self.weighted.order(r.front.objectives)
+        expected = self.expected_index(order, certificate)
         self.value("best.index", i, expected, f"plan's rule with weights {weights}")
+
+    def weighted_sum(self) -> None:
+        """The stored scales of the weighted-sum mode against the rebuilt problem's."""
+        if self.weighted is None:
+            return
+        now = weighted_sum(self.p, self.weighted.weights)
+        self.numbers("algorithm.settings.weighted_sum.scale", self.weighted.scale, now.scale)
+        self.value(
+            "algorithm.settings.weighted_sum.reference", self.weighted.reference, now.reference
+        )
 
     def expected_index(self, order: np.ndarray, certificate: Certificate) -> int:
         """``plan``'s choice. With every member certified (``front.n_certified`` set): the
