@@ -60,6 +60,20 @@ def save_all(
     -------
     The paths written, in that order.
     """
+    jobs, paths, n_proc = _figure_jobs(results, folder, replays, processes)
+    _draw(jobs, n_proc)
+    return paths
+
+
+#: A figure to draw: (cost weight, drawing with its path bound).
+_Job = tuple[float, Callable[[], Path]]
+
+
+def _figure_jobs(
+    results: Any, folder: Any, replays: Any, processes: Any
+) -> tuple[list[_Job], list[Path], int]:
+    """The arguments of :func:`save_all`, checked (nothing is drawn; ``folder`` is
+    created): the figures to draw, their paths in order and the number of processes."""
     res = as_results(results)
     try:
         root = Path(os.fspath(folder))
@@ -85,11 +99,10 @@ def save_all(
         draw_path = partial(tool_path_3d, r, replay=given.get(key))
         figures.append((4.2, root / f"tool_path_{suffixes[key]}.png", draw_path))
     jobs = [(weight, partial(draw, path)) for weight, path, draw in figures]
-    _draw(jobs, n_proc)
-    return [path for _, path, _ in figures]
+    return jobs, [path for _, path, _ in figures], n_proc
 
 
-def _draw(jobs: list[tuple[float, Callable[[], Path]]], processes: int) -> None:
+def _draw(jobs: list[_Job], processes: int) -> None:
     """Run the figure ``jobs`` (cost weight, drawing) on up to ``processes`` processes (this
     one included), the heaviest first, each to the least loaded process."""
     processes = min(processes, len(jobs))
