@@ -1,4 +1,4 @@
-"""adept_traj.viz.plots.png: the PNG files decode (by Pillow, which shares no code with
+"""adept_traj.viz.plots._png: the PNG files decode (by Pillow, which shares no code with
 the encoder) to exactly the pixels given, and a figure's file holds exactly the pixels
 matplotlib's own ``savefig`` gives."""
 
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from adept_traj.viz.plots._png import encode_png
 from adept_traj.viz.plots.common import new_figure, save_figure
-from adept_traj.viz.plots.png import encode_png
 
 
 def _decoded(data: bytes) -> tuple[np.ndarray, Image.Image]:

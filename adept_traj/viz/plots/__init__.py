@@ -19,7 +19,7 @@ function                     module                            figure
                                                                count) per generation
 :func:`save_all`             :mod:`.all_figures`               all of the above into a
                                                                folder
-:func:`start_save_all`       :mod:`.background`                the same in a forked
+:func:`start_save_all`       :mod:`.all_figures`               the same in a forked
                                                                process, the caller goes on
 ===========================  ================================  ============================
 
@@ -33,8 +33,7 @@ left alone. Units are SI. Bad arguments raise
 
 from __future__ import annotations
 
-from adept_traj.viz.plots.all_figures import save_all
-from adept_traj.viz.plots.background import BackgroundFigures, start_save_all
+from adept_traj.viz.plots.all_figures import BackgroundFigures, save_all, start_save_all
 from adept_traj.viz.plots.common import OBJECTIVE_LABELS
 from adept_traj.viz.plots.fronts import pareto_matrix
 from adept_traj.viz.plots.history import hypervolume_history

@@ -18,7 +18,7 @@ from adept_traj.errors import InvalidInputError
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult
 from adept_traj.viz.inputs import as_result
-from adept_traj.viz.plots.png import write_png
+from adept_traj.viz.plots._png import write_png
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -178,7 +178,7 @@ def save_figure(fig: Figure, path: Path) -> Path:
     a crash or Ctrl-C); return ``path``.
 
     The pixels are those ``savefig`` gives; the file is encoded by
-    :func:`adept_traj.viz.plots.png.write_png` (rows unfiltered, RGB, zlib level
+    ``adept_traj.viz.plots._png.write_png`` (rows unfiltered, RGB, zlib level
     :data:`PNG_COMPRESSION`: about 20 ms for a 1650 × 1650 figure against 60 ms by
     Pillow, whose encoder tries five filters per row, and smaller files). No text
     chunks (no matplotlib version): the same figure gives the same bytes with any
