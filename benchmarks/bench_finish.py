@@ -6,8 +6,10 @@ Run: ``python benchmarks/bench_finish.py RESULT_DIR [--repeat 3] [--compare OTHE
 --out out``). Each repeat starts a fresh process (matplotlib and meshcat not yet imported,
 as in a real run), loads the result and calls ``adept_traj.cli.plan._finish`` on a new
 folder: ``result.json`` and the CSV files, ``playback.html``, the five figures, the summary
-and the completion mark. It prints the wall time and the CPU time (the process and every
-child it waited for) of ``_finish`` alone, medians over the repeats.
+and the completion mark. It prints the wall time and the CPU time of ``_finish`` alone,
+medians over the repeats: in all, in the process itself, and in the processes it forked
+(and waited for). On a loaded machine the wall time follows the CPU time; the split tells
+how much of it the main process waits for on an idle one.
 
 ``--compare OTHER_CHECKOUT`` runs the same measurement with ``PYTHONPATH=OTHER_CHECKOUT``
 (e.g. an older version of the code) alternately with this checkout, so that both see the
@@ -40,24 +42,27 @@ opts = argparse.Namespace(
 folder = Path(sys.argv[2])
 folder.mkdir()
 
-def cpu():
-    own = resource.getrusage(resource.RUSAGE_SELF)
-    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+def cpu(who):
+    use = resource.getrusage(who)
+    return use.ru_utime + use.ru_stime
 
-c0, t0 = cpu(), time.perf_counter()
+own0, kids0, t0 = cpu(resource.RUSAGE_SELF), cpu(resource.RUSAGE_CHILDREN), time.perf_counter()
 code = cli_plan._finish(result, problem, folder, opts)
-wall, used = time.perf_counter() - t0, cpu() - c0
-print(json.dumps({"code": code, "wall": wall, "cpu": used}))
+wall = time.perf_counter() - t0
+own, kids = cpu(resource.RUSAGE_SELF) - own0, cpu(resource.RUSAGE_CHILDREN) - kids0
+import adept_traj
+print(json.dumps({"code": code, "wall": wall, "cpu": own + kids, "own": own, "kids": kids,
+                  "code_path": adept_traj.__file__}))
 """
 
 
 def finish_once(pythonpath: str, result_dir: str, out: Path) -> dict:
     """Wall and CPU time [s] of one ``_finish`` in a fresh process with ``pythonpath``."""
     env = {**os.environ, "PYTHONPATH": pythonpath}
+    # run in the output's folder: ``python -c`` puts its working folder first on sys.path
     done = subprocess.run(
-        [sys.executable, "-c", _FINISH, result_dir, str(out)],
-        env=env, check=True, capture_output=True, text=True,
+        [sys.executable, "-c", _FINISH, str(Path(result_dir).resolve()), str(out)],
+        env=env, cwd=out.parent, check=True, capture_output=True, text=True,
     )  # fmt: skip
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -80,16 +85,17 @@ def main() -> None:
                 out = Path(tmp) / f"{len(runs[name])}_{name.strip('-').replace(' ', '_')}"
                 runs[name].append(finish_once(path, args.result_dir, out))
     print(f"load average at end: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
-    print("| version | wall [s] (median) | CPU [s] (median) | wall runs | CPU runs |")
-    print("|---|---|---|---|---|")
+    print("| version | wall [s] | CPU [s] | CPU of the process [s] | CPU forked [s] | wall runs |")
+    print("|---|---|---|---|---|---|")
     medians = {}
     for name, rows in runs.items():
-        wall = statistics.median(r["wall"] for r in rows)
-        cpu = statistics.median(r["cpu"] for r in rows)
+        wall, cpu, own, kids = (
+            statistics.median(r[key] for r in rows) for key in ("wall", "cpu", "own", "kids")
+        )
         medians[name] = (wall, cpu)
+        assert all(r["code_path"].startswith(versions[name]) for r in rows), rows
         walls = ", ".join(f"{r['wall']:.2f}" for r in rows)
-        cpus = ", ".join(f"{r['cpu']:.2f}" for r in rows)
-        print(f"| {name} | {wall:.2f} | {cpu:.2f} | {walls} | {cpus} |")
+        print(f"| {name} | {wall:.2f} | {cpu:.2f} | {own:.2f} | {kids:.2f} | {walls} |")
     if args.compare:
         (w1, c1), (w0, c0) = medians["this checkout"], medians["--compare"]
         print(f"this checkout / --compare: wall {w1 / w0:.2f}x, CPU {c1 / c0:.2f}x")
