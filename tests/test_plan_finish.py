@@ -1,7 +1,8 @@
 """The finish of ``adept-traj plan`` (after the optimiser returns): the figures are drawn by
 a forked process while result.json is written; result.json is the same bytes as a plain
 save; an error of the figure process is reported (not swallowed), the exit status is not
-0 and the run is not marked complete. The optimiser is replaced by a stored result and
+0 and the run is not marked complete (that the error keeps its type and carries the forked
+traceback is tested on start_save_all, tests/test_plots_parallel.py). The optimiser is replaced by a stored result and
 the drawings by cheap fakes (forked processes inherit them)."""
 
 from __future__ import annotations
@@ -79,14 +80,3 @@ def test_an_error_of_the_figure_process_is_reported_and_the_run_not_completed(
     assert (tmp_path / "run" / "result.json").is_file()  # written meanwhile
     assert (tmp_path / "run" / "run.json").is_file()  # not marked complete
 
-
-def test_an_unexpected_error_of_the_figure_process_keeps_its_type_and_traceback(
-    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    bug = ZeroDivisionError("a bug in a figure")
-    with pytest.raises(ZeroDivisionError, match="a bug in a figure") as caught:
-        _plan(monkeypatch, stored, tmp_path / "run", pareto_matrix=_fake("p", bug))
-    (note,) = caught.value.__notes__
-    assert "forked process" in note
-    assert "Traceback" in note
-    assert (tmp_path / "run" / "run.json").is_file()
