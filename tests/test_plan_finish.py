@@ -2,8 +2,9 @@
 a forked process while result.json is written; result.json is the same bytes as a plain
 save; an error of the figure process is reported (not swallowed), the exit status is not
 0 and the run is not marked complete (that the error keeps its type and carries the forked
-traceback is tested on start_save_all, tests/test_plots_parallel.py). The optimiser is replaced by a stored result and
-the drawings by cheap fakes (forked processes inherit them)."""
+traceback is tested on start_save_all, tests/test_plots_parallel.py). The optimiser is
+replaced by a stored result and the drawings by cheap fakes (forked processes inherit
+them)."""
 
 from __future__ import annotations
 
