@@ -80,4 +80,3 @@ def test_an_error_of_the_figure_process_is_reported_and_the_run_not_completed(
     assert re.search(r"adept-traj: error: .*No space left on device.*joint_motion_nsga2", err)
     assert (tmp_path / "run" / "result.json").is_file()  # written meanwhile
     assert (tmp_path / "run" / "run.json").is_file()  # not marked complete
-
