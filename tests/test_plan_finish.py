@@ -28,6 +28,14 @@ def stored() -> PlanningResult:
     return PlanningResult.load(DATA / "result_v1")
 
 
+@pytest.fixture(scope="module")
+def plain(stored: PlanningResult, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The folder of a plain ``stored.save``."""
+    folder = tmp_path_factory.mktemp("plain") / "run"
+    stored.save(folder)
+    return folder
+
+
 def _fake(name: str, error: BaseException | None = None):
     def draw(_results, path, **_kwargs):
         if error is not None:
@@ -48,7 +56,7 @@ def _plan(monkeypatch: pytest.MonkeyPatch, result: PlanningResult, out: Path, **
 
 
 def test_the_figures_are_drawn_by_another_process_and_result_json_is_unchanged(
-    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    stored: PlanningResult, plain: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     assert _plan(monkeypatch, stored, tmp_path / "run") == 0
     figures = sorted((tmp_path / "run" / "figures").iterdir())
@@ -61,9 +69,8 @@ def test_the_figures_are_drawn_by_another_process_and_result_json_is_unchanged(
     ]
     writers = {int(p.read_text().split()[1]) for p in figures}
     assert os.getpid() not in writers
-    stored.save(tmp_path / "plain")
     for name in ("result.json", "front.csv", "best_trajectory.csv"):
-        assert (tmp_path / "run" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes()
+        assert (tmp_path / "run" / name).read_bytes() == (plain / name).read_bytes()
     assert not (tmp_path / "run" / "run.json").exists()  # marked complete
 
 
@@ -79,4 +86,17 @@ def test_an_error_of_the_figure_process_is_reported_and_the_run_not_completed(
     err = capsys.readouterr().err
     assert re.search(r"adept-traj: error: .*No space left on device.*joint_motion_nsga2", err)
     assert (tmp_path / "run" / "result.json").is_file()  # written meanwhile
+    assert (tmp_path / "run" / "run.json").is_file()  # not marked complete
+
+
+def test_the_result_is_saved_when_the_figures_cannot_start(
+    stored: PlanningResult, plain: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def no_fork(*_args, **_kwargs):
+        raise OSError(12, "Cannot allocate memory (fork)")
+
+    monkeypatch.setattr(all_figures, "BackgroundFigures", no_fork)
+    assert _plan(monkeypatch, stored, tmp_path / "run") == 2
+    saved = (tmp_path / "run" / "result.json").read_bytes()
+    assert saved == (plain / "result.json").read_bytes()
     assert (tmp_path / "run" / "run.json").is_file()  # not marked complete

@@ -284,9 +284,13 @@ def _finish(
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
     figures = None
-    if not opts.no_plots:
-        figures = start_figures({opts.algorithm: result}, folder / "figures",
-                                {opts.algorithm: replay})  # fmt: skip
+    try:
+        if not opts.no_plots:
+            figures = start_figures({opts.algorithm: result}, folder / "figures",
+                                    {opts.algorithm: replay})  # fmt: skip
+    except BaseException:  # e.g. no fork possible: the result is saved all the same
+        result.save(folder)
+        raise
     try:
         result.save(folder)
         if not opts.no_html:
