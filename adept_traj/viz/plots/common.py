@@ -174,10 +174,11 @@ def new_figure(width: float, height: float) -> Figure:
 
 
 def save_figure(fig: Figure, path: Path) -> Path:
-    """Write ``fig`` as a PNG at :data:`DPI` atomically (no half-written figure is left by
-    a crash or Ctrl-C); return ``path``.
+    """Write ``fig`` as a PNG at its own resolution (:data:`DPI` for every figure of
+    :func:`new_figure`) atomically (no half-written figure is left by a crash or Ctrl-C);
+    return ``path``.
 
-    The pixels are those ``savefig`` gives; the file is encoded by
+    The pixels are those ``savefig`` gives at that resolution; the file is encoded by
     ``adept_traj.viz.plots._png.write_png`` (rows unfiltered, RGB, zlib level
     :data:`PNG_COMPRESSION`: about 20 ms for a 1650 × 1650 figure against 60 ms by
     Pillow, whose encoder tries five filters per row, and smaller files). No text
