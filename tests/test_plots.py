@@ -283,3 +283,51 @@ def test_figures_are_the_same_bytes_every_time(
         assert data == figures[name].read_bytes(), name
         assert b"Software" not in data
         assert b"atplotlib" not in data
+
+
+def _drawn(monkeypatch: pytest.MonkeyPatch, module: object, draw) -> object:
+    """The matplotlib figure ``draw()`` builds in ``module`` (not rendered)."""
+    made = []
+
+    def keep(fig, path):
+        made.append(fig)
+        return path
+
+    monkeypatch.setattr(module, "save_figure", keep)
+    draw()
+    (fig,) = made
+    return fig
+
+
+def test_the_figures_draw_every_sample(
+    results: dict[str, PlanningResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What the figures hold, independent of how fast they are drawn: every 1 kHz sample
+    of the joint motion and of the tool path (nothing thinned), every front member in all
+    30 scatter panels, the extremes of each series where the panel puts them."""
+    from matplotlib.collections import LineCollection, PathCollection
+
+    from adept_traj.viz.plots import fronts, motion, tool_path
+
+    r = results["nsga2"]
+    dense, nq = r.best_trajectory, r.best_trajectory.nq
+    fig = _drawn(monkeypatch, motion, lambda: plots.joint_motion(r, tmp_path / "j.png"))
+    (ax,) = fig.axes
+    curves = [c for c in ax.collections if isinstance(c, LineCollection)][1].get_segments()
+    assert len(curves) == 5 * nq  # q, q̇, q̈, q⃛, τ of every joint
+    assert {len(c) for c in curves} == {len(dense.t)}
+    for curve, values in zip(curves[:nq], dense.q.T):  # positions: extremes kept, in place
+        lo, hi = curve[:, 1].min(), curve[:, 1].max()
+        scaled = (values - values.min()) / np.ptp(values) * (hi - lo) + lo
+        np.testing.assert_allclose(curve[:, 1], scaled, atol=1e-9)
+
+    fig = _drawn(monkeypatch, tool_path, lambda: plots.tool_path_3d(r, tmp_path / "t.png"))
+    assert len(fig.axes) == 4  # 3-D, top view, side view, colour bar
+    for view in fig.axes[1:3]:
+        coloured = [c for c in view.collections if c.get_array() is not None]
+        assert [len(c.get_segments()) for c in coloured] == [len(dense.t) - 1]
+
+    fig = _drawn(monkeypatch, fronts, lambda: plots.pareto_matrix(r, tmp_path / "p.png"))
+    (ax,) = fig.axes
+    scatters = [c for c in ax.collections if isinstance(c, PathCollection)]
+    assert sum(len(c.get_offsets()) for c in scatters) == 30 * (len(r.front) + 1)  # + best

@@ -1,10 +1,14 @@
 """save_all draws its figures on several processes: the same files, in the same order, as
 one process; a figure whose process fails is drawn again by the caller (its error raised
-there). The drawing functions are replaced by cheap fakes (forked processes inherit them)."""
+there). start_save_all draws them in a forked process while the caller goes on: the same
+files; its error is raised by wait(); cancel stops it. The drawing functions are replaced
+by cheap fakes (forked processes inherit them)."""
 
 from __future__ import annotations
 
 import os
+import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -80,3 +84,104 @@ def test_an_error_of_a_figure_is_raised_here(
 def test_processes_must_be_a_positive_integer(result: PlanningResult, tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match=r"processes must be an integer in \[1, ∞\]"):
         plots.save_all(result, tmp_path, processes=0)
+
+
+# ---------------------------------------------------------------- start_save_all
+def _waits_for(go: Path, name: str, pid_file: Path | None = None):
+    """A drawing that, in a forked process, waits (at most 20 s) for the file ``go``."""
+
+    def draw(_results, path, **_kwargs):
+        if pid_file is not None:
+            pid_file.write_text(str(os.getpid()))
+        for _ in range(2000):
+            if go.exists():
+                Path(path).write_text(f"{name} {os.getpid()}")
+                return Path(path)
+            time.sleep(0.01)
+        raise TimeoutError(f"{go} never appeared")
+
+    return draw
+
+
+def test_start_save_all_returns_at_once_and_writes_the_files_of_save_all(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    go = tmp_path / "go"
+    _patch(monkeypatch, pareto_matrix=_waits_for(go, "pareto_matrix"))
+    go.touch()
+    one = plots.save_all(result, tmp_path / "one", processes=1)
+    go.unlink()
+    with plots.start_save_all(result, tmp_path / "two") as drawing:
+        # the Pareto matrix cannot be drawn before this process goes on and makes `go`
+        assert not (tmp_path / "two" / "pareto_matrix.png").exists()
+        go.touch()
+        two = drawing.wait()
+    assert [p.name for p in two] == [p.name for p in one] == [p.name for p in drawing.paths]
+    assert os.getpid() not in _writers(two).values()  # all drawn by forked processes
+
+
+def test_an_error_of_the_forked_process_is_raised_by_wait(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _patch(monkeypatch, joint_motion=_fake("joint_motion", fails_in_child=True))
+    drawing = plots.start_save_all(result, tmp_path, processes=1)
+    with pytest.raises(ValueError, match="joint_motion failed in process") as caught:
+        drawing.wait()
+    assert f"in process {os.getpid()}" not in str(caught.value)  # not drawn again here
+    (note,) = caught.value.__notes__
+    assert "forked process" in note
+    assert "Traceback" in note
+    assert "in draw" in note  # the forked process' traceback
+
+
+class _Unpicklable(Exception):
+    def __init__(self, a: int, b: int) -> None:  # pickles, but does not unpickle
+        super().__init__(f"unpicklable {a} {b}")
+
+
+def test_an_error_that_does_not_unpickle_is_raised_as_its_text(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def draw(_results, path, **_kwargs):
+        raise _Unpicklable(1, 2)
+
+    _patch(monkeypatch, best_tradeoffs=draw)
+    with pytest.raises(
+        RuntimeError, match=r"(?s)in a forked process.*_Unpicklable: unpicklable 1 2"
+    ):
+        plots.start_save_all(result, tmp_path, processes=1).wait()
+
+
+def test_a_killed_forked_process_has_its_figures_drawn_here(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parent = os.getpid()
+
+    def draw(_results, path, **_kwargs):
+        if os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return _fake("tool_path_3d")(_results, path)
+
+    _patch(monkeypatch, tool_path_3d=draw)
+    paths = plots.start_save_all(result, tmp_path, processes=1).wait()
+    assert _writers(paths)["tool_path_nsga2.png"] == parent
+
+
+def test_cancel_stops_the_forked_process(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pid_file = tmp_path / "pid"
+    _patch(monkeypatch, pareto_matrix=_waits_for(tmp_path / "never", "p", pid_file))
+    with plots.start_save_all(result, tmp_path / "figs", processes=1):
+        for _ in range(2000):  # until the drawing has started
+            if pid_file.exists() and pid_file.read_text():
+                break
+            time.sleep(0.01)
+    with pytest.raises(ProcessLookupError):  # stopped and waited for by the with block
+        os.kill(int(pid_file.read_text()), 0)
+    assert not (tmp_path / "figs" / "pareto_matrix.png").exists()
+
+
+def test_start_save_all_checks_its_arguments_first(result: PlanningResult, tmp_path: Path) -> None:
+    with pytest.raises(InvalidInputError, match=r"processes must be an integer in \[1, ∞\]"):
+        plots.start_save_all(result, tmp_path, processes=0)

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from adept_traj.cli.report import save_figures
+from adept_traj.cli import report
+from adept_traj.cli.report import finish_figures, save_figures, start_figures
 from adept_traj.viz import plots
 
 
@@ -28,3 +29,23 @@ def test_missing_part_of_adept_traj_is_an_error(monkeypatch, tmp_path: Path):
     monkeypatch.setattr(plots, "save_all", _raise("adept_traj.viz.plots.fronts"))
     with pytest.raises(ImportError, match=r"adept_traj\.viz\.plots\.fronts"):
         save_figures({}, tmp_path)
+
+
+class _Drawing:
+    """A figure drawing under way whose wait raises an ImportError of ``name``."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def wait(self):
+        raise ImportError(f"No module named '{self.name}'", name=self.name)
+
+
+def test_background_figures_missing_matplotlib_is_a_note(monkeypatch, tmp_path: Path, capsys):
+    finish_figures(_Drawing("matplotlib.figure"), tmp_path)
+    assert "figures skipped" in capsys.readouterr().err
+    with pytest.raises(ImportError, match=r"adept_traj\.viz\.plots\.fronts"):
+        finish_figures(_Drawing("adept_traj.viz.plots.fronts"), tmp_path)
+    monkeypatch.setattr(report.importlib.util, "find_spec", lambda name: None)
+    assert start_figures({}, tmp_path) is None  # nothing started, nothing checked
+    assert "figures skipped (no module named 'matplotlib')" in capsys.readouterr().err

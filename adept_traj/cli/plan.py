@@ -42,7 +42,7 @@ from adept_traj.cli._run_folder import (
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import save_figures, summary
+from adept_traj.cli.report import finish_figures, start_figures, summary
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
     ALGORITHMS,
@@ -280,16 +280,30 @@ def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, res
 def _finish(
     result: PlanningResult, problem: TrajectoryProblem, folder: Path, opts: argparse.Namespace
 ) -> int:
-    """Write every output of the run, then mark it complete (the last step)."""
-    result.save(folder)
+    """Write every output of the run, then mark it complete (the last step). The figures
+    are drawn in a forked process while this one writes ``result.json`` and
+    ``playback.html``; an error of theirs is raised here, before the run is marked
+    complete."""
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
-    if not opts.no_html:
-        from adept_traj.viz import meshcat_scene
+    figures = None
+    try:
+        if not opts.no_plots:
+            figures = start_figures({opts.algorithm: result}, folder / "figures",
+                                    {opts.algorithm: replay})  # fmt: skip
+    except BaseException:  # e.g. no fork possible: the result is saved all the same
+        result.save(folder)
+        raise
+    try:
+        result.save(folder)
+        if not opts.no_html:
+            from adept_traj.viz import meshcat_scene
 
-        meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
-    if not opts.no_plots:
-        save_figures({opts.algorithm: result}, folder / "figures", {opts.algorithm: replay})
+            meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
+        finish_figures(figures, folder / "figures")
+    finally:
+        if figures is not None:
+            figures.cancel()  # stops the drawing if anything above failed (else a no-op)
     print(summary(result, folder))
     code = status.OK
     if opts.ros is not None:

@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from adept_traj.analysis import WeightedSum
 from adept_traj.results import PlanningResult, Replay
 
-__all__ = ["save_figures", "summary", "t_best_text", "weighted_sum_text"]
+__all__ = [
+    "finish_figures",
+    "save_figures",
+    "start_figures",
+    "summary",
+    "t_best_text",
+    "weighted_sum_text",
+]
 
 
 def t_best_text(result: PlanningResult) -> str:
@@ -93,6 +102,40 @@ def save_figures(
     except ImportError as exc:
         if (exc.name or "").split(".")[0] != "matplotlib":
             raise  # a broken install of adept_traj itself is an error, not a missing extra
+        print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
+        return
+    print(f"{len(paths)} figures in {folder}")
+
+
+def start_figures(
+    results: dict[str, PlanningResult],
+    folder: Path,
+    replays: dict[str, Replay] | None = None,
+) -> Any:
+    """Start drawing the figures of :func:`save_figures` in a forked process
+    (:func:`adept_traj.viz.plots.start_save_all`) and return the drawing under way, to be
+    ended by :func:`finish_figures`; ``None`` (a note on standard error) when matplotlib is
+    missing. matplotlib is imported by the forked process, not here."""
+    if importlib.util.find_spec("matplotlib") is None:
+        print("note: figures skipped (no module named 'matplotlib'); install the 'plot' "
+              "extra", file=sys.stderr)  # fmt: skip
+        return None
+    from adept_traj.viz import plots
+
+    return plots.start_save_all(results, folder, replays=replays)
+
+
+def finish_figures(drawing: Any, folder: Path) -> None:
+    """Wait for the figures started by :func:`start_figures` (``None``: nothing to do) and
+    say how many were written; their error is raised here (an :class:`ImportError` of
+    matplotlib is a note, as in :func:`save_figures`)."""
+    if drawing is None:
+        return
+    try:
+        paths = drawing.wait()
+    except ImportError as exc:
+        if (exc.name or "").split(".")[0] != "matplotlib":
+            raise
         print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
         return
     print(f"{len(paths)} figures in {folder}")

@@ -19,6 +19,8 @@ function                     module                            figure
                                                                count) per generation
 :func:`save_all`             :mod:`.all_figures`               all of the above into a
                                                                folder
+:func:`start_save_all`       :mod:`.all_figures`               the same in a forked
+                                                               process, the caller goes on
 ===========================  ================================  ============================
 
 :mod:`.common` holds what they share (labels, colours, checks, the figure canvas),
@@ -31,7 +33,7 @@ left alone. Units are SI. Bad arguments raise
 
 from __future__ import annotations
 
-from adept_traj.viz.plots.all_figures import save_all
+from adept_traj.viz.plots.all_figures import BackgroundFigures, save_all, start_save_all
 from adept_traj.viz.plots.common import OBJECTIVE_LABELS
 from adept_traj.viz.plots.fronts import pareto_matrix
 from adept_traj.viz.plots.history import hypervolume_history
@@ -41,10 +43,12 @@ from adept_traj.viz.plots.tradeoffs import best_tradeoffs
 
 __all__ = [
     "OBJECTIVE_LABELS",
+    "BackgroundFigures",
     "best_tradeoffs",
     "hypervolume_history",
     "joint_motion",
     "pareto_matrix",
     "save_all",
+    "start_save_all",
     "tool_path_3d",
 ]

@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.files import write_atomic
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult
 from adept_traj.viz.inputs import as_result
+from adept_traj.viz.plots._png import write_png
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -174,21 +174,15 @@ def new_figure(width: float, height: float) -> Figure:
 
 
 def save_figure(fig: Figure, path: Path) -> Path:
-    """Write ``fig`` as a PNG at :data:`DPI` atomically (no half-written figure is left by
-    a crash or Ctrl-C); return ``path``.
+    """Write ``fig`` as a PNG at its own resolution (:data:`DPI` for every figure of
+    :func:`new_figure`) atomically (no half-written figure is left by a crash or Ctrl-C);
+    return ``path``.
 
-    zlib level 1 (:data:`PNG_COMPRESSION`): about 0.02 s less per figure than matplotlib's
-    default level 6 (a quarter of the encoding time) for files up to a quarter larger.
-    No ``Software`` entry (matplotlib's version): the same figure gives the same
-    bytes with any matplotlib release.
+    The pixels are those ``savefig`` gives at that resolution; the file is encoded by
+    ``adept_traj.viz.plots._png.write_png`` (rows unfiltered, RGB, zlib level
+    :data:`PNG_COMPRESSION`: about 20 ms for a 1650 × 1650 figure against 60 ms by
+    Pillow, whose encoder tries five filters per row, and smaller files). No text
+    chunks (no matplotlib version): the same figure gives the same bytes with any
+    matplotlib release.
     """
-    return write_atomic(
-        path,
-        lambda tmp: fig.savefig(
-            tmp,
-            dpi=DPI,
-            format="png",
-            metadata={"Software": None},
-            pil_kwargs={"compress_level": PNG_COMPRESSION},
-        ),
-    )
+    return write_png(fig, path, PNG_COMPRESSION)

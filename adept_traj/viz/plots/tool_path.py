@@ -118,11 +118,12 @@ def tool_path_3d(
     # ---- 3-D
     for lines, style in layers:
         if lines:
-            ax.add_collection3d(Line3DCollection(lines, **style))
+            # one colour map for all (a collection without copies matplotlib's default)
+            ax.add_collection3d(Line3DCollection(lines, cmap=cmap, **style), autolim=False)
     segments = np.stack([tool[:-1], tool[1:]], axis=1)
     path3 = Line3DCollection(segments, cmap=cmap, norm=norm, linewidths=2.6)
     path3.set_array(t_mid)
-    ax.add_collection3d(path3)
+    ax.add_collection3d(path3, autolim=False)  # the limits are set below
     marks = {"depthshade": False, "zorder": 6, "edgecolors": "black"}
     ax.scatter(*tool[0], s=60, color=cmap(0.0), **marks)
     ax.scatter(*tool[-1], s=60, color=cmap(1.0), marker="s", **marks)
@@ -155,7 +156,8 @@ def tool_path_3d(
         i, j = dims
         for lines, style in (*layers, (close_layer, close_style)):
             if lines:
-                axv.add_collection(LineCollection([ln[:, dims] for ln in lines], **style))
+                flat = [ln[:, dims] for ln in lines]
+                axv.add_collection(LineCollection(flat, cmap=cmap, **style))
         path2 = LineCollection(segments[:, :, dims], cmap=cmap, norm=norm, linewidths=2.6)
         path2.set_array(t_mid)
         axv.add_collection(path2)
