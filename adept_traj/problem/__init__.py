@@ -29,6 +29,7 @@ from adept_traj.problem.spline_segments import (
     TrajectoryBounds,
     TrajectoryIntegrals,
     TrajectorySamples,
+    derivative_abs_max,
 )
 from adept_traj.problem.time_bound import KinematicBound, kinematic_lower_bound
 from adept_traj.problem.trajectory_problem import ProblemSettings, TrajectoryProblem
@@ -51,6 +52,7 @@ __all__ = [
     "TrajectoryProblem",
     "TrajectorySamples",
     "available_cores",
+    "derivative_abs_max",
     "from_pymoo",
     "kinematic_lower_bound",
     "local_constraints",
