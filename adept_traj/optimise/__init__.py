@@ -59,6 +59,8 @@ from adept_traj.optimise.polish_step import (
     time_optimal_run,
 )
 from adept_traj.optimise.population import (
+    cache_violations,
+    optimum,
     population_values,
 )
 from adept_traj.optimise.repair import (
@@ -95,6 +97,7 @@ __all__ = [
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "cache_violations",
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
@@ -105,6 +108,7 @@ __all__ = [
     "make_algorithm",
     "minimum_time",
     "optimise",
+    "optimum",
     "plan",
     "polish_fastest",
     "polish_members",

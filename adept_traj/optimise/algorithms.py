@@ -39,11 +39,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.algorithm import Algorithm
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
+from adept_traj.optimise.population import optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
@@ -160,9 +163,26 @@ def make_algorithm(
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 
-def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
-    from pymoo.algorithms.moo.nsga2 import NSGA2
+class _ArrayOptimum:
+    """Mixed into a pymoo algorithm: its ``opt`` after every generation (pymoo's
+    ``filter_optimum`` of the population, read through ``Population.get`` of three
+    properties per member) computed by :func:`~adept_traj.optimise.optimum` on arrays —
+    the same members in the same order."""
 
+    def _set_optimum(self) -> None:
+        self.opt = optimum(self.pop)  # type: ignore[attr-defined]
+
+
+class _PaperNSGA2(_ArrayOptimum, NSGA2):
+    """pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2`, its optimum on arrays."""
+
+
+class _PaperMODE(_ArrayOptimum, GeneticAlgorithm):
+    """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
+    survival (see the module docstring), its optimum on arrays."""
+
+
+def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
     # pymoo's eliminate_duplicates=True (the default of every algorithm here), its
     # decisions taken in blocks: no (pop, pop) distance matrix.
     dup = {"eliminate_duplicates": BlockedDuplicateElimination()}
@@ -171,7 +191,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
         from pymoo.operators.crossover.sbx import SBX
         from pymoo.operators.mutation.pm import PM
 
-        return NSGA2(
+        return _PaperNSGA2(
             pop_size=pop,
             sampling=sampling,
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
@@ -181,7 +201,6 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             repair=repair,
         )
     if key == "mode":
-        from pymoo.algorithms.base.genetic import GeneticAlgorithm
         from pymoo.algorithms.soo.nonconvex.de import Variant
         from pymoo.operators.control import NoParameterControl
         from pymoo.util.display.multi import MultiObjectiveOutput
@@ -196,7 +215,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             control=NoParameterControl,
             repair=repair,
         )
-        return GeneticAlgorithm(
+        return _PaperMODE(
             pop_size=pop,
             sampling=sampling,
             mating=variant,

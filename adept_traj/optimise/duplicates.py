@@ -22,10 +22,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from pymoo.core.duplicate import DefaultDuplicateElimination
+from pymoo.core.duplicate import DefaultDuplicateElimination, default_attr
 from scipy.spatial.distance import cdist
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.population import population_values
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["BLOCK_PAIRS", "BlockedDuplicateElimination"]
@@ -55,9 +56,9 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
         self.block_pairs = as_integer(block_pairs, "block_pairs", minimum=1, error=bad)
 
     def _do(self, pop: Any, other: Any, is_duplicate: np.ndarray) -> np.ndarray:
-        X = np.asarray(self.func(pop), dtype=float)
+        X = self._values(pop)
         n = len(X)
-        Y = X if other is None else np.asarray(self.func(other), dtype=float)
+        Y = X if other is None else self._values(other)
         rows = max(1, self.block_pairs // max(1, len(Y)))
         for start in range(0, n, rows):
             stop = min(n, start + rows)
@@ -71,3 +72,10 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
             D[np.isnan(D)] = np.inf
             is_duplicate[start:stop][np.less_equal(D, self.epsilon).any(axis=1)] = True
         return is_duplicate
+
+    def _values(self, pop: Any) -> np.ndarray:
+        """The decision vectors (n, n_var) of ``pop`` that ``func`` returns; pymoo's default
+        ``func`` (``Population.get("X")``) read once per member (the same array)."""
+        if self.func is default_attr:
+            return np.asarray(population_values(pop, "X"), dtype=float)
+        return np.asarray(self.func(pop), dtype=float)
