@@ -163,23 +163,16 @@ def make_algorithm(
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 
-class _ArrayOptimum:
-    """Mixed into a pymoo algorithm: its ``opt`` after every generation (pymoo's
-    ``filter_optimum`` of the population, read through ``Population.get`` of three
-    properties per member) computed by :func:`~adept_traj.optimise.optimum` on arrays —
-    the same members in the same order."""
+class _PaperMODE(GeneticAlgorithm):
+    """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
+    survival (see the module docstring); its ``opt`` after every generation (pymoo's
+    ``filter_optimum`` of the population, which reads three properties per member through
+    ``Population.get``) computed by :func:`~adept_traj.optimise.optimum` on arrays — the
+    same members in the same order. (NSGA-II keeps pymoo's own, cheaper ``opt``: its
+    rank-0 members.)"""
 
     def _set_optimum(self) -> None:
-        self.opt = optimum(self.pop)  # type: ignore[attr-defined]
-
-
-class _PaperNSGA2(_ArrayOptimum, NSGA2):
-    """pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2`, its optimum on arrays."""
-
-
-class _PaperMODE(_ArrayOptimum, GeneticAlgorithm):
-    """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
-    survival (see the module docstring), its optimum on arrays."""
+        self.opt = optimum(self.pop)
 
 
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
@@ -191,7 +184,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
         from pymoo.operators.crossover.sbx import SBX
         from pymoo.operators.mutation.pm import PM
 
-        return _PaperNSGA2(
+        return NSGA2(
             pop_size=pop,
             sampling=sampling,
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
