@@ -36,6 +36,9 @@ from adept_traj.optimise.loop import (
     RunState,
     optimise,
 )
+from adept_traj.optimise.mating import (
+    ArrayMating,
+)
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.planner import (
     plan,
@@ -75,6 +78,9 @@ from adept_traj.optimise.sampling import (
 from adept_traj.optimise.survival import (
     RankAndCrowdingSurvival,
 )
+from adept_traj.optimise.tournament import (
+    binary_tournament,
+)
 
 __all__ = [
     "ALGORITHMS",
@@ -88,6 +94,7 @@ __all__ = [
     "SPREAD_MEMBERS",
     "TIME_OPTIMAL",
     "AlgorithmSettings",
+    "ArrayMating",
     "BlockedDuplicateElimination",
     "FastEndSearch",
     "GenerationInfo",
@@ -97,6 +104,7 @@ __all__ = [
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "binary_tournament",
     "cache_violations",
     "certify_front_members",
     "check_population_memory",

@@ -46,10 +46,12 @@ from pymoo.core.algorithm import Algorithm
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
+from adept_traj.optimise.mating import ArrayMating
 from adept_traj.optimise.population import optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
+from adept_traj.optimise.tournament import binary_tournament
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
@@ -152,6 +154,8 @@ def make_algorithm(
     if fast_end > 1.0:
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
+    if key == "nsga2":  # the same offspring, its rounds on arrays
+        algorithm.mating = ArrayMating.of(algorithm.mating)
     if fast_end > 0 and hasattr(algorithm, "mating"):
         ramps = sampling if isinstance(sampling, RampSampling) else None
         algorithm.mating = FastEndSearch(algorithm.mating, fraction=fast_end, sampling=ramps)
@@ -183,10 +187,12 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
     if key == "nsga2":
         from pymoo.operators.crossover.sbx import SBX
         from pymoo.operators.mutation.pm import PM
+        from pymoo.operators.selection.tournament import TournamentSelection
 
         return NSGA2(
             pop_size=pop,
             sampling=sampling,
+            selection=TournamentSelection(func_comp=binary_tournament),
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
             mutation=PM(prob=1.0, prob_var=s["mutation_prob_var"], eta=s["mutation_eta"]),
             survival=RankAndCrowdingSurvival(),

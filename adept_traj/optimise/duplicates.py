@@ -57,12 +57,21 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
 
     def _do(self, pop: Any, other: Any, is_duplicate: np.ndarray) -> np.ndarray:
         X = self._values(pop)
-        n = len(X)
-        Y = X if other is None else self._values(other)
+        Y = None if other is None else self._values(other)
+        is_duplicate[self.duplicates(X, Y)] = True
+        return is_duplicate
+
+    def duplicates(self, X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
+        """(n,) bool: which rows of the decision vectors ``X`` (n, n_var) duplicate an earlier
+        row of ``X`` (``Y`` None) or any row of ``Y`` (m, n_var) — the decisions of
+        :meth:`_do` on arrays (the module's definition, ε = ``epsilon``)."""
+        n, own = len(X), Y is None
+        Y = X if Y is None else Y
+        marked = np.zeros(n, dtype=bool)
         rows = max(1, self.block_pairs // max(1, len(Y)))
         for start in range(0, n, rows):
             stop = min(n, start + rows)
-            if other is None:
+            if own:
                 # Only the columns j < i count: those of rows [start, stop) end before stop.
                 D = cdist(X[start:stop], X[:stop])
                 j = np.arange(stop)
@@ -70,8 +79,8 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
             else:
                 D = cdist(X[start:stop], Y)
             D[np.isnan(D)] = np.inf
-            is_duplicate[start:stop][np.less_equal(D, self.epsilon).any(axis=1)] = True
-        return is_duplicate
+            marked[start:stop] = np.less_equal(D, self.epsilon).any(axis=1)
+        return marked
 
     def _values(self, pop: Any) -> np.ndarray:
         """The decision vectors (n, n_var) of ``pop`` that ``func`` returns; pymoo's default
