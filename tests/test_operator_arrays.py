@@ -33,7 +33,8 @@ def _candidates(problem, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     ramps = RampSampling().ramps(problem, 40, rng)
     uniform = rng.uniform(problem.xl, problem.xu, size=(40, problem.n_var))
-    return np.concatenate([ramps, uniform])
+    straight = problem.trajectory.straight_line(1.5)[None]  # zero velocity, c3 = 0 spans
+    return np.concatenate([ramps, uniform, straight])
 
 
 @pytest.mark.parametrize("seed", [0, 1])

@@ -270,9 +270,13 @@ def derivative_abs_max(trajectory: Any, x: Any) -> tuple[np.ndarray, np.ndarray,
     :class:`~adept_traj.problem.BSplineTrajectory`).
 
     The same numbers, bit for bit, as ``trajectory.bounds(x).qd_abs_max``,
-    ``.qdd_abs_max`` and ``.qddd_abs_max`` (the same candidate values), without the
-    position extrema (the roots of :math:`\dot q`), which the kinematic time repair
-    (:func:`~adept_traj.optimise.kinematic_time`) does not need.
+    ``.qdd_abs_max`` and ``.qddd_abs_max``, without the position extrema (the roots of
+    :math:`\dot q`), which the kinematic time repair
+    (:func:`~adept_traj.optimise.kinematic_time`) does not need. The candidates are those
+    of :meth:`~adept_traj.problem.BSplineTrajectory.bounds`, each evaluated on its own:
+    at u = 0 the Horner forms reduce to :math:`c_1\,(S/T)` and :math:`2c_2\,(S/T)^2`
+    exactly up to the sign of a zero (the products by u = 0 are zeros), at u = 1 to
+    sums in the same order (products by 1 are exact), and only magnitudes are kept.
 
     Raises
     ------
@@ -280,12 +284,23 @@ def derivative_abs_max(trajectory: Any, x: Any) -> tuple[np.ndarray, np.ndarray,
         As :meth:`~adept_traj.problem.BSplineTrajectory.decode`.
     """
     T, P = trajectory.decode(x)
-    qd_val, qdd_val, qddd_val = _derivative_candidates(T, _segment_coefficients(P))
-    return (
-        np.abs(qd_val).max(axis=(-3, -2)),
-        np.abs(qdd_val).max(axis=(-3, -2)),
-        np.abs(qddd_val).max(axis=-2),
-    )
+    return _derivative_abs_max(T, _segment_coefficients(P))
+
+
+def _derivative_abs_max(T: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`derivative_abs_max` of travel times ``T`` (...) [s] and segment coefficients
+    ``c`` (..., S, 4, nq)."""
+    c3, c2, c1 = c[..., 0, :], c[..., 1, :], c[..., 2, :]  # (..., S, nq)
+    rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = _clip_candidates(-c2 / (3.0 * c3))
+    a3, b2 = 3.0 * c3, 2.0 * c2
+    qd = np.maximum(np.abs(c1 * rate), np.abs(((a3 + b2) + c1) * rate))  # u = 0, 1
+    np.maximum(qd, np.abs(((a3 * vertex + b2) * vertex + c1) * rate), out=qd)
+    rate2 = rate**2
+    j3 = 6.0 * c3
+    qdd = np.maximum(np.abs(b2 * rate2), np.abs((j3 + b2) * rate2))  # u = 0, 1
+    return qd.max(axis=-2), qdd.max(axis=-2), np.abs(j3 * rate**3).max(axis=-2)
 
 
 def _exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
