@@ -1,6 +1,6 @@
-"""NSGA-II's mating and binary tournament on arrays make pymoo's offspring and winners
-(pymoo's Mating and binary_tournament are the independent references), bit for bit, with
-the same draws from the algorithm's generator."""
+"""NSGA-II's mating and binary tournament and MODE's DE variation on arrays make pymoo's
+offspring and winners (pymoo's Mating, binary_tournament and Variant are the references),
+bit for bit, with the same draws from the algorithm's generator."""
 
 from __future__ import annotations
 
@@ -10,12 +10,15 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from pymoo.algorithms.moo.nsga2 import binary_tournament as pymoo_binary_tournament
+from pymoo.algorithms.soo.nonconvex.de import Variant
 from pymoo.core.mating import Mating
 from pymoo.core.population import Population
+from pymoo.operators.control import NoParameterControl
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     ArrayMating,
+    ArrayVariant,
     binary_tournament,
     make_algorithm,
     optimise,
@@ -110,3 +113,39 @@ def test_binary_tournament_refuses_bad_input() -> None:
     algorithm.tournament_type = "by_luck"
     with pytest.raises(ConfigurationError, match="by_luck"):
         binary_tournament(pop, np.zeros((4, 2), dtype=int), algorithm)
+
+
+@pytest.fixture(scope="module")
+def evolved_mode(problem):
+    """MODE (paper operators, no fast-end search) after 2 generations of 12."""
+    algorithm, _ = make_algorithm("mode", pop_size=12, n_gen=2, fast_end=0.0)
+    optimise(problem, algorithm, 2, seed=6)
+    return algorithm
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize(("crossover", "prob_mut"), [("bin", 0.0), ("bin", 0.5), ("exp", 0.0)])
+def test_array_variant_makes_pymoos_trial_vectors(
+    problem, evolved_mode, seed: int, crossover: str, prob_mut: float
+) -> None:
+    ours = evolved_mode.mating
+    assert isinstance(ours, ArrayVariant)
+    settings = {
+        "selection": "rand",
+        "n_diffs": 1,
+        "F": 0.5,
+        "crossover": crossover,
+        "CR": 0.9,
+        "prob_mut": prob_mut,
+        "control": NoParameterControl,
+        "repair": ours.repair,
+    }
+    state = np.random.default_rng(seed).bit_generator.state
+    out = {}
+    for name, variant in (("ours", ArrayVariant(**settings)), ("pymoo", Variant(**settings))):
+        rng = evolved_mode.random_state
+        rng.bit_generator.state = copy.deepcopy(state)
+        off = variant.do(problem, evolved_mode.pop, 12, algorithm=evolved_mode, random_state=rng)
+        out[name] = (population_values(off, "X"), rng.random())
+    assert np.array_equal(out["ours"][0].view(np.int64), out["pymoo"][0].view(np.int64))
+    assert out["ours"][1] == out["pymoo"][1]

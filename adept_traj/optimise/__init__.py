@@ -81,6 +81,9 @@ from adept_traj.optimise.survival import (
 from adept_traj.optimise.tournament import (
     binary_tournament,
 )
+from adept_traj.optimise.variant import (
+    ArrayVariant,
+)
 
 __all__ = [
     "ALGORITHMS",
@@ -95,6 +98,7 @@ __all__ = [
     "TIME_OPTIMAL",
     "AlgorithmSettings",
     "ArrayMating",
+    "ArrayVariant",
     "BlockedDuplicateElimination",
     "FastEndSearch",
     "GenerationInfo",

@@ -52,6 +52,7 @@ from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
 from adept_traj.optimise.tournament import binary_tournament
+from adept_traj.optimise.variant import ArrayVariant
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
@@ -200,11 +201,10 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             repair=repair,
         )
     if key == "mode":
-        from pymoo.algorithms.soo.nonconvex.de import Variant
         from pymoo.operators.control import NoParameterControl
         from pymoo.util.display.multi import MultiObjectiveOutput
 
-        variant = Variant(
+        variant = ArrayVariant(
             selection="rand",
             n_diffs=1,
             F=s["F"],
