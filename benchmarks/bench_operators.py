@@ -80,8 +80,9 @@ print(digest.hexdigest()[:16], np.median(ask[1:]), np.median(tell[1:]), ask.sum(
 def loop_run(code: Path, name: str, seed: int) -> dict[str, float | str]:
     """One optimiser run in a fresh process with ``code`` first on the path."""
     env = {**os.environ, "PYTHONPATH": str(code)}
-    out = subprocess.run(
+    out = subprocess.run(  # in ``code``: ``-c`` puts the working directory first on the path
         [sys.executable, "-c", _LOOP, name, str(seed)],
+        cwd=code,
         env=env,
         capture_output=True,
         text=True,
@@ -95,14 +96,14 @@ def loop_run(code: Path, name: str, seed: int) -> dict[str, float | str]:
 
 
 def plan_run(code: Path, name: str) -> float:
-    """CPU time [s] of ``adept-traj plan --workers 1`` (with its children), ``code`` first
-    on the path."""
+    """CPU time [s] of ``adept-traj plan --workers 1`` (with its children), run in ``code``
+    (``-m`` puts the working directory first on the path)."""
     env = {**os.environ, "PYTHONPATH": str(code)}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     with tempfile.TemporaryDirectory() as out:
         command = [sys.executable, "-m", "adept_traj.cli", "plan", "--workers", "1"]
         command += ["--algorithm", name, "--out", out]
-        subprocess.run(command, env=env, capture_output=True, check=True)
+        subprocess.run(command, cwd=code, env=env, capture_output=True, check=True)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
