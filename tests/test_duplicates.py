@@ -110,8 +110,10 @@ def test_a_seeded_run_gives_the_front_of_pymoos_elimination(
     removed: list[int] = []
 
     class Counting(BlockedDuplicateElimination):
-        def _do(self, pop, other, is_duplicate):
-            out = super()._do(pop, other, is_duplicate)
+        # Every decision goes through ``duplicates`` (pymoo's ``_do`` hook and the array
+        # mating of NSGA-II alike).
+        def duplicates(self, X, Y=None):
+            out = super().duplicates(X, Y)
             removed.append(int(out.sum()))
             return out
 

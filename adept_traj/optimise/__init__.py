@@ -36,6 +36,9 @@ from adept_traj.optimise.loop import (
     RunState,
     optimise,
 )
+from adept_traj.optimise.mating import (
+    ArrayMating,
+)
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.planner import (
     plan,
@@ -59,6 +62,8 @@ from adept_traj.optimise.polish_step import (
     time_optimal_run,
 )
 from adept_traj.optimise.population import (
+    cache_violations,
+    optimum,
     population_values,
 )
 from adept_traj.optimise.repair import (
@@ -72,6 +77,12 @@ from adept_traj.optimise.sampling import (
 )
 from adept_traj.optimise.survival import (
     RankAndCrowdingSurvival,
+)
+from adept_traj.optimise.tournament import (
+    binary_tournament,
+)
+from adept_traj.optimise.variant import (
+    ArrayVariant,
 )
 from adept_traj.optimise.weighted_move import (
     MAX_EVALUATIONS_PER_START,
@@ -98,6 +109,8 @@ __all__ = [
     "TIME_OPTIMAL",
     "WEIGHTED_BOX",
     "AlgorithmSettings",
+    "ArrayMating",
+    "ArrayVariant",
     "BlockedDuplicateElimination",
     "FastEndSearch",
     "GenerationInfo",
@@ -107,6 +120,8 @@ __all__ = [
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "binary_tournament",
+    "cache_violations",
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
@@ -117,6 +132,7 @@ __all__ = [
     "make_algorithm",
     "minimum_time",
     "optimise",
+    "optimum",
     "plan",
     "polish_fastest",
     "polish_members",

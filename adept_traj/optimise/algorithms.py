@@ -39,14 +39,20 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.algorithm import Algorithm
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
+from adept_traj.optimise.mating import ArrayMating
+from adept_traj.optimise.population import optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
+from adept_traj.optimise.tournament import binary_tournament
+from adept_traj.optimise.variant import ArrayVariant
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
@@ -149,6 +155,8 @@ def make_algorithm(
     if fast_end > 1.0:
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
+    if key == "nsga2":  # the same offspring, its rounds on arrays
+        algorithm.mating = ArrayMating.of(algorithm.mating)
     if fast_end > 0 and hasattr(algorithm, "mating"):
         ramps = sampling if isinstance(sampling, RampSampling) else None
         algorithm.mating = FastEndSearch(algorithm.mating, fraction=fast_end, sampling=ramps)
@@ -160,9 +168,19 @@ def make_algorithm(
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 
-def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
-    from pymoo.algorithms.moo.nsga2 import NSGA2
+class _PaperMODE(GeneticAlgorithm):
+    """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
+    survival (see the module docstring); its ``opt`` after every generation (pymoo's
+    ``filter_optimum`` of the population, which reads three properties per member through
+    ``Population.get``) computed by :func:`~adept_traj.optimise.optimum` on arrays — the
+    same members in the same order. (NSGA-II keeps pymoo's own, cheaper ``opt``: its
+    rank-0 members.)"""
 
+    def _set_optimum(self) -> None:
+        self.opt = optimum(self.pop)
+
+
+def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
     # pymoo's eliminate_duplicates=True (the default of every algorithm here), its
     # decisions taken in blocks: no (pop, pop) distance matrix.
     dup = {"eliminate_duplicates": BlockedDuplicateElimination()}
@@ -170,10 +188,12 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
     if key == "nsga2":
         from pymoo.operators.crossover.sbx import SBX
         from pymoo.operators.mutation.pm import PM
+        from pymoo.operators.selection.tournament import TournamentSelection
 
         return NSGA2(
             pop_size=pop,
             sampling=sampling,
+            selection=TournamentSelection(func_comp=binary_tournament),
             crossover=SBX(prob=s["crossover_prob"], eta=s["crossover_eta"]),
             mutation=PM(prob=1.0, prob_var=s["mutation_prob_var"], eta=s["mutation_eta"]),
             survival=RankAndCrowdingSurvival(),
@@ -181,12 +201,10 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             repair=repair,
         )
     if key == "mode":
-        from pymoo.algorithms.base.genetic import GeneticAlgorithm
-        from pymoo.algorithms.soo.nonconvex.de import Variant
         from pymoo.operators.control import NoParameterControl
         from pymoo.util.display.multi import MultiObjectiveOutput
 
-        variant = Variant(
+        variant = ArrayVariant(
             selection="rand",
             n_diffs=1,
             F=s["F"],
@@ -196,7 +214,7 @@ def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) ->
             control=NoParameterControl,
             repair=repair,
         )
-        return GeneticAlgorithm(
+        return _PaperMODE(
             pop_size=pop,
             sampling=sampling,
             mating=variant,

@@ -22,10 +22,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from pymoo.core.duplicate import DefaultDuplicateElimination
+from pymoo.core.duplicate import DefaultDuplicateElimination, default_attr
 from scipy.spatial.distance import cdist
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.population import population_values
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["BLOCK_PAIRS", "BlockedDuplicateElimination"]
@@ -55,13 +56,22 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
         self.block_pairs = as_integer(block_pairs, "block_pairs", minimum=1, error=bad)
 
     def _do(self, pop: Any, other: Any, is_duplicate: np.ndarray) -> np.ndarray:
-        X = np.asarray(self.func(pop), dtype=float)
-        n = len(X)
-        Y = X if other is None else np.asarray(self.func(other), dtype=float)
+        X = self._values(pop)
+        Y = None if other is None else self._values(other)
+        is_duplicate[self.duplicates(X, Y)] = True
+        return is_duplicate
+
+    def duplicates(self, X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
+        """(n,) bool: which rows of the decision vectors ``X`` (n, n_var) duplicate an earlier
+        row of ``X`` (``Y`` None) or any row of ``Y`` (m, n_var) — the decisions of
+        :meth:`_do` on arrays (the module's definition, ε = ``epsilon``)."""
+        n, own = len(X), Y is None
+        Y = X if Y is None else Y
+        marked = np.zeros(n, dtype=bool)
         rows = max(1, self.block_pairs // max(1, len(Y)))
         for start in range(0, n, rows):
             stop = min(n, start + rows)
-            if other is None:
+            if own:
                 # Only the columns j < i count: those of rows [start, stop) end before stop.
                 D = cdist(X[start:stop], X[:stop])
                 j = np.arange(stop)
@@ -69,5 +79,12 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
             else:
                 D = cdist(X[start:stop], Y)
             D[np.isnan(D)] = np.inf
-            is_duplicate[start:stop][np.less_equal(D, self.epsilon).any(axis=1)] = True
-        return is_duplicate
+            marked[start:stop] = np.less_equal(D, self.epsilon).any(axis=1)
+        return marked
+
+    def _values(self, pop: Any) -> np.ndarray:
+        """The decision vectors (n, n_var) of ``pop`` that ``func`` returns; pymoo's default
+        ``func`` (``Population.get("X")``) read once per member (the same array)."""
+        if self.func is default_attr:
+            return np.asarray(population_values(pop, "X"), dtype=float)
+        return np.asarray(self.func(pop), dtype=float)

@@ -1,4 +1,5 @@
-"""Arrays of a pymoo population's members, read once per member.
+r"""Arrays of a pymoo population's members, read once per member, and the per-member
+values pymoo computes one member at a time, computed for the whole population at once.
 
 pymoo's ``Population.get(key)`` asks each member ``hasattr(ind, key)`` then
 ``getattr(ind, key)``: every property (``CV``, ``FEAS``, …) is evaluated twice, through
@@ -6,14 +7,29 @@ two Python calls per member. The optimiser reads the population after every gene
 (the loop's progress and fronts, the checkpoint, the fast-end search, the survival), so
 :func:`population_values` reads each member's public attribute once and stacks the values
 exactly as ``Population.get`` does (same array, bit for bit).
+
+A member's total constraint violation CV is computed by pymoo lazily, on its first read,
+by ``calc_cv`` — one Python call chain per member (about 8 µs).
+:func:`cache_violations` computes it for every freshly evaluated member at once, with the
+same operations (hence the same bits) for pymoo's default configuration:
+
+.. math::
+    \mathrm{CV}_i = \sum_j \max(0,\ G_{ij} - 0) + 0 .
+
+:func:`optimum` is pymoo's ``filter_optimum(pop, least_infeasible=True)`` (what every
+algorithm stores as ``opt`` after each generation) on these arrays.
 """
 
 from __future__ import annotations
 
-import numpy as np
-from pymoo.core.population import Population
+from typing import Any
 
-__all__ = ["population_values"]
+import numpy as np
+from pymoo.core.individual import Individual, default_config
+from pymoo.core.population import Population
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+__all__ = ["cache_violations", "optimum", "population_values"]
 
 
 def population_values(pop: Population, key: str) -> np.ndarray:
@@ -21,3 +37,49 @@ def population_values(pop: Population, key: str) -> np.ndarray:
     ``Population.get(key)`` stacks it: ``"X"`` (n, n_var), ``"F"`` (n, n_obj), ``"G"``
     (n, n_constr), ``"CV"`` (n, 1) for n members ((0,) for an empty population)."""
     return np.array([getattr(ind, key) for ind in pop])
+
+
+def cache_violations(pop: Population) -> None:
+    """Set the total constraint violation CV ((1,) per member) of the members of ``pop``
+    whose CV pymoo would compute with its default configuration (no equality constraints,
+    inequality constraints G of one common length): the same numbers, bit for bit, as the
+    member's lazy ``CV`` property, computed for all of them at once. Other members are left
+    to pymoo. The members' ``G`` must not change afterwards (pymoo caches CV likewise)."""
+    default = default_config()
+    members = [
+        ind
+        for ind in pop
+        if ind.config == default
+        and (ind.H is None or len(ind.H) == 0)
+        and isinstance(ind.G, np.ndarray)
+        and ind.G.ndim == 1
+    ]
+    if not members or len({len(ind.G) for ind in members}) != 1 or len(members[0].G) == 0:
+        return
+    G = np.array([ind.G for ind in members], dtype=float)  # (n, n_constr)
+    # pymoo: sum(max(0, G - eps)) with eps = 0, plus the equality part, 0.0 without H.
+    cv = np.sum(np.maximum(0.0, G - 0.0), axis=1) + 0.0
+    for ind, value in zip(members, cv, strict=True):
+        ind.CV = np.array([value])
+
+
+def optimum(pop: Population | None) -> Population | None:
+    """pymoo's ``filter_optimum(pop, least_infeasible=True)``: the non-dominated feasible
+    members of ``pop`` (in pymoo's order), the single best one for one objective, else the
+    least infeasible member; ``None`` for an empty population."""
+    if pop is None or len(pop) == 0:
+        return None
+    eps = np.array([ind.config.get("cv_eps", 0.0) for ind in pop])
+    cv = population_values(pop, "CV")
+    ret: Any = pop[cv[:, 0] <= eps]
+    if len(ret) > 0:
+        F = population_values(ret, "F")
+        if F.shape[1] > 1:
+            ret = ret[NonDominatedSorting().do(F, only_non_dominated_front=True)]
+        else:
+            ret = ret[np.argmin(F[:, 0])]
+    else:
+        ret = pop[np.argmin(cv)]
+    if isinstance(ret, Individual):
+        ret = Population().create(ret)
+    return ret

@@ -26,6 +26,7 @@ import numpy as np
 from pymoo.core.repair import Repair
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.problem import derivative_abs_max
 from adept_traj.validation import as_scalar
 
 __all__ = ["KinematicTimeRepair", "kinematic_time"]
@@ -57,15 +58,11 @@ def _kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
     """:func:`kinematic_time` of one block ``x`` (k, n_var)."""
     unit = np.array(x, dtype=float)
     unit[..., 0] = 1.0
-    b = problem.trajectory.bounds(unit)
+    qd, qdd, qddd = derivative_abs_max(problem.trajectory, unit)  # the extrema at T = 1
     lim = problem.robot.limits
     with np.errstate(divide="ignore", invalid="ignore"):
         times = np.stack(
-            [
-                b.qd_abs_max / lim.velocity,
-                np.sqrt(b.qdd_abs_max / lim.acceleration),
-                np.cbrt(b.qddd_abs_max / lim.jerk),
-            ]
+            [qd / lim.velocity, np.sqrt(qdd / lim.acceleration), np.cbrt(qddd / lim.jerk)]
         )
     return np.nan_to_num(times, nan=0.0).max(axis=(0, -1))
 

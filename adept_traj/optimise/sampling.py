@@ -49,23 +49,37 @@ _GRID = np.linspace(0.0, 1.0, 2001)
 _BLOCK_CURVES = 512
 
 
+#: The half-distance to the nearer end of :data:`_GRID`, and its distance to the middle, in
+#: [0, 0.5]; ``_SIGN`` is +1 on the first half of the grid, -1 on the second.
+_HALF = np.minimum(_GRID, 1.0 - _GRID)
+_TO_MIDDLE = 0.5 - _HALF
+_SIGN = np.where(_GRID < 0.5, 1.0, -1.0)
+
+
 def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Normalised S-curves σ(u) (σ(0) = 0, σ(1) = 1, rest to rest) with jerk-phase fraction
     ``r``: acceleration ramps up over r, holds, ramps down over r (first half), mirrored
-    negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast."""
+    negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast.
+
+    Tabulated on :data:`_GRID` (two running sums of the acceleration), then interpolated;
+    only the ``2 k`` tabulated points each curve is read at are normalised. Both halves of
+    the grid are in [0, 0.5] and r > 0, so clipping the ramps below at 0 and the sign
+    ``where`` of the plain formula are exact no-ops and multiplications by ±1: the same
+    numbers, bit for bit."""
     r = np.asarray(r, dtype=float)[..., None]
-    g = _GRID
-    half = np.minimum(g, 1.0 - g)  # symmetric shape, sign from the half
-    acc = np.minimum(np.clip(half / r, 0.0, 1.0), np.clip((0.5 - half) / r, 0.0, 1.0))
-    acc = np.where(g < 0.5, acc, -acc)
-    vel = np.cumsum(acc, axis=-1)
-    pos = np.cumsum(vel, axis=-1)
-    pos = (pos - pos[..., :1]) / (pos[..., -1:] - pos[..., :1])
+    acc = np.minimum(np.minimum(_HALF / r, 1.0), np.minimum(_TO_MIDDLE / r, 1.0))
+    acc *= _SIGN
+    pos = np.cumsum(np.cumsum(acc, axis=-1, out=acc), axis=-1, out=acc)
+    first, last = pos[..., :1], pos[..., -1:]
     uu = np.clip(u, 0.0, 1.0)
-    idx = np.minimum((uu * (len(g) - 1)).astype(int), len(g) - 2)
-    w = uu * (len(g) - 1) - idx
-    take = np.take_along_axis
-    return take(pos, idx, axis=-1) * (1 - w) + take(pos, idx + 1, axis=-1) * w
+    idx = np.minimum((uu * (len(_GRID) - 1)).astype(int), len(_GRID) - 2)
+    w = uu * (len(_GRID) - 1) - idx
+    span = last - first
+
+    def at(i: np.ndarray) -> np.ndarray:
+        return (np.take_along_axis(pos, i, axis=-1) - first) / span
+
+    return at(idx) * (1 - w) + at(idx + 1) * w
 
 
 def _s_curves_blocked(u: np.ndarray, r: np.ndarray) -> np.ndarray:

@@ -17,7 +17,9 @@ member i is feasible when
 
 (pymoo's ``FEAS``, with the individuals' ``cv_eps``, 0 by default); the infeasible ones are
 ordered by ``numpy.argsort`` of their CV as pymoo orders them, the feasible ones go to
-pymoo's own ranking (:meth:`RankAndCrowding._do`, unchanged). Same survivors in the same
+pymoo's ranking (its non-dominated sorting and crowding distance, the last front cut by
+its randomised argsort), with their objectives read once per member and ``rank`` and
+``crowding`` written into each member's ``data`` directly. Same survivors in the same
 order, same ``rank`` and ``crowding`` data, same draws from the random generator
 (``tests/test_survival.py`` compares both on mixed populations).
 """
@@ -30,6 +32,7 @@ import numpy as np
 from pymoo.core.population import Population
 from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
 from pymoo.util import default_random_state
+from pymoo.util.randomized_argsort import randomized_argsort
 
 from adept_traj.optimise.population import population_values
 
@@ -85,3 +88,34 @@ class RankAndCrowdingSurvival(RankAndCrowding):
             where = {ind: k for k, ind in enumerate(pop)}
             return [where[ind] for ind in survivors]
         return survivors
+
+    def _do(
+        self,
+        problem: Any,
+        pop: Population,
+        *args: Any,
+        random_state: Any = None,
+        n_survive: int | None = None,
+        **kwargs: Any,
+    ) -> Population:
+        """pymoo's ranking of (feasible) members, F read once per member and ``rank`` and
+        ``crowding`` written straight into each member's ``data`` (what pymoo's
+        ``Individual.set`` does for a key that is not an attribute)."""
+        F = population_values(pop, "F").astype(float, copy=False)
+        survivors: list[int] = []
+        for k, front in enumerate(self.nds.do(F, n_stop_if_ranked=n_survive)):
+            keep = np.arange(len(front))
+            if len(survivors) + len(keep) > n_survive:
+                n_remove = len(survivors) + len(front) - n_survive
+                crowding = self.crowding_func.do(F[front, :], n_remove=n_remove)
+                keep = randomized_argsort(
+                    crowding, order="descending", method="numpy", random_state=random_state
+                )[:-n_remove]
+            else:
+                crowding = self.crowding_func.do(F[front, :], n_remove=0)
+            for j, i in enumerate(front):
+                data = pop[i].data
+                data["rank"] = k
+                data["crowding"] = crowding[j]
+            survivors.extend(front[keep])
+        return pop[survivors]

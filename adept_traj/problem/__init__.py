@@ -33,6 +33,7 @@ from adept_traj.problem.spline_segments import (
     TrajectoryBounds,
     TrajectoryIntegrals,
     TrajectorySamples,
+    derivative_abs_max,
 )
 from adept_traj.problem.time_bound import KinematicBound, kinematic_lower_bound
 from adept_traj.problem.trajectory_problem import ProblemSettings, TrajectoryProblem
@@ -56,6 +57,7 @@ __all__ = [
     "TrajectorySamples",
     "available_cores",
     "check_differentiable",
+    "derivative_abs_max",
     "from_pymoo",
     "kinematic_lower_bound",
     "local_constraints",

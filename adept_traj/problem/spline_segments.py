@@ -16,10 +16,11 @@ hooks here; the results are :class:`TrajectoryBounds` and :class:`TrajectoryInte
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-__all__ = ["TrajectoryBounds", "TrajectoryIntegrals", "TrajectorySamples"]
+__all__ = ["TrajectoryBounds", "TrajectoryIntegrals", "TrajectorySamples", "derivative_abs_max"]
 
 #: Uniform cubic B-spline basis matrix (rows: coefficients of u³, u², u, 1).
 _M = (
@@ -213,22 +214,13 @@ def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
     (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.bounds`)."""
     c = _segment_coefficients(P)
     c3, c2, c1, c0 = c[..., 0, :], c[..., 1, :], c[..., 2, :], c[..., 3, :]  # (..., S, nq)
-    rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
-
     r1, r2 = _quadratic_roots(3.0 * c3, 2.0 * c2, c1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        vertex = -c2 / (3.0 * c3)
     zeros = np.zeros_like(c3)
     ones = np.ones_like(c3)
     u_q = np.stack([zeros, ones, _clip_candidates(r1), _clip_candidates(r2)], axis=-3)
-    u_qd = np.stack([zeros, ones, _clip_candidates(vertex)], axis=-3)
-    u_qdd = np.stack([zeros, ones], axis=-3)
     cc3, cc2, cc1, cc0 = (ci[..., None, :, :] for ci in (c3, c2, c1, c0))
-
     q_val = ((cc3 * u_q + cc2) * u_q + cc1) * u_q + cc0  # (..., k, S, nq)
-    qd_val = ((3.0 * cc3 * u_qd + 2.0 * cc2) * u_qd + cc1) * rate[..., None, :, :]
-    qdd_val = (6.0 * cc3 * u_qdd + 2.0 * cc2) * rate[..., None, :, :] ** 2
-    qddd_val = 6.0 * c3 * rate**3  # (..., S, nq)
+    qd_val, qdd_val, qddd_val = _derivative_candidates(T, c)
 
     def ext(v: np.ndarray, axes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
         return v.min(axis=axes), v.max(axis=axes)
@@ -247,6 +239,68 @@ def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
         qddd_min=qddd_min,
         qddd_max=qddd_max,
     )
+
+
+def _derivative_candidates(
+    T: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""The values among which :math:`\dot q, \ddot q, \dddot q` reach their extrema, of
+    travel times ``T`` (...) [s] and segment coefficients ``c`` (..., S, 4, nq): velocities
+    (..., 3, S, nq) at u ∈ {0, 1, the vertex} [rad/s], accelerations (..., 2, S, nq) at
+    u ∈ {0, 1} [rad/s²], jerks (..., S, nq) [rad/s³]."""
+    c3, c2, c1 = c[..., 0, :], c[..., 1, :], c[..., 2, :]  # (..., S, nq)
+    rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = -c2 / (3.0 * c3)
+    zeros = np.zeros_like(c3)
+    ones = np.ones_like(c3)
+    u_qd = np.stack([zeros, ones, _clip_candidates(vertex)], axis=-3)
+    u_qdd = np.stack([zeros, ones], axis=-3)
+    cc3, cc2, cc1 = (ci[..., None, :, :] for ci in (c3, c2, c1))
+    qd_val = ((3.0 * cc3 * u_qd + 2.0 * cc2) * u_qd + cc1) * rate[..., None, :, :]
+    qdd_val = (6.0 * cc3 * u_qdd + 2.0 * cc2) * rate[..., None, :, :] ** 2
+    qddd_val = 6.0 * c3 * rate**3  # (..., S, nq)
+    return qd_val, qdd_val, qddd_val
+
+
+def derivative_abs_max(trajectory: Any, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Exact :math:`\max_t |\dot q_i|` [rad/s], :math:`\max_t |\ddot q_i|` [rad/s²] and
+    :math:`\max_t |\dddot q_i|` [rad/s³] over [0, T], each of shape ``(..., nq)``, of the
+    decision vectors ``x`` (..., n_var) of ``trajectory`` (a
+    :class:`~adept_traj.problem.BSplineTrajectory`).
+
+    The same numbers, bit for bit, as ``trajectory.bounds(x).qd_abs_max``,
+    ``.qdd_abs_max`` and ``.qddd_abs_max``, without the position extrema (the roots of
+    :math:`\dot q`), which the kinematic time repair
+    (:func:`~adept_traj.optimise.kinematic_time`) does not need. The candidates are those
+    of :meth:`~adept_traj.problem.BSplineTrajectory.bounds`, each evaluated on its own:
+    at u = 0 the Horner forms reduce to :math:`c_1\,(S/T)` and :math:`2c_2\,(S/T)^2`
+    exactly up to the sign of a zero (the products by u = 0 are zeros), at u = 1 to
+    sums in the same order (products by 1 are exact), and only magnitudes are kept.
+
+    Raises
+    ------
+    InputShapeError, InvalidInputError
+        As :meth:`~adept_traj.problem.BSplineTrajectory.decode`.
+    """
+    T, P = trajectory.decode(x)
+    return _derivative_abs_max(T, _segment_coefficients(P))
+
+
+def _derivative_abs_max(T: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`derivative_abs_max` of travel times ``T`` (...) [s] and segment coefficients
+    ``c`` (..., S, 4, nq)."""
+    c3, c2, c1 = c[..., 0, :], c[..., 1, :], c[..., 2, :]  # (..., S, nq)
+    rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = _clip_candidates(-c2 / (3.0 * c3))
+    a3, b2 = 3.0 * c3, 2.0 * c2
+    qd = np.maximum(np.abs(c1 * rate), np.abs(((a3 + b2) + c1) * rate))  # u = 0, 1
+    np.maximum(qd, np.abs(((a3 * vertex + b2) * vertex + c1) * rate), out=qd)
+    rate2 = rate**2
+    j3 = 6.0 * c3
+    qdd = np.maximum(np.abs(b2 * rate2), np.abs((j3 + b2) * rate2))  # u = 0, 1
+    return qd.max(axis=-2), qdd.max(axis=-2), np.abs(j3 * rate**3).max(axis=-2)
 
 
 def _exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:

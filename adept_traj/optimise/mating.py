@@ -1,0 +1,171 @@
+r"""pymoo's mating (selection, crossover, mutation, repair, duplicate elimination) on arrays.
+
+pymoo's :class:`~pymoo.core.mating.Mating` makes each generation's offspring in rounds:
+select parents, cross them over, mutate, repair, drop the duplicates (within the round,
+of the parents, of the offspring so far), and repeat for the missing ones until there are
+``n_offsprings`` (NSGA-II at the paper's settings: about 2.8 rounds a generation, since
+crossover probability 0.7 and a per-variable mutation probability 0.01 copy many parents
+unchanged). Every step builds a ``Population`` of ``Individual`` objects and reads or
+writes their ``X`` one member at a time.
+
+:class:`ArrayMating` takes the same steps on one (n, n_var) array of decision vectors and
+builds the ``Population`` once, at the end: the same operators' array hooks
+(``crossover._do``, ``mutation._do``, ``repair._do``,
+:meth:`~adept_traj.optimise.BlockedDuplicateElimination.duplicates`) called with the same
+arguments in the same order, the same draws from the algorithm's generator, hence the same
+offspring bit for bit. Per round, with :math:`n_m = \lceil n_{rem} / n_{off}\rceil`
+matings of parents :math:`I` (n_m, n_parents) chosen by the algorithm's selection:
+
+.. math::
+    X' = \begin{cases} \mathrm{crossover}(X_I) & u_k < p_c \\ X_{I_k}\ \text{(copied)} &
+    \text{else} \end{cases}, \qquad
+    X'' = \begin{cases} \mathrm{mutation}(X') & u'_k \le p_m \\ X' & \text{else}
+    \end{cases}, \qquad X''' = \mathrm{repair}(X'') ,
+
+then the rows of :math:`X'''` that duplicate an earlier row, a parent or an earlier
+offspring are dropped. It is used when the operators are pymoo's plain ones (no
+``vtype``, no operator-level repair) and the duplicate elimination is
+:class:`~adept_traj.optimise.BlockedDuplicateElimination` or none; otherwise, and without
+a random generator, it is pymoo's mating unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from pymoo.core.duplicate import NoDuplicateElimination
+from pymoo.core.mating import Mating
+from pymoo.core.population import Population
+from pymoo.core.repair import Repair
+from pymoo.core.variable import get
+
+from adept_traj.optimise.duplicates import BlockedDuplicateElimination
+from adept_traj.optimise.population import population_values
+
+__all__ = ["ArrayMating"]
+
+
+class ArrayMating(Mating):
+    """pymoo's :class:`~pymoo.core.mating.Mating` with its rounds on arrays (see the module
+    docstring). Parameters as pymoo's; :meth:`of` copies an existing mating's."""
+
+    @classmethod
+    def of(cls, mating: Mating) -> ArrayMating:
+        """The array form of ``mating`` (its selection, crossover, mutation, repair,
+        duplicate elimination and most rounds, shared, not copied)."""
+        return cls(
+            mating.selection,
+            mating.crossover,
+            mating.mutation,
+            repair=mating.repair,
+            eliminate_duplicates=mating.eliminate_duplicates,
+            n_max_iterations=mating.n_max_iterations,
+        )
+
+    def do(
+        self,
+        problem: Any,
+        pop: Population,
+        n_offsprings: int,
+        random_state: Any = None,
+        n_max_iterations: int | None = None,
+        **kwargs: Any,
+    ) -> Population:
+        """``n_offsprings`` children of ``pop`` (fewer if ``n_max_iterations`` rounds leave
+        only duplicates), as pymoo's ``Mating.do`` makes them from the same generator."""
+        if random_state is None or not self._plain():
+            return super().do(problem, pop, n_offsprings, random_state, n_max_iterations, **kwargs)
+        rounds = self.n_max_iterations if n_max_iterations is None else n_max_iterations
+        parents = population_values(pop, "X")
+        off = np.empty((0, problem.n_var))
+        n_rounds = 0
+        while len(off) < n_offsprings:
+            n_remaining = n_offsprings - len(off)
+            X = self._round(problem, pop, parents, n_remaining, random_state, **kwargs)
+            X = self._unique(X, parents, off)
+            off = np.concatenate([off, X[:n_remaining]])
+            n_rounds += 1
+            if n_rounds >= rounds:
+                break
+        return Population.new(X=off)
+
+    def _plain(self) -> bool:
+        """Whether the array rounds apply (pymoo's plain operators; see the module doc)."""
+        operators = (self.selection, self.crossover, self.mutation, self.repair)
+        return (
+            all(getattr(op, "vtype", None) is None for op in operators)
+            and all(getattr(op, "repair", None) is None for op in operators)
+            and isinstance(self.repair, Repair)
+            and isinstance(
+                self.eliminate_duplicates, BlockedDuplicateElimination | NoDuplicateElimination
+            )
+        )
+
+    def _round(
+        self,
+        problem: Any,
+        pop: Population,
+        parents: np.ndarray,
+        n_remaining: int,
+        rng: np.random.Generator,
+        **kwargs: Any,
+    ) -> np.ndarray:
+        """One round of pymoo's ``Mating._do`` and repair: (n_matings·n_off, n_var)."""
+        cross = self.crossover
+        n_matings = math.ceil(n_remaining / cross.n_offsprings)
+        index = self.selection(
+            problem,
+            pop,
+            n_matings,
+            n_parents=cross.n_parents,
+            to_pop=False,
+            random_state=rng,
+            **kwargs,
+        )
+        X = np.swapaxes(parents[np.asarray(index)], 0, 1)  # (n_parents, n_matings, n_var)
+        X = self._crossover(problem, X, rng, **kwargs)
+        mutated = self.mutation._do(problem, X, random_state=rng, **kwargs)
+        chosen = rng.random(size=len(X)) <= get(self.mutation.prob, size=len(X))
+        X[chosen] = mutated[chosen]
+        return np.asarray(self.repair._do(problem, X, random_state=rng, **kwargs))
+
+    def _crossover(
+        self, problem: Any, X: np.ndarray, rng: np.random.Generator, **kwargs: Any
+    ) -> np.ndarray:
+        """pymoo's ``Crossover.do`` of the parents ``X`` (n_parents, n_matings, n_var):
+        the children (n_off·n_matings, n_var)."""
+        cross = self.crossover
+        n_parents, n_off = cross.n_parents, cross.n_offsprings
+        n_matings = X.shape[1]
+        Xp = np.empty((n_off, n_matings, X.shape[-1]), dtype=X.dtype)
+        crossed = rng.random(n_matings) < get(cross.prob, size=n_matings)
+        if np.any(crossed):
+            Xp[:, crossed] = cross._do(problem, X, random_state=rng, **kwargs)[:, crossed]
+        for k in np.flatnonzero(~crossed):
+            if n_off < n_parents:
+                s = rng.choice(np.arange(n_parents), size=n_off, replace=False)
+            elif n_off == n_parents:
+                s = np.arange(n_parents)
+            else:
+                s = []
+                while len(s) < n_off:
+                    s.extend(rng.permutation(n_parents))
+                s = s[:n_off]
+            Xp[:, k] = np.copy(X[s, k])
+        return Xp.reshape(-1, X.shape[-1])
+
+    def _unique(self, X: np.ndarray, parents: np.ndarray, off: np.ndarray) -> np.ndarray:
+        """The rows of ``X`` that duplicate neither an earlier row, nor a parent, nor an
+        earlier offspring (pymoo's ``eliminate_duplicates.do(X, pop, off)``)."""
+        dup = self.eliminate_duplicates
+        if len(X) == 0 or isinstance(dup, NoDuplicateElimination):
+            return X
+        X = X[~dup.duplicates(X)]
+        for other in (parents, off):
+            if len(other) > 0:
+                if len(X) == 0:
+                    break
+                X = X[~dup.duplicates(X, other)]
+        return X
