@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, continuous_distance
+from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, _continuous_distance
 from adept_traj.analysis.dense_trajectory import (
     DenseStates,
     DenseTrajectory,
@@ -70,7 +70,7 @@ from adept_traj.analysis.limit_check import (
     _limit_checks,
     _limits,
 )
-from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, self_distance
+from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, _self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -338,9 +338,7 @@ def _certify(
         per_sample = pairs.min(axis=(1, 2))
         grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance(
-                problem, xa, t, qd, pairs, grid_hz, depth, exact, acceleration_bound=acc
-            )
+            found = _continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact, acc)
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
@@ -365,9 +363,7 @@ def _certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and self_distance(
-        problem, xa, t, q, qd, continuous, depth, acceleration_bound=acc
-    )
+    own = problem.self_check and _self_distance(problem, xa, t, q, qd, continuous, depth, acc)
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

@@ -50,6 +50,7 @@ import math
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -119,20 +120,21 @@ def obstacle_speeds(problem: TrajectoryProblem) -> np.ndarray:
 #: (lever arms (n_solids, nq), obstacle speeds (n_obstacles,)) of each problem, read-only:
 #: they depend on the robot and the scene alone, and a front certifies hundreds of moves of
 #: one problem (computing them took ≈ 1 ms per certificate).
-_RATES: weakref.WeakKeyDictionary[TrajectoryProblem, tuple[np.ndarray, np.ndarray]] = (
+_RATES: weakref.WeakKeyDictionary[TrajectoryProblem, tuple[np.ndarray, np.ndarray, Any, Any]] = (
     weakref.WeakKeyDictionary()
 )
 
 
 def _rates(problem: TrajectoryProblem) -> tuple[np.ndarray, np.ndarray]:
     """:func:`solid_lever_arms` and :func:`obstacle_speeds` of ``problem``, computed once
-    per problem (read-only arrays)."""
+    per problem and robot and scene (read-only arrays; computed anew when
+    ``problem.robot`` or ``problem.scene`` was replaced)."""
     rates = _RATES.get(problem)
-    if rates is None:
+    if rates is None or rates[2] is not problem.robot or rates[3] is not problem.scene:
         arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
         arms.flags.writeable = speeds.flags.writeable = False
-        rates = _RATES[problem] = (arms, speeds)
-    return rates
+        rates = _RATES[problem] = (arms, speeds, problem.robot, problem.scene)
+    return rates[0], rates[1]
 
 
 def _interval_bounds(
@@ -166,8 +168,6 @@ def continuous_distance(
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
     exact: bool = True,
-    *,
-    acceleration_bound: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """Lower-bound the distance between the samples and refine where needed.
 
@@ -182,21 +182,35 @@ def continuous_distance(
         exact: distances at the midpoints exact for every pair (``False``: lower bounds
             above the checker's influence distance, as
             :meth:`~adept_traj.collision.CollisionChecker.distances`).
-        acceleration_bound: (nq,) the spline's exact :math:`\\max_t |\\ddot q_j|`
-            [rad/s² | m/s²] if the caller has it
-            (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``.qdd_abs_max``);
-            ``None``: computed here.
 
     Returns:
         :class:`DistanceGuarantee`.
     """
+    acc = problem.trajectory.bounds(x).qdd_abs_max
+    return _continuous_distance(problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc)
+
+
+def _continuous_distance(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    qd: np.ndarray,
+    pairs: np.ndarray,
+    rate_hz: float,
+    max_depth: int,
+    exact: bool,
+    acc: np.ndarray,
+) -> DistanceGuarantee:
+    """:func:`continuous_distance` with the spline's exact largest |q̈| ``acc`` (nq,)
+    [rad/s² | m/s²] (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``.qdd_abs_max``
+    of ``x``) already computed by the caller, :func:`~adept_traj.analysis.certify`. Private:
+    a smaller ``acc`` would void the guarantee."""
     checker = problem.checker
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
         return checker.distances(q[None], t_m[None], exact=exact).distance[0]
 
     arms, speeds = _rates(problem)
-    acc = _acceleration_bound(problem, x, acceleration_bound)
     return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
 
 
@@ -208,8 +222,6 @@ def continuous_self_distance(
     pairs: np.ndarray,
     rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
-    *,
-    acceleration_bound: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """:func:`continuous_distance` for the robot's own solid pairs
     (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
@@ -217,8 +229,23 @@ def continuous_self_distance(
     Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
     solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
     obstacle speed). The midpoints' distances are exact below the margin, lower bounds
-    above it. The returned ``pair`` is ``(pair index, 0)``. ``acceleration_bound`` as for
-    :func:`continuous_distance`."""
+    above it. The returned ``pair`` is ``(pair index, 0)``."""
+    acc = problem.trajectory.bounds(x).qdd_abs_max
+    return _continuous_self_distance(problem, x, t, qd, pairs, rate_hz, max_depth, acc)
+
+
+def _continuous_self_distance(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    qd: np.ndarray,
+    pairs: np.ndarray,
+    rate_hz: float,
+    max_depth: int,
+    acc: np.ndarray,
+) -> DistanceGuarantee:
+    """:func:`continuous_self_distance` with the exact ``acc`` (nq,) of the caller (as
+    :func:`_continuous_distance`; private for the same reason)."""
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
@@ -227,18 +254,8 @@ def continuous_self_distance(
         return check.distances(q, exact_below=problem.settings.margin)[..., None]
 
     arms, speeds = check.lever_arms, np.zeros(1)
-    acc = _acceleration_bound(problem, x, acceleration_bound)
     pairs = pairs[..., None]
     return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
-
-
-def _acceleration_bound(
-    problem: TrajectoryProblem, x: np.ndarray, given: np.ndarray | None
-) -> np.ndarray:
-    """(nq,) the spline's exact largest |q̈| [rad/s² | m/s²]: ``given``, else computed."""
-    if given is not None:
-        return np.asarray(given, dtype=float)
-    return problem.trajectory.bounds(x).qdd_abs_max
 
 
 def _bisect(

@@ -231,12 +231,19 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
 
 
 #: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
-#: itself, not held here, so that the key can die) and its influence [m], made once: it
-#: takes ≈ 0.1 s (the broad phase's distance tables), as much as seven certificates, and
-#: the polish certifies its moves one call at a time.
-_CERTIFYING: weakref.WeakKeyDictionary[Any, tuple[TrajectoryProblem | None, float]] = (
-    weakref.WeakKeyDictionary()
-)
+#: itself, not held here, so that the key can die), its influence [m] and what it was made
+#: from (:func:`_made_from`), made once: it takes ≈ 0.1 s (the broad phase's distance
+#: tables), as much as seven certificates, and the polish certifies its moves one call at a
+#: time.
+_CERTIFYING: weakref.WeakKeyDictionary[
+    Any, tuple[TrajectoryProblem | None, float, tuple[Any, ...]]
+] = weakref.WeakKeyDictionary()
+
+
+def _made_from(problem: TrajectoryProblem) -> tuple[Any, ...]:
+    """The objects a certifying problem is made from (compared by identity: a problem whose
+    settings, robot, scene, start or goal were replaced gets a new one)."""
+    return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
 
 
 def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
@@ -245,17 +252,24 @@ def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, f
     (never raised; a pair whose broad-phase bound exceeds it needs no coal call; 100
     paper-front certificates: 0.85 s instead of 1.6 s with the default 0.05 m).
 
-    Made once per ``problem`` and kept while ``problem`` lives (the same object is returned
-    again; it evaluates in one process and, like ``problem`` itself, is not for use from
-    several threads at once). A caller about to fork certifying processes calls it first,
-    so that they share it.
+    Made once per ``problem`` and kept while ``problem`` lives and its settings, robot,
+    scene, start and goal are the same objects (the same object is returned again; made
+    anew when one of them was replaced, e.g. ``problem.settings`` with another margin; it
+    evaluates in one process and, like ``problem`` itself, is not for use from several
+    threads at once). A caller about to fork certifying processes calls it first, so that
+    they share it.
     """
     check_type(problem, TrajectoryProblem, "problem")
+    sources = _made_from(problem)
     made = _CERTIFYING.get(problem)
-    if made is None:
+    if (
+        made is None
+        or len(made[2]) != len(sources)
+        or any(a is not b for a, b in zip(made[2], sources))
+    ):
         fast, influence = _certifying_problem(problem)
-        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence)
-    fast, influence = made
+        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence, sources)
+    fast, influence, _ = made
     return (problem if fast is None else fast), influence
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from adept_traj.analysis.continuous import CONTINUOUS, continuous_self_distance
+from adept_traj.analysis.continuous import CONTINUOUS, _continuous_self_distance
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 
@@ -113,14 +113,10 @@ def self_distance(
     qd: np.ndarray,
     continuous: bool,
     max_depth: int,
-    *,
-    acceleration_bound: np.ndarray | None = None,
 ) -> SelfDistance:
     """The :class:`SelfDistance` of ``x`` (n_var,) sampled at ``t`` (n,) [s] with
     configurations ``q`` and speeds ``qd`` (n, nq), for :func:`~adept_traj.analysis.certify`
-    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on);
-    ``acceleration_bound`` (nq,) [rad/s² | m/s²]: the spline's exact largest :math:`|\\ddot q|`
-    if the caller has it (``None``: computed).
+    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on).
 
     The distances at the samples are exact where below the margin and lower bounds
     above it (:meth:`~adept_traj.collision.SelfCollision.distances` with ``exact_below``:
@@ -131,6 +127,23 @@ def self_distance(
     the check's influence distance, at most :data:`MIN_SEARCH` times (else it is reported
     as a bound, ``exact=False``), whatever ``certify``'s ``exact``.
     """
+    acc = problem.trajectory.bounds(x).qdd_abs_max
+    return _self_distance(problem, x, t, q, qd, continuous, max_depth, acc)
+
+
+def _self_distance(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    continuous: bool,
+    max_depth: int,
+    acc: np.ndarray,
+) -> SelfDistance:
+    """:func:`self_distance` with the spline's exact largest |q̈| ``acc`` (nq,)
+    [rad/s² | m/s²] computed by the caller, :func:`~adept_traj.analysis.certify` (private:
+    a smaller ``acc`` would void the continuous bound)."""
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
@@ -152,9 +165,7 @@ def self_distance(
     best, t_best, exact = float(d[k, p]), float(t[k]), bool(known[k, p])
     guarantee, bound = f"sampled at {grid_hz:g} Hz", None
     if continuous:
-        between = continuous_self_distance(
-            problem, x, t, qd, d, grid_hz, max_depth, acceleration_bound=acceleration_bound
-        )
+        between = _continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth, acc)
         guarantee, bound = between.guarantee, between.lower_bound
         if between.min_distance < best:  # (exact: below the margin) between the samples
             best, t_best, p = between.min_distance, between.t_min_distance, between.pair[0]
