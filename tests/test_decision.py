@@ -162,6 +162,15 @@ def test_combined_objective_weights_are_rescaled() -> None:
     np.testing.assert_allclose(objective_weights([2.0, 2.0, 4.0], 3), [0.25, 0.25, 0.5])
 
 
+def test_huge_weights_do_not_overflow() -> None:
+    """Weights whose sum overflows to inf are rescaled, not turned into zeros (review
+    finding: ``[1e308] * 6`` passed the check as all zeros and failed after the search)."""
+    np.testing.assert_allclose(objective_weights([1e308] * 6, 6), np.full(6, 1.0 / 6.0))
+    np.testing.assert_allclose(
+        objective_weights([1e308, 0.0, 1e308, 0.0, 0.0, 0.0], 6), [0.5, 0, 0.5, 0, 0, 0]
+    )
+
+
 def test_combined_objective_and_f_avg_by_hand() -> None:
     """On random rows (default bounds: the column extremes): f_c = Σ w_i (1 − n_i) with the
     weights summing to 1, F_avg = mean n_i; equal weights give f_c = 1 − F_avg."""

@@ -152,6 +152,9 @@ def objective_weights(weights: ArrayLike, m: int) -> np.ndarray:
     total = float(w.sum())
     if total <= 0.0:
         raise InvalidInputError(f"weights must have a positive sum; got {w.tolist()}")
+    if not np.isfinite(total):  # huge weights: their sum overflows; scale them down first
+        w = w / w.max()
+        total = float(w.sum())
     return w / total
 
 
