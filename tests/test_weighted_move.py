@@ -185,3 +185,60 @@ def test_cli_weights_turn_the_time_optimal_mode_into_the_weighted_sum(tmp_path, 
     assert weighted.algorithm_settings["weighted_sum"]["weights"] == list(ENERGY)
     assert weighted.best_objectives[0] > plain.best_objectives[0]
     assert main(["verify", str(tmp_path / "w")]) == 0
+
+
+def _resume_options(folder, saved: dict, *extra: str):
+    """The options ``plan --resume folder`` would run with, for a run file ``saved``."""
+    import argparse
+
+    from adept_traj.cli import plan as cli_plan
+    from adept_traj.cli._run_folder import write_arguments
+
+    parser = argparse.ArgumentParser()
+    cli_plan.add_parser(parser.add_subparsers())
+    write_arguments(folder, saved)
+    return cli_plan._options(parser.parse_args(["plan", "--resume", str(folder), *extra]))[0]
+
+
+def _run_file(tmp_path, *options: str) -> dict:
+    """The run file a new ``plan --out`` with ``options`` writes (without planning)."""
+    import argparse
+
+    from adept_traj.cli import plan as cli_plan
+
+    parser = argparse.ArgumentParser()
+    cli_plan.add_parser(parser.add_subparsers())
+    opts = cli_plan._options(parser.parse_args(["plan", "--out", str(tmp_path), *options]))[0]
+    return {k: getattr(opts, k) for k in cli_plan._SAVED}
+
+
+def test_an_earlier_versions_time_optimal_run_resumes_as_minimum_t(tmp_path) -> None:
+    """A time-optimal run file written before the weighted-sum mode holds the paper's
+    default weights, which that version ignored: it resumes as minimum T (review finding:
+    it resumed in the weighted-sum mode, another objective); a run file of this version
+    keeps its mode."""
+    from adept_traj.analysis import PAPER_WEIGHTS
+
+    old = {**_run_file(tmp_path, "--algorithm", "time-optimal"), "weights": list(PAPER_WEIGHTS)}
+    assert _resume_options(tmp_path, old).weights is None
+    with pytest.raises(ConfigurationError, match="--weights"):
+        _resume_options(tmp_path, old, "--weights", "1,1,1,1,1,1")
+    weighted = {
+        **_run_file(tmp_path, "--algorithm", "time-optimal", "--weights", "0,1,0,0,0,0"),
+        "time_optimal_weights": True,
+    }
+    assert _resume_options(tmp_path, weighted).weights == [0.0, 1.0, 0.0, 0.0, 0.0, 0.0]
+    nsga2 = _run_file(tmp_path)  # an NSGA-II run file of either version: the weights of f_c
+    assert _resume_options(tmp_path, nsga2).weights == list(PAPER_WEIGHTS)
+
+
+def test_a_new_run_file_marks_the_weighted_mode(tmp_path, monkeypatch) -> None:
+    """``plan`` writes the key that tells its run file from an earlier version's."""
+    from adept_traj.cli import main
+    from adept_traj.cli import plan as cli_plan
+
+    monkeypatch.setattr(cli_plan, "_run", lambda *args: 0)  # stop after the run file
+    assert main(["plan", "--algorithm", "time-optimal", "--out", str(tmp_path / "run")]) == 0
+    saved = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert saved["time_optimal_weights"] is True
+    assert saved["weights"] is None

@@ -69,6 +69,10 @@ _SAVED = (
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
+#: Written into :data:`RUN_FILE` since ``--algorithm time-optimal --weights`` is the
+#: weighted-sum mode: a time-optimal run file without it was written by an earlier version,
+#: whose time-optimal mode ignored the (saved, default) weights — it resumes as minimum T.
+_WEIGHTED_MODE_KEY = "time_optimal_weights"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -198,7 +202,11 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
             raise ConfigurationError("--resume DIR continues in DIR; do not give another --out")
         if args.overwrite:
             raise ConfigurationError("--overwrite starts a new run; it does not go with --resume")
-        options = _resumed_options(read_arguments(folder), given, folder)
+        saved = read_arguments(folder)
+        if saved.get("algorithm") == TIME_OPTIMAL and not saved.pop(_WEIGHTED_MODE_KEY, False):
+            saved["weights"] = None  # an earlier version's minimum-T run (see the key's note)
+        saved.pop(_WEIGHTED_MODE_KEY, None)
+        options = _resumed_options(saved, given, folder)
     options = {**args.plan_defaults, **options}
     opts = argparse.Namespace(**{**vars(args), **options})
     opts.ros = None if opts.ros is None else Path(opts.ros)
@@ -235,7 +243,8 @@ def run(args: argparse.Namespace) -> int:
             remove_written(folder)  # only with --overwrite: check_folder refused otherwise
             folder.mkdir(parents=True, exist_ok=True)
             saved = {k: getattr(opts, k) for k in _SAVED}
-            write_arguments(folder, {**saved, "ros": _comparable("ros", opts.ros)})
+            saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
+            write_arguments(folder, saved)
         return _run(opts, problem, folder, resume)
     finally:
         problem.close()
