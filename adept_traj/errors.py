@@ -14,6 +14,7 @@ __all__ = [
     "AdeptTrajError",
     "ConfigurationError",
     "CycleError",
+    "FigureError",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
@@ -93,6 +94,11 @@ class SceneFileNotFoundError(SceneError, FileNotFoundError):
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):
     """The local meshcat server could not be started or does not answer."""
+
+
+class FigureError(AdeptTrajError, RuntimeError):
+    """Drawing the figures failed in a forked process with an error that could not be
+    handed back as itself; the message holds that process' traceback."""
 
 
 class ResourceLimitError(InvalidInputError):

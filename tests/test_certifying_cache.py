@@ -7,8 +7,6 @@ from __future__ import annotations
 import dataclasses
 import inspect
 
-import numpy as np
-
 from adept_traj.analysis import (
     certify,
     certify_members,

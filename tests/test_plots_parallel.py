@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import adept_traj as at
-from adept_traj.errors import InvalidInputError
+from adept_traj.errors import FigureError, InvalidInputError
 from adept_traj.results import PlanningResult
 from adept_traj.viz import plots
 from adept_traj.viz.plots import all_figures
@@ -147,7 +147,7 @@ def test_an_error_that_does_not_unpickle_is_raised_as_its_text(
 
     _patch(monkeypatch, best_tradeoffs=draw)
     with pytest.raises(
-        RuntimeError, match=r"(?s)in a forked process.*_Unpicklable: unpicklable 1 2"
+        FigureError, match=r"(?s)in a forked process.*_Unpicklable: unpicklable 1 2"
     ):
         plots.start_save_all(result, tmp_path, processes=1).wait()
 

@@ -26,7 +26,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from adept_traj.errors import InvalidInputError
+from adept_traj.errors import FigureError, InvalidInputError
 from adept_traj.problem import available_cores
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.validation import as_integer, check_type
@@ -265,13 +265,13 @@ class BackgroundFigures:
 
 def _error(text: str, pickled: bytes | None) -> BaseException:
     """The forked process' error (unpickled) with its traceback ``text`` as a note; a
-    :class:`RuntimeError` holding ``text`` if it does not unpickle."""
+    :class:`~adept_traj.errors.FigureError` holding ``text`` if it does not unpickle."""
     try:
         error = pickle.loads(pickled) if pickled is not None else None
     except Exception:  # e.g. an exception class whose __init__ needs other arguments
         error = None
     if not isinstance(error, BaseException):
-        return RuntimeError(f"drawing the figures failed in a forked process:\n{text}")
+        return FigureError(f"drawing the figures failed in a forked process:\n{text}")
     error.add_note(f"raised while drawing the figures in a forked process:\n{text}")
     return error
 
