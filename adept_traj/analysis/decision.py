@@ -149,7 +149,8 @@ def objective_weights(weights: ArrayLike, m: int) -> np.ndarray:
         )
     if (w < 0).any():
         raise InvalidInputError(f"weights must be non-negative; got {w.tolist()}")
-    total = float(w.sum())
+    with np.errstate(over="ignore"):  # huge weights: handled below
+        total = float(w.sum())
     if total <= 0.0:
         raise InvalidInputError(f"weights must have a positive sum; got {w.tolist()}")
     if not np.isfinite(total):  # huge weights: their sum overflows; scale them down first
