@@ -100,11 +100,17 @@ def save_figures(
 
         paths = plots.save_all(results, folder, replays=replays)
     except ImportError as exc:
-        if (exc.name or "").split(".")[0] != "matplotlib":
-            raise  # a broken install of adept_traj itself is an error, not a missing extra
-        print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
+        _note_missing_matplotlib(exc)
         return
     print(f"{len(paths)} figures in {folder}")
+
+
+def _note_missing_matplotlib(exc: ImportError) -> None:
+    """A note on standard error for a missing matplotlib (the ``plot`` extra); any other
+    :class:`ImportError` (a broken install of adept_traj itself) is raised again."""
+    if (exc.name or "").split(".")[0] != "matplotlib":
+        raise exc
+    print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
 
 
 def start_figures(
@@ -134,8 +140,6 @@ def finish_figures(drawing: Any, folder: Path) -> None:
     try:
         paths = drawing.wait()
     except ImportError as exc:
-        if (exc.name or "").split(".")[0] != "matplotlib":
-            raise
-        print(f"note: figures skipped ({exc}); install the 'plot' extra", file=sys.stderr)
+        _note_missing_matplotlib(exc)
         return
     print(f"{len(paths)} figures in {folder}")
