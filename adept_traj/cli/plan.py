@@ -203,9 +203,9 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
         if args.overwrite:
             raise ConfigurationError("--overwrite starts a new run; it does not go with --resume")
         saved = read_arguments(folder)
-        if saved.get("algorithm") == TIME_OPTIMAL and not saved.pop(_WEIGHTED_MODE_KEY, False):
+        marked = saved.pop(_WEIGHTED_MODE_KEY, False)
+        if saved.get("algorithm") == TIME_OPTIMAL and not marked:
             saved["weights"] = None  # an earlier version's minimum-T run (see the key's note)
-        saved.pop(_WEIGHTED_MODE_KEY, None)
         options = _resumed_options(saved, given, folder)
     options = {**args.plan_defaults, **options}
     opts = argparse.Namespace(**{**vars(args), **options})
