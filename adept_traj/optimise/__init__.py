@@ -77,6 +77,7 @@ from adept_traj.optimise.sampling import (
 )
 from adept_traj.optimise.survival import (
     RankAndCrowdingSurvival,
+    crowding_distance,
 )
 from adept_traj.optimise.tournament import (
     binary_tournament,
@@ -125,6 +126,7 @@ __all__ = [
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
+    "crowding_distance",
     "epsilon_step",
     "has_checkpoint",
     "kinematic_time",

@@ -12,9 +12,16 @@ pymoo's :class:`~pymoo.core.duplicate.DefaultDuplicateElimination` (what
 with :math:`\varepsilon = 10^{-16}` and NaN distances never equal. It builds the whole
 (N, N) distance matrix and the indices of its upper triangle: about 17.5 B per pair,
 ≈ 440 MB at N = 5 000. :class:`BlockedDuplicateElimination` takes the same decisions
-(the same individuals removed, in the same order — each distance is the same scipy
-``cdist`` value of the same pair) from blocks of rows whose distance matrix holds at most
-:data:`BLOCK_PAIRS` pairs (≈ 16 MB for the matrix and ≈ 4 MB of masks), whatever N.
+(the same individuals removed, in the same order) without a distance matrix. A pair
+within ε differs by at most ε in every variable, so its row sums differ by at most
+:math:`n_{var}\,\varepsilon` plus the sums' rounding: the rows of Y sorted by their sum,
+a binary search gives each row of X the few candidates whose sums are that close (for
+a random population none but its copies). A candidate pair equal in every variable is
+at distance 0; one differing by more than ε in a variable is farther than ε; only a
+pair in between (a few ulps apart) has its distance computed, by the same scipy
+``cdist`` as pymoo (imported then only: ``scipy.spatial`` takes ≈ 0.2 s to import).
+Candidate pairs are compared in blocks of at most :data:`BLOCK_PAIRS` / n_var pairs
+(≈ 16 MB of differences), whatever N — also when many rows share a sum.
 """
 
 from __future__ import annotations
@@ -23,7 +30,6 @@ from typing import Any
 
 import numpy as np
 from pymoo.core.duplicate import DefaultDuplicateElimination, default_attr
-from scipy.spatial.distance import cdist
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.population import population_values
@@ -31,13 +37,14 @@ from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["BLOCK_PAIRS", "BlockedDuplicateElimination"]
 
-#: Largest number of (row, column) pairs whose distances are held at once: 2²¹ pairs,
-#: 16 MiB of float64 distances.
+#: Largest number of variable differences held at once (2²¹: 16 MiB of float64), i.e.
+#: BLOCK_PAIRS / n_var candidate pairs.
 BLOCK_PAIRS = 2**21
 
 
 class BlockedDuplicateElimination(DefaultDuplicateElimination):
-    """pymoo's default duplicate elimination with the distances computed in row blocks.
+    """pymoo's default duplicate elimination without its distance matrix (see the module
+    docstring).
 
     Parameters
     ----------
@@ -46,8 +53,8 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
         [rad] for control points, [s] for the travel time) at which two individuals are
         the same; pymoo's default 1e-16.
     block_pairs:
-        Largest number of distances held at once (default :data:`BLOCK_PAIRS`); any
-        value ≥ 1 gives the same decisions.
+        Largest number of variable differences held at once (default
+        :data:`BLOCK_PAIRS`); any value ≥ 1 gives the same decisions.
     """
 
     def __init__(self, epsilon: float = 1e-16, block_pairs: int = BLOCK_PAIRS, **kwargs: Any):
@@ -65,22 +72,66 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
         """(n,) bool: which rows of the decision vectors ``X`` (n, n_var) duplicate an earlier
         row of ``X`` (``Y`` None) or any row of ``Y`` (m, n_var) — the decisions of
         :meth:`_do` on arrays (the module's definition, ε = ``epsilon``)."""
-        n, own = len(X), Y is None
-        Y = X if Y is None else Y
-        marked = np.zeros(n, dtype=bool)
-        rows = max(1, self.block_pairs // max(1, len(Y)))
-        for start in range(0, n, rows):
-            stop = min(n, start + rows)
+        X = np.asarray(X, dtype=float)
+        own = Y is None
+        Y = X if own else np.asarray(Y, dtype=float)
+        marked = np.zeros(len(X), dtype=bool)
+        if len(X) == 0 or len(Y) == 0:
+            return marked
+        lo, hi, order = self._windows(X, Y)
+        counts = np.maximum(hi - lo, 0)
+        budget = max(1, self.block_pairs // max(1, X.shape[1]))  # pairs compared at once
+        ends = np.cumsum(counts)  # (n,) the last pair of each row, + 1
+        start = 0
+        while start < len(X):
+            # Rows [start, stop): their candidate pairs fit the budget (at least one row).
+            before = ends[start] - counts[start]
+            stop = max(start + 1, int(np.searchsorted(ends, before + budget, side="right")))
+            rows = np.arange(start, stop)
+            i = np.repeat(rows, counts[rows])
+            offset = np.repeat(lo[rows] - (ends[rows] - counts[rows] - before), counts[rows])
+            j = order[np.arange(len(i)) + offset]
             if own:
-                # Only the columns j < i count: those of rows [start, stop) end before stop.
-                D = cdist(X[start:stop], X[:stop])
-                j = np.arange(stop)
-                D[j[None, :] >= np.arange(start, stop)[:, None]] = np.inf
-            else:
-                D = cdist(X[start:stop], Y)
-            D[np.isnan(D)] = np.inf
-            marked[start:stop] = np.less_equal(D, self.epsilon).any(axis=1)
+                i, j = i[j < i], j[j < i]
+            self._mark(X, Y, i, j, marked)
+            start = stop
         return marked
+
+    def _reach(self) -> float:
+        """Largest difference [decision units] in one variable of a pair within
+        ``epsilon``, with margin: their distance is at least that difference (squares and
+        sums of non-negative terms only grow under rounding; 1e-150 where a square could
+        underflow to 0)."""
+        return max(self.epsilon * (1.0 + 1e-9), 1e-150)
+
+    def _windows(self, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """For each row of ``X``, the range ``[lo, hi)`` of the rows of ``Y`` sorted by their
+        sum (``order``) that can be within ``epsilon`` of it: every pair whose variables all
+        differ by at most :meth:`_reach` has row sums within ``width`` (those differences
+        plus both sums' rounding, at most n_var·2⁻⁵² times the sum of magnitudes each)."""
+        n_var, reach = X.shape[1], self._reach()
+        sx, sy = X.sum(axis=1), Y.sum(axis=1)
+        scale = np.abs(X).sum(axis=1) + n_var * reach + 1.0
+        width = 2.0 * n_var * reach + 8.0 * n_var * 2.0**-52 * scale
+        order = np.argsort(sy, kind="stable")
+        sorted_sums = sy[order]
+        lo = np.searchsorted(sorted_sums, sx - width, side="left")
+        hi = np.searchsorted(sorted_sums, sx + width, side="right")
+        return lo, hi, order
+
+    def _mark(self, X: np.ndarray, Y: np.ndarray, i: np.ndarray, j: np.ndarray, marked) -> None:
+        """Mark the rows ``i`` of ``X`` within ``epsilon`` of the rows ``j`` of ``Y``."""
+        gap = np.abs(X[i] - Y[j]).max(axis=1, initial=0.0)  # NaN: never within
+        # A pair differing by more than the reach in a variable is farther apart than
+        # epsilon; a pair equal in every variable is at distance 0. Only pairs in between
+        # (a few ulps apart) need the distance itself, as pymoo's cdist computes it.
+        near = gap <= self._reach()
+        marked[i[near & (gap == 0.0)]] = True
+        for a, b in zip(i[near & (gap > 0.0)], j[near & (gap > 0.0)], strict=True):
+            from scipy.spatial.distance import cdist  # rarely needed; heavy to import
+
+            if cdist(X[a : a + 1], Y[b : b + 1])[0, 0] <= self.epsilon:
+                marked[a] = True
 
     def _values(self, pop: Any) -> np.ndarray:
         """The decision vectors (n, n_var) of ``pop`` that ``func`` returns; pymoo's default

@@ -22,6 +22,21 @@ its randomised argsort), with their objectives read once per member and ``rank``
 ``crowding`` written into each member's ``data`` directly. Same survivors in the same
 order, same ``rank`` and ``crowding`` data, same draws from the random generator
 (``tests/test_survival.py`` compares both on mixed populations).
+
+The crowding distance of a front F (n, m), n > 2, is pymoo's ``calc_crowding_distance``
+(:func:`crowding_distance`, the same operations in the same order, hence the same bits):
+per objective k, with the members sorted by :math:`F_{\cdot k}` (stable) and
+:math:`F^{(0)}_k = -\infty`, :math:`F^{(n+1)}_k = +\infty` around them,
+
+.. math::
+    d_i = \frac{1}{m} \sum_k \frac{F^{(i+1)}_k - F^{(i-1)}_k}
+          {\max F_{\cdot k} - \min F_{\cdot k}}
+
+(a term 0 where all values of objective k are equal; :math:`+\infty` at the ends), and
+:math:`+\infty` for every member of a front of at most two. It is here rather than taken
+from pymoo's ``rank_and_crowding.metrics`` because that module imports ``scipy.spatial``
+(≈ 0.2 s at the start of every run) for other crowding measures; another
+``crowding_func`` than ``"cd"`` is still pymoo's.
 """
 
 from __future__ import annotations
@@ -30,19 +45,63 @@ from typing import Any
 
 import numpy as np
 from pymoo.core.population import Population
-from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
+from pymoo.core.survival import Survival
 from pymoo.util import default_random_state
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from pymoo.util.randomized_argsort import randomized_argsort
 
 from adept_traj.optimise.population import population_values
 
-__all__ = ["RankAndCrowdingSurvival"]
+__all__ = ["RankAndCrowdingSurvival", "crowding_distance"]
 
 
-class RankAndCrowdingSurvival(RankAndCrowding):
+def crowding_distance(F: np.ndarray) -> np.ndarray:
+    """(n,) crowding distances of the objective vectors ``F`` (n, m) of one front, as
+    pymoo's ``"cd"`` crowding function returns them (see the module docstring; +inf for
+    n ≤ 2)."""
+    F = np.array(F, dtype=np.double)
+    n_points, n_obj = F.shape
+    if n_points <= 2:
+        return np.full(n_points, np.inf)
+    order = np.argsort(F, axis=0, kind="mergesort")
+    F = F[order, np.arange(n_obj)]
+    dist = np.vstack([F, np.full(n_obj, np.inf)]) - np.vstack([np.full(n_obj, -np.inf), F])
+    norm = np.max(F, axis=0) - np.min(F, axis=0)
+    norm[norm == 0] = np.nan
+    to_last, to_next = dist[:-1] / norm, dist[1:] / norm
+    to_last[np.isnan(to_last)] = 0.0
+    to_next[np.isnan(to_next)] = 0.0
+    back = np.argsort(order, axis=0)
+    columns = np.arange(n_obj)
+    return np.sum(to_last[back, columns] + to_next[back, columns], axis=1) / n_obj
+
+
+class _CrowdingDistance:
+    """pymoo's ``"cd"`` crowding function object (``do(F, n_remove)``) by
+    :func:`crowding_distance`."""
+
+    def do(self, F: np.ndarray, n_remove: int = 0) -> np.ndarray:
+        return crowding_distance(F)
+
+
+class RankAndCrowdingSurvival(Survival):
     """pymoo's rank-and-crowding survival (NSGA-II's, MODE's here) with the feasibility
     split on arrays (see the module docstring). Parameters as pymoo's
-    :class:`~pymoo.operators.survival.rank_and_crowding.RankAndCrowding`."""
+    :class:`~pymoo.operators.survival.rank_and_crowding.RankAndCrowding`: ``nds`` the
+    non-dominated sorting (default pymoo's), ``crowding_func`` ``"cd"`` (the crowding
+    distance, :func:`crowding_distance`) or any of pymoo's."""
+
+    def __init__(self, nds: Any = None, crowding_func: Any = "cd") -> None:
+        super().__init__(filter_infeasible=True)
+        self.nds = nds if nds is not None else NonDominatedSorting()
+        if isinstance(crowding_func, str) and crowding_func == "cd":
+            self.crowding_func: Any = _CrowdingDistance()
+        else:  # pymoo's other measures (their module imports scipy.spatial)
+            from pymoo.operators.survival.rank_and_crowding.metrics import (
+                get_crowding_function,
+            )
+
+            self.crowding_func = get_crowding_function(crowding_func)
 
     @default_random_state
     def do(

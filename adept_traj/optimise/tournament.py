@@ -19,7 +19,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from pymoo.algorithms.moo.nsga2 import binary_tournament as pymoo_binary_tournament
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.population import population_values
@@ -50,8 +49,11 @@ def binary_tournament(pop: Any, P: np.ndarray, algorithm: Any, **kwargs: Any) ->
     crowding = [d.get("crowding") for d in data]
     feasible_members = np.union1d(a[~infeasible], b[~infeasible])
     if any(crowding[i] is None or rank[i] is None for i in feasible_members):
-        # A feasible member without survival data: pymoo's loop (and its errors).
-        return pymoo_binary_tournament(pop, P, algorithm, **kwargs)
+        # A feasible member without survival data: pymoo's loop (and its errors). Its
+        # module imports scipy.spatial: only here.
+        from pymoo.algorithms.moo.nsga2 import binary_tournament as pymoo_tournament
+
+        return pymoo_tournament(pop, P, algorithm, **kwargs)
     rank_arr = np.array([np.nan if r is None else r for r in rank], dtype=float)
     crowd_arr = np.array([np.nan if c is None else c for c in crowding], dtype=float)
 
