@@ -62,6 +62,7 @@ from adept_traj.optimise.polish_step import (
     time_optimal_run,
 )
 from adept_traj.optimise.population import (
+    ArrayEvaluator,
     cache_violations,
     optimum,
     population_values,
@@ -110,6 +111,7 @@ __all__ = [
     "TIME_OPTIMAL",
     "WEIGHTED_BOX",
     "AlgorithmSettings",
+    "ArrayEvaluator",
     "ArrayMating",
     "ArrayVariant",
     "BlockedDuplicateElimination",

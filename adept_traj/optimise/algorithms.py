@@ -49,7 +49,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.mating import ArrayMating
-from adept_traj.optimise.population import optimum, population_values
+from adept_traj.optimise.population import ArrayEvaluator, optimum, population_values
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
@@ -206,8 +206,9 @@ class _PaperMODE(GeneticAlgorithm):
 
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
     # pymoo's eliminate_duplicates=True (the default of every algorithm here), its
-    # decisions taken in blocks: no (pop, pop) distance matrix.
-    dup = {"eliminate_duplicates": BlockedDuplicateElimination()}
+    # decisions taken without a (pop, pop) distance matrix; pymoo's evaluator, its
+    # bookkeeping on arrays.
+    dup = {"eliminate_duplicates": BlockedDuplicateElimination(), "evaluator": ArrayEvaluator()}
 
     if key == "nsga2":
         from pymoo.operators.crossover.sbx import SBX

@@ -37,7 +37,11 @@ from adept_traj.optimise.checkpoint import (
     restore_algorithm,
     write_checkpoint,
 )
-from adept_traj.optimise.population import cache_violations, population_values
+from adept_traj.optimise.population import (
+    ArrayEvaluator,
+    cache_violations,
+    population_values,
+)
 from adept_traj.validation import as_scalar
 
 __all__ = ["CHECKPOINT_INTERVAL", "GenerationInfo", "RunState", "optimise"]
@@ -174,7 +178,8 @@ def optimise(
                 t0 = time.perf_counter()
                 algorithm.evaluator.eval(problem, infills, algorithm=algorithm)
                 evaluation_s += time.perf_counter() - t0
-                cache_violations(infills)  # what the survival reads, at once
+                if not isinstance(algorithm.evaluator, ArrayEvaluator):  # (it sets them)
+                    cache_violations(infills)  # what the survival reads, at once
             algorithm.tell(infills=infills)
             pop = algorithm.pop
             feasible = population_values(pop, "CV")[:, 0] <= 0.0

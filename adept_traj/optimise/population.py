@@ -18,6 +18,13 @@ same operations (hence the same bits) for pymoo's default configuration:
 
 :func:`optimum` is pymoo's ``filter_optimum(pop, least_infeasible=True)`` (what every
 algorithm stores as ``opt`` after each generation) on these arrays.
+
+:class:`ArrayEvaluator` is pymoo's ``Evaluator`` (what the algorithms of
+:func:`~adept_traj.optimise.make_algorithm` evaluate with) writing the evaluated rows
+into the members itself — pymoo's ``Population.set`` checks every value and calls
+``Individual.set`` (``hasattr``, then ``setattr``) for every member and key — and setting
+the members' CV as :func:`cache_violations` does, in the same pass: the same values in the
+same members (each its own copy of its row), ≈ 2× less time.
 """
 
 from __future__ import annotations
@@ -25,11 +32,12 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pymoo.core.evaluator import Evaluator
 from pymoo.core.individual import Individual, default_config
 from pymoo.core.population import Population
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-__all__ = ["cache_violations", "optimum", "population_values"]
+__all__ = ["ArrayEvaluator", "cache_violations", "optimum", "population_values"]
 
 
 def population_values(pop: Population, key: str) -> np.ndarray:
@@ -45,22 +53,58 @@ def cache_violations(pop: Population) -> None:
     inequality constraints G of one common length): the same numbers, bit for bit, as the
     member's lazy ``CV`` property, computed for all of them at once. Other members are left
     to pymoo. The members' ``G`` must not change afterwards (pymoo caches CV likewise)."""
+    _set_violations(list(pop), [ind.G for ind in pop])
+
+
+def _set_violations(members: list[Individual], G_rows: list[Any]) -> None:
+    """:func:`cache_violations` of ``members`` whose inequality constraints are ``G_rows``."""
     default = default_config()
-    members = [
-        ind
-        for ind in pop
+    chosen = [
+        (ind, g)
+        for ind, g in zip(members, G_rows, strict=True)
         if ind.config == default
         and (ind.H is None or len(ind.H) == 0)
-        and isinstance(ind.G, np.ndarray)
-        and ind.G.ndim == 1
+        and isinstance(g, np.ndarray)
+        and g.ndim == 1
     ]
-    if not members or len({len(ind.G) for ind in members}) != 1 or len(members[0].G) == 0:
+    if not chosen or len({len(g) for _, g in chosen}) != 1 or len(chosen[0][1]) == 0:
         return
-    G = np.array([ind.G for ind in members], dtype=float)  # (n, n_constr)
+    G = np.array([g for _, g in chosen], dtype=float)  # (n, n_constr)
     # pymoo: sum(max(0, G - eps)) with eps = 0, plus the equality part, 0.0 without H.
     cv = np.sum(np.maximum(0.0, G - 0.0), axis=1) + 0.0
-    for ind, value in zip(members, cv, strict=True):
+    for (ind, _), value in zip(chosen, cv, strict=True):
         ind.CV = np.array([value])
+
+
+class ArrayEvaluator(Evaluator):
+    """pymoo's :class:`~pymoo.core.evaluator.Evaluator` that writes the evaluated values
+    into the members at once and sets their CV (see the module docstring). Parameters as
+    pymoo's."""
+
+    def _eval(self, problem: Any, pop: Population, evaluate_values_of: list, **kwargs: Any):
+        out = problem.evaluate(
+            population_values(pop, "X"),
+            return_values_of=evaluate_values_of,
+            return_as_dictionary=True,
+            **kwargs,
+        )
+        members = list(pop)
+        for key, values in out.items():
+            if values is None:
+                continue
+            if not isinstance(values, np.ndarray) or values.ndim == 0 or len(values) != len(pop):
+                pop.set(key, values)  # pymoo's own handling (and errors)
+                continue
+            # pymoo's Population.set: a view of a row is copied (no array kept alive by it)
+            rows = [row.copy() for row in values] if values.ndim > 1 else list(values)
+            for ind, row in zip(members, rows, strict=True):
+                if hasattr(ind, key):
+                    setattr(ind, key, row)
+                else:
+                    ind.data[key] = row
+        for ind in members:
+            ind.evaluated.update(out.keys())
+        _set_violations(members, [ind.G for ind in members])
 
 
 def optimum(pop: Population | None) -> Population | None:
