@@ -12,6 +12,8 @@ from adept_traj.optimise.algorithms import (
 )
 from adept_traj.optimise.checkpoint import (
     CHECKPOINT_VERSION,
+    CapturedCheckpoint,
+    capture_checkpoint,
     checkpoint_arrays,
     has_checkpoint,
     load_checkpoint,
@@ -115,6 +117,7 @@ __all__ = [
     "ArrayMating",
     "ArrayVariant",
     "BlockedDuplicateElimination",
+    "CapturedCheckpoint",
     "FastEndSearch",
     "GenerationInfo",
     "KinematicTimeRepair",
@@ -125,6 +128,7 @@ __all__ = [
     "RunState",
     "binary_tournament",
     "cache_violations",
+    "capture_checkpoint",
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",

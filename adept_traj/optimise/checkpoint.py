@@ -50,6 +50,8 @@ from adept_traj.optimise.population import population_values
 
 __all__ = [
     "CHECKPOINT_VERSION",
+    "CapturedCheckpoint",
+    "capture_checkpoint",
     "checkpoint_arrays",
     "has_checkpoint",
     "load_checkpoint",
@@ -70,16 +72,20 @@ _LOOP_KEYS = {"fingerprint", "total_s", "evaluation_s", "history"}
 _EVALUATED = ("F", "G", "H")
 
 
-def _population_arrays(pop: Population, n_iter: int) -> dict[str, np.ndarray]:
+def _population_arrays(
+    pop: Population, n_iter: int, data: list[dict[str, Any]] | None = None
+) -> dict[str, np.ndarray]:
     """Numeric per-individual attributes of ``pop`` as arrays (for the checkpoint), with the
-    generation counter so that the two checkpoint files can be checked against each other.
+    generation counter so that the two checkpoint files can be checked against each other;
+    ``data`` the members' ``data`` dicts (default: as they are now).
 
     An attribute that only some members have (NSGA-II ranks only the feasible ones) is
     stored with the mask ``absent.<key>`` (pop,) of the members without it."""
+    data = [ind.data for ind in pop] if data is None else data
     out = {key: population_values(pop, key) for key in ("X", "F", "G", "CV")}
     out["n_iter"] = np.array(n_iter)
-    for key in sorted({key for ind in pop for key in ind.data}):
-        values = [ind.data.get(key) for ind in pop]
+    for key in sorted({key for d in data for key in d}):
+        values = [d.get(key) for d in data]
         have = np.array([v is not None for v in values])
         present = np.array([v for v in values if v is not None])
         if present.dtype == object:
@@ -104,12 +110,6 @@ def _restore_population(arrays: dict[str, np.ndarray]) -> Population:
     for ind in pop:
         ind.evaluated.update(_EVALUATED)
     return pop
-
-
-def _json_state(rng: np.random.Generator) -> dict[str, Any]:
-    """The generator's state as JSON-ready values (its 128-bit integers as Python ints)."""
-    state = rng.bit_generator.state
-    return json.loads(json.dumps(state, default=int))
 
 
 def has_checkpoint(folder: Path) -> bool:
@@ -148,18 +148,49 @@ def checkpoint_arrays(
     """The content of the checkpoint of ``algorithm`` as it is now (after a finished
     generation), for :func:`write_checkpoint`: new arrays and the metadata as JSON text, so
     that later generations change nothing in it (parameters as :func:`save_checkpoint`)."""
-    arrays = _population_arrays(algorithm.pop, int(algorithm.n_iter))
-    arrays.update({f"loop.{key}": np.asarray(value) for key, value in (extra or {}).items()})
-    state = {
-        "format": _FORMAT,
-        "version": CHECKPOINT_VERSION,
-        "n_iter": int(algorithm.n_iter),
-        "n_eval": int(algorithm.evaluator.n_eval),
-        "rng": _json_state(algorithm.random_state),
-        **meta,
-    }
-    arrays["meta"] = np.array(json.dumps(state))
-    return arrays
+    return capture_checkpoint(algorithm).arrays(meta, extra)
+
+
+class CapturedCheckpoint:
+    """What the checkpoint of an algorithm after a finished generation is made of, taken
+    without building its arrays (see :func:`capture_checkpoint`)."""
+
+    def __init__(self, algorithm: Any) -> None:
+        # The members' X, F, G and CV never change once evaluated; their data dicts (rank,
+        # crowding) are rewritten by later survivals, so they are copied.
+        self._members = list(algorithm.pop)
+        self._data = [dict(ind.data) for ind in self._members]
+        self._n_iter = int(algorithm.n_iter)
+        self._n_eval = int(algorithm.evaluator.n_eval)
+        self._rng = algorithm.random_state.bit_generator.state
+
+    def arrays(
+        self, meta: dict[str, Any], extra: dict[str, np.ndarray] | None = None
+    ) -> dict[str, np.ndarray]:
+        """The checkpoint's arrays, as :func:`checkpoint_arrays` made them when this was
+        captured (``meta`` and ``extra`` as there)."""
+        pop = Population(self._members) if self._members else Population()
+        arrays = _population_arrays(pop, self._n_iter, self._data)
+        arrays.update({f"loop.{key}": np.asarray(value) for key, value in (extra or {}).items()})
+        state = {
+            "format": _FORMAT,
+            "version": CHECKPOINT_VERSION,
+            "n_iter": self._n_iter,
+            "n_eval": self._n_eval,
+            "rng": json.loads(json.dumps(self._rng, default=int)),
+            **meta,
+        }
+        arrays["meta"] = np.array(json.dumps(state))
+        return arrays
+
+
+def capture_checkpoint(algorithm: Any) -> CapturedCheckpoint:
+    """The checkpoint of ``algorithm`` as it is now (after a finished generation), its
+    arrays made only when asked for (:meth:`CapturedCheckpoint.arrays`, e.g. when it is
+    written): the members, a copy of their ``data``, the counters and the generator's
+    state. Making the arrays every generation cost 0.5 ms (NSGA-II) to 1.6 ms (MODE) of the
+    main process; the loop writes about one generation in ten."""
+    return CapturedCheckpoint(algorithm)
 
 
 def write_checkpoint(folder: Path, arrays: dict[str, np.ndarray]) -> None:

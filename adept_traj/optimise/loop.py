@@ -32,7 +32,8 @@ import numpy as np
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.errors import ConfigurationError, PlanningInterrupted
 from adept_traj.optimise.checkpoint import (
-    checkpoint_arrays,
+    CapturedCheckpoint,
+    capture_checkpoint,
     load_checkpoint,
     restore_algorithm,
     write_checkpoint,
@@ -167,9 +168,9 @@ def optimise(
         fronts = _restored_fronts(arrays, len(history))
     start = time.perf_counter() - spent_total
     evaluation_s = spent_eval
-    # The checkpoint of the last finished generation not yet on disk, and when one was
-    # last written.
-    unwritten: dict[str, np.ndarray] | None = None
+    # The checkpoint of the last finished generation not yet on disk (captured, with its
+    # loop metadata and number of fronts), and when one was last written.
+    unwritten: tuple[CapturedCheckpoint, dict[str, Any], int] | None = None
     written_at = time.perf_counter()
     try:
         while algorithm.has_next():
@@ -208,17 +209,17 @@ def optimise(
                     "fingerprint": fingerprint,
                     "total_s": time.perf_counter() - start,
                     "evaluation_s": evaluation_s,
-                    "history": history,
+                    "history": list(history),
                 }
-                unwritten = checkpoint_arrays(algorithm, meta, _stored_fronts(fronts))
+                unwritten = (capture_checkpoint(algorithm), meta, len(fronts))
                 if time.perf_counter() - written_at >= interval or not algorithm.has_next():
-                    write_checkpoint(folder, unwritten)
+                    _write(folder, unwritten, fronts)
                     unwritten, written_at = None, time.perf_counter()
             if progress is not None:
                 progress(info)
     except KeyboardInterrupt:
         if folder is not None and unwritten is not None:
-            write_checkpoint(folder, unwritten)  # the last finished generation
+            _write(folder, unwritten, fronts)  # the last finished generation
         if folder is None:
             where, saved = " (no checkpoint folder)", None
         elif not history:
@@ -241,6 +242,17 @@ def optimise(
         history=history,
         fronts=fronts,
     )
+
+
+def _write(
+    folder: Path,
+    unwritten: tuple[CapturedCheckpoint, dict[str, Any], int],
+    fronts: list[np.ndarray],
+) -> None:
+    """Write a captured checkpoint with its loop metadata and its generations' fronts (the
+    first ``unwritten[2]`` of ``fronts``)."""
+    captured, meta, n_fronts = unwritten
+    write_checkpoint(folder, captured.arrays(meta, _stored_fronts(fronts[:n_fronts])))
 
 
 def _stored_fronts(fronts: list[np.ndarray]) -> dict[str, np.ndarray]:
