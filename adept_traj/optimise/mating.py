@@ -143,11 +143,12 @@ class ArrayMating(Mating):
         crossed = rng.random(n_matings) < get(cross.prob, size=n_matings)
         if np.any(crossed):
             Xp[:, crossed] = cross._do(problem, X, random_state=rng, **kwargs)[:, crossed]
+        if n_off == n_parents:  # the children of an uncrossed mating: copies of its parents
+            Xp[:, ~crossed] = X[:, ~crossed]
+            return Xp.reshape(-1, X.shape[-1])
         for k in np.flatnonzero(~crossed):
             if n_off < n_parents:
                 s = rng.choice(np.arange(n_parents), size=n_off, replace=False)
-            elif n_off == n_parents:
-                s = np.arange(n_parents)
             else:
                 s = []
                 while len(s) < n_off:
