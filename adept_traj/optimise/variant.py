@@ -71,7 +71,10 @@ class ArrayVariant(Variant):
         """The trial vectors (n_offsprings, n_var): pymoo's ``Variant.do`` up to its
         ``Population.new`` (pymoo's code; X read once per member)."""
         sel, n_diffs = get(self.selection, self.n_diffs, size=n_offsprings)
-        H = where_is_what(zip(sel, n_diffs, strict=True))
+        if _all_same(sel) and _all_same(n_diffs):  # where_is_what's one group, at once
+            H = {(sel[0], n_diffs[0]): list(range(n_offsprings))}
+        else:
+            H = where_is_what(zip(sel, n_diffs, strict=True))
         F, CR, jitter = get(self.F, self.CR, self.jitter, size=n_offsprings)
         X = population_values(pop, "X")
         donor = np.full((n_offsprings, problem.n_var), np.nan)
@@ -101,7 +104,9 @@ class ArrayVariant(Variant):
                 Xp = repair_random_init(Xp, XX[0], *problem.bounds(), random_state=rng)
             donor[targets] = Xp
         trial = np.full((n_offsprings, problem.n_var), np.nan)
-        for name, K in where_is_what(get(self.crossover, size=n_offsprings)).items():
+        kinds = get(self.crossover, size=n_offsprings)
+        groups = {kinds[0]: list(range(n_offsprings))} if _all_same(kinds) else where_is_what(kinds)
+        for name, K in groups.items():
             target, donors, rate = X[K], donor[K], CR[K]
             if name in ("bin", "exp"):
                 mask = mut_binomial if name == "bin" else mut_exp
@@ -118,3 +123,11 @@ class ArrayVariant(Variant):
                 raise ConfigurationError(f"unknown DE crossover {name!r}")
             trial[K] = trial_K
         return trial
+
+
+def _all_same(values: Any) -> bool:
+    """Whether the (n,) array ``values`` (n ≥ 1) holds one value n times: pymoo's
+    ``where_is_what`` (a Python loop over the n values) then makes one group of every
+    index, in order."""
+    values = np.asarray(values)
+    return values.ndim == 1 and len(values) > 0 and bool((values == values[0]).all())
