@@ -6,6 +6,7 @@ imports urllib, http, email and ssl); the pieces that replaced them give the sam
 from __future__ import annotations
 
 import ast
+import os
 import subprocess
 import sys
 from xml.sax.saxutils import quoteattr
@@ -78,3 +79,44 @@ def test_names_are_quoted_as_the_standard_library_quotes_them(name: str) -> None
     from adept_traj.robot.urdf_builder import _quoteattr
 
     assert _quoteattr(name) == quoteattr(name)
+
+
+_BLAS_THREADS = """
+import sys
+from types import SimpleNamespace
+import numpy as np
+from threadpoolctl import threadpool_info
+from adept_traj.optimise import member_polish, polish
+
+assert "scipy" not in sys.modules  # as in a run: scipy is first imported by the polish
+seen = []
+
+def record(*args, **kwargs):
+    seen.append(sorted({{(i["filepath"], i["num_threads"]) for i in threadpool_info()
+                         if i["user_api"] == "blas"}}))
+
+problem = SimpleNamespace(n_var=3, xl=np.zeros(3), xu=np.ones(3))  # what is checked first
+x0 = np.full(3, 0.5)
+polish._minimum_time = record
+polish.minimum_time(problem, x0)
+member_polish._solve = record
+member_polish._threads_limited(problem, x0)
+print(seen)
+"""
+
+
+def test_the_polish_limits_scipys_blas_too_when_scipy_is_imported_late() -> None:
+    # scipy (and its own OpenBLAS) is no longer imported when the run starts: the polish
+    # imports it inside its one-BLAS-thread section, whose limit covers only the BLAS
+    # libraries loaded before it (a multi-threaded BLAS changed the polished move's bits).
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
+    out = subprocess.run(
+        [sys.executable, "-c", _BLAS_THREADS.format()],
+        capture_output=True,
+        text=True,
+        check=True,
+        env=env,
+    )
+    for libraries in ast.literal_eval(out.stdout.strip().splitlines()[-1]):
+        assert len(libraries) >= 2  # numpy's OpenBLAS and scipy's
+        assert all(threads == 1 for _, threads in libraries), libraries

@@ -143,6 +143,7 @@ def _start(problem: Any, x0: Any) -> np.ndarray:
 
 
 def _threads_limited(problem: Any, x0: np.ndarray, *args: Any, **options: Any) -> PolishOutcome:
+    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
     from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
 
     with threadpool_limits(limits=1, user_api="blas"):

@@ -140,6 +140,7 @@ def minimum_time(
         raise ConfigurationError(f"tol must be > 0 [s]; got {tol}")
     if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
         raise ConfigurationError("x0 must lie inside the decision bounds (problem.xl, problem.xu)")
+    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
     from threadpoolctl import threadpool_limits  # lazy, as scipy.optimize
 
     # One BLAS thread: a multi-threaded BLAS sums in an order that depends on its thread
