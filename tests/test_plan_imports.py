@@ -97,26 +97,29 @@ def record(*args, **kwargs):
 
 problem = SimpleNamespace(n_var=3, xl=np.zeros(3), xu=np.ones(3))  # what is checked first
 x0 = np.full(3, 0.5)
-polish._minimum_time = record
-polish.minimum_time(problem, x0)
-member_polish._solve = record
-member_polish._threads_limited(problem, x0)
+if {which!r} == "polish":
+    polish._minimum_time = record
+    polish.minimum_time(problem, x0)
+else:
+    member_polish._solve = record
+    member_polish._threads_limited(problem, x0)
 print(seen)
 """
 
 
-def test_the_polish_limits_scipys_blas_too_when_scipy_is_imported_late() -> None:
+@pytest.mark.parametrize("which", ["polish", pytest.param("member_polish", marks=pytest.mark.slow)])
+def test_the_polish_limits_scipys_blas_too_when_scipy_is_imported_late(which: str) -> None:
     # scipy (and its own OpenBLAS) is no longer imported when the run starts: the polish
     # imports it inside its one-BLAS-thread section, whose limit covers only the BLAS
     # libraries loaded before it (a multi-threaded BLAS changed the polished move's bits).
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
     out = subprocess.run(
-        [sys.executable, "-c", _BLAS_THREADS.format()],
+        [sys.executable, "-c", _BLAS_THREADS.format(which=which)],
         capture_output=True,
         text=True,
         check=True,
         env=env,
     )
-    for libraries in ast.literal_eval(out.stdout.strip().splitlines()[-1]):
-        assert len(libraries) >= 2  # numpy's OpenBLAS and scipy's
-        assert all(threads == 1 for _, threads in libraries), libraries
+    (libraries,) = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+    assert len(libraries) >= 2  # numpy's OpenBLAS and scipy's
+    assert all(threads == 1 for _, threads in libraries), libraries
