@@ -107,3 +107,40 @@ def test_rows_sharing_a_sum_get_pymoos_decisions(block_pairs: int) -> None:
     ours = BlockedDuplicateElimination(block_pairs=block_pairs).do(pop, return_indices=True)
     assert [list(a) for a in ours] == [list(a) for a in reference]
     assert len(reference[2]) > 0
+
+
+def test_the_nsga2_of_make_algorithm_runs_as_pymoos_nsga2() -> None:
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.operators.crossover.sbx import SBX
+    from pymoo.operators.mutation.pm import PM
+    from pymoo.operators.selection.tournament import TournamentSelection
+
+    from adept_traj.optimise import ArrayMating, RankAndCrowdingSurvival, binary_tournament
+
+    start = np.random.default_rng(2).uniform(size=(16, 5))
+    ours, _ = make_algorithm("nsga2", pop_size=16, sampling=start, repair=False, fast_end=0)
+    theirs = NSGA2(
+        pop_size=16,
+        sampling=start,
+        selection=TournamentSelection(func_comp=binary_tournament),
+        crossover=SBX(prob=0.7, eta=10.0),
+        mutation=PM(prob=1.0, prob_var=0.01, eta=100.0),
+        survival=RankAndCrowdingSurvival(),
+        eliminate_duplicates=BlockedDuplicateElimination(),
+        evaluator=ArrayEvaluator(),
+    )
+    theirs.mating = ArrayMating.of(theirs.mating)
+    runs = []
+    for algorithm in (ours, theirs):
+        problem = Toy()
+        algorithm.setup(problem, seed=11, termination=("n_gen", 8), verbose=False)
+        opts = []
+        while algorithm.has_next():
+            infills = algorithm.ask()
+            algorithm.evaluator.eval(problem, infills, algorithm=algorithm)
+            algorithm.tell(infills=infills)
+            opts.append(algorithm.opt.get("X").tobytes())
+        runs.append((algorithm.pop.get("X").tobytes(), algorithm.pop.get("F").tobytes(), opts))
+        assert algorithm.tournament_type == "comp_by_dom_and_crowding"
+    assert runs[0] == runs[1]
+    assert type(ours.termination) is type(theirs.termination)

@@ -2,7 +2,8 @@
 
 :func:`make_algorithm` returns a configured pymoo algorithm and the settings actually used.
 
-**NSGA-II** (pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2`) with the paper's settings:
+**NSGA-II** (pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2`, assembled from the same
+parts without importing its module, which imports ``scipy.spatial``) with the paper's settings:
 population 100, 100 generations, SBX crossover with probability 0.7 and η = 10, polynomial
 mutation with η = 100 and "mutation probability" 0.01. The paper follows Deb's NSGA-II code,
 where the real-parameter mutation probability is the probability of mutating **each
