@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 
 def best_of(fn: Callable[[], object], repeat: int = 3) -> float:
@@ -14,3 +16,16 @@ def best_of(fn: Callable[[], object], repeat: int = 3) -> float:
         fn()
         times.append(time.perf_counter() - t0)
     return min(times)
+
+
+def compared_codes(here: Path, baseline: Path | None) -> dict[str, Path]:
+    """The copies of the code a paired benchmark runs: ``{"this": here}``, preceded by
+    ``"baseline"`` when one is given (run first in each pair)."""
+    if baseline is None:
+        return {"this": here}
+    return {"baseline": baseline.resolve(), "this": here}
+
+
+def load_average() -> str:
+    """The machine's load averages over 1, 5 and 15 minutes, as text."""
+    return ", ".join(f"{x:.1f}" for x in os.getloadavg())

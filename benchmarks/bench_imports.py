@@ -32,6 +32,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _timing import compared_codes, load_average  # benchmarks/_timing.py
+
 HERE = Path(__file__).resolve().parent.parent
 
 #: Modules whose presence after the import is reported.
@@ -74,11 +76,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="rounds (fresh processes)")
     parser.add_argument("--baseline", type=Path, help="another copy of the code to compare")
     args = parser.parse_args()
-    codes = {"this": HERE}
-    if args.baseline is not None:
-        codes = {"baseline": args.baseline.resolve(), "this": HERE}
-    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
-    print(f"load average at start {load}; {args.repeat} rounds, medians [s]")
+    codes = compared_codes(HERE, args.baseline)
+    print(f"load average at start {load_average()}; {args.repeat} rounds, medians [s]")
     rows: dict[str, list[dict[str, float | str]]] = {label: [] for label in codes}
     for _ in range(args.repeat):
         for label, code in codes.items():  # alternated: paired runs

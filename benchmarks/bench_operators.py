@@ -35,6 +35,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _timing import compared_codes, load_average  # benchmarks/_timing.py
+
 HERE = Path(__file__).resolve().parent.parent
 
 #: Issue #15: the main process' CPU per generation (all but the evaluations) −40 % or more.
@@ -127,11 +129,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3, help="runs of each command")
     parser.add_argument("--baseline", type=Path, help="another copy of the code to compare")
     args = parser.parse_args()
-    codes = {"this": HERE}
-    if args.baseline is not None:
-        codes = {"baseline": args.baseline.resolve(), "this": HERE}
-    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
-    print(f"load average at start {load}; CPU times (process_time), medians")
+    codes = compared_codes(HERE, args.baseline)
+    print(f"load average at start {load_average()}; CPU times (process_time), medians")
     for name in args.algorithms.split(","):
         for seed in (int(s) for s in args.seeds.split(",")):
             rows = {
