@@ -230,8 +230,9 @@ def _stopped(children: list, timeout: float = 30.0) -> bool:
 
 
 def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem) -> None:
-    """close(), a with block and garbage collection each stop the workers; after close()
-    a new pool starts and still gives the serial results."""
+    """close(), a with block and garbage collection each stop the workers (workers=2: the
+    main process and one forked worker); after close() a new one starts and still gives
+    the serial results."""
     rng = np.random.default_rng(31)
     x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(20, problem.n_var))
     serial = problem.evaluate_batch(x)
@@ -239,19 +240,19 @@ def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem)
     with TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2) as parallel:
         parallel.evaluate_batch(x)
         first = _new_children(before)
-        assert len(first) == 2
+        assert len(first) == 1
         parallel.close()
         assert _stopped(first)
         again = parallel.evaluate_batch(x)  # a new pool
         np.testing.assert_array_equal(again.objectives, serial.objectives)
         second = _new_children(before)
-        assert len(second) == 2
+        assert len(second) == 1
     assert _stopped(second)  # the with block closed it
 
     collected = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2)
     collected.evaluate_batch(x)
     third = _new_children(before)
-    assert len(third) == 2
+    assert len(third) == 1
     del collected
     gc.collect()
     assert _stopped(third)  # garbage collection stopped the pool: nothing kept the problem
@@ -270,19 +271,21 @@ def _pid_rows(x: np.ndarray) -> Evaluation:
 
 def test_parallel_evaluator_hands_the_function_to_forked_workers() -> None:
     """The function reaches the workers once, when they are forked: a closure (which pickle
-    refuses) works; rows come back in order, each chunk computed in a worker process."""
+    refuses) works; rows come back in order, the last chunk computed in the main process
+    and each other chunk in its own worker process."""
     offset = 10.0
     evaluate = lambda x: _pid_rows(x + offset)  # noqa: E731 (a closure cannot be pickled)
     x = np.arange(30.0).reshape(10, 3)
-    with ParallelEvaluator(evaluate, workers=2, n_var=3) as evaluator:
+    with ParallelEvaluator(evaluate, workers=3, n_var=3) as evaluator:
         ev = evaluator.evaluate(x)
         assert evaluator.running
     assert not evaluator.running
     np.testing.assert_array_equal(ev.objectives[:, 0], x[:, 0] + offset)
     pids = ev.objectives[:, 1]
-    assert len(set(pids[:5])) == 1
-    assert len(set(pids[5:])) == 1
-    assert os.getpid() not in pids  # computed in the workers
+    chunks = [pids[:4], pids[4:7], pids[7:]]  # np.array_split(10 rows, 3)
+    assert [len(set(c)) for c in chunks] == [1, 1, 1]
+    assert len({c[0] for c in chunks}) == 3
+    assert chunks[2][0] == os.getpid()  # the main process evaluates the last chunk
     assert ev.n_narrow == 10
     with pytest.raises(ConfigurationError, match="closed"):
         evaluator.evaluate(x)
