@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
-from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.distance_table import DistanceTable, table_bounds
 from adept_traj.collision.point_distance import (
     obstacle_signed_distance,
     point_signed_distance,
@@ -349,8 +349,8 @@ class BroadPhase:
             exact[static] = True
             done = static.copy()
             if q is not None:
-                for (k, o), table in self.tables.items():
-                    lower[o, k] = table.lower_bound(q[:, table.joint])
+                for (k, o), bound in table_bounds(self.tables, q).items():
+                    lower[o, k] = bound
                     done[o, k] = True
             balls = self.ball_centres(frames) if centres is None else centres
             self._ball_bounds(lower, balls, obstacle_poses, done)
