@@ -44,7 +44,12 @@ from multiprocessing.connection import Connection
 
 import numpy as np
 
-from adept_traj.errors import AdeptTrajError, ConfigurationError, InputShapeError
+from adept_traj.errors import (
+    AdeptTrajError,
+    ConfigurationError,
+    InputShapeError,
+    error_from_process,
+)
 from adept_traj.problem.evaluation import Evaluation, _concatenate
 from adept_traj.validation import as_batch, as_integer
 
@@ -132,19 +137,6 @@ def _pickled(exc: BaseException) -> bytes | None:
         return pickle.dumps(exc)
     except Exception:  # an exception that does not pickle: its traceback text only
         return None
-
-
-def _error(text: str, pickled: bytes | None) -> BaseException:
-    """A worker's exception (unpickled) with its traceback ``text`` as a note; an
-    :class:`~adept_traj.errors.AdeptTrajError` holding ``text`` if it does not unpickle."""
-    try:
-        error = pickle.loads(pickled) if pickled is not None else None
-    except Exception:  # e.g. an exception class whose __init__ needs other arguments
-        error = None
-    if not isinstance(error, BaseException):
-        return AdeptTrajError(f"the evaluation failed in a worker process:\n{text}")
-    error.add_note(f"raised in an evaluation worker process:\n{text}")
-    return error
 
 
 class ParallelEvaluator:
@@ -250,5 +242,10 @@ def _receive(process: multiprocessing.process.BaseProcess, connection: Connectio
             f"(exit code {process.exitcode})"
         ) from exc
     if text:
-        raise _error(text, payload)
+        raise error_from_process(
+            text,
+            payload,
+            "raised in an evaluation worker process",
+            AdeptTrajError(f"the evaluation failed in a worker process:\n{text}"),
+        )
     return payload
