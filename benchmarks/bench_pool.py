@@ -10,7 +10,9 @@ per call** of :meth:`TrajectoryProblem.evaluate_batch` on one process and on ``w
 (medians of ``--calls`` calls of a near-feasible population of the paper problem, the
 pool already started), their ratio (the speed-up), and the process CPU time per call of
 the parallel calls, the workers' included (:func:`resource.getrusage` of the process and
-of its children, read after the pool is closed).
+of its children, read after the pool is closed). The rows ``pop, nothing`` time the pool
+alone: a :class:`ParallelEvaluator` whose evaluation computes nothing (wall and
+main-process CPU time per call, medians of 10 × ``--calls`` calls).
 
 ``--against DIR`` runs this measurement in fresh processes of this tree's code and of the
 checkout ``DIR``'s alternately (``--pairs`` pairs) and prints both and the median of the
@@ -31,13 +33,34 @@ import time
 import numpy as np
 
 from adept_traj import Robot, Scene
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import Evaluation, ParallelEvaluator, TrajectoryProblem
 from adept_traj.testing.paper_moves import lift_then_lower  # a hand-made collision-free move
 
 
 def _cpu(who: int) -> float:
     usage = resource.getrusage(who)
     return usage.ru_utime + usage.ru_stime
+
+
+def _nothing(x: np.ndarray) -> Evaluation:
+    """An evaluation that computes nothing (the paper problem's shapes): the pool's own cost."""
+    k = len(x)
+    return Evaluation(np.zeros((k, 6)), np.zeros((k, 21)), np.zeros((k, 4)))
+
+
+def overhead(pop: int, calls: int, workers: int) -> dict[str, float]:
+    """Median wall and main-process CPU seconds per call of a :class:`ParallelEvaluator`
+    whose evaluation computes nothing, population ``pop`` (its own cost per generation)."""
+    x = np.random.default_rng(0).uniform(size=(pop, 65))
+    walls, cpus = [], []
+    with ParallelEvaluator(_nothing, workers, 65) as evaluator:
+        evaluator.evaluate(x)  # forks the workers
+        for _ in range(calls):
+            cpu0, start = _cpu(resource.RUSAGE_SELF), time.perf_counter()
+            evaluator.evaluate(x)
+            walls.append(time.perf_counter() - start)
+            cpus.append(_cpu(resource.RUSAGE_SELF) - cpu0)
+    return {"serial": 0.0, "parallel": statistics.median(walls), "cpu": statistics.median(cpus)}
 
 
 def measure(pops: list[int], calls: int, workers: int) -> dict[str, dict[str, float]]:
@@ -74,6 +97,8 @@ def measure(pops: list[int], calls: int, workers: int) -> dict[str, dict[str, fl
             "parallel": statistics.median(both),
             "cpu": cpu / calls,
         }
+    for pop in pops:
+        out[f"{pop}, nothing"] = overhead(pop, 10 * calls, workers)
     return out
 
 
@@ -82,7 +107,10 @@ def _show(label: str, runs: list[dict[str, dict[str, float]]]) -> None:
         s = statistics.median(r[pop]["serial"] for r in runs) * 1e3
         p = statistics.median(r[pop]["parallel"] for r in runs) * 1e3
         c = statistics.median(r[pop]["cpu"] for r in runs) * 1e3
-        print(f"{label:<7}{pop:>6}{s:>12.2f}{p:>12.2f}{s / p:>10.2f}×{c:>14.2f}")
+        if s == 0.0:  # the pool alone: no serial call, the main process' CPU time
+            print(f"{label:<7}{pop:>15}{'':>12}{p:>12.3f}{'':>11}{c:>14.3f}")
+        else:
+            print(f"{label:<7}{pop:>15}{s:>12.2f}{p:>12.2f}{s / p:>10.2f}×{c:>14.2f}")
 
 
 def main() -> None:
@@ -96,7 +124,7 @@ def main() -> None:
     args = parser.parse_args()
     pops = [int(p) for p in args.pops.split(",")]
     header = (
-        f"{'code':<7}{'pop':>6}{'1 proc [ms]':>12}{'parallel':>12}{'speed-up':>11}"
+        f"{'code':<7}{'pop':>15}{'1 proc [ms]':>12}{'parallel':>12}{'speed-up':>11}"
         f"{'CPU/call [ms]':>14}"
     )
     what = f"{args.workers} workers, medians of {args.calls} calls"

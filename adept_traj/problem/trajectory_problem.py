@@ -95,12 +95,13 @@ class ProblemSettings:
         ``"paper-ellipsoid"`` (eqs. 13–16 on the tool point).
     workers:
         Processes evaluating a population in parallel (default 1: in this process).
-        With ``workers > 1`` a population of at least 16 is split into contiguous chunks
-        evaluated by forked worker processes (Linux) of a
-        :class:`~adept_traj.problem.evaluator.ParallelEvaluator` that the problem owns;
-        results are identical to the serial evaluation. The workers are forked when first
-        needed and hold a snapshot of the problem (later edits of ``robot.model`` are not
-        seen by them); :meth:`TrajectoryProblem.close` stops them.
+        With ``workers > 1`` a population of at least 16 is split into ``workers``
+        contiguous chunks, evaluated by this process and ``workers - 1`` forked worker
+        processes (Linux) of a :class:`~adept_traj.problem.evaluator.ParallelEvaluator`
+        that the problem owns; results are identical to the serial evaluation. The
+        workers are forked when first needed and hold a snapshot of the problem (later
+        edits of ``robot.model`` are not seen by them); :meth:`TrajectoryProblem.close`
+        stops them.
     self_collision:
         Check the robot's own links against each other (the pairs of
         :class:`~adept_traj.collision.SelfCollision`) in the distance constraint and the
