@@ -8,7 +8,6 @@ can catch them all with one clause. Input errors also derive from :class:`ValueE
 from __future__ import annotations
 
 import os
-import pickle
 from pathlib import Path
 
 __all__ = [
@@ -144,6 +143,8 @@ def error_from_process(
     ``pickled`` there, with that process' traceback ``text`` as a note (``note``, a colon,
     the traceback), or ``fallback`` if it does not unpickle (e.g. an exception class whose
     ``__init__`` needs other arguments)."""
+    import pickle  # here: the command line's start-up never needs it
+
     try:
         error = pickle.loads(pickled) if pickled is not None else None
     except Exception:  # any failure to unpickle: the fallback, which holds the text
