@@ -374,7 +374,7 @@ def test_a_worker_exception_carries_the_worker_traceback() -> None:
     assert 'raise InvalidInputError("bad chunk in the worker")' in note
 
 
-def test_ctrl_c_in_the_main_process_stops_the_busy_worker_pids() -> None:
+def test_ctrl_c_in_the_main_process_stops_the_busy_workers() -> None:
     x = np.arange(8.0)[:, None] * np.ones((1, 2))
     before = _worker_pids()
     with ParallelEvaluator(_failing(os.getpid()), workers=3, n_var=2) as evaluator:
