@@ -27,6 +27,7 @@ __all__ = [
     "SceneError",
     "SceneFileNotFoundError",
     "UnreachableLocationError",
+    "error_from_process",
 ]
 
 
@@ -133,3 +134,22 @@ class UnreachableLocationError(InvalidInputError):
 class CycleError(ConfigurationError):
     """A cycle file (``docs/cycles.md``) is missing or malformed, or a cycle run folder
     does not match its cycle. The message names the file, the field and the valid range."""
+
+
+def error_from_process(
+    text: str, pickled: bytes | None, note: str, fallback: BaseException
+) -> BaseException:
+    """An exception raised in another (forked) process, to raise here: the exception
+    ``pickled`` there, with that process' traceback ``text`` as a note (``note``, a colon,
+    the traceback), or ``fallback`` if it does not unpickle (e.g. an exception class whose
+    ``__init__`` needs other arguments)."""
+    import pickle  # here: the command line's start-up never needs it
+
+    try:
+        error = pickle.loads(pickled) if pickled is not None else None
+    except Exception:  # any failure to unpickle: the fallback, which holds the text
+        error = None
+    if not isinstance(error, BaseException):
+        return fallback
+    error.add_note(f"{note}:\n{text}")
+    return error

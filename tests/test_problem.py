@@ -5,7 +5,9 @@ from __future__ import annotations
 import gc
 import multiprocessing
 import os
+import signal
 import time
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +16,10 @@ import pytest
 from adept_traj import Robot, Scene
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import (
+    AdeptTrajError,
     ConfigurationError,
     InputShapeError,
+    InvalidInputError,
     JointLimitError,
     RobotModelError,
 )
@@ -230,8 +234,9 @@ def _stopped(children: list, timeout: float = 30.0) -> bool:
 
 
 def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem) -> None:
-    """close(), a with block and garbage collection each stop the workers; after close()
-    a new pool starts and still gives the serial results."""
+    """close(), a with block and garbage collection each stop the workers (workers=2: the
+    main process and one forked worker); after close() a new one starts and still gives
+    the serial results."""
     rng = np.random.default_rng(31)
     x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(20, problem.n_var))
     serial = problem.evaluate_batch(x)
@@ -239,19 +244,19 @@ def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem)
     with TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2) as parallel:
         parallel.evaluate_batch(x)
         first = _new_children(before)
-        assert len(first) == 2
+        assert len(first) == 1
         parallel.close()
         assert _stopped(first)
         again = parallel.evaluate_batch(x)  # a new pool
         np.testing.assert_array_equal(again.objectives, serial.objectives)
         second = _new_children(before)
-        assert len(second) == 2
+        assert len(second) == 1
     assert _stopped(second)  # the with block closed it
 
     collected = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2)
     collected.evaluate_batch(x)
     third = _new_children(before)
-    assert len(third) == 2
+    assert len(third) == 1
     del collected
     gc.collect()
     assert _stopped(third)  # garbage collection stopped the pool: nothing kept the problem
@@ -270,19 +275,21 @@ def _pid_rows(x: np.ndarray) -> Evaluation:
 
 def test_parallel_evaluator_hands_the_function_to_forked_workers() -> None:
     """The function reaches the workers once, when they are forked: a closure (which pickle
-    refuses) works; rows come back in order, each chunk computed in a worker process."""
+    refuses) works; rows come back in order, the last chunk computed in the main process
+    and each other chunk in its own worker process."""
     offset = 10.0
     evaluate = lambda x: _pid_rows(x + offset)  # noqa: E731 (a closure cannot be pickled)
     x = np.arange(30.0).reshape(10, 3)
-    with ParallelEvaluator(evaluate, workers=2, n_var=3) as evaluator:
+    with ParallelEvaluator(evaluate, workers=3, n_var=3) as evaluator:
         ev = evaluator.evaluate(x)
         assert evaluator.running
     assert not evaluator.running
     np.testing.assert_array_equal(ev.objectives[:, 0], x[:, 0] + offset)
     pids = ev.objectives[:, 1]
-    assert len(set(pids[:5])) == 1
-    assert len(set(pids[5:])) == 1
-    assert os.getpid() not in pids  # computed in the workers
+    chunks = [pids[:4], pids[4:7], pids[7:]]  # np.array_split(10 rows, 3)
+    assert [len(set(c)) for c in chunks] == [1, 1, 1]
+    assert len({c[0] for c in chunks}) == 3
+    assert chunks[2][0] == os.getpid()  # the main process evaluates the last chunk
     assert ev.n_narrow == 10
     with pytest.raises(ConfigurationError, match="closed"):
         evaluator.evaluate(x)
@@ -293,3 +300,87 @@ def test_parallel_evaluator_hands_the_function_to_forked_workers() -> None:
             evaluator.evaluate(x[:1])
         with pytest.raises(InputShapeError, match=r"\(\.\.\., 3\)"):
             evaluator.evaluate(x[:, :2])
+
+
+# ParallelEvaluator's failures: a worker's exception, a killed worker, Ctrl-C in the main
+# process' own chunk. Each is raised in the main process, the workers are stopped, and the
+# next population is evaluated by new workers.
+
+#: First-variable values that make the evaluation function fail, by what they do.
+_RAISE, _KILL, _INTERRUPT, _UNPICKLABLE = -1.0, -2.0, -3.0, -4.0
+
+
+class _Unpicklable(Exception):
+    def __init__(self, a: int, b: int) -> None:  # pickle calls __init__ with one argument
+        super().__init__(f"{a} and {b}")
+
+
+def _failing(main_pid: int):
+    """An evaluation function whose chunk's first value says how it fails, and in which
+    process (worker or main): rows are (x0, the process id)."""
+
+    def evaluate(x: np.ndarray) -> Evaluation:
+        in_worker = os.getpid() != main_pid
+        if x[0, 0] == _RAISE and in_worker:
+            raise InvalidInputError("bad chunk in the worker")
+        if x[0, 0] == _UNPICKLABLE and in_worker:
+            raise _Unpicklable(1, 2)
+        if x[0, 0] == _KILL and in_worker:
+            os.kill(os.getpid(), signal.SIGKILL)
+        if x[-1, 0] == _INTERRUPT and not in_worker:
+            raise KeyboardInterrupt
+        return _pid_rows(x)
+
+    return evaluate
+
+
+def _worker_pids() -> set:
+    return {p.pid for p in multiprocessing.active_children()}
+
+
+@pytest.mark.parametrize(
+    ("first", "error", "match"),
+    [
+        (_RAISE, InvalidInputError, "bad chunk in the worker"),
+        (_UNPICKLABLE, AdeptTrajError, "_Unpicklable: 1 and 2"),
+        (_KILL, BrokenProcessPool, "ended abruptly"),
+    ],
+)
+def test_a_failed_worker_is_raised_here_and_new_workers_follow(first, error, match) -> None:
+    x = np.arange(8.0)[:, None] * np.ones((1, 2))
+    before = _worker_pids()
+    with ParallelEvaluator(_failing(os.getpid()), workers=2, n_var=2) as evaluator:
+        good = evaluator.evaluate(x)
+        old = _worker_pids() - before
+        bad = x.copy()
+        bad[0, 0] = first  # the worker's chunk (the main process takes the last one)
+        with pytest.raises(error, match=match):
+            evaluator.evaluate(bad)
+        assert not (old & _worker_pids())  # the old worker is stopped
+        again = evaluator.evaluate(x)  # by a new worker
+        assert (_worker_pids() - before) - old
+    np.testing.assert_array_equal(again.objectives[:, 0], good.objectives[:, 0])
+    assert again.objectives[0, 1] != good.objectives[0, 1]
+
+
+def test_a_worker_exception_carries_the_worker_traceback() -> None:
+    x = np.arange(8.0)[:, None] * np.ones((1, 2))
+    x[0, 0] = _RAISE
+    evaluator = ParallelEvaluator(_failing(os.getpid()), workers=2, n_var=2)
+    with evaluator, pytest.raises(InvalidInputError) as raised:
+        evaluator.evaluate(x)
+    (note,) = raised.value.__notes__
+    assert note.startswith("raised in an evaluation worker process:")
+    assert 'raise InvalidInputError("bad chunk in the worker")' in note
+
+
+def test_ctrl_c_in_the_main_process_stops_the_busy_workers() -> None:
+    x = np.arange(8.0)[:, None] * np.ones((1, 2))
+    before = _worker_pids()
+    with ParallelEvaluator(_failing(os.getpid()), workers=3, n_var=2) as evaluator:
+        bad = x.copy()
+        bad[-1, 0] = _INTERRUPT
+        with pytest.raises(KeyboardInterrupt):
+            evaluator.evaluate(bad)
+        assert _worker_pids() == before  # terminated while they evaluated, and waited for
+        np.testing.assert_array_equal(evaluator.evaluate(x).objectives[:, 0], x[:, 0])

@@ -21,7 +21,7 @@ from adept_traj.collision.distance_gradient import (
     DistanceGradients,
     distance_gradients,
 )
-from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.distance_table import DistanceTable, table_bounds
 from adept_traj.collision.lever_arms import pair_lever_arms, solid_lever_arms
 from adept_traj.collision.point_distance import point_signed_distance
 from adept_traj.collision.primitives import (
@@ -64,4 +64,5 @@ __all__ = [
     "shape_of",
     "solid_lever_arms",
     "sweep_clearance",
+    "table_bounds",
 ]

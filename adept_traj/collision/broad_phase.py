@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
-from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.distance_table import DistanceTable, table_bounds
 from adept_traj.collision.point_distance import (
     obstacle_signed_distance,
     point_signed_distance,
@@ -349,8 +349,8 @@ class BroadPhase:
             exact[static] = True
             done = static.copy()
             if q is not None:
-                for (k, o), table in self.tables.items():
-                    lower[o, k] = table.lower_bound(q[:, table.joint])
+                for (k, o), bound in table_bounds(self.tables, q).items():
+                    lower[o, k] = bound
                     done[o, k] = True
             balls = self.ball_centres(frames) if centres is None else centres
             self._ball_bounds(lower, balls, obstacle_poses, done)
@@ -427,13 +427,13 @@ class BroadPhase:
             return bound
         ps = self.solid_poses(frames, idx[still], k)
         po = po if po.ndim == 2 else po[still]
-        rot_o = np.broadcast_to(po[..., :3, :3], (still.size, 3, 3))
         delta = ps[:, :3, 3] - po[..., :3, 3]
         norm = np.sqrt(np.einsum("ni,ni->n", delta, delta))[:, None]
-        towards = np.divide(delta, norm, out=np.zeros_like(delta), where=norm > 0)
-        axes = np.concatenate([np.swapaxes(rot_o, -1, -2), towards[:, None]], axis=1)
+        axes = np.zeros((still.size, 4, 3))  # the obstacle's axes, then the centre line
+        axes[:, :3] = np.swapaxes(po[..., :3, :3], -1, -2)
+        np.divide(delta, norm, out=axes[:, 3], where=norm > 0)
         n_s = axes @ ps[:, :3, :3]  # rows: axes in the solid frame (R, 4, 3)
-        n_o = stack_times(axes, po[:3, :3]) if po.ndim == 2 else axes @ rot_o  # obstacle frame
+        n_o = stack_times(axes, po[:3, :3]) if po.ndim == 2 else axes @ po[:, :3, :3]
         gaps = (
             np.abs(np.einsum("nai,ni->na", axes, delta))
             - _ROUNDING

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["DistanceTable"]
+__all__ = ["DistanceTable", "table_bounds"]
 
 #: Subtracted from every bound [m]: coal's distances between primitives exceed the true
 #: distance by at most 3.4 µm (penetration; 2 nm beyond 1 mm of separation, measured in
@@ -58,11 +58,42 @@ class DistanceTable:
     def lower_bound(self, q: np.ndarray) -> np.ndarray:
         """(N,) lower bound [m] of the signed distance at joint values ``q`` (N,)
         [rad | m] (see the module docstring); ``-inf`` outside the grid."""
+        return self.bound_at(self.grid_position(q))
+
+    def grid_position(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Where the joint values ``q`` (N,) [rad | m] fall on the grid: (within the grid
+        (N,) bool, the grid interval's index i (N,), the position within it (N,) in
+        [0, 1]); the same for every table of the same :attr:`grid`."""
         u = (q - self.start) / self.step
         last = len(self.values) - 1
         inside = (u >= 0.0) & (u <= last)
         i = np.clip(np.floor(u), 0, last - 1).astype(np.intp)
-        frac = np.clip(u - i, 0.0, 1.0)
+        return inside, i, np.clip(u - i, 0.0, 1.0)
+
+    def bound_at(self, at: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+        """:meth:`lower_bound` at a :meth:`grid_position` ``at`` on this table's grid."""
+        inside, i, frac = at
         slope = self.lipschitz * self.step
         bound = np.maximum(self.values[i] - slope * frac, self.values[i + 1] - slope * (1.0 - frac))
         return np.where(inside, bound - _SLACK, -np.inf)
+
+    @property
+    def grid(self) -> tuple[int, float, float, int]:
+        """(joint, start, step, number of grid points)."""
+        return self.joint, self.start, self.step, len(self.values)
+
+
+def table_bounds(
+    tables: dict[tuple[int, int], DistanceTable], q: np.ndarray
+) -> dict[tuple[int, int], np.ndarray]:
+    """:meth:`DistanceTable.lower_bound` (N,) [m] of every table (by its key) at the
+    configurations ``q`` (N, nq) [rad | m]; tables on the same grid (e.g. one solid against
+    several obstacles) share one :meth:`~DistanceTable.grid_position`."""
+    grids: dict[tuple[int, float, float, int], tuple[np.ndarray, ...]] = {}
+    out = {}
+    for key, table in tables.items():
+        at = grids.get(table.grid)
+        if at is None:
+            at = grids[table.grid] = table.grid_position(q[:, table.joint])
+        out[key] = table.bound_at(at)
+    return out

@@ -106,12 +106,19 @@ def _in_obstacle_frame(points: np.ndarray, pose: np.ndarray) -> np.ndarray:
     if pose.ndim == 2:  # fixed obstacle: one GEMM
         flat = points.reshape(3, -1) - pose[:3, 3, None]
         return (pose[:3, :3].T @ flat).reshape(points.shape)
-    delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
+    delta = points - _origins(pose)  # (3, m, R)
     rt = np.ascontiguousarray(pose[:, :3, :3].transpose(2, 1, 0))  # rt[i, j] = R[:, j, i]
     out = np.empty_like(delta)
     for i in range(3):
         out[i] = rt[i, 0] * delta[0] + rt[i, 1] * delta[1] + rt[i, 2] * delta[2]
     return out
+
+
+def _origins(pose: np.ndarray) -> np.ndarray:
+    """The origins (3, 1, R) [m] of poses (R, 4, 4), component-major and contiguous (a
+    subtraction broadcasting the strided view ``pose[:, :3, 3].T`` is several times
+    slower than the copy)."""
+    return np.ascontiguousarray(pose[:, :3, 3].T)[:, None]
 
 
 def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray) -> np.ndarray:
@@ -124,7 +131,7 @@ def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray
     """
     if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
         return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
-    delta = points - pose[:, :3, 3].T[:, None, :]  # (3, m, R)
+    delta = points - _origins(pose)  # (3, m, R)
     sq = _dot3(delta, delta)
     if isinstance(shape, Sphere):
         sq = np.sqrt(sq, out=sq)

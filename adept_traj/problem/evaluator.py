@@ -1,40 +1,55 @@
-"""Parallel evaluation of a population on worker processes that the evaluator owns.
+"""Parallel evaluation of a population on the calling process and worker processes it owns.
 
 A :class:`~adept_traj.problem.TrajectoryProblem` with ``workers > 1`` creates one
-:class:`ParallelEvaluator` when a population first needs it. The evaluator owns
+:class:`ParallelEvaluator` when a population first needs it. ``workers`` is the number of
+processes that evaluate: the calling (main) process and ``workers - 1`` worker processes
+that the evaluator forks (Linux ``fork``) at its first population. A population ``x``
+(pop, n_var) is split into ``workers`` contiguous chunks (pop ≥ workers): each worker
+receives its chunk through its own pipe, the main process evaluates the last chunk
+meanwhile, then reads the workers' evaluations back. Each chunk is evaluated exactly as
+the serial evaluation would, so the results are identical, bit for bit, to evaluating
+``x`` in one process.
 
-- a :class:`concurrent.futures.ProcessPoolExecutor` whose ``workers`` processes are forked
-  (Linux ``fork`` start method) at its first population, and
-- the evaluation function the workers run, in practice a snapshot of the problem (a shallow
-  copy without the evaluator). The pool's ``initializer`` stores it, once, in a global of
-  each worker process (:data:`_WORKER_EVALUATE`): fork hands the function over by copying
-  the parent's memory, nothing is pickled, and only the population chunks and their
-  :class:`~adept_traj.problem.Evaluation` travel between the processes. In the parent
-  process that global stays ``None``: there is no registry of live problems.
+The workers run the evaluation function they inherited when they were forked (in practice
+a snapshot of the problem: a shallow copy without the evaluator); nothing is pickled but
+the chunks and their :class:`~adept_traj.problem.Evaluation`, with no helper thread and no
+queue in between (a :class:`concurrent.futures.ProcessPoolExecutor` hands each chunk
+through a queue thread and a feeder thread to one more process). The workers hold the
+problem as it was when they were forked: after an edit of the problem (e.g. of
+``robot.model``) close the evaluator, or the main process' chunk (which sees the edit)
+and the workers' chunks (which do not) disagree.
 
-A population ``x`` (pop, n_var) is split into ``workers`` contiguous chunks (pop ≥ workers);
-each worker evaluates its chunk exactly as the serial evaluation would, so the results are
-identical, bit for bit, to evaluating ``x`` in one process. Because the workers hold a
-snapshot, edits of the problem after the first parallel population (e.g. of
-``robot.model``) are not seen by them until the evaluator is closed and a new one made.
-
-The pool stops on :meth:`ParallelEvaluator.close`, on leaving a ``with`` block, and when the
-evaluator's ``owner`` (the problem) is garbage-collected (:func:`weakref.finalize`; the
-snapshot is a different object, so the pool does not keep its owner alive).
+Errors: an exception in a worker is raised in the main process (the same exception, with
+the worker's traceback as a note); a worker that dies (e.g. killed) raises
+:class:`concurrent.futures.process.BrokenProcessPool`; on either, and on Ctrl-C (the
+workers ignore SIGINT: the main process stops the run), the workers are stopped and the
+next population forks new ones. The workers stop on :meth:`ParallelEvaluator.close`, on
+leaving a ``with`` block, and when the evaluator's ``owner`` (the problem) is
+garbage-collected (:func:`weakref.finalize`; the snapshot is a different object, so the
+workers do not keep the owner alive); a worker whose main process dies reads the end of
+its pipe and exits.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import pickle
 import signal
+import traceback
 import weakref
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from multiprocessing.connection import Connection
 
 import numpy as np
 
-from adept_traj.errors import ConfigurationError, InputShapeError
+from adept_traj.errors import (
+    AdeptTrajError,
+    ConfigurationError,
+    InputShapeError,
+    error_from_process,
+)
 from adept_traj.problem.evaluation import Evaluation, _concatenate
 from adept_traj.validation import as_batch, as_integer
 
@@ -52,42 +67,95 @@ def available_cores() -> int:
     return max(1, n)
 
 
-#: The evaluation function of this worker process, set once by the pool's initializer
-#: (:func:`_start_worker`); ``None`` in every process that is not a pool worker.
-_WORKER_EVALUATE: Callable[[np.ndarray], Evaluation] | None = None
+class _Workers:
+    """The worker processes of one evaluator and the main process' end of their pipes
+    (mutable state shared with the evaluator's finalizer, which must not hold the
+    evaluator)."""
+
+    def __init__(self) -> None:
+        self.processes: list[multiprocessing.process.BaseProcess] = []
+        self.connections: list[Connection] = []
+        self.busy = False  # chunks sent whose evaluations are not read yet
+        self.pid = os.getpid()  # the process that forked them (and may stop them)
+
+    def start(self, evaluate: Callable[[np.ndarray], Evaluation], count: int) -> None:
+        """Fork ``count`` workers running ``evaluate``."""
+        context = multiprocessing.get_context("fork")
+        for _ in range(count):
+            mine, theirs = context.Pipe()
+            process = context.Process(
+                target=_serve, args=(evaluate, theirs, [mine, *self.connections]), daemon=True
+            )
+            process.start()
+            theirs.close()  # the worker's end lives in the worker only: EOF if it dies
+            self.processes.append(process)
+            self.connections.append(mine)
+
+    def stop(self, wait: bool) -> None:
+        """Close the pipes (an idle worker exits on reading their end); terminate workers
+        still evaluating; with ``wait``, wait for every worker to exit."""
+        processes, connections, busy = self.processes, self.connections, self.busy
+        self.processes, self.connections, self.busy = [], [], False
+        for connection in connections:
+            connection.close()
+        if os.getpid() != self.pid:  # a forked copy of the main process: not its workers
+            return
+        for process in processes:
+            if busy:
+                process.terminate()
+            if wait:
+                process.join()
 
 
-def _start_worker(evaluate: Callable[[np.ndarray], Evaluation]) -> None:
-    """Pool initializer, run once in each forked worker: keep the evaluation function, and
-    leave Ctrl-C to the parent (which checkpoints and stops the run)."""
-    global _WORKER_EVALUATE
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _WORKER_EVALUATE = evaluate
+def _serve(
+    evaluate: Callable[[np.ndarray], Evaluation],
+    connection: Connection,
+    inherited: list[Connection],
+) -> None:
+    """A worker's loop: read a chunk, send back ``("", its Evaluation)`` or ``(the
+    traceback, the pickled exception or None)``; return at the end of the pipe."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the main process' to handle
+    for other in inherited:  # the main process' ends of this and earlier workers' pipes
+        other.close()
+    while True:
+        try:
+            x = connection.recv()
+        except (EOFError, OSError):  # the evaluator closed the pipe, or its process died
+            return
+        try:
+            reply = pickle.dumps(("", evaluate(x)), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # sent to the main process, which raises it
+            reply = pickle.dumps((traceback.format_exc(), _pickled(exc)))
+        try:
+            connection.send_bytes(reply)
+        except OSError:  # the main process is gone
+            return
 
 
-def _evaluate_chunk(x: np.ndarray) -> Evaluation:
-    """Run in a worker: evaluate one chunk (k, n_var) of the population."""
-    if _WORKER_EVALUATE is None:  # only a pool started by ParallelEvaluator calls this
-        raise ConfigurationError("_evaluate_chunk runs in a ParallelEvaluator worker only")
-    return _WORKER_EVALUATE(x)
+def _pickled(exc: BaseException) -> bytes | None:
+    try:
+        return pickle.dumps(exc)
+    except Exception:  # an exception that does not pickle: its traceback text only
+        return None
 
 
 class ParallelEvaluator:
-    """Evaluates populations in contiguous chunks on ``workers`` forked processes it owns.
+    """Evaluates populations in contiguous chunks on the calling process and
+    ``workers - 1`` forked worker processes it owns.
 
     Parameters
     ----------
     evaluate:
         Function of a population (k, n_var) returning its :class:`Evaluation` (k rows);
-        the workers receive it once, when they are forked. It must not refer to ``owner``,
-        or the owner is never collected.
+        the workers receive it once, when they are forked, and the main process calls it on
+        its own chunk. It must not refer to ``owner``, or the owner is never collected.
     workers:
-        Number of worker processes, an integer ≥ 2.
+        Number of processes that evaluate (the main process included), an integer ≥ 2.
     n_var:
         Length of a decision vector (the population's last axis).
     owner:
-        The pool also stops when this object is garbage-collected (default: the evaluator
-        itself).
+        The workers also stop when this object is garbage-collected (default: the
+        evaluator itself).
 
     Raises
     ------
@@ -106,28 +174,26 @@ class ParallelEvaluator:
         self.n_var = as_integer(n_var, "n_var", minimum=1, error=ConfigurationError)
         if "fork" not in multiprocessing.get_all_start_methods():
             raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
-        self._pool = ProcessPoolExecutor(
-            max_workers=self.workers,
-            mp_context=multiprocessing.get_context("fork"),
-            initializer=_start_worker,
-            initargs=(evaluate,),
-        )
+        self._evaluate = evaluate
+        self._workers = _Workers()
         # Collected owner: stop without waiting (a finalizer must not block on the workers).
         self._finalizer = weakref.finalize(
-            self if owner is None else owner, self._pool.shutdown, wait=False, cancel_futures=True
+            self if owner is None else owner, self._workers.stop, wait=False
         )
 
     @property
     def running(self) -> bool:
-        """Whether the pool is open (not yet closed nor finalised)."""
+        """Whether the evaluator is open (not yet closed nor finalised)."""
         return self._finalizer.alive
 
     def evaluate(self, x: np.ndarray) -> Evaluation:
-        """Evaluate a population ``x`` (pop, n_var), pop ≥ ``workers``, on the workers.
+        """Evaluate a population ``x`` (pop, n_var), pop ≥ ``workers``.
 
         Returns the rows of the chunks' evaluations in the order of ``x`` (``seconds`` 0:
-        the caller times the call). If a chunk fails, the other chunks are cancelled and
-        the worker's exception is raised here.
+        the caller times the call). If a chunk fails, its exception is raised here (a
+        worker's with the worker's traceback as a note; a worker that died:
+        :class:`concurrent.futures.process.BrokenProcessPool`) and the workers are stopped
+        (new ones are forked for the next population).
         """
         if not self.running:
             raise ConfigurationError("this ParallelEvaluator is closed: make a new one")
@@ -137,23 +203,49 @@ class ParallelEvaluator:
                 f"x must have shape (pop, {self.n_var}) with pop ≥ workers = {self.workers}; "
                 f"got {xa.shape}"
             )
-        chunks = np.array_split(xa, self.workers)
-        futures = [self._pool.submit(_evaluate_chunk, c) for c in chunks]
+        chunks = np.array_split(xa, self.workers)  # the main process takes the last one
+        pool = self._workers
         try:
-            parts = [f.result() for f in futures]
-        except BaseException:
-            for f in futures:
-                f.cancel()
+            if not pool.processes:
+                pool.start(self._evaluate, self.workers - 1)
+            pool.busy = True
+            for connection, chunk in zip(pool.connections, chunks):
+                connection.send(np.ascontiguousarray(chunk))
+            mine = self._evaluate(chunks[-1])
+            parts = [_receive(p, c) for p, c in zip(pool.processes, pool.connections)]
+            pool.busy = False
+        except BaseException:  # a failed chunk, a dead worker, Ctrl-C: stop the workers
+            pool.stop(wait=True)
             raise
-        return _concatenate(parts)
+        return _concatenate([*parts, mine])
 
     def close(self) -> None:
         """Stop the worker processes and wait for them to exit (idempotent)."""
         if self._finalizer.detach() is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._workers.stop(wait=True)
 
     def __enter__(self) -> ParallelEvaluator:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _receive(process: multiprocessing.process.BaseProcess, connection: Connection) -> Evaluation:
+    """A worker's evaluation of its chunk, or its exception raised here."""
+    try:
+        text, payload = pickle.loads(connection.recv_bytes())
+    except (EOFError, OSError) as exc:  # the worker died without a word
+        process.join(timeout=1.0)
+        raise BrokenProcessPool(
+            f"an evaluation worker process (pid {process.pid}) ended abruptly "
+            f"(exit code {process.exitcode})"
+        ) from exc
+    if text:
+        raise error_from_process(
+            text,
+            payload,
+            "raised in an evaluation worker process",
+            AdeptTrajError(f"the evaluation failed in a worker process:\n{text}"),
+        )
+    return payload

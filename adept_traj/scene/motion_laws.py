@@ -348,12 +348,12 @@ class PendulumMotion(MotionLaw):
             z = −sin φ e_swing + cos φ e_z, translation = pivot.
         """
         phi = self.angle(t)
-        c, s = np.cos(phi)[..., None], np.sin(phi)[..., None]
-        out = np.zeros((*phi.shape, 4, 4))
-        out[..., :3, 0] = c * self.swing_axis + s * _EZ
-        out[..., :3, 1] = self.normal_axis
-        out[..., :3, 2] = -s * self.swing_axis + c * _EZ
-        out[..., :3, 3] = self.pivot
+        c, s, out = np.cos(phi), np.sin(phi), np.zeros((*phi.shape, 4, 4))
+        # row by row: a broadcast over a trailing axis of length 3 is several times slower
+        rows = zip(self.swing_axis.tolist(), _EZ.tolist(), self.normal_axis, self.pivot)
+        for i, (swing, ez, normal, pivot) in enumerate(rows):
+            out[..., i, 0], out[..., i, 1] = c * swing + s * ez, normal
+            out[..., i, 2], out[..., i, 3] = -s * swing + c * ez, pivot
         out[..., 3, 3] = 1.0
         return out
 
