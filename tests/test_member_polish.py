@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -116,10 +117,19 @@ def test_front_mode_of_a_small_run_polishes_only_the_fastest(problem, members, m
     alone (the fastest member's polish, tested in test_polish.py, is left out here)."""
     import adept_traj.optimise.polish_step as polish_step
 
-    monkeypatch.setattr(polish_step, "_polish_fastest", lambda problem, state, rate, made: state)
+    kinds = []
+
+    def fastest_only(problem, kind, x0, scale, rate_hz):
+        kinds.append(kind)  # the fastest member's polish, found nothing (costs 1 evaluation)
+        outcome = SimpleNamespace(n_evaluations=1, evaluation_s=0.0, x=x0)
+        return polish_step._Solved(outcome, None, 0.0)
+
+    monkeypatch.setattr(polish_step, "_solve", fastest_only)
     state = _state(problem, members, 100)
     out = polish_run(problem, state, 1000.0, "front", PAPER_WEIGHTS)
-    assert out is state
+    assert kinds == ["fastest"]
+    np.testing.assert_array_equal(out.X, state.X)
+    assert out.n_evaluations == 101
 
 
 def test_polish_settings(problem) -> None:
