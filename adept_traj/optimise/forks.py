@@ -4,8 +4,8 @@
 :func:`~adept_traj.optimise.certify_front_members`.
 
 A task is a module-level function ``fn(problem, *args)``. :class:`ProblemTasks` with
-``processes`` ≥ 2 forks that many processes (Linux ``fork``) once, which inherit the
-problem (and whatever the parent made of it before: e.g. its certifying problem,
+``processes`` ≥ 2 forks that many processes (Linux ``fork``) once, at its first task, which
+inherit the problem (and whatever the parent made of it before: e.g. its certifying problem,
 :func:`~adept_traj.analysis.certifying_problem`), so that nothing but each task's
 arguments and result is pickled; with one process, or where the platform has no
 ``fork``, every task runs in this process, in the order submitted, when its result is
@@ -62,10 +62,7 @@ class ProblemTasks:
         self._inline: deque[tuple[int, Callable[..., Any], tuple[Any, ...]]] = deque()
         self._done: queue.SimpleQueue[int] = queue.SimpleQueue()
         self._results: dict[int, Any] = {}
-        self._pool = None
-        if n > 1:
-            context = multiprocessing.get_context("fork")
-            self._pool = context.Pool(n, initializer=_start, initargs=(problem,))
+        self._pool: Any = None  # forked at the first task
 
     @property
     def running(self) -> int:
@@ -78,9 +75,14 @@ class ProblemTasks:
         ticket = self._next
         self._next += 1
         self._names[ticket] = name
-        if self._pool is None:
+        if self.processes == 1:
             self._inline.append((ticket, fn, args))
         else:
+            if self._pool is None:
+                context = multiprocessing.get_context("fork")
+                self._pool = context.Pool(
+                    self.processes, initializer=_start, initargs=(self.problem,)
+                )
             self._results[ticket] = self._pool.apply_async(
                 _call,
                 (fn, args),
@@ -94,7 +96,7 @@ class ProblemTasks:
         run now). Raises the task's error, with the forked process' traceback as a note."""
         if not self._names:
             raise ConfigurationError("no task is running")
-        if self._pool is None:
+        if self.processes == 1:
             ticket, fn, args = self._inline.popleft()
             self._names.pop(ticket)
             return ticket, fn(self.problem, *args)
@@ -126,9 +128,14 @@ class ProblemTasks:
 
 
 def _start(problem: Any) -> None:
-    """Pool initializer, once per forked process: keep the problem; Ctrl-C is the parent's."""
+    """Pool initializer, once per forked process: keep the problem; one BLAS thread (the
+    processes are as many as the cores: a BLAS thread pool would only compete with them,
+    and its idle threads spin); Ctrl-C is the parent's."""
     global _PROBLEM
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
+
+    threadpool_limits(limits=1)  # BLAS and OpenMP, for the life of this process
     _PROBLEM = problem
 
 
