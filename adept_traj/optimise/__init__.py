@@ -26,6 +26,7 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
+from adept_traj.optimise.forks import ProblemTasks
 from adept_traj.optimise.front_certificates import (
     certify_front_members,
 )
@@ -66,6 +67,7 @@ from adept_traj.optimise.population import (
     optimum,
     population_values,
 )
+from adept_traj.optimise.post_search import PostSearch, chunk_size
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -117,6 +119,8 @@ __all__ = [
     "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
+    "PostSearch",
+    "ProblemTasks",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
@@ -125,6 +129,7 @@ __all__ = [
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
+    "chunk_size",
     "epsilon_step",
     "has_checkpoint",
     "kinematic_time",
