@@ -14,7 +14,10 @@ Run: ``python benchmarks/bench_post_search.py [--baseline CHECKOUT] [--runs 5]
    stored state: what is timed is everything ``plan`` does after the search (wall time,
    and process CPU time with its children, :func:`resource.getrusage`). The baseline and
    this checkout alternate run by run (paired), so that the machine's load drifts alike
-   for both.
+   for both. The phases are timed too (wall and CPU): the polish, the front's
+   certificates and the reported solution's certificate (``_polish_run``,
+   ``_certify_front``, ``_certified_choice`` of the code before; ``PostSearch.polish`` and
+   ``PostSearch.certificates``, which includes the choice, of this one).
 3. Each run prints a SHA-256 of its result as ``result.json`` encodes it, without the
    timing (the measured times), OO and AE (computed from them) and the workers: the two
    versions must give the same hash (the same front, certificates, choice and T_best).
@@ -60,6 +63,32 @@ def _cpu():
     return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
 
 
+phases = {}
+
+
+def timed(owner, name, label):  # wrap owner.name: its wall and CPU time into phases[label]
+    real = getattr(owner, name)
+
+    def wrapper(*args, **kw):
+        w, c = time.perf_counter(), _cpu()
+        try:
+            return real(*args, **kw)
+        finally:
+            old = phases.get(label, (0.0, 0.0))
+            phases[label] = (old[0] + time.perf_counter() - w, old[1] + _cpu() - c)
+
+    setattr(owner, name, wrapper)
+
+
+if hasattr(planner, "_polish_run"):  # the code before issue #15's post-search
+    timed(planner, "_polish_run", "polish")
+    timed(planner, "_certify_front", "certificates")
+    timed(planner, "_certified_choice", "choice")
+else:
+    from adept_traj.optimise import post_search
+
+    timed(post_search.PostSearch, "polish", "polish")
+    timed(post_search.PostSearch, "certificates", "certificates")
 w0, c0 = time.perf_counter(), _cpu()
 result = planner.plan(problem, **kwargs)
 wall, cpu = time.perf_counter() - w0, _cpu() - c0
@@ -70,11 +99,12 @@ doc["metrics"].pop("OO")
 doc["metrics"].pop("AE")
 doc["problem_settings"].pop("workers")
 digest = hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()[:16]
-print(json.dumps({"wall": wall, "cpu": cpu, "hash": digest, "front": len(result.front)}))
+out = {"wall": wall, "cpu": cpu, "hash": digest, "front": len(result.front), "phases": phases}
+print(json.dumps(out))
 """
 
 
-def make_problem(case: str, workers: int):  # noqa: ANN201 (runs in the child, too)
+def make_problem(case: str, workers: int):
     """The problem of ``case`` (``nsga2:SEED``, ``mode:SEED`` or ``ur5:SEED``)."""
     import adept_traj as at
 
@@ -110,7 +140,7 @@ def make_state(case: str, path: Path, workers: int) -> None:
     problem = make_problem(case, workers)
     real, kept = planner.optimise, []
 
-    def storing(*args, **kw):  # noqa: ANN002, ANN003, ANN202
+    def storing(*args, **kw):
         kept.append(real(*args, **kw))
         return kept[-1]
 
@@ -128,8 +158,13 @@ def timed(checkout: Path, state: Path, case: str, workers: int) -> dict:
     """One fresh process of ``checkout``'s code: the post-search phases of ``case``."""
     env = {**os.environ, "PYTHONPATH": str(checkout)}
     args = [str(state), case, str(workers), str(HERE / "benchmarks")]
+    # -P: the current folder (maybe another checkout) must not come before PYTHONPATH
     out = subprocess.run(
-        [sys.executable, "-c", CHILD, *args], env=env, check=True, capture_output=True, text=True
+        [sys.executable, "-P", "-c", CHILD, *args],
+        env=env,
+        check=True,
+        capture_output=True,
+        text=True,
     )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -158,6 +193,13 @@ def main() -> None:
         print(f"{case} ({args.workers} workers; front of {runs['this'][0]['front']} members)")
         for name, rs in runs.items():
             walls, cpus = [r["wall"] for r in rs], [r["cpu"] for r in rs]
+            labels = sorted({k for r in rs for k in r["phases"]})
+            shown = "; ".join(
+                f"{k} {statistics.median(r['phases'][k][0] for r in rs):.3f} s wall, "
+                f"{statistics.median(r['phases'][k][1] for r in rs):.3f} s CPU"
+                for k in labels
+            )
+            print(f"  {name:8s} phases (medians): {shown}")
             print(
                 f"  {name:8s} wall median {statistics.median(walls):.3f} s "
                 f"({', '.join(f'{w:.3f}' for w in walls)}); CPU median "
