@@ -16,10 +16,9 @@ import pytest
 from adept_traj import TrajectoryProblem
 from adept_traj.analysis import PAPER_WEIGHTS, best_tradeoff
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.optimise import RampSampling, RunState, kinematic_time, planner, post_search
+from adept_traj.optimise import RampSampling, kinematic_time, planner, post_search
 from adept_traj.optimise.forks import ProblemTasks
 from adept_traj.optimise.polish_step import GRADIENT_COST, POLISH_SHARE, _polish_run
-from adept_traj.problem import to_pymoo
 from adept_traj.validation import deep_equal
 
 #: Three members of a paper-budget NSGA-II front (see the file's "source").
@@ -29,20 +28,10 @@ MEMBERS = Path(__file__).parent / "data" / "paper_front_members.json"
 RATE = 400.0
 
 
-def _state(problem: TrajectoryProblem, x: np.ndarray, budget: int) -> RunState:
-    """A final population of the members ``x`` whose polish may spend ``budget`` gradient
-    evaluations (``"front"``: a share of the search's evaluations)."""
-    ev = problem.evaluate_batch(x)
-    return RunState(
-        X=x,
-        F=to_pymoo(ev.objectives),
-        G=ev.constraints,
-        CV=np.maximum(ev.constraints, 0.0).sum(axis=1),
-        n_generations=1,
-        n_evaluations=int(np.ceil(budget * GRADIENT_COST / POLISH_SHARE)),
-        total_s=1.0,
-        evaluation_s=0.5,
-    )
+def _budget(budget: int) -> int:
+    """The search's evaluations whose ``"front"`` polish may spend ``budget`` gradient
+    evaluations."""
+    return int(np.ceil(budget * GRADIENT_COST / POLISH_SHARE))
 
 
 @pytest.fixture(scope="module")
@@ -98,8 +87,8 @@ ONE_STEP = 30
 
 
 @pytest.fixture(scope="module")
-def serial(problem, population):
-    state = _state(problem, population, ONE_STEP)
+def serial(problem, population, run_state):
+    state = run_state(problem, population, _budget(ONE_STEP))
     return state, _phases(problem, state, 1)
 
 
@@ -113,8 +102,10 @@ def test_serial_phases_are_the_polish_and_certificates_of_plan(problem, serial) 
 
 
 @pytest.mark.slow  # two full polishes (the fastest member and two steps): ~3 s
-def test_two_processes_give_the_serial_results_with_every_step(problem, population) -> None:
-    state = _state(problem, population, 10_000)
+def test_two_processes_give_the_serial_results_with_every_step(
+    problem, population, run_state
+) -> None:
+    state = run_state(problem, population, _budget(10_000))
     _same(_phases(problem, state, 2), _phases(problem, state, 1))
 
 
@@ -136,19 +127,21 @@ def test_two_processes_give_the_serial_results(problem, serial) -> None:
 
 
 @pytest.mark.slow  # three polishes: ~3 s
-def test_a_step_started_early_and_not_run_is_discarded(problem, population, monkeypatch) -> None:
+def test_a_step_started_early_and_not_run_is_discarded(
+    problem, population, monkeypatch, run_state
+) -> None:
     """Every step started as soon as a process is free (as if each solve spent nothing);
     the budget lets the fastest member's solve and one step run: the second step's result
     is dropped and the state is the serial one."""
     monkeypatch.setattr(post_search, "_LIKELY", 0)
-    probe = _state(problem, population, 10_000)
+    probe = run_state(problem, population, _budget(10_000))
     chosen = post_search._polish_plan(problem, probe, "front", PAPER_WEIGHTS)
     assert len(chosen.members) >= 2
     with post_search.PostSearch(problem, RATE, 1, False) as post:
         post.polish(probe, "front", PAPER_WEIGHTS)
         used = post._used(chosen)
     budget = used[0] + used[1] + 19  # one step fits, not two
-    state = _state(problem, population, budget)
+    state = run_state(problem, population, _budget(budget))
     expected = _polish_run(problem, state, RATE, "front", PAPER_WEIGHTS)
     started: list = []
     got = _phases(problem, state, 2, started=started)
@@ -158,8 +151,10 @@ def test_a_step_started_early_and_not_run_is_discarded(problem, population, monk
     assert got[0].n_evaluations == state.n_evaluations + used[0] + used[1]
 
 
-def test_an_error_of_a_forked_solve_is_raised_with_its_traceback(problem, population) -> None:
-    state = _state(problem, population, ONE_STEP)
+def test_an_error_of_a_forked_solve_is_raised_with_its_traceback(
+    problem, population, run_state
+) -> None:
+    state = run_state(problem, population, _budget(ONE_STEP))
     x = np.array(state.X, dtype=float)
     fastest = int(np.argmin(x[:, 0]))
     x[fastest, 1] = problem.xu[1] + 1.0  # refused by minimum_time, in the forked process

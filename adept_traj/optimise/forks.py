@@ -22,6 +22,7 @@ stops the processes at once, tasks still running included.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import queue
 import signal
@@ -32,7 +33,7 @@ from typing import Any
 from adept_traj.errors import ConfigurationError
 from adept_traj.validation import as_integer
 
-__all__ = ["ProblemTasks"]
+__all__ = ["ProblemTasks", "one_blas_thread"]
 
 #: The problem of this forked process, set once by the pool's initializer; ``None`` in
 #: every other process.
@@ -63,6 +64,7 @@ class ProblemTasks:
         self._done: queue.SimpleQueue[int] = queue.SimpleQueue()
         self._results: dict[int, Any] = {}
         self._pool: Any = None  # forked at the first task
+        self._blas: Any = None  # this process' BLAS thread limit while the pool lives
 
     @property
     def running(self) -> int:
@@ -79,6 +81,11 @@ class ProblemTasks:
             self._inline.append((ticket, fn, args))
         else:
             if self._pool is None:
+                # One BLAS thread in the processes, set before the fork (set in a forked
+                # process it would start OpenBLAS' threads there, which spin), and in
+                # this one while they run (it mostly waits for them).
+                self._blas = one_blas_thread()
+                self._blas.__enter__()
                 context = multiprocessing.get_context("fork")
                 self._pool = context.Pool(
                     self.processes, initializer=_start, initargs=(self.problem,)
@@ -117,6 +124,9 @@ class ProblemTasks:
         if pool is not None:
             pool.terminate()
             pool.join()
+        blas, self._blas = self._blas, None
+        if blas is not None:
+            blas.__exit__(None, None, None)
         self._names.clear()
         self._inline.clear()
 
@@ -127,15 +137,24 @@ class ProblemTasks:
         self.close()
 
 
+def one_blas_thread() -> contextlib.AbstractContextManager[Any]:
+    """A ``with`` block computing with one BLAS thread (:mod:`threadpoolctl`): SLSQP
+    amplifies the last-bit differences of a BLAS whose sums depend on its thread count.
+    In a :class:`ProblemTasks` process, which computes with one BLAS thread from its start
+    (set in the parent before the fork), nothing: setting the count there again would
+    start OpenBLAS' threads, which spin ≈ 20 ms each after starting."""
+    if _PROBLEM is not None:
+        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits  # lazy: scans the loaded libraries
+
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def _start(problem: Any) -> None:
-    """Pool initializer, once per forked process: keep the problem; one BLAS thread (the
-    processes are as many as the cores: a BLAS thread pool would only compete with them,
-    and its idle threads spin); Ctrl-C is the parent's."""
+    """Pool initializer, once per forked process: keep the problem; Ctrl-C is the parent's.
+    The process computes with one BLAS thread (the parent's setting at the fork)."""
     global _PROBLEM
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
-
-    threadpool_limits(limits=1)  # BLAS and OpenMP, for the life of this process
     _PROBLEM = problem
 
 
