@@ -195,3 +195,22 @@ def test_problem_tasks(problem) -> None:
     assert time.perf_counter() - started < 10.0
     with pytest.raises(ConfigurationError, match="processes"):
         ProblemTasks(problem, 0)
+
+
+def _interrupted(tasks: ProblemTasks, processes: list) -> None:
+    """Start two long tasks, then Ctrl-C (a KeyboardInterrupt while waiting); the forked
+    processes are appended to ``processes``."""
+    tasks.submit(_sleep, 60.0)
+    tasks.submit(_sleep, 60.0)
+    processes.extend(tasks._pool._pool)
+    raise KeyboardInterrupt
+
+
+def test_ctrl_c_stops_the_forked_processes(problem) -> None:
+    started = time.perf_counter()
+    forked, processes = ProblemTasks(problem, 2), []
+    with pytest.raises(KeyboardInterrupt), forked:
+        _interrupted(forked, processes)
+    assert len(processes) == 2
+    assert not any(p.is_alive() for p in processes)
+    assert time.perf_counter() - started < 10.0
