@@ -92,6 +92,7 @@ def serial(problem, population, run_state):
     return state, _phases(problem, state, 1)
 
 
+@pytest.mark.slow  # a third polish: ~1 s
 def test_serial_phases_are_the_polish_and_certificates_of_plan(problem, serial) -> None:
     """One process: the polish of polish_run and a summary per feasible front member."""
     state, (polished, made, front, summaries, _, _) = serial
