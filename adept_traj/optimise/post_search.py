@@ -59,7 +59,7 @@ __all__ = ["PostSearch", "chunk_size"]
 _LIKELY = 2 * MAX_EVALUATIONS
 
 #: Most batches of dense samples per certificate task (:func:`chunk_size`).
-_MOST_BATCHES = 8
+_MOST_BATCHES = 16
 
 
 def chunk_size(samples: Any, most: int, processes: int) -> int:
