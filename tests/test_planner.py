@@ -92,7 +92,8 @@ def test_every_feasible_member_is_certified(
 
     monkeypatch.setattr(post_search, "certify_members", fake_members)
     monkeypatch.setattr(post_search, "certify", fake_certify)
-    x = np.arange(4.0)[:, None]
+    x = np.zeros((4, problem.n_var))
+    x[:, 0] = np.arange(4.0)  # the fakes read the row from T
     feasible = np.array([False, True, True, True])
     order = np.array([2, 0, 1, 3])
     for processes in (1, 2):  # in this process (the order is seen), then forked

@@ -15,7 +15,7 @@ import pytest
 
 from adept_traj import TrajectoryProblem
 from adept_traj.analysis import PAPER_WEIGHTS, best_tradeoff
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
 from adept_traj.optimise import RampSampling, kinematic_time, planner, post_search
 from adept_traj.optimise.forks import ProblemTasks
 from adept_traj.optimise.polish_step import GRADIENT_COST, POLISH_SHARE, _polish_run
@@ -215,3 +215,17 @@ def test_ctrl_c_stops_the_forked_processes(problem) -> None:
     assert len(processes) == 2
     assert not any(p.is_alive() for p in processes)
     assert time.perf_counter() - started < 10.0
+
+
+def test_bad_input_is_refused_before_any_work(problem) -> None:
+    with pytest.raises(InvalidInputError, match="rate_hz"):
+        post_search.PostSearch(problem, 0.0, 2, True)
+    with pytest.raises(InvalidInputError, match="problem"):
+        post_search.PostSearch(None, RATE, 2, True)
+    x = np.zeros((3, problem.n_var))
+    with post_search.PostSearch(problem, RATE, 2, True) as post:
+        with pytest.raises(InputShapeError, match="permutation"):
+            post.certificates(x, np.ones(3, bool), np.array([0, 1, 1]), None)
+        with pytest.raises(InputShapeError, match="shape"):
+            post.certificates(x[:, :4], np.ones(3, bool), np.arange(3), None)
+        assert post._tasks._pool is None  # nothing forked

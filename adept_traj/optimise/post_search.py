@@ -5,7 +5,10 @@ worker count of processes (:class:`~adept_traj.optimise.forks.ProblemTasks`).
 Every piece depends on its own arguments alone (a solve on its start, a certificate on its
 member), so the order in which they run changes nothing: the results are those of the
 serial phases, bit for bit (with one process they run in the serial order, in this
-process). :class:`PostSearch` orders the work so that both cores stay busy:
+process). Before the first fork the main process makes the certifying problem
+(:func:`~adept_traj.analysis.certifying_problem`) and, for a polish, imports
+``scipy.optimize``, so that the processes inherit both. :class:`PostSearch` orders the
+work so that both cores stay busy:
 
 1. the polish (:meth:`PostSearch.polish`): the fastest member's solve first; each ε-step
    when it is sure to run (the budget rule of ``_PolishPlan.runs`` in
@@ -42,12 +45,14 @@ from adept_traj.analysis import (
     dense_samples,
     non_dominated,
 )
+from adept_traj.errors import InputShapeError
 from adept_traj.optimise.forks import ProblemTasks
 from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS
 from adept_traj.optimise.polish_solves import _polished, _solve, _Solved
 from adept_traj.optimise.polish_step import _polish_plan, polish_mode
-from adept_traj.problem import from_pymoo
+from adept_traj.problem import TrajectoryProblem, from_pymoo
+from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
 
 __all__ = ["PostSearch", "chunk_size"]
 
@@ -113,7 +118,9 @@ class PostSearch:
     """
 
     def __init__(self, problem: Any, rate_hz: float, processes: int, speculate: bool) -> None:
-        self.problem, self.rate_hz = problem, rate_hz
+        check_type(problem, TrajectoryProblem, "problem")
+        self.problem = problem
+        self.rate_hz = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
         certifying_problem(problem)  # made here: the forked processes inherit it
         self._tasks = ProblemTasks(problem, processes)
         self._parallel = self._tasks.processes > 1
@@ -215,6 +222,18 @@ class PostSearch:
             ``None`` for the others; the exact :class:`~adept_traj.analysis.Certificate`
             of the reported solution; its row).
         """
+        x = as_batch(x, "x", self.problem.n_var)
+        if x.ndim != 2:
+            raise InputShapeError(f"x must have shape (n, {self.problem.n_var}); got {x.shape}")
+        feasible = np.asarray(feasible, dtype=bool)
+        order = np.asarray(order)
+        if feasible.shape != (len(x),) or sorted(order.tolist()) != list(range(len(x))):
+            raise InputShapeError(
+                f"feasible must have shape ({len(x)},) and order must be a permutation of "
+                f"0…{len(x) - 1}; got shapes {feasible.shape} and {order.shape}"
+            )
+        if max_certify is not None:
+            max_certify = as_integer(max_certify, "max_certify", minimum=1)
         candidates = [int(k) for k in order if feasible[k]][:max_certify]
         keys = [row.tobytes() for row in x]
         self._spare = _Queue(x[:0], self.rate_hz)
