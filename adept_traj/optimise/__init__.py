@@ -26,7 +26,7 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
-from adept_traj.optimise.forks import ProblemTasks
+from adept_traj.optimise.forks import ProblemTasks, one_blas_thread
 from adept_traj.optimise.front_certificates import (
     certify_front_members,
 )
@@ -136,6 +136,7 @@ __all__ = [
     "load_checkpoint",
     "make_algorithm",
     "minimum_time",
+    "one_blas_thread",
     "optimise",
     "optimum",
     "plan",
