@@ -28,6 +28,7 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
+from adept_traj.optimise.forks import ProblemTasks, one_blas_thread
 from adept_traj.optimise.front_certificates import (
     certify_front_members,
 )
@@ -69,6 +70,7 @@ from adept_traj.optimise.population import (
     optimum,
     population_values,
 )
+from adept_traj.optimise.post_search import PostSearch, chunk_size
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -123,6 +125,8 @@ __all__ = [
     "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
+    "PostSearch",
+    "ProblemTasks",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
@@ -132,6 +136,7 @@ __all__ = [
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
+    "chunk_size",
     "crowding_distance",
     "epsilon_step",
     "has_checkpoint",
@@ -139,6 +144,7 @@ __all__ = [
     "load_checkpoint",
     "make_algorithm",
     "minimum_time",
+    "one_blas_thread",
     "optimise",
     "optimum",
     "plan",
