@@ -9,6 +9,7 @@ inherit them)."""
 
 from __future__ import annotations
 
+import argparse
 import multiprocessing
 import os
 import re
@@ -235,3 +236,30 @@ def test_start_and_wait_check_their_arguments(stored: PlanningResult, tmp_path: 
             helper.wait()
         pid = helper.pid
     assert _gone(pid, within=0.0)
+
+
+@pytest.mark.slow
+def test_the_helper_writes_the_same_files_as_the_caller(
+    stored: PlanningResult, tmp_path: Path
+) -> None:
+    """Real figures and page: with a ready helper and without one, byte for byte."""
+    scene, robot = at.Scene.paper(), at.Robot.adept_one_xl()
+    problem = argparse.Namespace(robot=robot, scene=scene)
+    opts = argparse.Namespace(
+        no_html=False, no_plots=False, ros=None, allow_infeasible=False, algorithm="nsga2"
+    )
+    for name in ("helper", "caller"):
+        (tmp_path / name).mkdir()
+    with finisher.start_finisher(robot, scene, figures=True, html=True) as helper:
+        assert helper.ready(120.0)
+        assert plan_command._finish(stored, problem, tmp_path / "helper", opts, helper) == 0
+    assert plan_command._finish(stored, problem, tmp_path / "caller", opts) == 0
+    caller, helped = (_files(tmp_path / name) for name in ("caller", "helper"))
+    assert len([f for f in caller if f.endswith(".png")]) == 5
+    assert "playback.html" in caller
+    assert helped == caller  # the same names, the same bytes
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    """{path relative to ``folder``: bytes} of every file below ``folder``."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
