@@ -15,7 +15,8 @@ how much of it the main process waits for on an idle one.
 :mod:`adept_traj.viz.finisher` (started before the timing, as ``plan`` starts it with the
 run, and waited for until its imports are done, as on an idle machine): the main process
 then saves ``result.json`` while the helper, whose imports are done, draws and writes the
-page. Its CPU columns do not count the helper's imports (done during the run).
+page. Its CPU columns count the helper's imports too (done during a real run, at nice 19; the
+helper is reaped, and its CPU time counted, inside ``_finish``).
 
 ``--compare OTHER_CHECKOUT`` runs the same measurement with ``PYTHONPATH=OTHER_CHECKOUT``
 (e.g. an older version of the code) alternately with this checkout, so that both see the
