@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-import pickle
 import signal
 import sys
 import threading
@@ -319,11 +318,10 @@ def _helper(
         try:
             paths = _write(results, figures_dir, html_path, robot, scene)
         except Exception as exc:  # every error is sent to the caller, which raises it
-            code, text = 1, traceback.format_exc()
-            try:
-                pickled = pickle.dumps(exc)
-            except Exception:  # sent as text only
-                pickled = None
+            from adept_traj.viz.plots.all_figures import _report
+
+            code = 1
+            text, pickled = _report(exc)
         conn.send((text, pickled, paths))
         conn.close()
     except BaseException:  # SIGTERM (cancel, the caller's death) or a broken pipe
