@@ -138,6 +138,27 @@ def test_an_error_of_the_helper_is_raised_and_the_run_not_completed(
     assert _gone(int(marker.read_text().split()[0]), within=0.0)
 
 
+def test_a_helper_killed_while_drawing_has_its_work_done_by_the_caller(
+    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(finisher, "_preload", _marking_preload(tmp_path / "preload"))
+    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
+    caller = os.getpid()
+
+    def dies_unless_in_the_caller(_results, path, **_kwargs):
+        if os.getpid() != caller:
+            os.kill(os.getpid(), signal.SIGKILL)  # the helper (or a fork) killed outright
+        Path(path).write_text(f"tool {os.getpid()}")
+        return Path(path)
+
+    out = tmp_path / "run"
+    code = _plan(monkeypatch, stored, out, "--no-html", tool_path_3d=dies_unless_in_the_caller)
+    assert code == 0
+    assert (out / "figures" / "tool_path_nsga2.png").read_text() == f"tool {caller}"
+    assert len(list((out / "figures").iterdir())) == 5
+    assert not (out / "run.json").exists()  # marked complete
+
+
 @pytest.mark.parametrize("raised", [KeyboardInterrupt, RuntimeError])
 def test_ctrl_c_or_an_error_during_the_run_stops_the_helper(
     raised: type[BaseException],

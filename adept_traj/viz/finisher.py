@@ -176,8 +176,9 @@ class Finisher:
             self.cancel()
             raise
         self._reap()
+        order, self._order = self._order, None
         if message is None:
-            return _write(*self._order, self._robot, self._scene)
+            return _write(*order, self._robot, self._scene)
         text, pickled, paths = message
         if text:
             from adept_traj.viz.plots.all_figures import _error
