@@ -14,6 +14,8 @@ and both best trade-offs.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import importlib.util
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -44,6 +46,7 @@ from adept_traj.cycle import (
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import PlanningInterrupted, plan
 from adept_traj.results import PlanningResult, Replay
+from adept_traj.viz.finisher import start_finisher
 
 __all__ = ["add_parser", "comparison_markdown", "run"]
 
@@ -220,36 +223,62 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_arguments(args)
     runs = (("nsga2", args.pop_nsga2), ("mode", args.pop_mode))
     results = {}
-    try:
-        for name, pop in runs:  # both refused before either starts
-            check_run_options(problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}")
-        for name, pop in runs:
-            with ProgressReporter(name, quiet=args.quiet) as progress:
-                results[name] = plan(
-                    problem,
-                    name,
-                    seed=args.seed,
-                    pop_size=pop,
-                    n_gen=args.gens,
-                    weights=args.weights,
-                    progress=progress,
-                    rate_hz=args.rate,
+    with contextlib.ExitStack() as stack:
+        try:
+            for name, pop in runs:  # both refused before either starts
+                check_run_options(
+                    problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}"
                 )
-            results[name].save(args.out / name)
-            print(summary(results[name], args.out / name))
-    except PlanningInterrupted as exc:  # no checkpoint: the finished runs are saved
-        print(f"{exc}", file=sys.stderr)
-        return status.INTERRUPTED
-    finally:
-        problem.close()
-    if not args.no_plots:
-        replays = {
-            name: Replay.of(r, robot=problem.robot, scene=problem.scene)
-            for name, r in results.items()
-        }
-        save_figures(results, args.out / "figures", replays)
+            # the figures' helper imports matplotlib while the runs go on (at nice 19)
+            finisher = stack.enter_context(_finisher(args, problem))
+            _plan_both(args, problem, runs, results)
+        except PlanningInterrupted as exc:  # no checkpoint: the finished runs are saved
+            print(f"{exc}", file=sys.stderr)
+            return status.INTERRUPTED
+        finally:
+            problem.close()
+        if not args.no_plots:
+            figures = args.out / "figures"
+            if finisher is not None and finisher.start(results, figures=figures):
+                print(f"{len(finisher.wait())} figures in {figures}")
+            else:
+                replays = {
+                    name: Replay.of(r, robot=problem.robot, scene=problem.scene)
+                    for name, r in results.items()
+                }
+                save_figures(results, figures, replays)
     text = comparison_markdown(results, args.weights)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "comparison.md").write_text(text)
     print(text)
     return status.OK
+
+
+def _finisher(args: argparse.Namespace, problem: Any) -> Any:
+    """The helper process that will draw the figures (:mod:`adept_traj.viz.finisher`), in
+    a context that stops it; an empty context (``None``) with ``--no-plots``, without
+    matplotlib or when no process can be forked (the figures are then drawn here)."""
+    if args.no_plots or importlib.util.find_spec("matplotlib") is None:
+        return contextlib.nullcontext(None)
+    try:
+        return start_finisher(problem.robot, problem.scene, figures=True, html=False)
+    except OSError:  # e.g. no memory to fork
+        return contextlib.nullcontext(None)
+
+
+def _plan_both(args: argparse.Namespace, problem: Any, runs: tuple, results: dict) -> None:
+    """Run NSGA-II and MODE in turn into ``results``, each saved and summarised."""
+    for name, pop in runs:
+        with ProgressReporter(name, quiet=args.quiet) as progress:
+            results[name] = plan(
+                problem,
+                name,
+                seed=args.seed,
+                pop_size=pop,
+                n_gen=args.gens,
+                weights=args.weights,
+                progress=progress,
+                rate_hz=args.rate,
+            )
+        results[name].save(args.out / name)
+        print(summary(results[name], args.out / name))

@@ -20,6 +20,8 @@ refused before the run starts.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -57,6 +59,7 @@ from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
 from adept_traj.scene import SHIPPED_SCENES
 from adept_traj.validation import as_integer
+from adept_traj.viz.finisher import Finisher, start_finisher
 
 __all__ = ["RUN_FILE", "add_parser", "run"]
 
@@ -245,12 +248,34 @@ def run(args: argparse.Namespace) -> int:
             saved = {k: getattr(opts, k) for k in _SAVED}
             saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
             write_arguments(folder, saved)
-        return _run(opts, problem, folder, resume)
+        with _finisher(opts, problem) as finisher:
+            return _run(opts, problem, folder, resume, finisher)
     finally:
         problem.close()
 
 
-def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, resume: bool) -> int:
+def _finisher(opts: argparse.Namespace, problem: TrajectoryProblem) -> Any:
+    """The helper process that will write the figures and ``playback.html``
+    (:func:`adept_traj.viz.finisher.start_finisher`: it imports matplotlib and meshcat at
+    the lowest priority while the run goes on), in a context that stops it; an empty
+    context (``None``) with ``--no-plots --no-html``, without matplotlib (the finish says
+    so) or when no process can be forked (the finish writes them itself)."""
+    figures, html = not opts.no_plots, not opts.no_html
+    if not (figures or html) or (figures and importlib.util.find_spec("matplotlib") is None):
+        return contextlib.nullcontext(None)
+    try:
+        return start_finisher(problem.robot, problem.scene, figures=figures, html=html)
+    except OSError:  # e.g. no memory to fork: the finish writes the files itself
+        return contextlib.nullcontext(None)
+
+
+def _run(
+    opts: argparse.Namespace,
+    problem: TrajectoryProblem,
+    folder: Path,
+    resume: bool,
+    finisher: Finisher | None = None,
+) -> int:
     """Plan, save and mark the run complete; on Ctrl-C say how to resume."""
     checkpoint = folder / CHECKPOINT
     try:
@@ -269,7 +294,7 @@ def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, res
                 rate_hz=opts.rate,
                 polish="off" if opts.no_polish else opts.polish,
             )
-        return _finish(result, problem, folder, opts)
+        return _finish(result, problem, folder, opts, finisher)
     except PlanningInterrupted as exc:
         if exc.checkpoint is None:
             sys.stderr.write(
@@ -287,14 +312,51 @@ def _run(opts: argparse.Namespace, problem: TrajectoryProblem, folder: Path, res
 
 
 def _finish(
-    result: PlanningResult, problem: TrajectoryProblem, folder: Path, opts: argparse.Namespace
+    result: PlanningResult,
+    problem: TrajectoryProblem,
+    folder: Path,
+    opts: argparse.Namespace,
+    finisher: Finisher | None = None,
 ) -> int:
     """Write every output of the run, then mark it complete (the last step). The figures
-    are drawn in a forked process while this one writes ``result.json`` and
-    ``playback.html``; an error of theirs is raised here, before the run is marked
+    and ``playback.html`` are written by ``finisher`` (the helper process started with the
+    run, if it is ready) or else by :func:`_write_outputs`, while this process writes
+    ``result.json``; an error of theirs is raised here, before the run is marked
     complete."""
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
+    figures = None if opts.no_plots else folder / "figures"
+    html = None if opts.no_html else folder / HTML_FILE
+    try:
+        handed = finisher is not None and finisher.start(
+            {opts.algorithm: result}, figures=figures, html=html
+        )
+    except BaseException:  # the result is saved all the same
+        result.save(folder)
+        raise
+    if handed:
+        try:
+            result.save(folder)
+            paths = finisher.wait()
+        finally:
+            finisher.cancel()  # stops the helper if anything above failed (else a no-op)
+        if figures is not None:
+            print(f"{len(paths)} figures in {figures}")
+    else:
+        _write_outputs(result, folder, opts, replay)
+    print(summary(result, folder))
+    code = status.OK
+    if opts.ros is not None:
+        code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)
+    commit(folder)
+    return code
+
+
+def _write_outputs(
+    result: PlanningResult, folder: Path, opts: argparse.Namespace, replay: Replay
+) -> None:
+    """Without a ready helper: the figures drawn in a forked process while this one writes
+    ``result.json`` and ``playback.html`` (its error raised here)."""
     figures = None
     try:
         if not opts.no_plots:
@@ -313,12 +375,6 @@ def _finish(
     finally:
         if figures is not None:
             figures.cancel()  # stops the drawing if anything above failed (else a no-op)
-    print(summary(result, folder))
-    code = status.OK
-    if opts.ros is not None:
-        code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)
-    commit(folder)
-    return code
 
 
 def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool, replay: Replay) -> int:

@@ -276,6 +276,16 @@ def _error(text: str, pickled: bytes | None) -> BaseException:
     return error
 
 
+def _report(exc: BaseException) -> tuple[str, bytes | None]:
+    """In a forked process, while ``exc`` is handled: its traceback and ``exc`` pickled
+    (``None`` if it does not pickle: sent as text only), for :func:`_error` in the caller."""
+    text = traceback.format_exc()
+    try:
+        return text, pickle.dumps(exc)
+    except Exception:  # e.g. an attribute that does not pickle
+        return text, None
+
+
 def _child(jobs: list[_Job], processes: int, sender: Any) -> None:
     """In the forked process: draw, send ``("", None)`` or (the error's traceback, the
     pickled error or ``None``), and end at once (``os._exit``: none of the parent's exit
@@ -286,11 +296,8 @@ def _child(jobs: list[_Job], processes: int, sender: Any) -> None:
     try:
         _draw(jobs, processes)
     except BaseException as exc:  # every error is sent to the caller, which raises it
-        code, text = 1, traceback.format_exc()
-        try:
-            pickled = pickle.dumps(exc)
-        except Exception:  # sent as text only
-            pickled = None
+        code = 1
+        text, pickled = _report(exc)
     try:
         sender.send((text, pickled))
         sender.close()
