@@ -35,7 +35,7 @@ _DRIVER = r"""
 import os, signal, sys
 import adept_traj.cli._run_folder as run_folder
 import adept_traj.cli.plan as plan_command
-import adept_traj.optimise.post_search as post_search
+import adept_traj.optimise.planner as planner
 import adept_traj.problem.trajectory_problem as trajectory_problem
 import adept_traj.results.csv_codec as csv_codec
 import adept_traj.results.json_codec as json_codec
@@ -46,7 +46,7 @@ from adept_traj.cli import main
 how, where, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 owner, name = {
     "evaluate": (trajectory_problem.TrajectoryProblem, "_evaluate"),
-    "certify": (post_search.PostSearch, "certificates"),  # the front's and the reported
+    "certify": (planner, "certify"),
     "result_json": (json_codec, "_write_json"),
     "front_csv": (csv_codec, "_write_front_csv"),
     "html": (meshcat_scene, "static_html"),

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -14,12 +13,13 @@ from adept_traj.analysis import PAPER_WEIGHTS, certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     MAX_EVALUATIONS,
+    RunState,
     epsilon_step,
     polish_members,
     polish_mode,
     polish_run,
 )
-from adept_traj.problem import MAXIMISED
+from adept_traj.problem import MAXIMISED, to_pymoo
 
 #: Three members of a paper-budget NSGA-II front (see the file's "source").
 MEMBERS = Path(__file__).parent / "data" / "paper_front_members.json"
@@ -82,12 +82,24 @@ def test_input_is_checked_before_any_work(problem, members, scale) -> None:
         epsilon_step(paper, members[0], 0, scale)
 
 
-def test_polish_members_appends_the_dominating_move(
-    problem, members, scale, step, run_state
-) -> None:
+def _state(problem: TrajectoryProblem, x: np.ndarray, n_evaluations: int) -> RunState:
+    ev = problem.evaluate_batch(x)
+    return RunState(
+        X=x,
+        F=to_pymoo(ev.objectives),
+        G=ev.constraints,
+        CV=np.maximum(ev.constraints, 0.0).sum(axis=1),
+        n_generations=1,
+        n_evaluations=n_evaluations,
+        total_s=1.0,
+        evaluation_s=0.5,
+    )
+
+
+def test_polish_members_appends_the_dominating_move(problem, members, scale, step) -> None:
     """The kept step joins the population (its start stays: the front extraction drops
     it); evaluations and time are counted."""
-    state = run_state(problem, members, 100)
+    state = _state(problem, members, 100)
     out = polish_members(problem, state, [2], scale, 1000.0)
     assert len(out.X) == len(members) + 1
     np.testing.assert_array_equal(out.X[-1], step.x)
@@ -99,26 +111,15 @@ def test_polish_members_appends_the_dominating_move(
     assert none.n_evaluations == 100
 
 
-def test_front_mode_of_a_small_run_polishes_only_the_fastest(
-    problem, members, monkeypatch, run_state
-) -> None:
+def test_front_mode_of_a_small_run_polishes_only_the_fastest(problem, members, monkeypatch) -> None:
     """A quarter of 100 evaluations pays for no member step: "front" leaves the members
     alone (the fastest member's polish, tested in test_polish.py, is left out here)."""
     import adept_traj.optimise.polish_step as polish_step
 
-    kinds = []
-
-    def fastest_only(problem, kind, x0, scale, rate_hz):
-        kinds.append(kind)  # the fastest member's polish, found nothing (costs 1 evaluation)
-        outcome = SimpleNamespace(n_evaluations=1, evaluation_s=0.0, x=x0)
-        return polish_step._Solved(outcome, None, 0.0)
-
-    monkeypatch.setattr(polish_step, "_solve", fastest_only)
-    state = run_state(problem, members, 100)
+    monkeypatch.setattr(polish_step, "_polish_fastest", lambda problem, state, rate, made: state)
+    state = _state(problem, members, 100)
     out = polish_run(problem, state, 1000.0, "front", PAPER_WEIGHTS)
-    assert kinds == ["fastest"]
-    np.testing.assert_array_equal(out.X, state.X)
-    assert out.n_evaluations == 101
+    assert out is state
 
 
 def test_polish_settings(problem) -> None:
@@ -153,11 +154,11 @@ def test_all_mode_keeps_hypervolume_and_certifies(problem) -> None:
     assert full.front.n_certified == int(np.all(full.front.constraints <= 0.0, axis=1).sum())
 
 
-def test_no_member_step_without_objective_gradients(problem, members, scale, run_state) -> None:
+def test_no_member_step_without_objective_gradients(problem, members, scale) -> None:
     """A problem whose objectives have no gradients (the paper's z3 penalty) keeps its
     members: the default polish of plan must not fail there."""
     paper = TrajectoryProblem(
         problem.robot, problem.scene, problem.start, problem.goal, z3="paper-sphere"
     )
-    state = run_state(paper, members, 10_000)
+    state = _state(paper, members, 10_000)
     assert polish_members(paper, state, [0, 1, 2], scale, 1000.0) is state

@@ -10,7 +10,7 @@ import pytest
 
 import adept_traj as at
 from adept_traj.analysis import certify
-from adept_traj.optimise import planner, post_search
+from adept_traj.optimise import planner
 from adept_traj.results import NO_FEASIBLE_WARNING
 
 
@@ -57,7 +57,7 @@ def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monk
         certified.append(x)
         return certify(problem, x, **kwargs)
 
-    monkeypatch.setattr(post_search, "certify", counting)
+    monkeypatch.setattr(planner, "certify", counting)
     # MODE with 12 x 2 finds no feasible member (seed 1)
     res = at.plan(problem, "mode", seed=1, pop_size=12, n_gen=2)
     assert len(res.front) == 10  # never empty: the 10 least infeasible
@@ -79,31 +79,31 @@ def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monk
     ],
 )
 def test_every_feasible_member_is_certified(
-    problem, monkeypatch, passes, max_certify, expected_tries, certified, reported
+    monkeypatch, passes, max_certify, expected_tries, certified, reported
 ) -> None:
     tried = []
 
-    def fake_members(problem, x, rate_hz):
-        tried.extend(int(row[0]) for row in x)
-        return tuple(SimpleNamespace(feasible=int(row[0]) in passes) for row in x)
+    def fake_members(problem, x, members, rate_hz):
+        out = [None] * len(x)
+        for k in members:
+            tried.append(k)
+            out[k] = SimpleNamespace(feasible=k in passes)
+        return tuple(out)
 
     def fake_certify(problem, x, rate_hz):
         return SimpleNamespace(index=int(x[0]))
 
-    monkeypatch.setattr(post_search, "certify_members", fake_members)
-    monkeypatch.setattr(post_search, "certify", fake_certify)
-    x = np.zeros((4, problem.n_var))
-    x[:, 0] = np.arange(4.0)  # the fakes read the row from T
-    feasible = np.array([False, True, True, True])
+    monkeypatch.setattr(planner, "certify_front_members", fake_members)
+    monkeypatch.setattr(planner, "certify", fake_certify)
+    front = SimpleNamespace(x=np.arange(4.0)[:, None], feasible=np.array([False, True, True, True]))
     order = np.array([2, 0, 1, 3])
-    for processes in (1, 2):  # in this process (the order is seen), then forked
-        tried.clear()
-        with post_search.PostSearch(problem, 1000.0, processes, True) as post:
-            summaries, certificate, index = post.certificates(x, feasible, order, max_certify)
-        mask = np.array([s is not None and s.feasible for s in summaries])
-        assert tried == (expected_tries if processes == 1 else [])
-        np.testing.assert_array_equal(np.flatnonzero(mask), certified)
-        assert (index, certificate.index) == (reported, reported)
+    summaries = planner._certify_front(None, front, order, 1000.0, max_certify)
+    mask = np.array([s is not None and s.feasible for s in summaries])
+    assert tried == expected_tries
+    np.testing.assert_array_equal(np.flatnonzero(mask), certified)
+    front = SimpleNamespace(x=front.x, feasible=mask)
+    certificate, index = planner._certified_choice(None, front, order, 1000.0)
+    assert (index, certificate.index) == (reported, reported)
 
 
 @pytest.mark.slow  # 10 kHz re-check of every member: ~7 s (slow tier, run by .ci/run)

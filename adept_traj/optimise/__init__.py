@@ -28,7 +28,6 @@ from adept_traj.optimise.duplicates import (
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
-from adept_traj.optimise.forks import ProblemTasks, one_blas_thread
 from adept_traj.optimise.front_certificates import (
     certify_front_members,
 )
@@ -70,7 +69,6 @@ from adept_traj.optimise.population import (
     optimum,
     population_values,
 )
-from adept_traj.optimise.post_search import PostSearch, chunk_size
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -125,8 +123,6 @@ __all__ = [
     "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
-    "PostSearch",
-    "ProblemTasks",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
@@ -136,7 +132,6 @@ __all__ = [
     "certify_front_members",
     "check_population_memory",
     "checkpoint_arrays",
-    "chunk_size",
     "crowding_distance",
     "epsilon_step",
     "has_checkpoint",
@@ -144,7 +139,6 @@ __all__ = [
     "load_checkpoint",
     "make_algorithm",
     "minimum_time",
-    "one_blas_thread",
     "optimise",
     "optimum",
     "plan",

@@ -8,15 +8,14 @@ NSGA-II's 100 members, 4.3 s for MODE's 500).
 costly and the cheap ones), each process calls
 :func:`~adept_traj.analysis.certify_members` once on its share, and the summaries come
 back in the members' rows. Every certificate depends on its member alone, so the result is
-the serial one, field for field (tested). Fork hands the problem to the processes
-(:class:`~adept_traj.optimise.forks.ProblemTasks`: nothing is pickled but each process'
-members and their summaries). :func:`~adept_traj.plan` certifies its front with
-:class:`~adept_traj.optimise.post_search.PostSearch` instead (the same summaries, made
-while the polish runs).
+the serial one, field for field (tested). Fork hands the problem and the decision vectors
+to the processes (nothing is pickled but the lists of rows and the summaries).
 """
 
 from __future__ import annotations
 
+import multiprocessing
+import signal
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,12 +26,15 @@ from adept_traj.analysis.member_certificate import (
     certify_members,
     certifying_problem,
 )
-from adept_traj.errors import InputShapeError
-from adept_traj.optimise.forks import ProblemTasks
+from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
 
 __all__ = ["certify_front_members"]
+
+#: (problem, x, rate_hz) of the certifying process, set once by the pool's initializer;
+#: ``None`` in every other process.
+_JOB: tuple[TrajectoryProblem, np.ndarray, float] | None = None
 
 
 def certify_front_members(
@@ -68,23 +70,39 @@ def certify_front_members(
     rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
     n_proc = problem.settings.workers if workers is None else workers
     n_proc = min(as_integer(n_proc, "workers", minimum=1), len(rows))
-    if n_proc <= 1:
+    if n_proc <= 1 or "fork" not in multiprocessing.get_all_start_methods():
         return certify_members(problem, xs, rows, rate_hz=rate)
     certifying_problem(problem)  # made once here: the forked processes inherit it
     shares = [rows[i::n_proc] for i in range(n_proc)]
+    pool = multiprocessing.get_context("fork").Pool(
+        n_proc, initializer=_start, initargs=(problem, xs, rate)
+    )
+    try:
+        parts = pool.map(_certify_share, shares, chunksize=1)
+        pool.close()
+    except BaseException:  # Ctrl-C included: stop the processes at once
+        pool.terminate()
+        raise
+    finally:
+        pool.join()
     out: list[MemberCertificate | None] = [None] * len(xs)
-    with ProblemTasks(problem, n_proc) as tasks:
-        tickets = {
-            tasks.submit(_certify_share, xs[share], rate, name="certificates"): share
-            for share in shares
-        }
-        while tasks.running:
-            ticket, part = tasks.wait()
-            for k, certificate in zip(tickets[ticket], part):
-                out[k] = certificate
+    for share, part in zip(shares, parts):
+        for k, certificate in zip(share, part):
+            out[k] = certificate
     return tuple(out)
 
 
-def _certify_share(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> tuple:
-    """Task: the summaries of the members ``x`` (k, n_var), in that order."""
-    return certify_members(problem, x, rate_hz=rate_hz)
+def _start(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> None:
+    """Pool initializer, once per forked process: keep the job; Ctrl-C is the parent's."""
+    global _JOB
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _JOB = (problem, x, rate_hz)
+
+
+def _certify_share(rows: list[int]) -> list[MemberCertificate]:
+    """Run in a certifying process: the summaries of ``rows``, in that order."""
+    if _JOB is None:  # only a pool started by certify_front_members calls this
+        raise ConfigurationError("_certify_share runs in a certify_front_members process only")
+    problem, x, rate_hz = _JOB
+    out = certify_members(problem, x, rows, rate_hz=rate_hz)
+    return [out[k] for k in rows]

@@ -49,7 +49,6 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.forks import one_blas_thread
 from adept_traj.optimise.polish import PolishOutcome
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.problem import MAXIMISED, local_constraints, objective_gradients
@@ -144,7 +143,10 @@ def _start(problem: Any, x0: Any) -> np.ndarray:
 
 
 def _threads_limited(problem: Any, x0: np.ndarray, *args: Any, **options: Any) -> PolishOutcome:
-    with one_blas_thread():  # as in minimum_time
+    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
+    from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
+
+    with threadpool_limits(limits=1, user_api="blas"):
         return _solve(problem, x0, *args, **options)
 
 

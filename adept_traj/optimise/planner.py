@@ -16,10 +16,7 @@ Steps:
    certified members. The reported solution is the first certified member in the
    trade-off order (the best trade-off when it passes), with its exact certificate; if
    none passes, the trade-off choice with its failing certificate. A front of
-   least-infeasible members thus costs one certificate. Steps 4 and 5 run on the
-   problem's ``workers`` processes (:class:`~adept_traj.optimise.post_search.PostSearch`:
-   the polish's solves, the front's certificates made meanwhile, the reported solution's
-   certificate), with the serial results, bit for bit.
+   least-infeasible members thus costs one certificate.
 5. **Polish** (default; before steps 2–4; :func:`~adept_traj.optimise.polish_run`): the
    fastest feasible member of the final population is polished by SLSQP
    (:func:`~adept_traj.optimise.polish_fastest`), then (``polish="front"``, the default)
@@ -40,12 +37,13 @@ from __future__ import annotations
 
 import json
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis.certificate import Certificate, certify
 from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff, objective_weights
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
@@ -53,6 +51,7 @@ from adept_traj.analysis.indicators import (
     normalised_hypervolume,
     objective_bounds,
 )
+from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
     optimizer_overhead,
@@ -62,9 +61,9 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.analysis.weighted_sum import WeightedSum
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
+from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, time_optimal_run
-from adept_traj.optimise.post_search import PostSearch
+from adept_traj.optimise.polish_step import TIME_OPTIMAL, _polish_run, polish_mode, time_optimal_run
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.optimise.weighted_move import weighted_run
 from adept_traj.problem import TrajectoryProblem, from_pymoo
@@ -147,6 +146,47 @@ def _history(state: Any, final_front: np.ndarray | None) -> list[GenerationRecor
             )
         )
     return records
+
+
+def _certify_front(
+    problem: TrajectoryProblem,
+    front: Front,
+    order: np.ndarray,
+    rate_hz: float,
+    max_certify: int | None,
+    known: Mapping[bytes, MemberCertificate] | None = None,
+) -> tuple[MemberCertificate | None, ...]:
+    """(n,) the summary of each member's dense certificate with the continuous guarantee
+    (:func:`~adept_traj.analysis.certify_members`, on the problem's workers:
+    :func:`~adept_traj.optimise.certify_front_members`), ``None`` for a member not certified.
+
+    Only members the optimiser marked feasible are certified (a member that violates a
+    constraint at the optimiser's samples fails the dense check as well), in the trade-off
+    ``order`` (n,), at most ``max_certify`` of them (``None``: all). A member whose
+    ``x.tobytes()`` is in ``known`` (the polish's summaries, made the same way) keeps that
+    summary instead of being certified again.
+    """
+    candidates = [int(k) for k in order if front.feasible[k]]
+    if max_certify is not None:
+        candidates = candidates[:max_certify]
+    known = {} if known is None else known
+    reused = {k: known[front.x[k].tobytes()] for k in candidates if front.x[k].tobytes() in known}
+    todo = [k for k in candidates if k not in reused]
+    out = list(certify_front_members(problem, front.x, todo, rate_hz=rate_hz))
+    for k, summary in reused.items():
+        out[k] = summary
+    return tuple(out)
+
+
+def _certified_choice(
+    problem: TrajectoryProblem, front: Front, order: np.ndarray, rate_hz: float
+) -> tuple[Certificate, int]:
+    """(certificate, front index) of the reported solution: the first certified member in
+    the trade-off ``order`` (n,), or the best trade-off ``order[0]`` with its failing
+    certificate when none is; the certificate computes every distance exactly."""
+    passed = [int(k) for k in order if front.feasible[k]]
+    index = passed[0] if passed else int(order[0])
+    return certify(problem, front.x[index], rate_hz=rate_hz), index
 
 
 def warn_missing_limits(robot: str, limits: JointLimits) -> None:
@@ -235,6 +275,7 @@ def plan(
         objective_weights(weights, 6)  # bad weights refused before any long work
     warn_missing_limits(problem.robot.name, problem.robot.limits)
     n_searched: int | None = 0  # population rows made by the search (the rest by the local solver)
+    polished: dict[bytes, MemberCertificate] = {}  # the polish's certificates, by x.tobytes()
     if algorithm == TIME_OPTIMAL and weights is not None:
         state, settings_dict = weighted_run(problem, seed, weights, **params)
         weighted = WeightedSum.from_settings(settings_dict)
@@ -258,15 +299,29 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-    with PostSearch(problem, rate_hz, problem.settings.workers, max_certify is None) as post:
-        if name != TIME_OPTIMAL:
-            state = post.polish(state, polish, _weights(weights))[0]
-        front, rows, objectives, feasible, warning = _front(state)
-        choice = best_tradeoff(front.objectives, _weights(weights))
-        order = choice.order if weighted is None else weighted.order(front.objectives)
-        summaries, certificate, index = post.certificates(
-            front.x, front.feasible, order, max_certify
-        )
+        state, polished = _polish_run(problem, state, rate_hz, polish, _weights(weights))
+    # The final population's values as the run computed them (z4 back to positive).
+    objectives = from_pymoo(state.F)
+    constraints = np.asarray(state.G, dtype=float)
+    feasible = np.all(constraints <= 0.0, axis=1)
+    if feasible.any():
+        rows = np.flatnonzero(feasible)
+        rows = rows[non_dominated(objectives[rows])]
+        warning = None
+    else:
+        violation = np.maximum(constraints, 0.0).sum(axis=1)
+        rows = np.argsort(violation, kind="stable")[:_LEAST_INFEASIBLE]
+        warning = NO_FEASIBLE_WARNING
+    rows = np.unique(rows)  # deterministic order
+    front = Front(
+        x=state.X[rows],
+        objectives=objectives[rows],
+        constraints=constraints[rows],
+        feasible=feasible[rows],
+    )
+    choice = best_tradeoff(front.objectives, _weights(weights))
+    order = choice.order if weighted is None else weighted.order(front.objectives)
+    summaries = _certify_front(problem, front, order, rate_hz, max_certify, polished)
     certified = np.array([s is not None and s.feasible for s in summaries], dtype=bool)
     front = Front(
         x=front.x,
@@ -276,6 +331,7 @@ def plan(
         n_certified=int(certified.sum()),
         certificates=summaries,
     )
+    certificate, index = _certified_choice(problem, front, order, rate_hz)
     lo, hi = objective_bounds(front.objectives)
     metrics = Metrics(
         ssm=spread(front.objectives) if len(rows) > 1 else None,
@@ -306,33 +362,6 @@ def plan(
         history=_history(state, front.objectives if feasible.any() else None),
         warning=warning,
     )
-
-
-def _front(state: Any) -> tuple[Front, np.ndarray, np.ndarray, np.ndarray, str | None]:
-    """The front of the final population (the feasible non-dominated members, else the
-    :data:`_LEAST_INFEASIBLE` least infeasible ones with a warning), its population rows
-    (m,), the population's objectives (pop, 6) (z4 positive) and feasibility (pop,), and
-    the warning (``None``: some member is feasible)."""
-    # The final population's values as the run computed them (z4 back to positive).
-    objectives = from_pymoo(state.F)
-    constraints = np.asarray(state.G, dtype=float)
-    feasible = np.all(constraints <= 0.0, axis=1)
-    if feasible.any():
-        rows = np.flatnonzero(feasible)
-        rows = rows[non_dominated(objectives[rows])]
-        warning = None
-    else:
-        violation = np.maximum(constraints, 0.0).sum(axis=1)
-        rows = np.argsort(violation, kind="stable")[:_LEAST_INFEASIBLE]
-        warning = NO_FEASIBLE_WARNING
-    rows = np.unique(rows)  # deterministic order
-    front = Front(
-        x=state.X[rows],
-        objectives=objectives[rows],
-        constraints=constraints[rows],
-        feasible=feasible[rows],
-    )
-    return front, rows, objectives, feasible, warning
 
 
 def _weights(weights: Sequence[float] | None) -> Sequence[float]:

@@ -39,7 +39,6 @@ import numpy as np
 
 from adept_traj.analysis.member_certificate import certify_members
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.forks import one_blas_thread
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
@@ -141,10 +140,13 @@ def minimum_time(
         raise ConfigurationError(f"tol must be > 0 [s]; got {tol}")
     if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
         raise ConfigurationError("x0 must lie inside the decision bounds (problem.xl, problem.xu)")
+    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
+    from threadpoolctl import threadpool_limits  # lazy, as scipy.optimize
+
     # One BLAS thread: a multi-threaded BLAS sums in an order that depends on its thread
     # count, and SLSQP amplifies the last-bit differences (a move polished in a Dask worker,
     # single-threaded, differed from the same move polished here at 1e-13 s).
-    with one_blas_thread():
+    with threadpool_limits(limits=1, user_api="blas"):
         return _minimum_time(problem, x0, max_iter, tol, buffer)
 
 

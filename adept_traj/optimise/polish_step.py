@@ -32,6 +32,7 @@ seeded ramps) as a population, for the same front extraction and certificates.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
@@ -39,20 +40,12 @@ import numpy as np
 
 from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
-from adept_traj.analysis.member_certificate import MemberCertificate
+from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.loop import RunState
-from adept_traj.optimise.polish import time_optimal
-from adept_traj.optimise.polish_solves import (
-    _POLISH_ITERATIONS,
-    _fastest_row,
-    _polished,
-    _PolishPlan,
-    _solve,
-    _Solved,
-    _with_members,
-)
-from adept_traj.problem import from_pymoo
+from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
+from adept_traj.optimise.polish import PolishOutcome, minimum_time, time_optimal
+from adept_traj.problem import from_pymoo, to_pymoo
 from adept_traj.robot.limits import LIMITS
 
 __all__ = [
@@ -91,6 +84,10 @@ POLISH_SHARE = 0.25
 #: The name of the single-objective mode of :func:`~adept_traj.plan`.
 TIME_OPTIMAL = "time-optimal"
 
+#: SLSQP iterations of the polish (a start near an optimum converges in 3–10; from a slow
+#: detour SLSQP may not converge at all).
+_POLISH_ITERATIONS = 30
+
 
 def polish_fastest(problem: Any, state: RunState, rate_hz: float) -> RunState:
     """``state`` with the polished fastest member appended to its population when it passes
@@ -114,11 +111,28 @@ def _polish_fastest(
 ) -> RunState:
     """:func:`polish_fastest`, adding the summary of the certificate it made (if any) to
     ``certified`` under the move's ``x.tobytes()``."""
-    start = _fastest_row(state)
-    if start is None:
+    X = np.asarray(state.X, dtype=float)
+    feasible = np.flatnonzero(np.all(np.asarray(state.G) <= 0.0, axis=1))
+    if len(feasible) == 0:
         return state
-    solved = _solve(problem, "fastest", np.asarray(state.X, dtype=float)[start], None, rate_hz)
-    return _polished(state, solved, None, certified)
+    start = feasible[np.argmin(X[feasible, 0])]
+    outcome = minimum_time(problem, X[start], max_iter=_POLISH_ITERATIONS)
+    tic = time.perf_counter()
+    keep = (
+        outcome.feasible
+        and outcome.x[0] < X[start, 0]
+        and _certified(problem, outcome.x, rate_hz, certified)
+    )
+    spent = outcome.seconds + time.perf_counter() - tic
+    counted = dataclasses.replace(
+        state,
+        n_evaluations=state.n_evaluations + outcome.n_evaluations,
+        total_s=state.total_s + spent,
+        evaluation_s=state.evaluation_s + outcome.evaluation_s,
+    )
+    if not keep:
+        return counted
+    return _with_members(counted, [outcome])
 
 
 def polish_mode(polish: Any) -> str:
@@ -139,22 +153,6 @@ def polish_run(problem: Any, state: RunState, rate_hz: float, mode: str, weights
     return _polish_run(problem, state, rate_hz, mode, weights)[0]
 
 
-def _polish_plan(problem: Any, state: RunState, mode: str, weights: Any) -> _PolishPlan:
-    """The plan of the polish ``mode`` (:data:`POLISH_MODES`) of ``state``
-    with the f_c ``weights`` (6,): the members chosen on the front before any polish."""
-    mode = polish_mode(mode)
-    if mode == "off":
-        return _PolishPlan(None, np.empty(0, dtype=int), np.ones(6), None)
-    members, scale = _chosen_members(state, mode, weights)
-    torque_limit = problem.robot.limits.bound(LIMITS[4].name)
-    if problem.settings.z3 != "clearance" or not np.all(np.isfinite(torque_limit)):
-        members = np.empty(0, dtype=int)  # no objective gradients (objective_gradients refuses)
-    budget = None
-    if mode == "front":
-        budget = int(POLISH_SHARE * state.n_evaluations / GRADIENT_COST)
-    return _PolishPlan(_fastest_row(state), members, scale, budget)
-
-
 def _polish_run(
     problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any
 ) -> tuple[RunState, dict[bytes, MemberCertificate]]:
@@ -162,21 +160,30 @@ def _polish_run(
     move's ``x.tobytes()`` (:func:`~adept_traj.analysis.certify_members` at ``rate_hz``
     with its default tolerance: what :func:`~adept_traj.plan` makes for a front member, so
     that ``plan`` certifies no polished move twice)."""
+    mode = polish_mode(mode)
     certified: dict[bytes, MemberCertificate] = {}
-    chosen = _polish_plan(problem, state, mode, weights)
-    if polish_mode(mode) == "off":
+    if mode == "off":
         return state, certified
-    X = np.asarray(state.X, dtype=float)
-    fastest = None
-    if chosen.fastest is not None:
-        fastest = _solve(problem, "fastest", X[chosen.fastest], None, rate_hz)
-    used = [0 if fastest is None else fastest.outcome.n_evaluations]
-    steps: list[_Solved] = []
-    while chosen.runs(used):
-        k = chosen.members[len(steps)]
-        steps.append(_solve(problem, "step", X[k], chosen.scale, rate_hz))
-        used.append(steps[-1].outcome.n_evaluations)
-    return _polished(state, fastest, steps, certified), certified
+    members, scale = _chosen_members(state, mode, weights)
+    budget = None
+    if mode == "front":
+        budget = int(POLISH_SHARE * state.n_evaluations / GRADIENT_COST)
+    before = state.n_evaluations
+    state = _polish_fastest(problem, state, rate_hz, certified)
+    if budget is not None:
+        budget -= state.n_evaluations - before
+    state = _polish_members(problem, state, members, scale, rate_hz, budget, certified)
+    return state, certified
+
+
+def _certified(
+    problem: Any, x: np.ndarray, rate_hz: float, certified: dict[bytes, MemberCertificate]
+) -> bool:
+    """Whether the move ``x`` (n_var,) passes its certificate; its summary is added to
+    ``certified``."""
+    summary = certify_members(problem, x[None], rate_hz=rate_hz)[0]
+    certified[x.tobytes()] = summary
+    return summary.feasible
 
 
 def _chosen_members(state: RunState, mode: str, weights: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -241,17 +248,52 @@ def polish_members(
         is polished only while a whole step (at most
         :data:`~adept_traj.optimise.member_polish.MAX_EVALUATIONS`) fits in what is left.
     """
+    return _polish_members(problem, state, members, scale, rate_hz, max_evaluations, {})
+
+
+def _polish_members(
+    problem: Any,
+    state: RunState,
+    members: Any,
+    scale: Any,
+    rate_hz: float,
+    max_evaluations: int | None,
+    certified: dict[bytes, MemberCertificate],
+) -> RunState:
+    """:func:`polish_members`, adding the summaries of the certificates it made to
+    ``certified`` under each move's ``x.tobytes()``."""
     rows = np.asarray(members, dtype=int).ravel()
     torque_limit = problem.robot.limits.bound(LIMITS[4].name)
     if problem.settings.z3 != "clearance" or not np.all(np.isfinite(torque_limit)):
         return state  # no objective gradients (objective_gradients refuses)
-    chosen = _PolishPlan(None, rows, np.asarray(scale, dtype=float), max_evaluations)
+    if len(rows) == 0:
+        return state
     X = np.asarray(state.X, dtype=float)
-    used, steps = [0], []
-    while chosen.runs(used):
-        steps.append(_solve(problem, "step", X[rows[len(steps)]], chosen.scale, rate_hz))
-        used.append(steps[-1].outcome.n_evaluations)
-    return _polished(state, None, steps, {})
+    kept, n_evaluations, seconds, evaluation_s = [], 0, 0.0, 0.0
+    for k in rows:
+        if max_evaluations is not None and n_evaluations + MAX_EVALUATIONS > max_evaluations:
+            break
+        outcome = epsilon_step(problem, X[k], 0, scale)
+        tic = time.perf_counter()
+        ok = (
+            outcome.feasible
+            and outcome.x[0] < X[k, 0]
+            and _certified(problem, outcome.x, rate_hz, certified)
+        )
+        seconds += outcome.seconds + time.perf_counter() - tic
+        n_evaluations += outcome.n_evaluations
+        evaluation_s += outcome.evaluation_s
+        if ok:
+            kept.append(outcome)
+    if n_evaluations == 0:  # no step ran
+        return state
+    counted = dataclasses.replace(
+        state,
+        n_evaluations=state.n_evaluations + n_evaluations,
+        total_s=state.total_s + seconds,
+        evaluation_s=state.evaluation_s + evaluation_s,
+    )
+    return _with_members(counted, kept) if kept else counted
 
 
 def time_optimal_run(problem: Any, seed: int, **params: Any) -> tuple[RunState, dict[str, Any]]:
@@ -287,3 +329,17 @@ def time_optimal_run(problem: Any, seed: int, **params: Any) -> tuple[RunState, 
         if not any(np.allclose(o.x, e.x, rtol=0.0, atol=1e-9) for e in outcomes[:i])
     ]
     return _with_members(empty, distinct), settings
+
+
+def _with_members(state: RunState, outcomes: list[PolishOutcome]) -> RunState:
+    """``state`` with the polished moves appended to its population (pymoo's signs)."""
+    if not outcomes:
+        raise ConfigurationError("no polished move to add")
+    G = np.array([o.constraints for o in outcomes])
+    return dataclasses.replace(
+        state,
+        X=np.concatenate([state.X, [o.x for o in outcomes]]),
+        F=np.concatenate([state.F, to_pymoo(np.array([o.objectives for o in outcomes]))]),
+        G=np.concatenate([state.G, G]),
+        CV=np.concatenate([np.ravel(state.CV), np.maximum(G, 0.0).sum(axis=1)]),
+    )
