@@ -384,3 +384,29 @@ def test_ctrl_c_in_the_main_process_stops_the_busy_workers() -> None:
             evaluator.evaluate(bad)
         assert _worker_pids() == before  # terminated while they evaluated, and waited for
         np.testing.assert_array_equal(evaluator.evaluate(x).objectives[:, 0], x[:, 0])
+
+
+def test_a_forked_copy_of_the_owner_evaluates_in_itself() -> None:
+    """A process forked from the evaluator's owner after its workers started (e.g. a task
+    process certifying front members) must not use the owner's pipes: it evaluates the
+    whole population itself, and the owner's workers still serve the owner."""
+    x = np.arange(12.0)[:, None] * np.ones((1, 2))
+    with ParallelEvaluator(_pid_rows, workers=2, n_var=2) as evaluator:
+        evaluator.evaluate(x)  # the owner's worker is running now
+        read, write = os.pipe()
+        child = os.fork()
+        if child == 0:  # the forked copy: report whether every row was its own
+            try:
+                rows = evaluator.evaluate(x).objectives
+                ok = bool(np.all(rows[:, 1] == os.getpid()) and np.all(rows[:, 0] == x[:, 0]))
+                os.write(write, b"1" if ok else b"0")
+            finally:
+                os._exit(0)
+        os.close(write)
+        answer = os.read(read, 1)
+        os.close(read)
+        os.waitpid(child, 0)
+        again = evaluator.evaluate(x).objectives
+    assert answer == b"1"
+    np.testing.assert_array_equal(again[:, 0], x[:, 0])
+    assert len(set(again[:, 1])) == 2  # the owner's worker and the owner itself

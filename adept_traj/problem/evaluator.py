@@ -203,8 +203,13 @@ class ParallelEvaluator:
                 f"x must have shape (pop, {self.n_var}) with pop ≥ workers = {self.workers}; "
                 f"got {xa.shape}"
             )
-        chunks = np.array_split(xa, self.workers)  # the main process takes the last one
         pool = self._workers
+        if os.getpid() != pool.pid:
+            # A forked copy of the process that owns the workers (e.g. a process that
+            # certifies front members): their pipes are not its own; it evaluates the
+            # population itself (the same rows bit for bit).
+            return self._evaluate(xa)
+        chunks = np.array_split(xa, self.workers)  # the main process takes the last one
         try:
             if not pool.processes:
                 pool.start(self._evaluate, self.workers - 1)
