@@ -55,12 +55,16 @@ owner, name = {
     "committed": (run_folder, "sync_folder"),  # run.json removed, the checkpoint not yet
 }[where]
 original, calls = getattr(owner, name), []
+# The command's process: the signal goes to it even when the instant comes in a process
+# it forked (the figures and playback.html are written by the finish's helper process),
+# as a Ctrl-C at the terminal or a kill of the command would.
+MAIN = os.getpid()
 
 
 def stopping(*args, **kwargs):
     calls.append(1)
     if len(calls) == n:
-        os.kill(os.getpid(), signal.SIGKILL if how == "kill" else signal.SIGINT)
+        os.kill(MAIN, signal.SIGKILL if how == "kill" else signal.SIGINT)
     return original(*args, **kwargs)
 
 
