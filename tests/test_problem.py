@@ -296,10 +296,64 @@ def test_parallel_evaluator_hands_the_function_to_forked_workers() -> None:
     with pytest.raises(ConfigurationError, match=r"workers must be an integer in \[2, ∞\]"):
         ParallelEvaluator(evaluate, workers=1, n_var=3)
     with ParallelEvaluator(evaluate, workers=2, n_var=3) as evaluator:
-        with pytest.raises(InputShapeError, match=r"pop ≥ workers = 2; got \(1, 3\)"):
-            evaluator.evaluate(x[:1])
+        with pytest.raises(InputShapeError, match=r"pop ≥ 1; got \(0, 3\)"):
+            evaluator.evaluate(x[:0])
         with pytest.raises(InputShapeError, match=r"\(\.\.\., 3\)"):
             evaluator.evaluate(x[:, :2])
+
+
+def test_a_population_smaller_than_the_workers_is_cut_into_fewer_chunks() -> None:
+    """More workers than rows (``--workers`` defaults to the cores: a many-core machine and
+    a small population): one row per process, the last workers idle, the rows in order."""
+    x = np.arange(6.0).reshape(3, 2)
+    with ParallelEvaluator(_pid_rows, workers=5, n_var=2) as evaluator:
+        ev = evaluator.evaluate(x)
+        one = evaluator.evaluate(x[:1])
+    np.testing.assert_array_equal(ev.objectives[:, 0], x[:, 0])
+    assert len(set(ev.objectives[:, 1])) == 3
+    assert ev.objectives[-1, 1] == os.getpid()
+    np.testing.assert_array_equal(one.objectives[:, 0], x[:1, 0])
+    assert one.objectives[0, 1] == os.getpid()
+
+
+def test_a_worker_killed_between_populations_is_a_broken_pool() -> None:
+    """A worker that died while idle (its pipe broken) is reported as a broken pool, not
+    as a bare ``BrokenPipeError``; the next population is evaluated by new workers."""
+    x = np.arange(8.0)[:, None] * np.ones((1, 2))
+    before = _worker_pids()
+    with ParallelEvaluator(_pid_rows, workers=2, n_var=2) as evaluator:
+        evaluator.evaluate(x)
+        (worker,) = _worker_pids() - before
+        os.kill(worker, signal.SIGKILL)
+        deadline = time.monotonic() + 5.0
+        while worker in _worker_pids() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        with pytest.raises(BrokenProcessPool, match="ended abruptly"):
+            evaluator.evaluate(x)
+        np.testing.assert_array_equal(evaluator.evaluate(x).objectives[:, 0], x[:, 0])
+
+
+def test_workers_stop_although_another_fork_holds_their_pipes() -> None:
+    """A process forked from the owner while the workers live holds copies of the
+    owner's pipe ends, so closing them sends no end-of-file: ``close`` tells the workers
+    to stop and returns."""
+    x = np.arange(8.0)[:, None] * np.ones((1, 2))
+    evaluator = ParallelEvaluator(_pid_rows, workers=2, n_var=2)
+    evaluator.evaluate(x)
+    read, write = os.pipe()
+    holder = os.fork()
+    if holder == 0:  # holds every inherited descriptor until the test lets it go
+        os.close(write)
+        os.read(read, 1)
+        os._exit(0)
+    os.close(read)
+    try:
+        start = time.monotonic()
+        evaluator.close()
+        assert time.monotonic() - start < 4.0
+    finally:
+        os.close(write)
+        os.waitpid(holder, 0)
 
 
 # ParallelEvaluator's failures: a worker's exception, a killed worker, Ctrl-C in the main

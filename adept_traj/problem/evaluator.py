@@ -4,7 +4,7 @@ A :class:`~adept_traj.problem.TrajectoryProblem` with ``workers > 1`` creates on
 :class:`ParallelEvaluator` when a population first needs it. ``workers`` is the number of
 processes that evaluate: the calling (main) process and ``workers - 1`` worker processes
 that the evaluator forks (Linux ``fork``) at its first population. A population ``x``
-(pop, n_var) is split into ``workers`` contiguous chunks (pop ≥ workers): each worker
+(pop, n_var) is split into ``min(workers, pop)`` contiguous chunks: each worker
 receives its chunk through its own pipe, the main process evaluates the last chunk
 meanwhile, then reads the workers' evaluations back. Each chunk is evaluated exactly as
 the serial evaluation would, so the results are identical, bit for bit, to evaluating
@@ -32,6 +32,7 @@ its pipe and exits.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import pickle
@@ -67,6 +68,10 @@ def available_cores() -> int:
     return max(1, n)
 
 
+#: Seconds a worker is given to exit on the evaluator's word before it is terminated.
+_STOP_TIMEOUT = 5.0
+
+
 class _Workers:
     """The worker processes of one evaluator and the main process' end of their pipes
     (mutable state shared with the evaluator's finalizer, which must not hold the
@@ -96,15 +101,24 @@ class _Workers:
         still evaluating; with ``wait``, wait for every worker to exit."""
         processes, connections, busy = self.processes, self.connections, self.busy
         self.processes, self.connections, self.busy = [], [], False
+        mine = os.getpid() == self.pid  # else a forked copy of the main process
         for connection in connections:
+            if mine and not busy:
+                # An explicit word: another process forked from this one may hold a copy
+                # of this end of the pipe, and the worker would never read its end.
+                with contextlib.suppress(OSError):
+                    connection.send(None)
             connection.close()
-        if os.getpid() != self.pid:  # a forked copy of the main process: not its workers
+        if not mine:
             return
         for process in processes:
             if busy:
                 process.terminate()
             if wait:
-                process.join()
+                process.join(timeout=_STOP_TIMEOUT)
+                if process.is_alive():  # deaf to the word: stopped outright
+                    process.terminate()
+                    process.join()
 
 
 def _serve(
@@ -121,6 +135,8 @@ def _serve(
         try:
             x = connection.recv()
         except (EOFError, OSError):  # the evaluator closed the pipe, or its process died
+            return
+        if x is None:  # the evaluator's word to stop
             return
         try:
             reply = pickle.dumps(("", evaluate(x)), protocol=pickle.HIGHEST_PROTOCOL)
@@ -187,21 +203,22 @@ class ParallelEvaluator:
         return self._finalizer.alive
 
     def evaluate(self, x: np.ndarray) -> Evaluation:
-        """Evaluate a population ``x`` (pop, n_var), pop ≥ ``workers``.
+        """Evaluate a population ``x`` (pop, n_var), pop ≥ 1.
 
-        Returns the rows of the chunks' evaluations in the order of ``x`` (``seconds`` 0:
-        the caller times the call). If a chunk fails, its exception is raised here (a
-        worker's with the worker's traceback as a note; a worker that died:
+        ``x`` is cut into ``min(workers, pop)`` chunks (a population smaller than
+        ``workers`` leaves the last workers idle). Returns the rows of the chunks'
+        evaluations in the order of ``x`` (``seconds`` 0: the caller times the call). If
+        a chunk fails, its exception is raised here (a worker's with the worker's
+        traceback as a note; a worker that died, while evaluating or before:
         :class:`concurrent.futures.process.BrokenProcessPool`) and the workers are stopped
         (new ones are forked for the next population).
         """
         if not self.running:
             raise ConfigurationError("this ParallelEvaluator is closed: make a new one")
         xa = as_batch(x, "x", self.n_var)
-        if xa.ndim != 2 or len(xa) < self.workers:
+        if xa.ndim != 2 or len(xa) < 1:
             raise InputShapeError(
-                f"x must have shape (pop, {self.n_var}) with pop ≥ workers = {self.workers}; "
-                f"got {xa.shape}"
+                f"x must have shape (pop, {self.n_var}) with pop ≥ 1; got {xa.shape}"
             )
         pool = self._workers
         if os.getpid() != pool.pid:
@@ -209,15 +226,17 @@ class ParallelEvaluator:
             # certifies front members): their pipes are not its own; it evaluates the
             # population itself (the same rows bit for bit).
             return self._evaluate(xa)
-        chunks = np.array_split(xa, self.workers)  # the main process takes the last one
+        # The main process takes the last chunk; workers beyond the chunks stay idle.
+        chunks = np.array_split(xa, min(self.workers, len(xa)))
         try:
             if not pool.processes:
                 pool.start(self._evaluate, self.workers - 1)
             pool.busy = True
-            for connection, chunk in zip(pool.connections, chunks):
-                connection.send(np.ascontiguousarray(chunk))
+            used = list(zip(pool.processes, pool.connections))[: len(chunks) - 1]
+            for (process, connection), chunk in zip(used, chunks):
+                _send(process, connection, np.ascontiguousarray(chunk))
             mine = self._evaluate(chunks[-1])
-            parts = [_receive(p, c) for p, c in zip(pool.processes, pool.connections)]
+            parts = [_receive(p, c) for p, c in used]
             pool.busy = False
         except BaseException:  # a failed chunk, a dead worker, Ctrl-C: stop the workers
             pool.stop(wait=True)
@@ -234,6 +253,21 @@ class ParallelEvaluator:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _send(
+    process: multiprocessing.process.BaseProcess, connection: Connection, chunk: np.ndarray
+) -> None:
+    """Send ``chunk`` to a worker; a worker that died (e.g. killed between two
+    populations) is a :class:`~concurrent.futures.process.BrokenProcessPool`."""
+    try:
+        connection.send(chunk)
+    except OSError as exc:  # EPIPE: the worker's end is gone
+        process.join(timeout=1.0)
+        raise BrokenProcessPool(
+            f"an evaluation worker process (pid {process.pid}) ended abruptly "
+            f"(exit code {process.exitcode})"
+        ) from exc
 
 
 def _receive(process: multiprocessing.process.BaseProcess, connection: Connection) -> Evaluation:
