@@ -97,7 +97,7 @@ class ProblemSettings:
         Processes evaluating a population in parallel (default 1: in this process).
         With ``workers > 1`` a population of at least 16 is split into ``workers``
         chunks (one row each if fewer), evaluated by this process and ``workers - 1``
-        forked processes (Linux) of a :class:`~adept_traj.problem.ParallelEvaluator`
+        forked processes (Linux) of a :class:`~adept_traj.problem.evaluator.ParallelEvaluator`
         that the problem owns; results are identical to the serial evaluation. The
         workers are forked when first needed and hold a snapshot of the problem (later
         edits of ``robot.model`` are not seen by them); :meth:`TrajectoryProblem.close`
