@@ -144,3 +144,18 @@ def test_the_nsga2_of_make_algorithm_runs_as_pymoos_nsga2() -> None:
         assert algorithm.tournament_type == "comp_by_dom_and_crowding"
     assert runs[0] == runs[1]
     assert type(ours.termination) is type(theirs.termination)
+
+
+def test_duplicates_of_rows_whose_sums_are_not_finite_match_pymoo() -> None:
+    """Rows whose sum overflows (or holds inf or NaN) are compared with every row: the
+    decisions are pymoo's, and no numpy warning is raised."""
+    big, inf, nan = 1e308, np.inf, np.nan
+    X = np.array([[big, big], [big, big], [0, 1], [inf, 1], [inf, 1], [nan, 0], [0, 1.0]])
+    with np.errstate(all="ignore"):
+        expected = DefaultDuplicateElimination()._do(
+            Population.new(X=X), None, np.zeros(len(X), dtype=bool)
+        )
+    with np.errstate(all="raise"):
+        ours = BlockedDuplicateElimination().duplicates(X)
+    np.testing.assert_array_equal(ours, expected)
+    assert ours.tolist() == [False, True, False, False, False, False, True]

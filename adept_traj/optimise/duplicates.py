@@ -110,18 +110,26 @@ class BlockedDuplicateElimination(DefaultDuplicateElimination):
         differ by at most :meth:`_reach` has row sums within ``width`` (those differences
         plus both sums' rounding, at most n_var·2⁻⁵² times the sum of magnitudes each)."""
         n_var, reach = X.shape[1], self._reach()
-        sx, sy = X.sum(axis=1), Y.sum(axis=1)
-        scale = np.abs(X).sum(axis=1) + n_var * reach + 1.0
-        width = 2.0 * n_var * reach + 8.0 * n_var * 2.0**-52 * scale
-        order = np.argsort(sy, kind="stable")
-        sorted_sums = sy[order]
-        lo = np.searchsorted(sorted_sums, sx - width, side="left")
-        hi = np.searchsorted(sorted_sums, sx + width, side="right")
+        with np.errstate(invalid="ignore", over="ignore"):  # non-finite sums: below
+            sx, sy = X.sum(axis=1), Y.sum(axis=1)
+            scale = np.abs(X).sum(axis=1) + n_var * reach + 1.0
+            width = 2.0 * n_var * reach + 8.0 * n_var * 2.0**-52 * scale
+            order = np.argsort(sy, kind="stable")
+            sorted_sums = sy[order]
+            lo = np.searchsorted(sorted_sums, sx - width, side="left")
+            hi = np.searchsorted(sorted_sums, sx + width, side="right")
+        # A sum that is not finite (an overflow, an infinite or NaN variable) bounds
+        # nothing: such a row is compared with every row of Y.
+        wide = ~(np.isfinite(sx) & np.isfinite(width))
+        lo[wide], hi[wide] = 0, len(Y)
+        if not np.all(np.isfinite(sy)):
+            lo[:], hi[:] = 0, len(Y)  # a non-finite sum of Y sorts anywhere: all pairs
         return lo, hi, order
 
     def _mark(self, X: np.ndarray, Y: np.ndarray, i: np.ndarray, j: np.ndarray, marked) -> None:
         """Mark the rows ``i`` of ``X`` within ``epsilon`` of the rows ``j`` of ``Y``."""
-        gap = np.abs(X[i] - Y[j]).max(axis=1, initial=0.0)  # NaN: never within
+        with np.errstate(invalid="ignore"):  # inf − inf
+            gap = np.abs(X[i] - Y[j]).max(axis=1, initial=0.0)  # NaN: never within
         # A pair differing by more than the reach in a variable is farther apart than
         # epsilon; a pair equal in every variable is at distance 0. Only pairs in between
         # (a few ulps apart) need the distance itself, as pymoo's cdist computes it.

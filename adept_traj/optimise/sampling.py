@@ -66,10 +66,8 @@ def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
         acceleration is
 
         .. math::
-            a = \mathrm{clip}\!\left(rac{s\,\min(h,\ 0.5 - h)}{r},\ -1,\ 1
-    ight)
-              = s\,\min\!\left(rac{h}{r},\ rac{0.5 - h}{r},\ 1
-    ight)
+            a = \mathrm{clip}\!\left(\frac{s\,\min(h,\ 0.5 - h)}{r},\ -1,\ 1\right)
+              = s\,\min\!\left(\frac{h}{r},\ \frac{0.5 - h}{r},\ 1\right)
 
         (s = ±1 the half's sign, h the distance to the nearer end), the same numbers bit for
         bit as the right-hand side: r > 0, so the smaller numerator gives the smaller rounded
