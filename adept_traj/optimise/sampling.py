@@ -58,22 +58,22 @@ _SIGNED_RISE = np.where(_GRID < 0.5, 1.0, -1.0) * np.minimum(_HALF, 0.5 - _HALF)
 
 def _s_curve(u: np.ndarray, r: np.ndarray) -> np.ndarray:
     r"""Normalised S-curves σ(u) (σ(0) = 0, σ(1) = 1, rest to rest) with jerk-phase fraction
-        ``r``: acceleration ramps up over r, holds, ramps down over r (first half), mirrored
-        negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast.
+    ``r``: acceleration ramps up over r, holds, ramps down over r (first half), mirrored
+    negative in the second half. ``u`` (..., k) clipped to [0, 1]; ``r`` (...) broadcast.
 
-        Tabulated on :data:`_GRID` (two running sums of the acceleration), then interpolated;
-        only the ``2 k`` tabulated points each curve is read at are normalised. The
-        acceleration is
+    Tabulated on :data:`_GRID` (two running sums of the acceleration), then interpolated;
+    only the ``2 k`` tabulated points each curve is read at are normalised. The
+    acceleration is
 
-        .. math::
-            a = \mathrm{clip}\!\left(\frac{s\,\min(h,\ 0.5 - h)}{r},\ -1,\ 1\right)
-              = s\,\min\!\left(\frac{h}{r},\ \frac{0.5 - h}{r},\ 1\right)
+    .. math::
+        a = \mathrm{clip}\!\left(\frac{s\,\min(h,\ 0.5 - h)}{r},\ -1,\ 1\right)
+          = s\,\min\!\left(\frac{h}{r},\ \frac{0.5 - h}{r},\ 1\right)
 
-        (s = ±1 the half's sign, h the distance to the nearer end), the same numbers bit for
-        bit as the right-hand side: r > 0, so the smaller numerator gives the smaller rounded
-        quotient, and a sign of ±1 commutes with the rounded division and the clipping. One
-        division and two clippings in place instead of two divisions, three minima and a
-        product (≈ 35 % less of the curve's table)."""
+    (s = ±1 the half's sign, h the distance to the nearer end), the same numbers bit for
+    bit as the right-hand side: r > 0, so the smaller numerator gives the smaller rounded
+    quotient, and a sign of ±1 commutes with the rounded division and the clipping. One
+    division and two clippings in place instead of two divisions, three minima and a
+    product (≈ 35 % less of the curve's table)."""
     r = np.asarray(r, dtype=float)[..., None]
     acc = np.divide(_SIGNED_RISE, r)
     np.minimum(acc, 1.0, out=acc)
