@@ -14,6 +14,8 @@ import multiprocessing
 import os
 import re
 import signal
+import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -239,6 +241,22 @@ def test_a_helper_dies_with_its_killed_caller(ready: bool, tmp_path: Path) -> No
     os.kill(caller.pid, signal.SIGKILL)
     caller.join()
     assert _gone(helper)
+
+
+def test_a_script_that_never_cancels_its_helper_still_exits(tmp_path: Path) -> None:
+    """multiprocessing joins its children at exit; a helper still waiting for its order
+    is stopped first, so the interpreter exits (it hung before)."""
+    script = (
+        "import adept_traj as at\n"
+        "from adept_traj.viz.finisher import start_finisher\n"
+        "f = start_finisher(at.Robot.adept_one_xl(), at.Scene.paper(), figures=True, html=False)\n"
+        "print(f.pid, flush=True)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert _gone(int(done.stdout.split()[-1]))
 
 
 def test_start_and_wait_check_their_arguments(stored: PlanningResult, tmp_path: Path) -> None:

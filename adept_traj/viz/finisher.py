@@ -26,6 +26,7 @@ stops it and returns ``False``, and the caller writes the files itself.
 
 from __future__ import annotations
 
+import atexit
 import multiprocessing
 import os
 import signal
@@ -108,6 +109,9 @@ class Finisher:
         process.start()  # (flushes sys.stdout and sys.stderr before the fork)
         child.close()
         self._process, self.pid = process, process.pid
+        # A caller that never cancels: stopped at the interpreter's exit, before
+        # multiprocessing's own exit hook (registered earlier, run later) joins it.
+        atexit.register(self.cancel)
 
     def ready(self, timeout: float = 0.0) -> bool:
         """Whether the helper has finished its imports (waiting up to ``timeout`` [s]);
@@ -200,6 +204,7 @@ class Finisher:
         self._process.join()
         self._conn.close()
         self._process, self.pid = None, None
+        atexit.unregister(self.cancel)
 
     def __enter__(self) -> Finisher:
         return self
