@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from pymoo.operators.survival.rank_and_crowding.metrics import get_crowding_function
 
+from adept_traj.errors import InputShapeError
 from adept_traj.optimise import crowding_distance
 
 #: Modules that neither the plan command's import nor a run's generations may load.
@@ -123,3 +124,9 @@ def test_the_polish_limits_scipys_blas_too_when_scipy_is_imported_late(which: st
     (libraries,) = ast.literal_eval(out.stdout.strip().splitlines()[-1])
     assert len(libraries) >= 2  # numpy's OpenBLAS and scipy's
     assert all(threads == 1 for _, threads in libraries), libraries
+
+
+@pytest.mark.parametrize("F", [np.ones(3), np.ones((3, 0))])
+def test_crowding_distance_refuses_what_is_not_a_front(F) -> None:
+    with pytest.raises(InputShapeError, match=r"F must have shape \(n, m\)"):
+        crowding_distance(F)

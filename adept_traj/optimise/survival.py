@@ -50,6 +50,7 @@ from pymoo.util import default_random_state
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from pymoo.util.randomized_argsort import randomized_argsort
 
+from adept_traj.errors import InputShapeError
 from adept_traj.optimise.population import population_values
 
 __all__ = ["RankAndCrowdingSurvival", "crowding_distance"]
@@ -60,6 +61,8 @@ def crowding_distance(F: np.ndarray) -> np.ndarray:
     pymoo's ``"cd"`` crowding function returns them (see the module docstring; +inf for
     n ≤ 2)."""
     F = np.array(F, dtype=np.double)
+    if F.ndim != 2 or F.shape[1] < 1:
+        raise InputShapeError(f"F must have shape (n, m) with m ≥ 1 objectives; got {F.shape}")
     n_points, n_obj = F.shape
     if n_points <= 2:
         return np.full(n_points, np.inf)
