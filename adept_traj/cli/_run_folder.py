@@ -17,9 +17,12 @@ is the user's and is left alone.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -194,3 +197,25 @@ def commit(folder: Path) -> None:
     (folder / RUN_FILE).unlink(missing_ok=True)
     sync_folder(folder)
     shutil.rmtree(folder / CHECKPOINT, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path) -> Iterator[None]:
+    """Hold the run folder ``folder`` (made if missing) for one process while the block
+    runs: another ``adept-traj`` process on it (``plan --resume`` or ``--overwrite`` while
+    the run goes on) gets a :class:`~adept_traj.errors.ConfigurationError` instead of
+    writing beside it. An advisory ``flock(2)`` on the folder itself (nothing is written
+    into it), released when the block ends and every process forked in it has ended."""
+    folder.mkdir(parents=True, exist_ok=True)
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ConfigurationError(
+                f"{folder} is in use by another adept-traj process (its run is still going "
+                "on): wait for it to end, or stop it, then try again"
+            ) from None
+        yield
+    finally:
+        os.close(fd)

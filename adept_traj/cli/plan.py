@@ -36,6 +36,7 @@ from adept_traj.cli._run_folder import (
     as_path,
     check_folder,
     commit,
+    folder_lock,
     is_complete,
     read_arguments,
     remove_written,
@@ -242,14 +243,14 @@ def run(args: argparse.Namespace) -> int:
     try:
         # memory of the population and of the dense certificate, before anything is written
         check_run_options(problem, opts.algorithm, opts.pop, opts.gens, opts.rate)
-        if not resume:
-            remove_written(folder)  # only with --overwrite: check_folder refused otherwise
-            folder.mkdir(parents=True, exist_ok=True)
-            saved = {k: getattr(opts, k) for k in _SAVED}
-            saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
-            write_arguments(folder, saved)
-        with _finisher(opts, problem) as finisher:
-            return _run(opts, problem, folder, resume, finisher)
+        with folder_lock(folder):  # no second process writing into the folder meanwhile
+            if not resume:
+                remove_written(folder)  # only with --overwrite: check_folder refused otherwise
+                saved = {k: getattr(opts, k) for k in _SAVED}
+                saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
+                write_arguments(folder, saved)
+            with _finisher(opts, problem) as finisher:
+                return _run(opts, problem, folder, resume, finisher)
     finally:
         problem.close()
 
