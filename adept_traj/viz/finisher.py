@@ -61,7 +61,8 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     """Fork the helper that will write a run's figures and/or ``playback.html``.
 
     Call it once the run's robot and scene exist and before the optimiser's worker
-    processes start (they would inherit the helper's pipe); the helper imports what the
+    processes start (forked after them, the helper would hold copies of their pipes, and
+    nothing but the evaluator's stop word would end them); the helper imports what the
     outputs need at nice :data:`IMPORT_NICENESS` and waits for :meth:`Finisher.start`.
 
     Parameters
