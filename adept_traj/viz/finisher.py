@@ -274,6 +274,16 @@ def _preload(figures: bool, html: bool) -> None:
         import adept_traj.viz.meshcat_scene  # noqa: F401
 
 
+def _terminated(*_: object) -> None:
+    """The helper's SIGTERM handler (``cancel``, the caller's death): stop the figure share
+    it forked, if any, and end at once. No exception is raised: a ``SystemExit`` raised
+    where the signal lands (e.g. in a fork handler of :mod:`logging`) would be printed as
+    "Exception ignored" and the helper would go on."""
+    for child in multiprocessing.active_children():
+        child.terminate()
+    os._exit(128 + signal.SIGTERM)
+
+
 def _die_with(parent: int) -> None:
     """Ask Linux for SIGTERM when the parent dies (``PR_SET_PDEATHSIG``); end now if it
     is gone already."""
@@ -305,7 +315,7 @@ def _helper(
     code = 0
     try:
         callers_end.close()
-        signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
+        signal.signal(signal.SIGTERM, _terminated)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
         _die_with(parent)
         failed: list[str] = []

@@ -153,7 +153,12 @@ def _draw(jobs: list[_Job], processes: int) -> None:
 
 def _draw_share(draws: list[Callable[[], Path]]) -> None:
     """Run in a forked process: draw these figures; any error ends it with status 1 (the
-    caller draws its figures again and reports the error)."""
+    caller draws its figures again and reports the error). It ends with its parent (a
+    parent stopped outright cannot terminate it)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)  # PDEATHSIG
     try:
         for draw in draws:
             draw()
