@@ -30,7 +30,6 @@ import atexit
 import multiprocessing
 import os
 import signal
-import sys
 import threading
 import traceback
 from collections.abc import Mapping
@@ -274,23 +273,12 @@ def _preload(figures: bool, html: bool) -> None:
         import adept_traj.viz.meshcat_scene  # noqa: F401
 
 
-def _terminated(*_: object) -> None:
-    """The helper's SIGTERM handler (``cancel``, the caller's death): stop the figure share
-    it forked, if any, and end at once. No exception is raised: a ``SystemExit`` raised
-    where the signal lands (e.g. in a fork handler of :mod:`logging`) would be printed as
-    "Exception ignored" and the helper would go on."""
-    for child in multiprocessing.active_children():
-        child.terminate()
-    os._exit(128 + signal.SIGTERM)
-
-
 def _die_with(parent: int) -> None:
     """Ask Linux for SIGTERM when the parent dies (``PR_SET_PDEATHSIG``); end now if it
     is gone already."""
-    if sys.platform.startswith("linux"):
-        import ctypes
+    from adept_traj.viz.plots.all_figures import _end_with_parent
 
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
+    _end_with_parent()
     if os.getppid() != parent:
         os._exit(0)
 
@@ -315,6 +303,8 @@ def _helper(
     code = 0
     try:
         callers_end.close()
+        from adept_traj.viz.plots.all_figures import _terminated
+
         signal.signal(signal.SIGTERM, _terminated)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
         _die_with(parent)

@@ -155,10 +155,7 @@ def _draw_share(draws: list[Callable[[], Path]]) -> None:
     """Run in a forked process: draw these figures; any error ends it with status 1 (the
     caller draws its figures again and reports the error). It ends with its parent (a
     parent stopped outright cannot terminate it)."""
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)  # PDEATHSIG
+    _end_with_parent()
     try:
         for draw in draws:
             draw()
@@ -291,12 +288,30 @@ def _report(exc: BaseException) -> tuple[str, bytes | None]:
         return text, None
 
 
+def _end_with_parent() -> None:
+    """Ask Linux for SIGTERM when this forked process' parent dies
+    (``PR_SET_PDEATHSIG``): a parent stopped outright cannot terminate it."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
+
+
+def _terminated(*_: object) -> None:
+    """SIGTERM handler of a process that draws (``cancel``, its caller's death): stop the
+    processes it forked and end at once. No exception is raised: a ``SystemExit`` raised
+    where the signal lands (e.g. in a fork handler of :mod:`logging`) would be printed as
+    "Exception ignored" and the process would go on."""
+    for child in multiprocessing.active_children():
+        child.terminate()
+    os._exit(128 + signal.SIGTERM)
+
+
 def _child(jobs: list[_Job], processes: int, sender: Any) -> None:
     """In the forked process: draw, send ``("", None)`` or (the error's traceback, the
     pickled error or ``None``), and end at once (``os._exit``: none of the parent's exit
     handlers runs here)."""
-    # SIGTERM (cancel) unwinds through the drawing, which stops its own processes
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
+    signal.signal(signal.SIGTERM, _terminated)  # cancel
     code, text, pickled = 0, "", None
     try:
         _draw(jobs, processes)
