@@ -263,11 +263,16 @@ def _send(
     try:
         connection.send(chunk)
     except OSError as exc:  # EPIPE: the worker's end is gone
-        process.join(timeout=1.0)
-        raise BrokenProcessPool(
-            f"an evaluation worker process (pid {process.pid}) ended abruptly "
-            f"(exit code {process.exitcode})"
-        ) from exc
+        raise _broken(process) from exc
+
+
+def _broken(process: multiprocessing.process.BaseProcess) -> BrokenProcessPool:
+    """The error for a worker that died (its pipe broken or closed), once it is reaped."""
+    process.join(timeout=1.0)
+    return BrokenProcessPool(
+        f"an evaluation worker process (pid {process.pid}) ended abruptly "
+        f"(exit code {process.exitcode})"
+    )
 
 
 def _receive(process: multiprocessing.process.BaseProcess, connection: Connection) -> Evaluation:
@@ -275,11 +280,7 @@ def _receive(process: multiprocessing.process.BaseProcess, connection: Connectio
     try:
         text, payload = pickle.loads(connection.recv_bytes())
     except (EOFError, OSError) as exc:  # the worker died without a word
-        process.join(timeout=1.0)
-        raise BrokenProcessPool(
-            f"an evaluation worker process (pid {process.pid}) ended abruptly "
-            f"(exit code {process.exitcode})"
-        ) from exc
+        raise _broken(process) from exc
     if text:
         raise error_from_process(
             text,
