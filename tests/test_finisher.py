@@ -24,6 +24,7 @@ import pytest
 
 import adept_traj as at
 import adept_traj.cli.plan as plan_command
+import adept_traj.cli.report as report
 from adept_traj.cli.app import main
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, Replay
@@ -189,7 +190,7 @@ def test_no_helper_with_no_plots_and_no_html(
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     started = []
-    monkeypatch.setattr(plan_command, "start_finisher", lambda *a, **k: started.append(a))
+    monkeypatch.setattr(report, "start_finisher", lambda *a, **k: started.append(a))
     assert _plan(monkeypatch, stored, tmp_path / "run", "--no-plots", "--no-html") == 0
     assert started == []
     assert (tmp_path / "run" / "result.json").is_file()

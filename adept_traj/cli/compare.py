@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib.util
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -34,7 +33,7 @@ from adept_traj.cli import status
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import save_figures, summary
+from adept_traj.cli.report import finisher_for, save_figures, summary
 from adept_traj.cli.robot_options import source_from_arguments
 from adept_traj.cycle import (
     parse_seeds,
@@ -46,7 +45,6 @@ from adept_traj.cycle import (
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import PlanningInterrupted, plan
 from adept_traj.results import PlanningResult, Replay
-from adept_traj.viz.finisher import start_finisher
 
 __all__ = ["add_parser", "comparison_markdown", "run"]
 
@@ -230,7 +228,9 @@ def run(args: argparse.Namespace) -> int:
                     problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}"
                 )
             # the figures' helper imports matplotlib while the runs go on (at nice 19)
-            finisher = stack.enter_context(_finisher(args, problem))
+            finisher = stack.enter_context(
+                finisher_for(problem, figures=not args.no_plots, html=False)
+            )
             _plan_both(args, problem, runs, results)
         except PlanningInterrupted as exc:  # no checkpoint: the finished runs are saved
             print(f"{exc}", file=sys.stderr)
@@ -252,18 +252,6 @@ def run(args: argparse.Namespace) -> int:
     (args.out / "comparison.md").write_text(text)
     print(text)
     return status.OK
-
-
-def _finisher(args: argparse.Namespace, problem: Any) -> Any:
-    """The helper process that will draw the figures (:mod:`adept_traj.viz.finisher`), in
-    a context that stops it; an empty context (``None``) with ``--no-plots``, without
-    matplotlib or when no process can be forked (the figures are then drawn here)."""
-    if args.no_plots or importlib.util.find_spec("matplotlib") is None:
-        return contextlib.nullcontext(None)
-    try:
-        return start_finisher(problem.robot, problem.scene, figures=True, html=False)
-    except OSError:  # e.g. no memory to fork
-        return contextlib.nullcontext(None)
 
 
 def _plan_both(args: argparse.Namespace, problem: Any, runs: tuple, results: dict) -> None:

@@ -20,8 +20,6 @@ refused before the run starts.
 from __future__ import annotations
 
 import argparse
-import contextlib
-import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -45,7 +43,7 @@ from adept_traj.cli._run_folder import (
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import finish_figures, start_figures, summary
+from adept_traj.cli.report import finish_figures, finisher_for, start_figures, summary
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
     ALGORITHMS,
@@ -60,7 +58,7 @@ from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
 from adept_traj.scene import SHIPPED_SCENES
 from adept_traj.validation import as_integer
-from adept_traj.viz.finisher import Finisher, start_finisher
+from adept_traj.viz.finisher import Finisher
 
 __all__ = ["RUN_FILE", "add_parser", "run"]
 
@@ -249,25 +247,10 @@ def run(args: argparse.Namespace) -> int:
                 saved = {k: getattr(opts, k) for k in _SAVED}
                 saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
                 write_arguments(folder, saved)
-            with _finisher(opts, problem) as finisher:
-                return _run(opts, problem, folder, resume, finisher)
+            with finisher_for(problem, figures=not opts.no_plots, html=not opts.no_html) as f:
+                return _run(opts, problem, folder, resume, f)
     finally:
         problem.close()
-
-
-def _finisher(opts: argparse.Namespace, problem: TrajectoryProblem) -> Any:
-    """The helper process that will write the figures and ``playback.html``
-    (:func:`adept_traj.viz.finisher.start_finisher`: it imports matplotlib and meshcat at
-    the lowest priority while the run goes on), in a context that stops it; an empty
-    context (``None``) with ``--no-plots --no-html``, without matplotlib (the finish says
-    so) or when no process can be forked (the finish writes them itself)."""
-    figures, html = not opts.no_plots, not opts.no_html
-    if not (figures or html) or (figures and importlib.util.find_spec("matplotlib") is None):
-        return contextlib.nullcontext(None)
-    try:
-        return start_finisher(problem.robot, problem.scene, figures=figures, html=html)
-    except OSError:  # e.g. no memory to fork: the finish writes the files itself
-        return contextlib.nullcontext(None)
 
 
 def _run(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import sys
 from pathlib import Path
@@ -11,9 +12,11 @@ import numpy as np
 
 from adept_traj.analysis import WeightedSum
 from adept_traj.results import PlanningResult, Replay
+from adept_traj.viz.finisher import start_finisher
 
 __all__ = [
     "finish_figures",
+    "finisher_for",
     "save_figures",
     "start_figures",
     "summary",
@@ -143,3 +146,17 @@ def finish_figures(drawing: Any, folder: Path) -> None:
         _note_missing_matplotlib(exc)
         return
     print(f"{len(paths)} figures in {folder}")
+
+
+def finisher_for(problem: Any, *, figures: bool, html: bool) -> Any:
+    """The helper process that will write a run's figures and/or ``playback.html``
+    (:func:`adept_traj.viz.finisher.start_finisher`: it imports matplotlib and meshcat at
+    the lowest priority while the run goes on), in a context that stops it; an empty
+    context (``None``) when neither output is asked for, without matplotlib for the figures
+    (the finish says so) or when no process can be forked (the caller writes them)."""
+    if not (figures or html) or (figures and importlib.util.find_spec("matplotlib") is None):
+        return contextlib.nullcontext(None)
+    try:
+        return start_finisher(problem.robot, problem.scene, figures=figures, html=html)
+    except OSError:  # e.g. no memory to fork: the caller writes the files itself
+        return contextlib.nullcontext(None)
