@@ -7,6 +7,12 @@ Tables 3–5 beside ours in ``DIR/comparison.md``.
 interquartile range and rank-sum test of every metric to ``DIR/study.md`` and
 ``DIR/study.json``, with box plots in ``DIR/figures/study_boxplots.png``.
 
+``--out DIR`` is held by one ``adept-traj`` process at a time (a second one on it is
+refused), and a folder holding the files of an earlier ``compare`` (``comparison.md``, the
+runs in ``nsga2/`` and ``mode/``, their figures) is refused unless ``--overwrite`` is given,
+which removes those files (and only those) first; a seed study's folder must be empty
+unless ``--resume`` keeps its saved runs.
+
 F_avg, f_c and HV are computed on common bounds: the extremes over both feasible fronts
 and both best trade-offs.
 """
@@ -30,6 +36,13 @@ from adept_traj.analysis import (
     objective_bounds,
 )
 from adept_traj.cli import status
+from adept_traj.cli._run_folder import (
+    FIGURES,
+    as_path,
+    folder_lock,
+    remove_written,
+    written_files,
+)
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
@@ -56,7 +69,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--gens", type=int, help="generations of both (default 100)")
     p.add_argument("--pop-nsga2", type=int, help="NSGA-II population (default 100)")
     p.add_argument("--pop-mode", type=int, help="MODE population (default 500)")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=str, required=True, help="output folder")
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the files of an earlier compare in --out (only the files compare writes)",
+    )
     p.add_argument("--no-plots", action="store_true", help="do not write figures/*.png")
     p.add_argument(
         "--seeds",
@@ -65,6 +83,48 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--scheduler", help="with --seeds: address of a running Dask scheduler")
     p.add_argument("--resume", action="store_true", help="with --seeds: keep the saved runs")
     return p
+
+
+#: The comparison table ``compare`` writes at the top of ``--out``.
+COMPARISON_FILE = "comparison.md"
+#: The run folders ``compare`` writes in ``--out``, one per algorithm.
+_RUN_FOLDERS = ("nsga2", "mode")
+
+
+def compare_files(folder: Path) -> list[Path]:
+    """The files of ``folder`` that a ``compare`` (without ``--seeds``) writes and that
+    exist, sorted: :data:`COMPARISON_FILE`, each run folder's files
+    (:func:`~adept_traj.cli._run_folder.written_files`) and the figures in
+    ``figures/``."""
+    found = [folder / COMPARISON_FILE] if (folder / COMPARISON_FILE).exists() else []
+    for name in _RUN_FOLDERS:
+        found += written_files(folder / name)
+    found += [p for p in written_files(folder) if p.parent == folder / FIGURES]
+    return sorted(found)
+
+
+def _check_out(folder: Path, overwrite: bool) -> None:
+    """Refuse ``folder`` before any work if it holds an earlier compare's files and
+    ``overwrite`` is false (:class:`~adept_traj.errors.ConfigurationError`)."""
+    if folder.exists() and not folder.is_dir():
+        raise ConfigurationError(f"--out {folder} is a file, not a folder")
+    found = compare_files(folder)
+    if found and not overwrite:
+        names = ", ".join(str(p.relative_to(folder)) for p in found)
+        raise ConfigurationError(
+            f"--out {folder} holds files of an earlier compare ({names}); --overwrite "
+            "replaces them, or choose another folder"
+        )
+
+
+def _remove_earlier(folder: Path) -> None:
+    """Remove an earlier compare's files from ``folder`` (only those: see
+    :func:`compare_files`)."""
+    (folder / COMPARISON_FILE).unlink(missing_ok=True)
+    for name in _RUN_FOLDERS:
+        remove_written(folder / name)
+    for path in compare_files(folder):  # what is left: the figures
+        path.unlink()
 
 
 #: The paper's Tables 3–5, as printed (strings keep their printed digits).
@@ -183,10 +243,21 @@ def comparison_markdown(results: dict[str, PlanningResult], weights: Sequence[fl
 def _run_study(args: argparse.Namespace) -> int:
     """``compare --seeds``: the seed study on Dask and its report."""
     seeds = parse_seeds(args.seeds)
+    if args.overwrite:
+        raise ConfigurationError(
+            "--overwrite does not go with --seeds: a seed study needs an empty --out, or "
+            "--resume to keep its saved runs"
+        )
     problem = problem_from_arguments(args)
     problem.close()
     for name, pop in (("nsga2", args.pop_nsga2), ("mode", args.pop_mode)):
         check_run_options(problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}")
+    with folder_lock(args.out):  # no second process writing into the folder meanwhile
+        return _study(args, problem, seeds)
+
+
+def _study(args: argparse.Namespace, problem: Any, seeds: list[int]) -> int:
+    """The seed study of :func:`_run_study`, with ``--out`` held."""
     with tqdm(
         total=2 * len(seeds), desc="runs", unit="run", disable=args.quiet, file=sys.stderr
     ) as bar:
@@ -214,10 +285,12 @@ def _run_study(args: argparse.Namespace) -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``; return the exit status (0, or 130 when interrupted)."""
+    args = argparse.Namespace(**{**vars(args), "out": as_path(args.out, "--out")})
     if args.seeds is not None:
         return _run_study(args)
     if args.scheduler is not None or args.resume:
         raise ConfigurationError("--scheduler and --resume need --seeds")
+    _check_out(args.out, args.overwrite)
     problem = problem_from_arguments(args)
     runs = (("nsga2", args.pop_nsga2), ("mode", args.pop_mode))
     results = {}
@@ -227,6 +300,9 @@ def run(args: argparse.Namespace) -> int:
                 check_run_options(
                     problem, name, pop, args.gens, args.rate, pop_option=f"--pop-{name}"
                 )
+            stack.enter_context(folder_lock(args.out))  # one process writes into it
+            _check_out(args.out, args.overwrite)  # again, now that no other one can write
+            _remove_earlier(args.out)  # only with --overwrite: refused above otherwise
             # the figures' helper imports matplotlib while the runs go on (at nice 19)
             finisher = stack.enter_context(
                 finisher_for(problem, figures=not args.no_plots, html=False)
