@@ -47,3 +47,40 @@ def test_the_lock_is_released_when_the_block_ends(tmp_path: Path) -> None:
         with pytest.raises(ConfigurationError, match="in use"), folder_lock(out):
             pass
     os.close(_held_elsewhere(out))  # free again
+
+
+_CYCLE = """\
+name = "one"
+scene = "empty.toml"
+
+[[location]]
+name = "home"
+joints = [0.1682, 1.3849, 0.08, -0.7555]
+
+[[location]]
+name = "place"
+joints = [-0.761, 0.245, 0.2, 1.0095]
+
+[[move]]
+from = "home"
+to = "place"
+"""
+
+
+def test_cycle_holds_its_folder_too(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``cycle --resume`` started twice on one folder: the second is refused unwritten."""
+    (tmp_path / "c.toml").write_text(_CYCLE)
+    (tmp_path / "empty.toml").write_text('name = "empty"\n')
+    out = tmp_path / "out"
+    out.mkdir()
+    fd = _held_elsewhere(out)
+    try:
+        code = main(["cycle", str(tmp_path / "c.toml"), "--out", str(out), "--resume", "--quiet"])
+        empty = main(["cycle", str(tmp_path / "c.toml"), "--out", "", "--quiet"])
+    finally:
+        os.close(fd)
+    assert code == empty == 2
+    err = capsys.readouterr().err
+    assert "is in use by another adept-traj process" in err
+    assert "--out is empty" in err
+    assert list(out.iterdir()) == []

@@ -7,6 +7,8 @@ finished move is saved at once in ``DIR/moves/NAME/``; ``--resume`` keeps those 
 saved for the same task. At the end ``DIR/cycle.json``, ``DIR/cycle.md`` and
 ``DIR/cycle_gantt.png`` (unless ``--no-plots``) report each move and the cycle time, and
 ``DIR/playback.html`` (unless ``--no-playback``) plays the whole cycle in a browser.
+``DIR`` is held by one ``adept-traj`` process at a time: a second one on it (e.g. the same
+``--resume`` started twice) is refused before it writes anything.
 
 Exit status 0 when every move's reported solution is certified, 1 otherwise
 (:data:`~adept_traj.cli.status.NOT_CERTIFIED`).
@@ -17,10 +19,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from tqdm import tqdm
 
 from adept_traj.cli import status
+from adept_traj.cli._run_folder import as_path, folder_lock
 from adept_traj.cycle import (
     PLAYBACK_FILE,
     cycle_html,
@@ -37,7 +41,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``cycle`` and its options."""
     p = sub.add_parser("cycle", help="plan every move of a cycle file (TOML) on Dask")
     p.add_argument("file", type=Path, help="cycle file (docs/cycles.md)")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=str, required=True, help="output folder")
     p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--resume", action="store_true", help="keep the moves already saved")
@@ -51,22 +55,29 @@ def run(args: argparse.Namespace) -> int:
     """Run ``cycle``; return the exit status."""
     if args.workers is not None:
         as_integer(args.workers, "--workers", minimum=1, maximum=1024)
+    out = as_path(args.out, "--out")
     cycle = read_cycle_file(args.file)  # every location solved before any task starts
+    with folder_lock(out):  # no second process writing into the folder meanwhile
+        return _run(args, cycle, out)
+
+
+def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
+    """The moves of ``cycle`` and their report, with ``out`` held (:func:`run`)."""
     with tqdm(
         total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
     ) as bar:
         results = run_cycle(
             cycle,
-            args.out,
+            out,
             workers=args.workers,
             scheduler=args.scheduler,
             resume=args.resume,
             progress=lambda name: bar.update(1),
         )
-    summary = write_cycle_report(cycle, results, args.out, figure=not args.no_plots)
+    summary = write_cycle_report(cycle, results, out, figure=not args.no_plots)
     if not args.no_playback:
         names = [m.name for m in cycle.moves]
-        robot, page = cycle.robot.load(), args.out / PLAYBACK_FILE
+        robot, page = cycle.robot.load(), out / PLAYBACK_FILE
         cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
-    print((args.out / "cycle.md").read_text(encoding="utf-8"))
+    print((out / "cycle.md").read_text(encoding="utf-8"))
     return status.OK if summary["all_certified"] else status.NOT_CERTIFIED
