@@ -68,6 +68,7 @@ from adept_traj.optimise.population import (
     cache_violations,
     optimum,
     population_values,
+    ranked_optimum,
 )
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
@@ -148,6 +149,7 @@ __all__ = [
     "polish_run",
     "population_bytes",
     "population_values",
+    "ranked_optimum",
     "restore_algorithm",
     "save_checkpoint",
     "time_optimal",

@@ -50,7 +50,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.mating import ArrayMating
-from adept_traj.optimise.population import ArrayEvaluator, optimum, population_values
+from adept_traj.optimise.population import ArrayEvaluator, population_values, ranked_optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
@@ -197,12 +197,13 @@ class _PaperMODE(GeneticAlgorithm):
     """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
     survival (see the module docstring); its ``opt`` after every generation (pymoo's
     ``filter_optimum`` of the population, which reads three properties per member through
-    ``Population.get``) computed by :func:`~adept_traj.optimise.optimum` on arrays — the
-    same members in the same order. (NSGA-II keeps pymoo's own, cheaper ``opt``: its
-    rank-0 members.)"""
+    ``Population.get`` and sorts the population again) is
+    :func:`~adept_traj.optimise.ranked_optimum`: the feasible members the survival ranked
+    0 — the same members in the same order. (NSGA-II keeps pymoo's own ``opt``: its rank-0
+    members.)"""
 
     def _set_optimum(self) -> None:
-        self.opt = optimum(self.pop)
+        self.opt = ranked_optimum(self.pop)
 
 
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:
