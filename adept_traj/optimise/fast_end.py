@@ -44,9 +44,11 @@ import numpy as np
 from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.mating import ArrayMating
 from adept_traj.optimise.population import population_values
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.variant import ArrayVariant
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["FastEndSearch"]
@@ -119,18 +121,23 @@ class FastEndSearch:
         evaluated: the number of evaluations is the mating's."""
         rng = kwargs.get("random_state")
         feasible = np.flatnonzero(population_values(pop, "CV")[:, 0] <= 0.0) if len(pop) else []
-        off = self.mating.do(problem, pop, n_offsprings, **kwargs)
-        if rng is None or len(off) == 0:
-            return off
+        # The mating's children as an array when it can make them so (its members are
+        # built once, below, without the replaced ones), else as a population.
+        arrays = rng is not None and _makes_arrays(self.mating)
+        if arrays:
+            off: Any = self.mating.offspring(problem, pop, n_offsprings, **kwargs)
+        else:
+            off = self.mating.do(problem, pop, n_offsprings, **kwargs)
         n_local = min(round(self.fraction * n_offsprings), len(off))
         n_new = round(self.immigrants * n_local)
         n_bump = n_local - n_new if len(feasible) else 0
-        if n_new + n_bump == 0:
-            return off
+        if rng is None or len(off) == 0 or n_new + n_bump == 0:
+            return Population.new(X=off) if arrays else off
         # Replace a random subset of the mating's children (not its last ones: pymoo's DE
         # uses the first members of the population as targets, in order).
         keep = np.sort(rng.permutation(len(off))[: len(off) - n_new - n_bump])
-        children = self.sampling.ramps(problem, n_new, rng)
+        # (each immigrant's T is set below: the ramps' own fast times are not needed)
+        children = self.sampling.ramps(problem, n_new, rng, fast_times=False)
         if n_bump:
             X = population_values(pop, "X")
             fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
@@ -138,6 +145,8 @@ class FastEndSearch:
             children = np.concatenate([children, self._perturb(problem, parents, rng)])
         t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
         children[:, 0] = np.clip(t_kin, problem.xl[0], problem.xu[0])
+        if arrays:
+            return Population.new(X=np.concatenate([off[keep], children]))
         return Population.merge(off[keep], Population.new(X=children))
 
     def _perturb(self, problem: Any, parents: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -162,6 +171,14 @@ class FastEndSearch:
         free = free + amplitude * bump
         children = traj.encode(parents[:, 0], free)
         return np.clip(children, problem.xl, problem.xu)
+
+
+def _makes_arrays(mating: Any) -> bool:
+    """Whether ``mating`` makes its children as an array (``offspring``, the decision
+    vectors of the members its ``do`` would return: those of
+    :class:`~adept_traj.optimise.ArrayMating` and :class:`~adept_traj.optimise.ArrayVariant`
+    with pymoo's plain operators)."""
+    return isinstance(mating, ArrayMating | ArrayVariant) and mating.makes_arrays()
 
 
 def _envelope(xi: np.ndarray) -> np.ndarray:

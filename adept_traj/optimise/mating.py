@@ -41,6 +41,7 @@ from pymoo.core.population import Population
 from pymoo.core.repair import Repair
 from pymoo.core.variable import get
 
+from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.population import population_values
 
@@ -77,6 +78,38 @@ class ArrayMating(Mating):
         only duplicates), as pymoo's ``Mating.do`` makes them from the same generator."""
         if random_state is None or not self._plain():
             return super().do(problem, pop, n_offsprings, random_state, n_max_iterations, **kwargs)
+        X = self.offspring(problem, pop, n_offsprings, random_state, n_max_iterations, **kwargs)
+        return Population.new(X=X)
+
+    def makes_arrays(self) -> bool:
+        """Whether :meth:`offspring` applies (pymoo's plain operators, see the module
+        docstring)."""
+        return self._plain()
+
+    def offspring(
+        self,
+        problem: Any,
+        pop: Population,
+        n_offsprings: int,
+        random_state: Any = None,
+        n_max_iterations: int | None = None,
+        **kwargs: Any,
+    ) -> np.ndarray:
+        """The decision vectors (n, n_var), n ≤ ``n_offsprings``, of the children :meth:`do`
+        makes from the generator ``random_state`` (the same draws), without building their
+        members.
+
+        Raises
+        ------
+        ConfigurationError
+            No ``random_state``, or operators that are not pymoo's plain ones
+            (:meth:`makes_arrays` is false).
+        """
+        if random_state is None or not self._plain():
+            raise ConfigurationError(
+                "ArrayMating.offspring needs a random_state and pymoo's plain operators "
+                "(no vtype, no operator-level repair); use do()"
+            )
         rounds = self.n_max_iterations if n_max_iterations is None else n_max_iterations
         parents = population_values(pop, "X")
         off = np.empty((0, problem.n_var))
@@ -89,7 +122,7 @@ class ArrayMating(Mating):
             n_rounds += 1
             if n_rounds >= rounds:
                 break
-        return Population.new(X=off)
+        return off
 
     def _plain(self) -> bool:
         """Whether the array rounds apply (pymoo's plain operators; see the module doc)."""

@@ -47,13 +47,48 @@ class ArrayVariant(Variant):
     ) -> Population:
         """``n_offsprings`` trial vectors from ``pop``, as pymoo's ``Variant.do`` makes them
         from ``algorithm.random_state``."""
+        if not self._plain():
+            return super().do(problem, pop, n_offsprings, algorithm=algorithm, **kwargs)
+        off = Population.new(X=self._offspring(problem, pop, n_offsprings, algorithm, **kwargs))
+        self.control.advance(off)
+        return off
+
+    def makes_arrays(self) -> bool:
+        """Whether :meth:`offspring` applies: plain operators (see the module docstring)
+        and a parameter control without parameters to set on the trial vectors (MODE's
+        ``NoParameterControl``)."""
+        return self._plain() and not self.control.params
+
+    def offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any = None, **kwargs
+    ) -> np.ndarray:
+        """The decision vectors (n_offsprings, n_var) of the trial vectors :meth:`do` makes
+        (the same draws from ``algorithm.random_state``), without building their members.
+
+        Raises
+        ------
+        ConfigurationError
+            :meth:`makes_arrays` is false (use :meth:`do`).
+        """
+        if not self.makes_arrays():
+            raise ConfigurationError(
+                "ArrayVariant.offspring needs pymoo's plain operators and a parameter "
+                "control without parameters; use do()"
+            )
+        return self._offspring(problem, pop, n_offsprings, algorithm, **kwargs)
+
+    def _plain(self) -> bool:
+        """Whether the mutation and the repair are pymoo's plain operators."""
         operators = (self.mutation, self.repair)
-        plain = isinstance(self.repair, Repair) and all(
+        return isinstance(self.repair, Repair) and all(
             getattr(op, "vtype", None) is None and getattr(op, "repair", None) is None
             for op in operators
         )
-        if not plain:
-            return super().do(problem, pop, n_offsprings, algorithm=algorithm, **kwargs)
+
+    def _offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any, **kwargs
+    ) -> np.ndarray:
+        """:meth:`offspring` without the check."""
         rng = algorithm.random_state
         self.control.tell(pop=pop)
         self.control.do(n_offsprings)
@@ -61,9 +96,7 @@ class ArrayVariant(Variant):
         mutated = self.mutation._do(problem, trial, random_state=rng)
         chosen = rng.random(size=n_offsprings) <= get(self.mutation.prob, size=n_offsprings)
         trial[chosen] = mutated[chosen]
-        off = Population.new(X=np.asarray(self.repair._do(problem, trial, **kwargs)))
-        self.control.advance(off)
-        return off
+        return np.asarray(self.repair._do(problem, trial, **kwargs))
 
     def _trial(
         self, problem: Any, pop: Population, n_offsprings: int, rng: np.random.Generator
