@@ -40,10 +40,12 @@ from pymoo.core.mating import Mating
 from pymoo.core.population import Population
 from pymoo.core.repair import Repair
 from pymoo.core.variable import get
+from pymoo.operators.selection.tournament import TournamentSelection
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.population import population_values
+from adept_traj.optimise.tournament import TournamentArrays, binary_tournament, select_parents
 
 __all__ = ["ArrayMating"]
 
@@ -112,11 +114,13 @@ class ArrayMating(Mating):
             )
         rounds = self.n_max_iterations if n_max_iterations is None else n_max_iterations
         parents = population_values(pop, "X")
+        # NSGA-II's tournaments read the members' values once for all rounds
+        arrays = TournamentArrays.of(pop) if self._array_selection(kwargs) else None
         off = np.empty((0, problem.n_var))
         n_rounds = 0
         while len(off) < n_offsprings:
             n_remaining = n_offsprings - len(off)
-            X = self._round(problem, pop, parents, n_remaining, random_state, **kwargs)
+            X = self._round(problem, pop, parents, arrays, n_remaining, random_state, **kwargs)
             X = self._unique(X, parents, off)
             off = np.concatenate([off, X[:n_remaining]])
             n_rounds += 1
@@ -136,11 +140,24 @@ class ArrayMating(Mating):
             )
         )
 
+    def _array_selection(self, kwargs: dict[str, Any]) -> bool:
+        """Whether the selection is NSGA-II's binary tournament (pymoo's
+        ``TournamentSelection`` of :func:`~adept_traj.optimise.binary_tournament`, pressure
+        2), which :func:`~adept_traj.optimise.select_parents` makes on arrays."""
+        sel = self.selection
+        return (
+            isinstance(sel, TournamentSelection)
+            and sel.func_comp is binary_tournament
+            and sel.pressure == 2
+            and "algorithm" in kwargs
+        )
+
     def _round(
         self,
         problem: Any,
         pop: Population,
         parents: np.ndarray,
+        arrays: TournamentArrays | None,
         n_remaining: int,
         rng: np.random.Generator,
         **kwargs: Any,
@@ -148,15 +165,21 @@ class ArrayMating(Mating):
         """One round of pymoo's ``Mating._do`` and repair: (n_matings·n_off, n_var)."""
         cross = self.crossover
         n_matings = math.ceil(n_remaining / cross.n_offsprings)
-        index = self.selection(
-            problem,
-            pop,
-            n_matings,
-            n_parents=cross.n_parents,
-            to_pop=False,
-            random_state=rng,
-            **kwargs,
-        )
+        if arrays is not None:
+            options = {k: v for k, v in kwargs.items() if k != "algorithm"}
+            index = select_parents(
+                pop, arrays, n_matings, cross.n_parents, kwargs["algorithm"], rng, **options
+            )
+        else:
+            index = self.selection(
+                problem,
+                pop,
+                n_matings,
+                n_parents=cross.n_parents,
+                to_pop=False,
+                random_state=rng,
+                **kwargs,
+            )
         X = np.swapaxes(parents[np.asarray(index)], 0, 1)  # (n_parents, n_matings, n_var)
         X = self._crossover(problem, X, rng, **kwargs)
         mutated = self.mutation._do(problem, X, random_state=rng, **kwargs)
@@ -192,14 +215,11 @@ class ArrayMating(Mating):
 
     def _unique(self, X: np.ndarray, parents: np.ndarray, off: np.ndarray) -> np.ndarray:
         """The rows of ``X`` that duplicate neither an earlier row, nor a parent, nor an
-        earlier offspring (pymoo's ``eliminate_duplicates.do(X, pop, off)``)."""
+        earlier offspring (pymoo's ``eliminate_duplicates.do(X, pop, off)``, whose three
+        passes drop a row by three tests of the row alone): the rows of ``X`` that
+        duplicate no earlier row of ``[parents; off; X]``, in one pass."""
         dup = self.eliminate_duplicates
         if len(X) == 0 or isinstance(dup, NoDuplicateElimination):
             return X
-        X = X[~dup.duplicates(X)]
-        for other in (parents, off):
-            if len(other) > 0:
-                if len(X) == 0:
-                    break
-                X = X[~dup.duplicates(X, other)]
-        return X
+        before = len(parents) + len(off)
+        return X[~dup.duplicates(np.concatenate([parents, off, X]))[before:]]
