@@ -40,9 +40,11 @@ from pymoo.core.mating import Mating
 from pymoo.core.population import Population
 from pymoo.core.repair import Repair
 from pymoo.core.variable import get
+from pymoo.operators.crossover.sbx import SBX, SimulatedBinaryCrossover
 from pymoo.operators.selection.tournament import TournamentSelection
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.crossover import sbx_children
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.population import population_values
 from adept_traj.optimise.tournament import TournamentArrays, binary_tournament, select_parents
@@ -197,7 +199,9 @@ class ArrayMating(Mating):
         n_matings = X.shape[1]
         Xp = np.empty((n_off, n_matings, X.shape[-1]), dtype=X.dtype)
         crossed = rng.random(n_matings) < get(cross.prob, size=n_matings)
-        if np.any(crossed):
+        if np.any(crossed) and type(cross) in (SBX, SimulatedBinaryCrossover) and n_off == 2:
+            Xp[:, crossed] = sbx_children(problem, cross, X, crossed, rng)  # the same bits
+        elif np.any(crossed):
             Xp[:, crossed] = cross._do(problem, X, random_state=rng, **kwargs)[:, crossed]
         if n_off == n_parents:  # the children of an uncrossed mating: copies of its parents
             Xp[:, ~crossed] = X[:, ~crossed]

@@ -61,10 +61,12 @@ def _kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
     qd, qdd, qddd = derivative_abs_max(problem.trajectory, unit)  # the extrema at T = 1
     lim = problem.robot.limits
     with np.errstate(divide="ignore", invalid="ignore"):
-        times = np.stack(
-            [qd / lim.velocity, np.sqrt(qdd / lim.acceleration), np.cbrt(qddd / lim.jerk)]
-        )
-    return np.nan_to_num(times, nan=0.0).max(axis=(0, -1))
+        v, a, j = qd / lim.velocity, np.sqrt(qdd / lim.acceleration), np.cbrt(qddd / lim.jerk)
+    # The largest time over the three kinds and the joints, a NaN (0/0: a zero limit, no
+    # motion) counting as 0 and ±inf as the largest float (``nan_to_num``): that map keeps
+    # the order of the times, so it is applied to the largest non-NaN time (``fmax``
+    # skips NaN; NaN only if all are) — the same number.
+    return np.nan_to_num(np.fmax.reduce(np.fmax(np.fmax(v, a), j), axis=-1), nan=0.0)
 
 
 class KinematicTimeRepair(Repair):
