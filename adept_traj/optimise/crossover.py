@@ -63,8 +63,8 @@ def sbx_children(
     spread, exchange = spread[mine], exchange[mine]
     rows = np.flatnonzero(crossed)
     cross = cross[rows]
-    Q = X[:, rows]  # a copy: the children start as their parents
-    p1, p2 = Q[0][cross], Q[1][cross]
+    pair = X[:, rows]  # a copy: the children start as their parents
+    p1, p2 = pair[0][cross], pair[1][cross]
     small = p1 < p2
     y1, y2 = np.where(small, p1, p2), np.where(small, p2, p1)
     lo, hi = np.broadcast_to(xl, cross.shape)[cross], np.broadcast_to(xu, cross.shape)[cross]
@@ -76,11 +76,11 @@ def sbx_children(
     child1, child2 = np.where(small, c1, c2), np.where(small, c2, c1)
     swap = np.bitwise_xor(exchange < prob_bin, p1 > p2)
     child1, child2 = np.where(swap, (child2, child1), (child1, child2))
-    Q[0][cross], Q[1][cross] = child1, child2
+    pair[0][cross], pair[1][cross] = child1, child2
     # pymoo's repair_clamp of each child: a value below its lower bound becomes the bound,
     # then one above its upper bound (NaN stays)
-    Q = np.where(Q < xl, xl, Q)
-    return np.where(Q > xu, xu, Q)
+    pair = np.where(pair < xl, xl, pair)
+    return np.where(pair > xu, xu, pair)
 
 
 def _spread(beta: np.ndarray, u: np.ndarray, eta: np.ndarray) -> np.ndarray:
