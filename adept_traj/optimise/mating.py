@@ -46,6 +46,7 @@ from pymoo.operators.selection.tournament import TournamentSelection
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.crossover import sbx_children
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
+from adept_traj.optimise.mutation import mutate
 from adept_traj.optimise.population import population_values
 from adept_traj.optimise.tournament import TournamentArrays, binary_tournament, select_parents
 
@@ -184,9 +185,7 @@ class ArrayMating(Mating):
             )
         X = np.swapaxes(parents[np.asarray(index)], 0, 1)  # (n_parents, n_matings, n_var)
         X = self._crossover(problem, X, rng, **kwargs)
-        mutated = self.mutation._do(problem, X, random_state=rng, **kwargs)
-        chosen = rng.random(size=len(X)) <= get(self.mutation.prob, size=len(X))
-        X[chosen] = mutated[chosen]
+        X = mutate(problem, self.mutation, X, rng)
         return np.asarray(self.repair._do(problem, X, random_state=rng, **kwargs))
 
     def _crossover(

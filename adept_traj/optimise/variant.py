@@ -33,6 +33,7 @@ from pymoo.operators.selection.rnd import fast_fill_random
 from pymoo.util.misc import where_is_what
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.mutation import mutate
 from adept_traj.optimise.population import population_values
 
 __all__ = ["ArrayVariant"]
@@ -93,9 +94,7 @@ class ArrayVariant(Variant):
         self.control.tell(pop=pop)
         self.control.do(n_offsprings)
         trial = self._trial(problem, pop, n_offsprings, rng)
-        mutated = self.mutation._do(problem, trial, random_state=rng)
-        chosen = rng.random(size=n_offsprings) <= get(self.mutation.prob, size=n_offsprings)
-        trial[chosen] = mutated[chosen]
+        trial = mutate(problem, self.mutation, trial, rng)
         return np.asarray(self.repair._do(problem, trial, **kwargs))
 
     def _trial(
