@@ -104,9 +104,9 @@ class ArrayVariant(Variant):
         ``Population.new`` (pymoo's code; X read once per member)."""
         sel, n_diffs = get(self.selection, self.n_diffs, size=n_offsprings)
         if _all_same(sel) and _all_same(n_diffs):  # where_is_what's one group, at once
-            H = {(sel[0], n_diffs[0]): list(range(n_offsprings))}
-        else:
-            H = where_is_what(zip(sel, n_diffs, strict=True))
+            H = {(sel[0], n_diffs[0]): np.arange(n_offsprings)}
+        else:  # (index arrays: the same rows as pymoo's lists, without converting them)
+            H = _as_arrays(where_is_what(zip(sel, n_diffs, strict=True)))
         F, CR, jitter = get(self.F, self.CR, self.jitter, size=n_offsprings)
         X = population_values(pop, "X")
         donor = np.full((n_offsprings, problem.n_var), np.nan)
@@ -137,7 +137,11 @@ class ArrayVariant(Variant):
             donor[targets] = Xp
         trial = np.full((n_offsprings, problem.n_var), np.nan)
         kinds = get(self.crossover, size=n_offsprings)
-        groups = {kinds[0]: list(range(n_offsprings))} if _all_same(kinds) else where_is_what(kinds)
+        groups = (
+            {kinds[0]: np.arange(n_offsprings)}
+            if _all_same(kinds)
+            else _as_arrays(where_is_what(kinds))
+        )
         for name, K in groups.items():
             target, donors, rate = X[K], donor[K], CR[K]
             if name in ("bin", "exp"):
@@ -163,3 +167,8 @@ def _all_same(values: Any) -> bool:
     index, in order."""
     values = np.asarray(values)
     return values.ndim == 1 and len(values) > 0 and bool((values == values[0]).all())
+
+
+def _as_arrays(groups: dict[Any, list[int]]) -> dict[Any, np.ndarray]:
+    """``where_is_what``'s groups with their index lists as integer arrays."""
+    return {key: np.asarray(index, dtype=np.intp) for key, index in groups.items()}
