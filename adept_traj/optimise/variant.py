@@ -35,6 +35,7 @@ from pymoo.util.misc import where_is_what
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.mutation import mutate
 from adept_traj.optimise.population import population_values
+from adept_traj.optimise.repair import KinematicTimeRepair
 
 __all__ = ["ArrayVariant"]
 
@@ -78,6 +79,29 @@ class ArrayVariant(Variant):
             )
         return self._offspring(problem, pop, n_offsprings, algorithm, **kwargs)
 
+    def unrepaired_offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any = None, **kwargs
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The trial vectors of :meth:`offspring` before their kinematic time repair
+        (n_offsprings, n_var) and the repair's draws (:meth:`KinematicTimeRepair.snaps
+        <adept_traj.optimise.KinematicTimeRepair.snaps>`, (n_offsprings,) bool), made
+        where the repair makes them: ``repair.repaired(problem, X, snapped)`` of any rows
+        gives those rows of :meth:`offspring`, whose draws were the same.
+
+        Raises
+        ------
+        ConfigurationError
+            :meth:`makes_arrays` is false or the repair is not a
+            :class:`~adept_traj.optimise.KinematicTimeRepair`.
+        """
+        if not (self.makes_arrays() and isinstance(self.repair, KinematicTimeRepair)):
+            raise ConfigurationError(
+                "ArrayVariant.unrepaired_offspring needs plain operators and the kinematic "
+                "time repair; use offspring()"
+            )
+        trial = self._unrepaired(problem, pop, n_offsprings, algorithm)
+        return trial, self.repair.snaps(len(trial), kwargs.get("random_state"))
+
     def _plain(self) -> bool:
         """Whether the mutation and the repair are pymoo's plain operators."""
         operators = (self.mutation, self.repair)
@@ -90,12 +114,18 @@ class ArrayVariant(Variant):
         self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any, **kwargs
     ) -> np.ndarray:
         """:meth:`offspring` without the check."""
+        trial = self._unrepaired(problem, pop, n_offsprings, algorithm)
+        return np.asarray(self.repair._do(problem, trial, **kwargs))
+
+    def _unrepaired(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any
+    ) -> np.ndarray:
+        """The trial vectors (n_offsprings, n_var) after the mutation, before the repair."""
         rng = algorithm.random_state
         self.control.tell(pop=pop)
         self.control.do(n_offsprings)
         trial = self._trial(problem, pop, n_offsprings, rng)
-        trial = mutate(problem, self.mutation, trial, rng)
-        return np.asarray(self.repair._do(problem, trial, **kwargs))
+        return mutate(problem, self.mutation, trial, rng)
 
     def _trial(
         self, problem: Any, pop: Population, n_offsprings: int, rng: np.random.Generator
