@@ -99,6 +99,9 @@ class ArrayEvaluator(Evaluator):
             **kwargs,
         )
         members = list(pop)
+        # pymoo's Individual.set asks each member hasattr(ind, key): for plain members,
+        # whether their class has the attribute (F, G, H, ...), asked once per key
+        plain = all(type(ind) is Individual for ind in members)
         for key, values in out.items():
             if values is None:
                 continue
@@ -107,13 +110,18 @@ class ArrayEvaluator(Evaluator):
                 continue
             # pymoo's Population.set: a view of a row is copied (no array kept alive by it)
             rows = [row.copy() for row in values] if values.ndim > 1 else list(values)
+            if plain and isinstance(getattr(Individual, key, None), property):
+                for ind, row in zip(members, rows, strict=True):
+                    setattr(ind, key, row)
+                continue
             for ind, row in zip(members, rows, strict=True):
                 if hasattr(ind, key):
                     setattr(ind, key, row)
                 else:
                     ind.data[key] = row
+        keys = out.keys()
         for ind in members:
-            ind.evaluated.update(out.keys())
+            ind.evaluated.update(keys)
         _set_violations(members, [ind.G for ind in members])
 
 
