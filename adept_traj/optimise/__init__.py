@@ -21,6 +21,9 @@ from adept_traj.optimise.checkpoint import (
     save_checkpoint,
     write_checkpoint,
 )
+from adept_traj.optimise.crossover import (
+    sbx_children,
+)
 from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
     BlockedDuplicateElimination,
@@ -63,6 +66,9 @@ from adept_traj.optimise.polish_step import (
     polish_run,
     time_optimal_run,
 )
+from adept_traj.optimise.mutation import (
+    mutate,
+)
 from adept_traj.optimise.population import (
     ArrayEvaluator,
     cache_violations,
@@ -84,7 +90,9 @@ from adept_traj.optimise.survival import (
     crowding_distance,
 )
 from adept_traj.optimise.tournament import (
+    TournamentArrays,
     binary_tournament,
+    select_parents,
 )
 from adept_traj.optimise.variant import (
     ArrayVariant,
@@ -100,33 +108,34 @@ from adept_traj.optimise.weighted_move import (
 
 __all__ = [
     "ALGORITHMS",
-    "BLOCK_PAIRS",
-    "CHECKPOINT_INTERVAL",
-    "CHECKPOINT_VERSION",
-    "GRADIENT_COST",
-    "MAX_EVALUATIONS",
-    "MAX_EVALUATIONS_PER_START",
-    "POLISH_MODES",
-    "POLISH_SHARE",
-    "SPREAD_MEMBERS",
-    "STEP_EVALUATIONS",
-    "STOP_DECREASE",
-    "TIME_OPTIMAL",
-    "WEIGHTED_BOX",
     "AlgorithmSettings",
     "ArrayEvaluator",
     "ArrayMating",
     "ArrayVariant",
+    "BLOCK_PAIRS",
     "BlockedDuplicateElimination",
+    "CHECKPOINT_INTERVAL",
+    "CHECKPOINT_VERSION",
     "CapturedCheckpoint",
     "FastEndSearch",
+    "GRADIENT_COST",
     "GenerationInfo",
     "KinematicTimeRepair",
+    "MAX_EVALUATIONS",
+    "MAX_EVALUATIONS_PER_START",
+    "POLISH_MODES",
+    "POLISH_SHARE",
     "PlanningInterrupted",
     "PolishOutcome",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "SPREAD_MEMBERS",
+    "STEP_EVALUATIONS",
+    "STOP_DECREASE",
+    "TIME_OPTIMAL",
+    "TournamentArrays",
+    "WEIGHTED_BOX",
     "binary_tournament",
     "cache_violations",
     "capture_checkpoint",
@@ -140,6 +149,7 @@ __all__ = [
     "load_checkpoint",
     "make_algorithm",
     "minimum_time",
+    "mutate",
     "optimise",
     "optimum",
     "plan",
@@ -152,6 +162,8 @@ __all__ = [
     "ranked_optimum",
     "restore_algorithm",
     "save_checkpoint",
+    "sbx_children",
+    "select_parents",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",
