@@ -45,6 +45,9 @@ from adept_traj.optimise.mating import (
     ArrayMating,
 )
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
+from adept_traj.optimise.mutation import (
+    mutate,
+)
 from adept_traj.optimise.planner import (
     plan,
     warn_missing_limits,
@@ -65,9 +68,6 @@ from adept_traj.optimise.polish_step import (
     polish_mode,
     polish_run,
     time_optimal_run,
-)
-from adept_traj.optimise.mutation import (
-    mutate,
 )
 from adept_traj.optimise.population import (
     ArrayEvaluator,
@@ -108,34 +108,34 @@ from adept_traj.optimise.weighted_move import (
 
 __all__ = [
     "ALGORITHMS",
-    "AlgorithmSettings",
-    "ArrayEvaluator",
-    "ArrayMating",
-    "ArrayVariant",
     "BLOCK_PAIRS",
-    "BlockedDuplicateElimination",
     "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
-    "CapturedCheckpoint",
-    "FastEndSearch",
     "GRADIENT_COST",
-    "GenerationInfo",
-    "KinematicTimeRepair",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
     "POLISH_MODES",
     "POLISH_SHARE",
+    "SPREAD_MEMBERS",
+    "STEP_EVALUATIONS",
+    "STOP_DECREASE",
+    "TIME_OPTIMAL",
+    "WEIGHTED_BOX",
+    "AlgorithmSettings",
+    "ArrayEvaluator",
+    "ArrayMating",
+    "ArrayVariant",
+    "BlockedDuplicateElimination",
+    "CapturedCheckpoint",
+    "FastEndSearch",
+    "GenerationInfo",
+    "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
-    "SPREAD_MEMBERS",
-    "STEP_EVALUATIONS",
-    "STOP_DECREASE",
-    "TIME_OPTIMAL",
     "TournamentArrays",
-    "WEIGHTED_BOX",
     "binary_tournament",
     "cache_violations",
     "capture_checkpoint",

@@ -27,6 +27,16 @@ offspring are dropped. It is used when the operators are pymoo's plain ones (no
 ``vtype``, no operator-level repair) and the duplicate elimination is
 :class:`~adept_traj.optimise.BlockedDuplicateElimination` or none; otherwise, and without
 a random generator, it is pymoo's mating unchanged.
+
+Within a generation's rounds (the same decisions and draws): NSGA-II's binary tournaments
+read the members' CV, F, rank and crowding once
+(:func:`~adept_traj.optimise.select_parents`), SBX is computed for the crossed matings
+only (:func:`~adept_traj.optimise.sbx_children`), the polynomial mutation for the rows it
+keeps (:func:`~adept_traj.optimise.mutate`), and a round's three duplicate tests (within
+the round, against the parents, against the offspring so far, each a test of the row
+alone) are one pass over ``[parents; offspring; round]``. :meth:`ArrayMating.offspring`
+returns the children's decision vectors without building their members (for
+:class:`~adept_traj.optimise.FastEndSearch`, which builds the generation's members once).
 """
 
 from __future__ import annotations

@@ -12,6 +12,9 @@ pymoo's :func:`pymoo.algorithms.moo.nsga2.binary_tournament` decides each tourna
 :func:`binary_tournament` takes every decision at once on arrays (comparisons involving
 NaN are ties, as in pymoo) and breaks the ties with the same draws, one per tie, in the
 tournaments' order: the same winners and the same generator state.
+:func:`select_parents` is pymoo's ``TournamentSelection`` of it (pressure 2): pymoo's
+random permutations of the members, paired, decided on :class:`TournamentArrays` read once
+per generation for all of its mating rounds.
 """
 
 from __future__ import annotations

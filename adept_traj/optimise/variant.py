@@ -15,6 +15,14 @@ array, and builds the ``Population`` once, at the end: the same trial vectors bi
 and the same generator state. It is used when the mutation and the repair are plain
 pymoo operators (no ``vtype``, no operator-level repair); otherwise it is pymoo's
 ``Variant`` unchanged.
+
+The mutation is :func:`~adept_traj.optimise.mutate` (MODE's polynomial mutation at
+probability 0: its draws made, none computed). :meth:`ArrayVariant.offspring` returns the
+trial vectors without building their members, and
+:meth:`ArrayVariant.unrepaired_offspring` returns them before their kinematic time repair
+with the repair's draws (:meth:`~adept_traj.optimise.KinematicTimeRepair.snaps`), so that
+:class:`~adept_traj.optimise.FastEndSearch` repairs only the trial vectors it keeps, in
+one call with its own children's kinematic times: the same numbers.
 """
 
 from __future__ import annotations
