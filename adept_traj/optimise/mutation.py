@@ -31,9 +31,11 @@ def mutate(problem: Any, mutation: Any, X: np.ndarray, rng: np.random.Generator)
     with probability ``mutation.prob`` replaced by their mutation (see the module
     docstring)."""
     n = len(X)
-    if type(mutation) not in (PM, PolynomialMutation):
+    prob = get(mutation.prob, size=n)
+    if type(mutation) not in (PM, PolynomialMutation) or np.all(prob >= 1.0):
+        # (every row kept, e.g. NSGA-II's PM at probability 1: nothing to leave out)
         mutated = mutation._do(problem, X, random_state=rng)
-        chosen = rng.random(size=n) <= get(mutation.prob, size=n)
+        chosen = rng.random(size=n) <= prob
         X[chosen] = mutated[chosen]
         return X
     xl, xu = problem.xl, problem.xu
@@ -49,7 +51,7 @@ def mutate(problem: Any, mutation: Any, X: np.ndarray, rng: np.random.Generator)
             mask[k, forced[int(k)]] = True
     mask[:, xl == xu] = False
     spread = rng.random(int(mask.sum()))
-    chosen = rng.random(size=n) <= get(mutation.prob, size=n)
+    chosen = rng.random(size=n) <= prob
     if chosen.any():
         rows = np.flatnonzero(chosen)
         replay = _Replay(
