@@ -52,7 +52,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.mating import ArrayMating
-from adept_traj.optimise.population import ArrayEvaluator, population_values, ranked_optimum
+from adept_traj.optimise.population import ArrayEvaluator, ranked_optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
@@ -213,12 +213,17 @@ class _PaperNSGA2(_StampedGeneticAlgorithm):
         self.tournament_type = "comp_by_dom_and_crowding"
 
     def _set_optimum(self, **kwargs: Any) -> None:
-        cv = population_values(self.pop, "CV")[:, 0]
-        feasible = cv <= np.array([ind.config.get("cv_eps", 0.0) for ind in self.pop])
+        # one pass over the members: CV, its tolerance, whether the survival ranked it 0
+        members = [
+            (ind.CV[0], ind.config.get("cv_eps", 0.0), ind.data.get("rank") == 0)
+            for ind in self.pop
+        ]
+        cv = np.array([m[0] for m in members])
+        feasible = cv <= np.array([m[1] for m in members])
         if not feasible.any():  # pymoo's has_feasible, on arrays
             self.opt = self.pop[[np.argmin(cv)]]
         else:
-            self.opt = self.pop[np.array([ind.data.get("rank") == 0 for ind in self.pop])]
+            self.opt = self.pop[np.array([m[2] for m in members])]
 
 
 class _PaperMODE(_StampedGeneticAlgorithm):
