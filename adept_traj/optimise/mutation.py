@@ -5,8 +5,9 @@ pymoo's :class:`~pymoo.core.mutation.Mutation` mutates **every** row of the offs
 row, :math:`u_k \le p`). MODE's DE variation calls pymoo's polynomial mutation (PM) at
 ``prob = 0``: 500 rows mutated a generation, none kept. :func:`mutate` makes PM's draws
 for all rows — the (n, n_var) uniforms of the variables to mutate (each with probability
-``prob_var``), one integer per row that drew none when ``at_least_once`` (one call per
-row, in order), one uniform per mutated variable — then the per-row choice, and computes
+``prob_var``), one integer per row that drew none when ``at_least_once`` (pymoo makes one
+call per row, in order; one call of that size gives the same numbers and generator state,
+tested against pymoo), one uniform per mutated variable — then the per-row choice, and computes
 the mutation for the chosen rows only, by pymoo's own ``mut_pm`` fed with the chosen rows'
 draws (:class:`_Replay`): the same rows, the same bits, the same generator state.
 Another mutation than PM runs as pymoo runs it.
@@ -46,9 +47,12 @@ def mutate(problem: Any, mutation: Any, X: np.ndarray, rng: np.random.Generator)
     mask = uniforms < (np.ones(n) * prob_var)[:, None]
     forced: dict[int, Any] = {}
     if mutation.at_least_once:
-        for k in np.flatnonzero(~np.any(mask, axis=1)):
-            forced[int(k)] = rng.integers(X.shape[1])
-            mask[k, forced[int(k)]] = True
+        # pymoo draws one integer per row without a variable, one call each: the same
+        # numbers (and generator state) as one call of that size
+        empty = np.flatnonzero(~np.any(mask, axis=1))
+        picks = rng.integers(X.shape[1], size=len(empty))
+        mask[empty, picks] = True
+        forced = dict(zip(empty.tolist(), picks, strict=True))
     mask[:, xl == xu] = False
     spread = rng.random(int(mask.sum()))
     chosen = rng.random(size=n) <= prob
