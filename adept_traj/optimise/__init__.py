@@ -21,6 +21,9 @@ from adept_traj.optimise.checkpoint import (
     save_checkpoint,
     write_checkpoint,
 )
+from adept_traj.optimise.crossover import (
+    sbx_children,
+)
 from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
     BlockedDuplicateElimination,
@@ -42,6 +45,9 @@ from adept_traj.optimise.mating import (
     ArrayMating,
 )
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
+from adept_traj.optimise.mutation import (
+    mutate,
+)
 from adept_traj.optimise.planner import (
     plan,
     warn_missing_limits,
@@ -68,6 +74,7 @@ from adept_traj.optimise.population import (
     cache_violations,
     optimum,
     population_values,
+    ranked_optimum,
 )
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
@@ -83,7 +90,9 @@ from adept_traj.optimise.survival import (
     crowding_distance,
 )
 from adept_traj.optimise.tournament import (
+    TournamentArrays,
     binary_tournament,
+    select_parents,
 )
 from adept_traj.optimise.variant import (
     ArrayVariant,
@@ -126,6 +135,7 @@ __all__ = [
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
+    "TournamentArrays",
     "binary_tournament",
     "cache_violations",
     "capture_checkpoint",
@@ -139,6 +149,7 @@ __all__ = [
     "load_checkpoint",
     "make_algorithm",
     "minimum_time",
+    "mutate",
     "optimise",
     "optimum",
     "plan",
@@ -148,8 +159,11 @@ __all__ = [
     "polish_run",
     "population_bytes",
     "population_values",
+    "ranked_optimum",
     "restore_algorithm",
     "save_checkpoint",
+    "sbx_children",
+    "select_parents",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",

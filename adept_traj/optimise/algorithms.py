@@ -43,6 +43,8 @@ from typing import Any
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.algorithm import Algorithm
+from pymoo.core.individual import Individual
+from pymoo.core.population import Population
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.display.multi import MultiObjectiveOutput
 
@@ -50,7 +52,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.duplicates import BlockedDuplicateElimination
 from adept_traj.optimise.fast_end import FastEndSearch
 from adept_traj.optimise.mating import ArrayMating
-from adept_traj.optimise.population import ArrayEvaluator, optimum, population_values
+from adept_traj.optimise.population import ArrayEvaluator, ranked_optimum
 from adept_traj.optimise.repair import KinematicTimeRepair
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.survival import RankAndCrowdingSurvival
@@ -171,7 +173,33 @@ def make_algorithm(
     return algorithm, AlgorithmSettings(name=key, pop_size=pop, n_gen=gens, params=settings)
 
 
-class _PaperNSGA2(GeneticAlgorithm):
+class _StampedGeneticAlgorithm(GeneticAlgorithm):
+    """pymoo's genetic algorithm whose ``infill`` stamps each generation's offspring with
+    ``n_gen`` and ``n_iter`` straight into each member's ``data``, what pymoo's
+    ``Algorithm.infill`` does through ``Population.set`` (per member and key a
+    ``hasattr`` that fails and a call of ``Individual.set``): the same values in the same
+    members."""
+
+    def infill(self) -> Population | None:
+        if self.problem is None or not self.is_initialized:
+            return super().infill()  # the first call: pymoo's initialisation
+        infills = self._infill()
+        if infills is None:
+            return None
+        members = list(infills)
+        if all(type(ind) is Individual for ind in members):  # no attribute n_gen / n_iter
+            n_iter = self.n_iter
+            for ind in members:
+                data = ind.data
+                data["n_gen"] = n_iter
+                data["n_iter"] = n_iter
+        else:
+            infills.set("n_gen", self.n_iter)
+            infills.set("n_iter", self.n_iter)
+        return infills
+
+
+class _PaperNSGA2(_StampedGeneticAlgorithm):
     """pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2` as this module configures it:
     its genetic algorithm, binary tournament type, output, termination and ``opt`` (the
     rank-0 members, or the least infeasible one), without importing
@@ -185,24 +213,30 @@ class _PaperNSGA2(GeneticAlgorithm):
         self.tournament_type = "comp_by_dom_and_crowding"
 
     def _set_optimum(self, **kwargs: Any) -> None:
-        cv = population_values(self.pop, "CV")[:, 0]
-        feasible = cv <= np.array([ind.config.get("cv_eps", 0.0) for ind in self.pop])
+        # one pass over the members: CV, its tolerance, whether the survival ranked it 0
+        members = [
+            (ind.CV[0], ind.config.get("cv_eps", 0.0), ind.data.get("rank") == 0)
+            for ind in self.pop
+        ]
+        cv = np.array([m[0] for m in members])
+        feasible = cv <= np.array([m[1] for m in members])
         if not feasible.any():  # pymoo's has_feasible, on arrays
             self.opt = self.pop[[np.argmin(cv)]]
         else:
-            self.opt = self.pop[np.array([ind.data.get("rank") == 0 for ind in self.pop])]
+            self.opt = self.pop[np.array([m[2] for m in members])]
 
 
-class _PaperMODE(GeneticAlgorithm):
+class _PaperMODE(_StampedGeneticAlgorithm):
     """pymoo's genetic algorithm with the DE/rand/1/bin variation and rank-and-crowding
     survival (see the module docstring); its ``opt`` after every generation (pymoo's
     ``filter_optimum`` of the population, which reads three properties per member through
-    ``Population.get``) computed by :func:`~adept_traj.optimise.optimum` on arrays — the
-    same members in the same order. (NSGA-II keeps pymoo's own, cheaper ``opt``: its
-    rank-0 members.)"""
+    ``Population.get`` and sorts the population again) is
+    :func:`~adept_traj.optimise.ranked_optimum`: the feasible members the survival ranked
+    0 — the same members in the same order. (NSGA-II keeps pymoo's own ``opt``: its rank-0
+    members.)"""
 
     def _set_optimum(self) -> None:
-        self.opt = optimum(self.pop)
+        self.opt = ranked_optimum(self.pop)
 
 
 def _build(key: str, pop: int, sampling: Any, s: dict[str, Any], repair: Any) -> Algorithm:

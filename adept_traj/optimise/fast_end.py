@@ -44,9 +44,11 @@ import numpy as np
 from pymoo.core.population import Population
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.mating import ArrayMating
 from adept_traj.optimise.population import population_values
-from adept_traj.optimise.repair import kinematic_time
+from adept_traj.optimise.repair import KinematicTimeRepair, kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.variant import ArrayVariant
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["FastEndSearch"]
@@ -119,25 +121,47 @@ class FastEndSearch:
         evaluated: the number of evaluations is the mating's."""
         rng = kwargs.get("random_state")
         feasible = np.flatnonzero(population_values(pop, "CV")[:, 0] <= 0.0) if len(pop) else []
-        off = self.mating.do(problem, pop, n_offsprings, **kwargs)
-        if rng is None or len(off) == 0:
-            return off
+        # The mating's children as an array when it can make them so (its members are
+        # built once, below, without the replaced ones), else as a population.
+        arrays = rng is not None and _makes_arrays(self.mating)
+        # MODE's trial vectors: their kinematic time repair made for the kept ones only,
+        # with the children's kinematic times (the repair's draws made where it makes them)
+        repair = getattr(self.mating, "repair", None)
+        deferred = arrays and isinstance(self.mating, ArrayVariant)
+        deferred = deferred and isinstance(repair, KinematicTimeRepair)
+        if deferred:
+            off, snapped = self.mating.unrepaired_offspring(problem, pop, n_offsprings, **kwargs)
+        elif arrays:
+            off = self.mating.offspring(problem, pop, n_offsprings, **kwargs)
+        else:
+            off = self.mating.do(problem, pop, n_offsprings, **kwargs)
         n_local = min(round(self.fraction * n_offsprings), len(off))
         n_new = round(self.immigrants * n_local)
         n_bump = n_local - n_new if len(feasible) else 0
-        if n_new + n_bump == 0:
-            return off
+        if rng is None or len(off) == 0 or n_new + n_bump == 0:
+            if deferred:
+                off = repair.repaired(problem, off, snapped)
+            return Population.new(X=off) if arrays else off
         # Replace a random subset of the mating's children (not its last ones: pymoo's DE
         # uses the first members of the population as targets, in order).
         keep = np.sort(rng.permutation(len(off))[: len(off) - n_new - n_bump])
-        children = self.sampling.ramps(problem, n_new, rng)
+        # (each immigrant's T is set below: the ramps' own fast times are not needed)
+        children = self.sampling.ramps(problem, n_new, rng, fast_times=False)
         if n_bump:
             X = population_values(pop, "X")
             fastest = feasible[np.argsort(X[feasible, 0], kind="stable")[: self.n_elite]]
             parents = X[fastest[rng.integers(0, len(fastest), size=n_bump)]]
             children = np.concatenate([children, self._perturb(problem, parents, rng)])
-        t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
+        if deferred:  # one kinematic time call for the kept trial vectors and the children
+            t_all = kinematic_time(problem, np.concatenate([off[keep], children]))
+            kept = repair.repaired(problem, off[keep], snapped[keep], t_all[: len(keep)])
+            t_kin = t_all[len(keep) :] * (1.0 + _SLACK)
+        else:
+            kept = off[keep]
+            t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
         children[:, 0] = np.clip(t_kin, problem.xl[0], problem.xu[0])
+        if arrays:
+            return Population.new(X=np.concatenate([kept, children]))
         return Population.merge(off[keep], Population.new(X=children))
 
     def _perturb(self, problem: Any, parents: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -162,6 +186,14 @@ class FastEndSearch:
         free = free + amplitude * bump
         children = traj.encode(parents[:, 0], free)
         return np.clip(children, problem.xl, problem.xu)
+
+
+def _makes_arrays(mating: Any) -> bool:
+    """Whether ``mating`` makes its children as an array (``offspring``, the decision
+    vectors of the members its ``do`` would return: those of
+    :class:`~adept_traj.optimise.ArrayMating` and :class:`~adept_traj.optimise.ArrayVariant`
+    with pymoo's plain operators)."""
+    return isinstance(mating, ArrayMating | ArrayVariant) and mating.makes_arrays()
 
 
 def _envelope(xi: np.ndarray) -> np.ndarray:

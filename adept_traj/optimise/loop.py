@@ -182,11 +182,12 @@ def optimise(
                 if not isinstance(algorithm.evaluator, ArrayEvaluator):  # (it sets them)
                     cache_violations(infills)  # what the survival reads, at once
             algorithm.tell(infills=infills)
-            pop = algorithm.pop
-            feasible = population_values(pop, "CV")[:, 0] <= 0.0
-            X, F = population_values(pop, "X"), population_values(pop, "F")
-            best_t = float(X[feasible, 0].min()) if feasible.any() else None
-            F = F[feasible]
+            # one pass over the members: CV, travel time T and objectives
+            members = [(ind.CV[0], ind.X[0], ind.F) for ind in algorithm.pop]
+            feasible = np.array([m[0] for m in members]) <= 0.0
+            T = np.array([m[1] for m in members])
+            best_t = float(T[feasible].min()) if feasible.any() else None
+            F = np.array([m[2] for m in members])[feasible]
             fronts.append(F[non_dominated(F, maximised=False)] if len(F) else F)
             info = GenerationInfo(
                 generation=len(history) + 1,

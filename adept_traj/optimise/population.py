@@ -17,7 +17,11 @@ same operations (hence the same bits) for pymoo's default configuration:
     \mathrm{CV}_i = \sum_j \max(0,\ G_{ij} - 0) + 0 .
 
 :func:`optimum` is pymoo's ``filter_optimum(pop, least_infeasible=True)`` (what every
-algorithm stores as ``opt`` after each generation) on these arrays.
+algorithm stores as ``opt`` after each generation) on these arrays. :func:`ranked_optimum`
+is the same filter of the survivors of a rank-and-crowding survival without sorting them
+again: the survivors' feasible non-dominated members are those the survival ranked 0 (a
+survivor of rank k > 0 is dominated by a member of rank k − 1, which survived too, since
+the fronts are filled in rank order).
 
 :class:`ArrayEvaluator` is pymoo's ``Evaluator`` (what the algorithms of
 :func:`~adept_traj.optimise.make_algorithm` evaluate with) writing the evaluated rows
@@ -37,7 +41,13 @@ from pymoo.core.individual import Individual, default_config
 from pymoo.core.population import Population
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-__all__ = ["ArrayEvaluator", "cache_violations", "optimum", "population_values"]
+__all__ = [
+    "ArrayEvaluator",
+    "cache_violations",
+    "optimum",
+    "population_values",
+    "ranked_optimum",
+]
 
 
 def population_values(pop: Population, key: str) -> np.ndarray:
@@ -89,6 +99,9 @@ class ArrayEvaluator(Evaluator):
             **kwargs,
         )
         members = list(pop)
+        # pymoo's Individual.set asks each member hasattr(ind, key): for plain members,
+        # whether their class has the attribute (F, G, H, ...), asked once per key
+        plain = all(type(ind) is Individual for ind in members)
         for key, values in out.items():
             if values is None:
                 continue
@@ -97,13 +110,18 @@ class ArrayEvaluator(Evaluator):
                 continue
             # pymoo's Population.set: a view of a row is copied (no array kept alive by it)
             rows = [row.copy() for row in values] if values.ndim > 1 else list(values)
+            if plain and isinstance(getattr(Individual, key, None), property):
+                for ind, row in zip(members, rows, strict=True):
+                    setattr(ind, key, row)
+                continue
             for ind, row in zip(members, rows, strict=True):
                 if hasattr(ind, key):
                     setattr(ind, key, row)
                 else:
                     ind.data[key] = row
+        keys = out.keys()
         for ind in members:
-            ind.evaluated.update(out.keys())
+            ind.evaluated.update(keys)
         _set_violations(members, [ind.G for ind in members])
 
 
@@ -127,3 +145,22 @@ def optimum(pop: Population | None) -> Population | None:
     if isinstance(ret, Individual):
         ret = Population().create(ret)
     return ret
+
+
+def ranked_optimum(pop: Population | None) -> Population | None:
+    """:func:`optimum` of the survivors ``pop`` of
+    :class:`~adept_traj.optimise.RankAndCrowdingSurvival` (the same members in the same
+    order): the feasible members with ``rank`` 0, read from each member's data instead of
+    sorting the population again (see the module docstring). A population whose feasible
+    members are not all ranked, or with one objective, goes to :func:`optimum`."""
+    if pop is None or len(pop) < 2:
+        return optimum(pop)
+    feasible = np.empty(len(pop), dtype=bool)
+    rank = np.empty(len(pop), dtype=object)
+    for i, ind in enumerate(pop):  # one pass: CV, its tolerance and the survival's rank
+        feasible[i] = ind.CV[0] <= ind.config.get("cv_eps", 0.0)
+        rank[i] = ind.data.get("rank")
+    n_obj = len(pop[0].F)
+    if not feasible.any() or n_obj < 2 or any(r is None for r in rank[feasible]):
+        return optimum(pop)
+    return pop[feasible & (rank == 0)]

@@ -61,10 +61,12 @@ def _kinematic_time(problem: Any, x: np.ndarray) -> np.ndarray:
     qd, qdd, qddd = derivative_abs_max(problem.trajectory, unit)  # the extrema at T = 1
     lim = problem.robot.limits
     with np.errstate(divide="ignore", invalid="ignore"):
-        times = np.stack(
-            [qd / lim.velocity, np.sqrt(qdd / lim.acceleration), np.cbrt(qddd / lim.jerk)]
-        )
-    return np.nan_to_num(times, nan=0.0).max(axis=(0, -1))
+        v, a, j = qd / lim.velocity, np.sqrt(qdd / lim.acceleration), np.cbrt(qddd / lim.jerk)
+    # The largest time over the three kinds and the joints, a NaN (0/0: a zero limit, no
+    # motion) counting as 0 and ±inf as the largest float (``nan_to_num``): that map keeps
+    # the order of the times, so it is applied to the largest non-NaN time (``fmax``
+    # skips NaN; NaN only if all are) — the same number.
+    return np.nan_to_num(np.fmax.reduce(np.fmax(np.fmax(v, a), j), axis=-1), nan=0.0)
 
 
 class KinematicTimeRepair(Repair):
@@ -89,10 +91,31 @@ class KinematicTimeRepair(Repair):
         X = np.array(X, dtype=float)
         if X.size == 0:
             return X
-        t_kin = kinematic_time(problem, X) * (1.0 + _SLACK)
-        T = np.maximum(X[:, 0], t_kin)
-        rng = kwargs.get("random_state")
+        return self.repaired(problem, X, self.snaps(len(X), kwargs.get("random_state")))
+
+    def snaps(self, n: int, rng: np.random.Generator | None) -> np.ndarray:
+        """(n,) bool: which of n candidates get T exactly at their kinematic minimum — the
+        draws the repair makes (one uniform each from ``rng``; none, all false, at
+        ``snap`` 0 or without a generator)."""
         if self.snap > 0.0 and rng is not None:
-            T = np.where(rng.uniform(size=len(T)) < self.snap, t_kin, T)
+            return rng.uniform(size=n) < self.snap
+        return np.zeros(n, dtype=bool)
+
+    def repaired(
+        self,
+        problem: Any,
+        X: np.ndarray,
+        snapped: np.ndarray,
+        t_kin: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The candidates ``X`` (n, n_var) repaired (a copy): T raised to its kinematic
+        minimum, or set to it where ``snapped`` (n,) (from :meth:`snaps`), clipped to
+        T's bounds. ``t_kin`` (n,) [s]: the candidates' :func:`kinematic_time` if already
+        computed (e.g. with other rows)."""
+        X = np.array(X, dtype=float)
+        if X.size == 0:
+            return X
+        t_kin = (kinematic_time(problem, X) if t_kin is None else t_kin) * (1.0 + _SLACK)
+        T = np.where(snapped, t_kin, np.maximum(X[:, 0], t_kin))
         X[:, 0] = np.clip(T, problem.xl[0], problem.xu[0])
         return X

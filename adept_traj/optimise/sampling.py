@@ -195,9 +195,17 @@ class RampSampling(Sampling):
             x[0] = problem.trajectory.straight_line(0.5 * (problem.xl[0] + problem.xu[0]))
         return np.clip(x, problem.xl, problem.xu)
 
-    def ramps(self, problem: Any, n_samples: int, rng: np.random.Generator) -> np.ndarray:
+    def ramps(
+        self, problem: Any, n_samples: int, rng: np.random.Generator, *, fast_times: bool = True
+    ) -> np.ndarray:
         """(n_samples, n_var) random ramps (the module's distribution, without the straight
-        move), clipped to the decision bounds; randomness from ``rng`` only."""
+        move), clipped to the decision bounds; randomness from ``rng`` only.
+
+        ``fast_times=False`` leaves the travel time T of the half that would get T just
+        above its kinematic minimum at its uniform draw (the same draws are made, the
+        kinematic minima are not computed): for a caller that sets every T itself, as
+        :class:`~adept_traj.optimise.FastEndSearch` does; every other number is the
+        same."""
         traj = problem.trajectory
         nq = traj.nq
         xi = traj.free_abscissae
@@ -220,5 +228,7 @@ class RampSampling(Sampling):
         )  # (n_samples, n_free, nq)
         x = traj.encode(T, free)
         fast = rng.uniform(size=n_samples) < 0.5
-        x[fast, 0] = kinematic_time(problem, x[fast]) * rng.uniform(1.0, 1.3, size=fast.sum())
+        above = rng.uniform(1.0, 1.3, size=fast.sum())
+        if fast_times:
+            x[fast, 0] = kinematic_time(problem, x[fast]) * above
         return np.clip(x, problem.xl, problem.xu)

@@ -127,8 +127,10 @@ class RankAndCrowdingSurvival(Survival):
                 problem, pop, *args, n_survive=n_survive, random_state=random_state, **kwargs
             )
         else:
-            cv = population_values(pop, "CV")  # (n, 1)
-            eps = np.array([ind.config.get("cv_eps", 0.0) for ind in pop])
+            # one pass over the members: CV (n, 1), its tolerance, the objectives
+            members = [(ind.CV, ind.config.get("cv_eps", 0.0), ind.F) for ind in pop]
+            cv = np.array([m[0] for m in members])
+            eps = np.array([m[1] for m in members])
             feasible = np.flatnonzero(cv[:, 0] <= eps)
             infeasible = np.flatnonzero(~(cv[:, 0] <= eps))
             infeasible = infeasible[np.argsort(cv[infeasible, 0])]
@@ -141,6 +143,7 @@ class RankAndCrowdingSurvival(Survival):
                     *args,
                     n_survive=min(len(feasible), n_survive),
                     random_state=random_state,
+                    objectives=np.array([members[i][2] for i in feasible]),
                     **kwargs,
                 )
             n_remaining = n_survive - len(survivors)
@@ -158,12 +161,15 @@ class RankAndCrowdingSurvival(Survival):
         *args: Any,
         random_state: Any = None,
         n_survive: int | None = None,
+        objectives: np.ndarray | None = None,
         **kwargs: Any,
     ) -> Population:
-        """pymoo's ranking of (feasible) members, F read once per member and ``rank`` and
-        ``crowding`` written straight into each member's ``data`` (what pymoo's
-        ``Individual.set`` does for a key that is not an attribute)."""
-        F = population_values(pop, "F").astype(float, copy=False)
+        """pymoo's ranking of (feasible) members, F read once per member (or given:
+        ``objectives``, the members' F stacked) and ``rank`` and ``crowding`` written
+        straight into each member's ``data`` (what pymoo's ``Individual.set`` does for a
+        key that is not an attribute)."""
+        F = population_values(pop, "F") if objectives is None else objectives
+        F = F.astype(float, copy=False)
         survivors: list[int] = []
         for k, front in enumerate(self.nds.do(F, n_stop_if_ranked=n_survive)):
             keep = np.arange(len(front))

@@ -15,6 +15,14 @@ array, and builds the ``Population`` once, at the end: the same trial vectors bi
 and the same generator state. It is used when the mutation and the repair are plain
 pymoo operators (no ``vtype``, no operator-level repair); otherwise it is pymoo's
 ``Variant`` unchanged.
+
+The mutation is :func:`~adept_traj.optimise.mutate` (MODE's polynomial mutation at
+probability 0: its draws made, none computed). :meth:`ArrayVariant.offspring` returns the
+trial vectors without building their members, and
+:meth:`ArrayVariant.unrepaired_offspring` returns them before their kinematic time repair
+with the repair's draws (:meth:`~adept_traj.optimise.KinematicTimeRepair.snaps`), so that
+:class:`~adept_traj.optimise.FastEndSearch` repairs only the trial vectors it keeps, in
+one call with its own children's kinematic times: the same numbers.
 """
 
 from __future__ import annotations
@@ -33,7 +41,9 @@ from pymoo.operators.selection.rnd import fast_fill_random
 from pymoo.util.misc import where_is_what
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.mutation import mutate
 from adept_traj.optimise.population import population_values
+from adept_traj.optimise.repair import KinematicTimeRepair
 
 __all__ = ["ArrayVariant"]
 
@@ -47,23 +57,83 @@ class ArrayVariant(Variant):
     ) -> Population:
         """``n_offsprings`` trial vectors from ``pop``, as pymoo's ``Variant.do`` makes them
         from ``algorithm.random_state``."""
+        if not self._plain():
+            return super().do(problem, pop, n_offsprings, algorithm=algorithm, **kwargs)
+        off = Population.new(X=self._offspring(problem, pop, n_offsprings, algorithm, **kwargs))
+        self.control.advance(off)
+        return off
+
+    def makes_arrays(self) -> bool:
+        """Whether :meth:`offspring` applies: plain operators (see the module docstring)
+        and a parameter control without parameters to set on the trial vectors (MODE's
+        ``NoParameterControl``)."""
+        return self._plain() and not self.control.params
+
+    def offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any = None, **kwargs
+    ) -> np.ndarray:
+        """The decision vectors (n_offsprings, n_var) of the trial vectors :meth:`do` makes
+        (the same draws from ``algorithm.random_state``), without building their members.
+
+        Raises
+        ------
+        ConfigurationError
+            :meth:`makes_arrays` is false (use :meth:`do`).
+        """
+        if not self.makes_arrays():
+            raise ConfigurationError(
+                "ArrayVariant.offspring needs pymoo's plain operators and a parameter "
+                "control without parameters; use do()"
+            )
+        return self._offspring(problem, pop, n_offsprings, algorithm, **kwargs)
+
+    def unrepaired_offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any = None, **kwargs
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The trial vectors of :meth:`offspring` before their kinematic time repair
+        (n_offsprings, n_var) and the repair's draws (:meth:`KinematicTimeRepair.snaps
+        <adept_traj.optimise.KinematicTimeRepair.snaps>`, (n_offsprings,) bool), made
+        where the repair makes them: ``repair.repaired(problem, X, snapped)`` of any rows
+        gives those rows of :meth:`offspring`, whose draws were the same.
+
+        Raises
+        ------
+        ConfigurationError
+            :meth:`makes_arrays` is false or the repair is not a
+            :class:`~adept_traj.optimise.KinematicTimeRepair`.
+        """
+        if not (self.makes_arrays() and isinstance(self.repair, KinematicTimeRepair)):
+            raise ConfigurationError(
+                "ArrayVariant.unrepaired_offspring needs plain operators and the kinematic "
+                "time repair; use offspring()"
+            )
+        trial = self._unrepaired(problem, pop, n_offsprings, algorithm)
+        return trial, self.repair.snaps(len(trial), kwargs.get("random_state"))
+
+    def _plain(self) -> bool:
+        """Whether the mutation and the repair are pymoo's plain operators."""
         operators = (self.mutation, self.repair)
-        plain = isinstance(self.repair, Repair) and all(
+        return isinstance(self.repair, Repair) and all(
             getattr(op, "vtype", None) is None and getattr(op, "repair", None) is None
             for op in operators
         )
-        if not plain:
-            return super().do(problem, pop, n_offsprings, algorithm=algorithm, **kwargs)
+
+    def _offspring(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any, **kwargs
+    ) -> np.ndarray:
+        """:meth:`offspring` without the check."""
+        trial = self._unrepaired(problem, pop, n_offsprings, algorithm)
+        return np.asarray(self.repair._do(problem, trial, **kwargs))
+
+    def _unrepaired(
+        self, problem: Any, pop: Population, n_offsprings: int, algorithm: Any
+    ) -> np.ndarray:
+        """The trial vectors (n_offsprings, n_var) after the mutation, before the repair."""
         rng = algorithm.random_state
         self.control.tell(pop=pop)
         self.control.do(n_offsprings)
         trial = self._trial(problem, pop, n_offsprings, rng)
-        mutated = self.mutation._do(problem, trial, random_state=rng)
-        chosen = rng.random(size=n_offsprings) <= get(self.mutation.prob, size=n_offsprings)
-        trial[chosen] = mutated[chosen]
-        off = Population.new(X=np.asarray(self.repair._do(problem, trial, **kwargs)))
-        self.control.advance(off)
-        return off
+        return mutate(problem, self.mutation, trial, rng)
 
     def _trial(
         self, problem: Any, pop: Population, n_offsprings: int, rng: np.random.Generator
@@ -72,9 +142,9 @@ class ArrayVariant(Variant):
         ``Population.new`` (pymoo's code; X read once per member)."""
         sel, n_diffs = get(self.selection, self.n_diffs, size=n_offsprings)
         if _all_same(sel) and _all_same(n_diffs):  # where_is_what's one group, at once
-            H = {(sel[0], n_diffs[0]): list(range(n_offsprings))}
-        else:
-            H = where_is_what(zip(sel, n_diffs, strict=True))
+            H = {(sel[0], n_diffs[0]): np.arange(n_offsprings)}
+        else:  # (index arrays: the same rows as pymoo's lists, without converting them)
+            H = _as_arrays(where_is_what(zip(sel, n_diffs, strict=True)))
         F, CR, jitter = get(self.F, self.CR, self.jitter, size=n_offsprings)
         X = population_values(pop, "X")
         donor = np.full((n_offsprings, problem.n_var), np.nan)
@@ -105,7 +175,11 @@ class ArrayVariant(Variant):
             donor[targets] = Xp
         trial = np.full((n_offsprings, problem.n_var), np.nan)
         kinds = get(self.crossover, size=n_offsprings)
-        groups = {kinds[0]: list(range(n_offsprings))} if _all_same(kinds) else where_is_what(kinds)
+        groups = (
+            {kinds[0]: np.arange(n_offsprings)}
+            if _all_same(kinds)
+            else _as_arrays(where_is_what(kinds))
+        )
         for name, K in groups.items():
             target, donors, rate = X[K], donor[K], CR[K]
             if name in ("bin", "exp"):
@@ -131,3 +205,8 @@ def _all_same(values: Any) -> bool:
     index, in order."""
     values = np.asarray(values)
     return values.ndim == 1 and len(values) > 0 and bool((values == values[0]).all())
+
+
+def _as_arrays(groups: dict[Any, list[int]]) -> dict[Any, np.ndarray]:
+    """``where_is_what``'s groups with their index lists as integer arrays."""
+    return {key: np.asarray(index, dtype=np.intp) for key, index in groups.items()}
