@@ -103,6 +103,8 @@ class BatchKinematics:
         self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
         #: Parent frame (njoints - 1,) of every joint (0 = universe).
         self.parents = np.array([j.parent for j in joints], dtype=int)
+        # Per joint: (c, ±1) when its axis is ±e_c (then z = ±column c of its frame), or None.
+        self._axis_column = [_axis_column(j.axis) for j in joints]
 
     def joint_frames(self, q: np.ndarray) -> np.ndarray:
         """Joint frames, component-major: (njoints, 3, 4, N) — the top three rows of the
@@ -184,6 +186,45 @@ class BatchKinematics:
             else:
                 jac[:3, j.index] += z
         return jac
+
+    def _jacobian_rows(
+        self, frames: np.ndarray, point_joint: int, point: np.ndarray, rows: list[int]
+    ) -> np.ndarray:
+        """The rows ``rows`` (indices into (v_x, v_y, v_z, ω_x, ω_y, ω_z)) of
+        :meth:`frame_jacobian`, (len(rows), nq, N): the same values, but a zero entry may
+        differ in sign (a joint axis along an axis of its frame reads that column of the
+        frame, ±1 × x, instead of the dot product with the axis, x + 0·y + 0·z; exact, as x
+        is, but for the sign of a zero). For measures that do not see the sign of zero
+        (e.g. :math:`|\\det J|`)."""
+        jac = np.zeros((len(rows), self.nq, frames.shape[-1]))
+        for i, j in enumerate(self._joints, start=1):
+            if not self._ancestor[point_joint, i]:
+                continue
+            column = self._axis_column[i - 1]
+            if column is None:
+                z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
+            else:
+                z = frames[i, :, column[0]] if column[1] > 0 else -frames[i, :, column[0]]
+            z = z if j.scale == 1.0 else j.scale * z
+            r = point - frames[i, :, 3] if j.revolute else None
+            for out, row in enumerate(rows):
+                if not j.revolute:
+                    if row < 3:
+                        jac[out, j.index] += z[row]
+                elif row >= 3:
+                    jac[out, j.index] += z[row - 3]
+                else:  # z × r, as in frame_jacobian
+                    a, b = (row + 1) % 3, (row + 2) % 3
+                    jac[out, j.index] += z[a] * r[b] - z[b] * r[a]
+        return jac
+
+
+def _axis_column(axis: np.ndarray) -> tuple[int, float] | None:
+    """``(c, ±1)`` when the unit ``axis`` (3,) is ±e_c exactly, else None."""
+    nonzero = np.flatnonzero(axis)
+    if len(nonzero) == 1 and abs(axis[nonzero[0]]) == 1.0:
+        return int(nonzero[0]), float(axis[nonzero[0]])
+    return None
 
 
 def _one_dof_joint(model: pin.Model, i: int, s: np.ndarray) -> _Joint:
