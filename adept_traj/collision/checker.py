@@ -223,8 +223,10 @@ class CollisionChecker:
                 poses.append(fixed)
                 continue
             key = id(ob.motion)
-            if key not in laws:
-                laws[key] = _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
+            if key not in laws:  # contiguous once, not in each product below
+                laws[key] = np.ascontiguousarray(
+                    _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
+                )
             poses.append(stack_times(laws[key], ob.offset))  # = to_base @ ob.pose(t)
         return poses
 

@@ -247,6 +247,10 @@ class PendulumMotion(MotionLaw):
         object.__setattr__(self, "omega", omega)
         object.__setattr__(self, "g", g)
         object.__setattr__(self, "swing_axis", readonly_copy(axis))
+        # The frame's constant columns as floats, for pose() (not fields: equality, hashing
+        # and replace() read the fields only).
+        columns = zip(axis.tolist(), _EZ.tolist(), np.cross(_EZ, axis).tolist(), pivot.tolist())
+        object.__setattr__(self, "_pose_rows", tuple(columns))
 
     # ------------------------------------------------------------------ derived constants
     @property
@@ -350,8 +354,7 @@ class PendulumMotion(MotionLaw):
         phi = self.angle(t)
         c, s, out = np.cos(phi), np.sin(phi), np.zeros((*phi.shape, 4, 4))
         # row by row: a broadcast over a trailing axis of length 3 is several times slower
-        rows = zip(self.swing_axis.tolist(), _EZ.tolist(), self.normal_axis, self.pivot)
-        for i, (swing, ez, normal, pivot) in enumerate(rows):
+        for i, (swing, ez, normal, pivot) in enumerate(self._pose_rows):
             out[..., i, 0], out[..., i, 1] = c * swing + s * ez, normal
             out[..., i, 2], out[..., i, 3] = -s * swing + c * ez, pivot
         out[..., 3, 3] = 1.0
