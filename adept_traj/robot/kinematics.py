@@ -126,23 +126,24 @@ class BatchKinematics:
         frames = np.empty((len(self._joints) + 1, 3, 4, n))
         frames[0] = np.eye(4)[:3, :, None]
         for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
-            a = compose(frames[j.parent], pre)
             dst = frames[i]
+            np.matmul(pre.T, frames[j.parent], out=dst)  # = compose(parent, pre), in place
             qi = (
                 qf[:, j.index]
                 if j.scale == 1.0 and j.offset == 0.0
                 else j.scale * qf[:, j.index] + j.offset
             )
-            if j.revolute:
+            if j.revolute:  # columns 0, 1: c a0 + s a1 and c a1 − s a0, in place
                 c, s = np.cos(qi), np.sin(qi)
-                dst[:, 0] = c * a[:, 0] + s * a[:, 1]
-                dst[:, 1] = c * a[:, 1] - s * a[:, 0]
-                dst[:, 2:] = a[:, 2:]
+                a0, a1 = dst[:, 0].copy(), dst[:, 1].copy()
+                np.multiply(c, a0, out=dst[:, 0])
+                dst[:, 0] += s * a1
+                np.multiply(c, a1, out=dst[:, 1])
+                dst[:, 1] -= s * a0
                 if post is not None:
                     dst[:] = compose(dst, post)
             else:
-                dst[:] = a
-                dst[:, 3] += np.tensordot(j.axis, a[:, :3], axes=([0], [1])) * qi
+                dst[:, 3] += np.tensordot(j.axis, dst[:, :3], axes=([0], [1])) * qi
         return frames
 
     def joint_poses(self, q: np.ndarray) -> np.ndarray:
