@@ -45,25 +45,31 @@ def point_signed_distance(shape: object, p: np.ndarray) -> np.ndarray:
     return signed_distance_xyz(shape, p[..., 0], p[..., 1], p[..., 2])
 
 
-def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+def signed_distance_xyz(
+    shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """:func:`point_signed_distance` with the coordinates [m] as separate arrays (...)
-    (the broad phase keeps points component-major: contiguous, fast elementwise)."""
+    (the broad phase keeps points component-major: contiguous, fast elementwise); written
+    into ``out`` (the broadcast shape of the coordinates) if given."""
     if isinstance(shape, Sphere):
-        return _norm3(x, y, z) - shape.radius
+        return np.subtract(_norm3(x, y, z), shape.radius, out=out)
     if isinstance(shape, Box):
-        return _box_distance(shape, x, y, z)
+        return _box_distance(shape, x, y, z, out)
     if isinstance(shape, Cylinder):
-        return _cylinder_distance(shape, np.sqrt(x * x + y * y), z)
+        return _cylinder_distance(shape, np.sqrt(x * x + y * y), z, out)
     if isinstance(shape, Capsule):
         half = 0.5 * shape.length
         dz = z - np.clip(z, -half, half)
-        return _norm3(x, y, dz) - shape.radius
+        return np.subtract(_norm3(x, y, dz), shape.radius, out=out)
     raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
 
 
-def _box_distance(shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """Signed distance [m] of points (x, y, z) (...) in the box's frame; the same
-    operations as the formula of :func:`point_signed_distance`, on few temporaries."""
+def _box_distance(
+    shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
+    """Signed distance [m] of points (x, y, z) (...) in the box's frame (into ``out`` if
+    given); the same operations as the formula of :func:`point_signed_distance`, on few
+    temporaries."""
     hx, hy, hz = (0.5 * float(v) for v in shape.size)
     shape_xyz = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z))
     ex, ey, ez = (np.abs(v, out=np.empty(shape_xyz)) for v in (x, y, z))
@@ -81,21 +87,25 @@ def _box_distance(shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np
     ez *= ez
     ex += ey
     ex += ez
-    outside = np.sqrt(ex, out=ex)
+    outside = np.sqrt(ex, out=ex if out is None else out)
     outside += inside
-    return outside[()]  # a scalar for scalar coordinates
+    return outside[()]  # a scalar for scalar coordinates (out: the array itself)
 
 
-def _cylinder_distance(shape: Cylinder, rho: np.ndarray, z: np.ndarray) -> np.ndarray:
+def _cylinder_distance(
+    shape: Cylinder, rho: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """Signed distance [m] of points at distance ``rho`` (...) [m] from the cylinder's
-    axis and ``z`` (...) [m] along it (from its centre)."""
+    axis and ``z`` (...) [m] along it (from its centre), into ``out`` if given."""
     shape_rz = np.broadcast_shapes(np.shape(rho), np.shape(z))
     radial = np.subtract(rho, shape.radius, out=np.empty(shape_rz))
     axial = np.abs(z, out=np.empty(shape_rz))
     axial -= 0.5 * shape.length
     inside = np.maximum(radial, axial, out=np.empty(shape_rz))
     np.minimum(inside, 0.0, out=inside)
-    outside = np.hypot(np.maximum(radial, 0.0, out=radial), np.maximum(axial, 0.0, out=axial))
+    outside = np.hypot(
+        np.maximum(radial, 0.0, out=radial), np.maximum(axial, 0.0, out=axial), out=out
+    )
     outside += inside
     return outside[()]
 
@@ -121,36 +131,42 @@ def _origins(pose: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(pose[:, :3, 3].T)[:, None]
 
 
-def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray) -> np.ndarray:
+def obstacle_signed_distance(
+    shape: object, points: np.ndarray, pose: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """Exact signed distance (m, R) [m] of points (3, m, R) (base frame, component-major) to
-    an obstacle ``shape`` at ``pose`` (4, 4) or (R, 4, 4).
+    an obstacle ``shape`` at ``pose`` (4, 4) or (R, 4, 4), written into ``out`` (m, R) if
+    given (e.g. a view of a larger array: no copy of the result).
 
     A moving sphere needs only its centre, a moving cylinder or capsule only its axis
     :math:`a` (the third column of its rotation): with :math:`d = p - t_o`,
     :math:`z = a \\cdot d` and :math:`\\rho = \\sqrt{\\lVert d \\rVert^2 - z^2}`.
     """
     if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
-        return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
+        return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose), out=out)
     delta = points - _origins(pose)  # (3, m, R)
     sq = _dot3(delta, delta)
     if isinstance(shape, Sphere):
-        sq = np.sqrt(sq, out=sq)
+        sq = np.sqrt(sq, out=sq if out is None else out)
         sq -= shape.radius
         return sq
     z = _dot3(np.ascontiguousarray(pose[:, :3, 2].T)[:, None], delta)  # axis (3, 1, R)
     rho = np.subtract(sq, np.multiply(z, z), out=sq)
     rho = np.sqrt(np.maximum(rho, 0.0, out=rho), out=rho)
     if isinstance(shape, Cylinder):  # sqrt(rho² + 0²) is rho exactly: skip it
-        return _cylinder_distance(shape, rho, z)
-    return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
+        return _cylinder_distance(shape, rho, z, out)
+    return signed_distance_xyz(shape, rho, np.zeros_like(rho), z, out)
 
 
-def points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
+def points_in_joint(
+    frames: np.ndarray, points: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """Points (3, m, R) [m] in the base frame, component-major with the samples innermost,
     for joint frames ``frames`` (12, R) (rows: the 3 × 4 top of each pose, row-major) and
-    points (m, 3) fixed in the joint frame."""
+    points (m, 3) fixed in the joint frame; written into ``out`` (3, m, R) if given."""
     f = frames.reshape(3, 4, -1)  # (row i, column j, R)
-    out = np.empty((3, len(points), f.shape[-1]))
+    if out is None:
+        out = np.empty((3, len(points), f.shape[-1]))
     px, py, pz = (points[:, j, None] for j in range(3))
     term = np.empty(out.shape[1:])
     for i in range(3):  # px f_i0 + py f_i1 + pz f_i2 + f_i3, in that order, in place
