@@ -392,18 +392,12 @@ class BroadPhase:
         for o, shape in enumerate(self.obstacle_shape):
             ks = np.flatnonzero(~done[:, o])
             if len(ks):
-                # A contiguous run of solids is a view (no gather): its distances are
-                # written into ``lower`` directly, the subtraction in place.
-                if ks[-1] - ks[0] == len(ks) - 1:
-                    run = slice(ks[0], ks[-1] + 1)
-                    d = obstacle_signed_distance(
-                        shape, balls[:, run], obstacle_poses[o], out=lower[run, o]
-                    )
-                    d -= radius[run]
-                else:
-                    d = obstacle_signed_distance(shape, balls[:, ks], obstacle_poses[o])
-                    d -= radius[ks]
-                    lower[ks, o] = d
+                # A contiguous run of solids is a view (no gather), the subtraction is in
+                # place on the fresh distances, then one write into ``lower``.
+                run = slice(ks[0], ks[-1] + 1) if ks[-1] - ks[0] == len(ks) - 1 else ks
+                d = obstacle_signed_distance(shape, balls[:, run], obstacle_poses[o])
+                d -= radius[run]
+                lower[run, o] = d
             for k in np.flatnonzero(done[:, o] & ~self.static[:, o]):
                 gap = np.flatnonzero(np.isneginf(lower[k, o]))
                 if len(gap):

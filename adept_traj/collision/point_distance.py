@@ -45,31 +45,25 @@ def point_signed_distance(shape: object, p: np.ndarray) -> np.ndarray:
     return signed_distance_xyz(shape, p[..., 0], p[..., 1], p[..., 2])
 
 
-def signed_distance_xyz(
-    shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
-) -> np.ndarray:
+def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     """:func:`point_signed_distance` with the coordinates [m] as separate arrays (...)
-    (the broad phase keeps points component-major: contiguous, fast elementwise); written
-    into ``out`` (the broadcast shape of the coordinates) if given."""
+    (the broad phase keeps points component-major: contiguous, fast elementwise)."""
     if isinstance(shape, Sphere):
-        return np.subtract(_norm3(x, y, z), shape.radius, out=out)
+        return _norm3(x, y, z) - shape.radius
     if isinstance(shape, Box):
-        return _box_distance(shape, x, y, z, out)
+        return _box_distance(shape, x, y, z)
     if isinstance(shape, Cylinder):
-        return _cylinder_distance(shape, np.sqrt(x * x + y * y), z, out)
+        return _cylinder_distance(shape, np.sqrt(x * x + y * y), z)
     if isinstance(shape, Capsule):
         half = 0.5 * shape.length
         dz = z - np.clip(z, -half, half)
-        return np.subtract(_norm3(x, y, dz), shape.radius, out=out)
+        return _norm3(x, y, dz) - shape.radius
     raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
 
 
-def _box_distance(
-    shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
-) -> np.ndarray:
-    """Signed distance [m] of points (x, y, z) (...) in the box's frame (into ``out`` if
-    given); the same operations as the formula of :func:`point_signed_distance`, on few
-    temporaries."""
+def _box_distance(shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Signed distance [m] of points (x, y, z) (...) in the box's frame; the same
+    operations as the formula of :func:`point_signed_distance`, on few temporaries."""
     hx, hy, hz = (0.5 * float(v) for v in shape.size)
     shape_xyz = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z))
     ex, ey, ez = (np.abs(v, out=np.empty(shape_xyz)) for v in (x, y, z))
@@ -87,25 +81,21 @@ def _box_distance(
     ez *= ez
     ex += ey
     ex += ez
-    outside = np.sqrt(ex, out=ex if out is None else out)
+    outside = np.sqrt(ex, out=ex)
     outside += inside
-    return outside[()]  # a scalar for scalar coordinates (out: the array itself)
+    return outside[()]  # a scalar for scalar coordinates
 
 
-def _cylinder_distance(
-    shape: Cylinder, rho: np.ndarray, z: np.ndarray, out: np.ndarray | None = None
-) -> np.ndarray:
+def _cylinder_distance(shape: Cylinder, rho: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Signed distance [m] of points at distance ``rho`` (...) [m] from the cylinder's
-    axis and ``z`` (...) [m] along it (from its centre), into ``out`` if given."""
+    axis and ``z`` (...) [m] along it (from its centre)."""
     shape_rz = np.broadcast_shapes(np.shape(rho), np.shape(z))
     radial = np.subtract(rho, shape.radius, out=np.empty(shape_rz))
     axial = np.abs(z, out=np.empty(shape_rz))
     axial -= 0.5 * shape.length
     inside = np.maximum(radial, axial, out=np.empty(shape_rz))
     np.minimum(inside, 0.0, out=inside)
-    outside = np.hypot(
-        np.maximum(radial, 0.0, out=radial), np.maximum(axial, 0.0, out=axial), out=out
-    )
+    outside = np.hypot(np.maximum(radial, 0.0, out=radial), np.maximum(axial, 0.0, out=axial))
     outside += inside
     return outside[()]
 
@@ -131,31 +121,28 @@ def _origins(pose: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(pose[:, :3, 3].T)[:, None]
 
 
-def obstacle_signed_distance(
-    shape: object, points: np.ndarray, pose: np.ndarray, out: np.ndarray | None = None
-) -> np.ndarray:
+def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray) -> np.ndarray:
     """Exact signed distance (m, R) [m] of points (3, m, R) (base frame, component-major) to
-    an obstacle ``shape`` at ``pose`` (4, 4) or (R, 4, 4), written into ``out`` (m, R) if
-    given (e.g. a view of a larger array: no copy of the result).
+    an obstacle ``shape`` at ``pose`` (4, 4) or (R, 4, 4).
 
     A moving sphere needs only its centre, a moving cylinder or capsule only its axis
     :math:`a` (the third column of its rotation): with :math:`d = p - t_o`,
     :math:`z = a \\cdot d` and :math:`\\rho = \\sqrt{\\lVert d \\rVert^2 - z^2}`.
     """
     if pose.ndim == 2 or not isinstance(shape, (Sphere, Cylinder, Capsule)):
-        return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose), out=out)
+        return signed_distance_xyz(shape, *_in_obstacle_frame(points, pose))
     delta = points - _origins(pose)  # (3, m, R)
     sq = _dot3(delta, delta)
     if isinstance(shape, Sphere):
-        sq = np.sqrt(sq, out=sq if out is None else out)
+        sq = np.sqrt(sq, out=sq)
         sq -= shape.radius
         return sq
     z = _dot3(np.ascontiguousarray(pose[:, :3, 2].T)[:, None], delta)  # axis (3, 1, R)
     rho = np.subtract(sq, np.multiply(z, z), out=sq)
     rho = np.sqrt(np.maximum(rho, 0.0, out=rho), out=rho)
     if isinstance(shape, Cylinder):  # sqrt(rho² + 0²) is rho exactly: skip it
-        return _cylinder_distance(shape, rho, z, out)
-    return signed_distance_xyz(shape, rho, np.zeros_like(rho), z, out)
+        return _cylinder_distance(shape, rho, z)
+    return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
 
 
 def points_in_joint(
