@@ -192,11 +192,13 @@ class BatchKinematics:
         self, frames: np.ndarray, point_joint: int, point: np.ndarray, rows: list[int]
     ) -> np.ndarray:
         """The rows ``rows`` (indices into (v_x, v_y, v_z, ω_x, ω_y, ω_z)) of
-        :meth:`frame_jacobian`, (len(rows), nq, N): the same values, but a zero entry may
-        differ in sign (a joint axis along an axis of its frame reads that column of the
-        frame, ±1 × x, instead of the dot product with the axis, x + 0·y + 0·z; exact, as x
-        is, but for the sign of a zero). For measures that do not see the sign of zero
-        (e.g. :math:`|\\det J|`)."""
+        :meth:`frame_jacobian`, (len(rows), nq, N), for a manipulability measure. When they
+        make a square matrix (len(rows) = nq, the measure :math:`|\\det J_t|`), only those
+        rows are formed, and a joint axis along an axis of its frame reads that column of
+        the frame (±1 × x instead of the dot product x + 0·y + 0·z: the same values, but a
+        zero may differ in sign, which the absolute value of a determinant does not see)."""
+        if len(rows) != self.nq:  # a Gram determinant: exactly frame_jacobian's rows
+            return self.frame_jacobian(frames, point_joint, point)[rows]
         jac = np.zeros((len(rows), self.nq, frames.shape[-1]))
         for i, j in enumerate(self._joints, start=1):
             if not self._ancestor[point_joint, i]:

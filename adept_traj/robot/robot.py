@@ -368,13 +368,7 @@ class Robot:
             tau = pin.rneaInParallel(
                 1, pool, np.asfortranarray(qf.T), np.asfortranarray(vf.T), np.asfortranarray(af.T)
             ).T
-        # tau + damping · v + friction · sign(v), the second sum in place (a new array
-        # first: numpy's reductions of u, e.g. einsum, may sum in another order on
-        # Pinocchio's buffer, whose alignment differs)
-        tau = tau + self.model.damping * vf
-        coulomb = coulomb_sign(vf)
-        coulomb *= self.model.friction
-        tau += coulomb
+        tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
         return tau.reshape(shape)
 
     def _tool_frames(self, frames: np.ndarray) -> np.ndarray:
@@ -397,10 +391,7 @@ class Robot:
         (3, 4, N), component-major (the determinant reads contiguous entries)."""
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
         parent = self.model.frames[self._tool_id].parentJoint
-        if len(rows) == self.nq:  # |det J_t|: blind to the sign of zero entries
-            jac = self.kinematics._jacobian_rows(frames, parent, tool[:, 3], rows)
-        else:
-            jac = self.kinematics.frame_jacobian(frames, parent, tool[:, 3])[rows]  # (m, nq, N)
+        jac = self.kinematics._jacobian_rows(frames, parent, tool[:, 3], rows)  # (m, nq, N)
         return manipulability_measure(np.moveaxis(jac, -1, 0))
 
 
