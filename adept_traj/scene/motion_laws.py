@@ -247,10 +247,8 @@ class PendulumMotion(MotionLaw):
         object.__setattr__(self, "omega", omega)
         object.__setattr__(self, "g", g)
         object.__setattr__(self, "swing_axis", readonly_copy(axis))
-        # The frame's constant columns as floats, for pose() (not fields: equality, hashing
-        # and replace() read the fields only).
-        columns = zip(axis.tolist(), _EZ.tolist(), np.cross(_EZ, axis).tolist(), pivot.tolist())
-        object.__setattr__(self, "_pose_rows", tuple(columns))
+        rows = zip(axis.tolist(), _EZ.tolist(), np.cross(_EZ, axis).tolist(), pivot.tolist())
+        object.__setattr__(self, "_pose_rows", tuple(rows))  # pose()'s constants; no field
 
     # ------------------------------------------------------------------ derived constants
     @property
