@@ -15,6 +15,7 @@ hooks here; the results are :class:`TrajectoryBounds` and :class:`TrajectoryInte
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -154,6 +155,19 @@ def _basis(s: np.ndarray, order: int, n_segments: int) -> np.ndarray:
     return B
 
 
+#: Grids of at most this many times keep their basis (:func:`_shared_basis`; 0.7 MB at 19 segments).
+_SHARED_GRID = 4096
+
+
+@functools.lru_cache(maxsize=16)
+def _shared_basis(s_bytes: bytes, order: int, n_segments: int) -> np.ndarray:
+    """:func:`_basis` at the times ``np.frombuffer(s_bytes)``, made once per grid (a
+    problem samples every population at the same times) and read-only."""
+    basis = _basis(np.frombuffer(s_bytes), order, n_segments)
+    basis.flags.writeable = False
+    return basis
+
+
 def _sample(
     T: np.ndarray, P: np.ndarray, s: np.ndarray, orders: tuple[int, ...]
 ) -> TrajectorySamples:
@@ -163,7 +177,9 @@ def _sample(
     out: list[np.ndarray | None] = [None, None, None, None]
     for r in orders:
         P_r = P if r == 0 else P * (T[..., None, None] ** (-r))  # small: scale before
-        out[r] = _basis(s, r, P.shape[-2] - 3) @ P_r
+        S = P.shape[-2] - 3
+        basis = _shared_basis(s.tobytes(), r, S) if len(s) <= _SHARED_GRID else _basis(s, r, S)
+        out[r] = basis @ P_r
     t = T[..., None] * s
     return TrajectorySamples(t=t, q=out[0], qd=out[1], qdd=out[2], qddd=out[3])
 
