@@ -232,15 +232,13 @@ class BroadPhase:
         """Poses (R, 4, 4) at the samples ``rows`` (R,) of the joint frames ``frames``
         (njoints, 3, 4, N) of solid ``k``, or of solid ``k[i]`` at ``rows[i]`` for ``k`` (R,)
         (formed in one batch per solid)."""
-        if np.ndim(k):
-            pose = np.empty((len(rows), 4, 4))
-            for s in np.unique(k).tolist():
-                sel = np.flatnonzero(k == s)
-                pose[sel] = self.solid_poses(frames, rows[sel], s)
-            return pose
         pose = np.empty((len(rows), 4, 4))
-        pose[:, :3] = compose(frames[self.parents[k]][..., rows], self.local[k]).transpose(2, 0, 1)
         pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+        solids = np.unique(k).tolist() if np.ndim(k) else [k]
+        for s in solids:  # each solid's rows straight into their slots
+            sel = np.flatnonzero(k == s) if np.ndim(k) else slice(None)
+            top = compose(frames[self.parents[s]][..., rows[sel]], self.local[s])
+            pose[sel, :3] = top.transpose(2, 0, 1)
         return pose
 
     def _table_joint(self, robot: Robot, k: int, o: int) -> int | None:
