@@ -212,7 +212,9 @@ def _candidates(*roots: np.ndarray) -> np.ndarray:
     return u
 
 
-def _cubic_at(c3: np.ndarray, c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, u: np.ndarray):
+def _cubic_at(
+    c3: np.ndarray, c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, u: np.ndarray
+) -> np.ndarray:
     """:math:`((c_3 u + c_2) u + c_1) u + c_0` (in that order) of coefficients (..., 1, S,
     nq) at parameters ``u`` (..., k, S, nq), in place on one new array."""
     out = c3 * u
