@@ -1,12 +1,17 @@
 """The evaluator's pieces written in place or read from caches (issue #15, fourth pass),
 against independent references: Pinocchio's own kinematics, Jacobians and geometry
 placements, scipy's B-splines, numpy's LU determinant and the pendulum's closed-form bob
-position. (The whole evaluation is compared bit for bit with the previous code by the
-benchmark of docs/performance.md, not here: a stored reference would be fragile.)"""
+position; and the heap kept between blocks against the page faults the kernel counts.
+(The whole evaluation is compared bit for bit with the previous code by the benchmark of
+docs/performance.md, not here: a stored reference would be fragile.)"""
 
 from __future__ import annotations
 
 import dataclasses
+import os
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pinocchio as pin
@@ -154,3 +159,48 @@ def test_solid_poses_and_ball_centres_match_pinocchio_geometry_placements() -> N
         for n in range(len(q)):
             ref = placed[n][k][:3, :3] @ local + placed[n][k][:3, 3]
             np.testing.assert_allclose(centres[:, k, n], ref, atol=1e-12)
+
+
+_BLOCKS = textwrap.dedent(
+    """
+    import resource, sys
+    import numpy as np
+    from adept_traj.problem import keep_heap
+
+    if sys.argv[1] == "keep":
+        assert keep_heap() and keep_heap()  # set once, then the recorded outcome
+    a = np.ones(300_000)  # 2.4 MB, mapped and freed: glibc's thresholds follow it
+    del a
+
+    def block():  # 8 × 1 MB of temporaries from the heap's top, then freed
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        parts = [np.ones(125_000) for _ in range(8)]
+        del parts
+        return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+    print(min(block() for _ in range(4)))
+    """
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc only")
+def test_kept_heap_serves_the_next_block_without_page_faults() -> None:
+    """By default glibc gives the freed top of the heap back after each block and the next
+    block faults about 1 200 pages in again; with keep_heap() none (in a new process: the
+    parameters are the whole process')."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("MALLOC_", "GLIBC_"))}
+    faults = {}
+    for mode in ("default", "keep"):
+        done = subprocess.run(
+            [sys.executable, "-c", _BLOCKS, mode], env=env, capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        faults[mode] = int(done.stdout.split()[-1])
+    assert faults["keep"] < 50 < 1000 < faults["default"], faults
+
+
+def test_keep_heap_leaves_the_users_malloc_settings_alone() -> None:
+    code = "from adept_traj.problem import keep_heap; print(keep_heap())"
+    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "1000000"}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert done.stdout.strip() == "False", done.stderr
