@@ -6,17 +6,17 @@ sign convention and the paper's penalty (``objectives``), smooth per-sample cons
 with their Jacobians for local solvers (``gradients``), the objectives' gradients
 (``objective_gradients``), :class:`TrajectoryProblem`
 (``trajectory_problem``) with its :class:`Evaluation` (``evaluation``), its parallel
-evaluator (``evaluator``), the heap it keeps between blocks (``heap``) and its plain-loop
+evaluator (``evaluator``), the heap it keeps between blocks (``_heap``) and its plain-loop
 reference (``reference``).
 """
 
 from __future__ import annotations
 
+from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
 from adept_traj.problem.gradients import CONSTRAINT_KINDS, LocalConstraints, local_constraints
-from adept_traj.problem.heap import keep_heap
 from adept_traj.problem.objective_gradients import (
     ObjectiveGradients,
     check_differentiable,

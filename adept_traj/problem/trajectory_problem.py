@@ -52,10 +52,10 @@ from pymoo.core.problem import Problem
 
 from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
+from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
 from adept_traj.problem.evaluator import ParallelEvaluator
-from adept_traj.problem.heap import keep_heap
 from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
 from adept_traj.problem.time_bound import kinematic_lower_bound
 from adept_traj.robot.limits import LIMITS
