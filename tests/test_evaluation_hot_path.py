@@ -100,16 +100,16 @@ def test_ball_level_is_the_ball_distance(paper_frames: tuple, gap: bool) -> None
     broad, _, frames, poses = paper_frames
     n = frames.shape[-1]
     balls = broad.ball_centres(frames)
-    done = np.zeros((broad.n_obstacles, broad.n_solids), dtype=bool)
+    done = np.zeros((broad.n_solids, broad.n_obstacles), dtype=bool)
     if gap:
-        done[:, 2] = True
-    lower = np.full((broad.n_obstacles, broad.n_solids, n), np.nan)
+        done[2] = True
+    lower = np.full((broad.n_solids, broad.n_obstacles, n), np.nan)
     broad._ball_bounds(lower, balls, poses, done)
     for o, shape in enumerate(broad.obstacle_shape):
         pose = np.broadcast_to(poses[o], (n, 4, 4))
         for k in range(broad.n_solids):
-            if done[o, k]:
-                assert np.isnan(lower[o, k]).all()  # left alone
+            if done[k, o]:
+                assert np.isnan(lower[k, o]).all()  # left alone
                 continue
             local = np.einsum("nji,nj->ni", pose[:, :3, :3], balls[:, k].T - pose[:, :3, 3])
             if isinstance(shape, Box):
@@ -118,7 +118,7 @@ def test_ball_level_is_the_ball_distance(paper_frames: tuple, gap: bool) -> None
                 d = cylinder_reference(local, shape.radius, 0.5 * shape.length)
             else:  # the pendulum's bob
                 d = np.linalg.norm(local, axis=-1) - shape.radius
-            np.testing.assert_allclose(lower[o, k], d - broad.ball_radius[k], atol=1e-12)
+            np.testing.assert_allclose(lower[k, o], d - broad.ball_radius[k], atol=1e-12)
 
 
 def test_stack_times_is_the_stacked_product() -> None:

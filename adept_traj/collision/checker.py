@@ -223,8 +223,10 @@ class CollisionChecker:
                 poses.append(fixed)
                 continue
             key = id(ob.motion)
-            if key not in laws:
-                laws[key] = _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
+            if key not in laws:  # contiguous once, not in each product below
+                laws[key] = np.ascontiguousarray(
+                    _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
+                )
             poses.append(stack_times(laws[key], ob.offset))  # = to_base @ ob.pose(t)
         return poses
 
@@ -235,10 +237,8 @@ class CollisionChecker:
     def _narrow(self, solid_pose: np.ndarray, obstacle_pose: np.ndarray, s: int, o: int) -> float:
         """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses."""
         tf_solid, tf_obstacle = self._tf
-        tf_solid.setRotation(solid_pose[:3, :3])
-        tf_solid.setTranslation(solid_pose[:3, 3])
-        tf_obstacle.setRotation(obstacle_pose[:3, :3])
-        tf_obstacle.setTranslation(obstacle_pose[:3, 3])
+        tf_solid.setTransform(solid_pose[:3, :3], solid_pose[:3, 3])  # one call, not two
+        tf_obstacle.setTransform(obstacle_pose[:3, :3], obstacle_pose[:3, 3])
         self._result.clear()
         return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
 

@@ -145,12 +145,15 @@ def obstacle_signed_distance(shape: object, points: np.ndarray, pose: np.ndarray
     return signed_distance_xyz(shape, rho, np.zeros_like(rho), z)
 
 
-def points_in_joint(frames: np.ndarray, points: np.ndarray) -> np.ndarray:
+def points_in_joint(
+    frames: np.ndarray, points: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """Points (3, m, R) [m] in the base frame, component-major with the samples innermost,
     for joint frames ``frames`` (12, R) (rows: the 3 × 4 top of each pose, row-major) and
-    points (m, 3) fixed in the joint frame."""
+    points (m, 3) fixed in the joint frame; written into ``out`` (3, m, R) if given."""
     f = frames.reshape(3, 4, -1)  # (row i, column j, R)
-    out = np.empty((3, len(points), f.shape[-1]))
+    if out is None:
+        out = np.empty((3, len(points), f.shape[-1]))
     px, py, pz = (points[:, j, None] for j in range(3))
     term = np.empty(out.shape[1:])
     for i in range(3):  # px f_i0 + py f_i1 + pz f_i2 + f_i3, in that order, in place

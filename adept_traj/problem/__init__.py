@@ -6,11 +6,13 @@ sign convention and the paper's penalty (``objectives``), smooth per-sample cons
 with their Jacobians for local solvers (``gradients``), the objectives' gradients
 (``objective_gradients``), :class:`TrajectoryProblem`
 (``trajectory_problem``) with its :class:`Evaluation` (``evaluation``), its parallel
-evaluator (``evaluator``) and its plain-loop reference (``reference``).
+evaluator (``evaluator``), the heap it keeps between blocks (``_heap``) and its plain-loop
+reference (``reference``).
 """
 
 from __future__ import annotations
 
+from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
@@ -59,6 +61,7 @@ __all__ = [
     "check_differentiable",
     "derivative_abs_max",
     "from_pymoo",
+    "keep_heap",
     "kinematic_lower_bound",
     "local_constraints",
     "objective_gradients",

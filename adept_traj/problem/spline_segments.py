@@ -15,6 +15,7 @@ hooks here; the results are :class:`TrajectoryBounds` and :class:`TrajectoryInte
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -154,6 +155,19 @@ def _basis(s: np.ndarray, order: int, n_segments: int) -> np.ndarray:
     return B
 
 
+#: Grids of at most this many times keep their basis (:func:`_shared_basis`; 0.7 MB at 19 segments).
+_SHARED_GRID = 4096
+
+
+@functools.lru_cache(maxsize=16)
+def _shared_basis(s_bytes: bytes, order: int, n_segments: int) -> np.ndarray:
+    """:func:`_basis` at the times ``np.frombuffer(s_bytes)``, made once per grid (a
+    problem samples every population at the same times) and read-only."""
+    basis = _basis(np.frombuffer(s_bytes), order, n_segments)
+    basis.flags.writeable = False
+    return basis
+
+
 def _sample(
     T: np.ndarray, P: np.ndarray, s: np.ndarray, orders: tuple[int, ...]
 ) -> TrajectorySamples:
@@ -163,7 +177,9 @@ def _sample(
     out: list[np.ndarray | None] = [None, None, None, None]
     for r in orders:
         P_r = P if r == 0 else P * (T[..., None, None] ** (-r))  # small: scale before
-        out[r] = _basis(s, r, P.shape[-2] - 3) @ P_r
+        S = P.shape[-2] - 3
+        basis = _shared_basis(s.tobytes(), r, S) if len(s) <= _SHARED_GRID else _basis(s, r, S)
+        out[r] = basis @ P_r
     t = T[..., None] * s
     return TrajectorySamples(t=t, q=out[0], qd=out[1], qdd=out[2], qddd=out[3])
 
@@ -178,10 +194,36 @@ def _gauss_legendre(n_segments: int, n_per_segment: int) -> tuple[np.ndarray, np
     return s.ravel(), w.ravel().copy()
 
 
-def _clip_candidates(u: np.ndarray) -> np.ndarray:
-    """Map candidate parameters to [0, 1]; NaN/inf (no root) become 0 (an endpoint)."""
+def _clip_candidates(u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Map candidate parameters to [0, 1]; NaN/inf (no root) become 0 (an endpoint)
+    (into ``out`` if given)."""
     u = np.where(np.isfinite(u), u, 0.0)
-    return np.clip(u, 0.0, 1.0)
+    return np.clip(u, 0.0, 1.0, out=out)
+
+
+def _candidates(*roots: np.ndarray) -> np.ndarray:
+    """Parameters (..., 2 + len(roots), S, nq): u = 0, u = 1, then each of ``roots``
+    (..., S, nq) clipped (:func:`_clip_candidates`), written in place (no stack)."""
+    u = np.empty((*roots[0].shape[:-2], 2 + len(roots), *roots[0].shape[-2:]))
+    u[..., 0, :, :] = 0.0
+    u[..., 1, :, :] = 1.0
+    for i, r in enumerate(roots, start=2):
+        _clip_candidates(r, out=u[..., i, :, :])
+    return u
+
+
+def _cubic_at(
+    c3: np.ndarray, c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, u: np.ndarray
+) -> np.ndarray:
+    """:math:`((c_3 u + c_2) u + c_1) u + c_0` (in that order) of coefficients (..., 1, S,
+    nq) at parameters ``u`` (..., k, S, nq), in place on one new array."""
+    out = c3 * u
+    out += c2
+    out *= u
+    out += c1
+    out *= u
+    out += c0
+    return out
 
 
 def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -214,13 +256,11 @@ def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
     (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.bounds`)."""
     c = _segment_coefficients(P)
     c3, c2, c1, c0 = c[..., 0, :], c[..., 1, :], c[..., 2, :], c[..., 3, :]  # (..., S, nq)
-    r1, r2 = _quadratic_roots(3.0 * c3, 2.0 * c2, c1)
-    zeros = np.zeros_like(c3)
-    ones = np.ones_like(c3)
-    u_q = np.stack([zeros, ones, _clip_candidates(r1), _clip_candidates(r2)], axis=-3)
+    a3, b2 = 3.0 * c3, 2.0 * c2
+    u_q = _candidates(*_quadratic_roots(a3, b2, c1))  # (..., 4, S, nq)
     cc3, cc2, cc1, cc0 = (ci[..., None, :, :] for ci in (c3, c2, c1, c0))
-    q_val = ((cc3 * u_q + cc2) * u_q + cc1) * u_q + cc0  # (..., k, S, nq)
-    qd_val, qdd_val, qddd_val = _derivative_candidates(T, c)
+    q_val = _cubic_at(cc3, cc2, cc1, cc0, u_q)  # (..., k, S, nq)
+    qd_val, qdd_val, qddd_val = _derivative_candidates(T, c, a3, b2)
 
     def ext(v: np.ndarray, axes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
         return v.min(axis=axes), v.max(axis=axes)
@@ -242,23 +282,28 @@ def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
 
 
 def _derivative_candidates(
-    T: np.ndarray, c: np.ndarray
+    T: np.ndarray, c: np.ndarray, a3: np.ndarray, b2: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r"""The values among which :math:`\dot q, \ddot q, \dddot q` reach their extrema, of
-    travel times ``T`` (...) [s] and segment coefficients ``c`` (..., S, 4, nq): velocities
-    (..., 3, S, nq) at u ∈ {0, 1, the vertex} [rad/s], accelerations (..., 2, S, nq) at
-    u ∈ {0, 1} [rad/s²], jerks (..., S, nq) [rad/s³]."""
+    travel times ``T`` (...) [s] and segment coefficients ``c`` (..., S, 4, nq) (with
+    ``a3`` = 3 c₃ and ``b2`` = 2 c₂ (..., S, nq)): velocities (..., 3, S, nq) at
+    u ∈ {0, 1, the vertex} [rad/s], accelerations (..., 2, S, nq) at u ∈ {0, 1} [rad/s²],
+    jerks (..., S, nq) [rad/s³]. Each value in the order of the formula
+    :math:`((3c_3 u + 2c_2) u + c_1)\,r`, :math:`(6 c_3 u + 2 c_2)\,r^2`, in place."""
     c3, c2, c1 = c[..., 0, :], c[..., 1, :], c[..., 2, :]  # (..., S, nq)
     rate = c.shape[-3] / T[..., None, None]  # (..., 1, 1) d/dt = rate·d/du
     with np.errstate(divide="ignore", invalid="ignore"):
-        vertex = -c2 / (3.0 * c3)
-    zeros = np.zeros_like(c3)
-    ones = np.ones_like(c3)
-    u_qd = np.stack([zeros, ones, _clip_candidates(vertex)], axis=-3)
-    u_qdd = np.stack([zeros, ones], axis=-3)
-    cc3, cc2, cc1 = (ci[..., None, :, :] for ci in (c3, c2, c1))
-    qd_val = ((3.0 * cc3 * u_qd + 2.0 * cc2) * u_qd + cc1) * rate[..., None, :, :]
-    qdd_val = (6.0 * cc3 * u_qdd + 2.0 * cc2) * rate[..., None, :, :] ** 2
+        vertex = -c2 / a3
+    u_qd = _candidates(vertex)  # (..., 3, S, nq): 0, 1, the vertex
+    rate4 = rate[..., None, :, :]
+    qd_val = a3[..., None, :, :] * u_qd
+    qd_val += b2[..., None, :, :]
+    qd_val *= u_qd
+    qd_val += c1[..., None, :, :]
+    qd_val *= rate4
+    qdd_val = (6.0 * c3)[..., None, :, :] * u_qd[..., :2, :, :]
+    qdd_val += b2[..., None, :, :]
+    qdd_val *= rate4**2
     qddd_val = 6.0 * c3 * rate**3  # (..., S, nq)
     return qd_val, qdd_val, qddd_val
 

@@ -52,6 +52,7 @@ from pymoo.core.problem import Problem
 
 from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
+from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
 from adept_traj.problem.evaluator import ParallelEvaluator
@@ -319,11 +320,10 @@ class TrajectoryProblem(Problem):
         return self._evaluator
 
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
-        step = max(1, _BLOCK_SAMPLES // len(self.s))
-        count = max(1, round(len(x) / step))  # equal blocks of at most ≈ 1.5 step
-        if count == 1:
-            return self._evaluate_block(x)
-        return _concatenate([self._evaluate_block(b) for b in np.array_split(x, count)])
+        keep_heap()  # a block's freed temporaries serve the next one (no page faults)
+        step = max(1, _BLOCK_SAMPLES // len(self.s))  # equal blocks of at most ≈ 1.5 step
+        blocks = [self._evaluate_block(b) for b in np.array_split(x, max(1, round(len(x) / step)))]
+        return blocks[0] if len(blocks) == 1 else _concatenate(blocks)
 
     def _evaluate_block(self, x: np.ndarray) -> Evaluation:
         traj, robot, st = self.trajectory, self.robot, self.settings

@@ -103,6 +103,8 @@ class BatchKinematics:
         self.axes = np.array([j.axis for j in joints]).reshape(-1, 3)
         #: Parent frame (njoints - 1,) of every joint (0 = universe).
         self.parents = np.array([j.parent for j in joints], dtype=int)
+        # Per joint: (c, ±1) when its axis is ±e_c (then z = ±column c of its frame), or None.
+        self._axis_column = [_axis_column(j.axis) for j in joints]
 
     def joint_frames(self, q: np.ndarray) -> np.ndarray:
         """Joint frames, component-major: (njoints, 3, 4, N) — the top three rows of the
@@ -124,23 +126,24 @@ class BatchKinematics:
         frames = np.empty((len(self._joints) + 1, 3, 4, n))
         frames[0] = np.eye(4)[:3, :, None]
         for i, (j, pre, post) in enumerate(zip(self._joints, self._pre, self._post), start=1):
-            a = compose(frames[j.parent], pre)
             dst = frames[i]
+            np.matmul(pre.T, frames[j.parent], out=dst)  # = compose(parent, pre), in place
             qi = (
                 qf[:, j.index]
                 if j.scale == 1.0 and j.offset == 0.0
                 else j.scale * qf[:, j.index] + j.offset
             )
-            if j.revolute:
+            if j.revolute:  # columns 0, 1: c a0 + s a1 and c a1 − s a0, in place
                 c, s = np.cos(qi), np.sin(qi)
-                dst[:, 0] = c * a[:, 0] + s * a[:, 1]
-                dst[:, 1] = c * a[:, 1] - s * a[:, 0]
-                dst[:, 2:] = a[:, 2:]
+                a0, a1 = dst[:, 0].copy(), dst[:, 1].copy()
+                np.multiply(c, a0, out=dst[:, 0])
+                dst[:, 0] += s * a1
+                np.multiply(c, a1, out=dst[:, 1])
+                dst[:, 1] -= s * a0
                 if post is not None:
                     dst[:] = compose(dst, post)
             else:
-                dst[:] = a
-                dst[:, 3] += np.tensordot(j.axis, a[:, :3], axes=([0], [1])) * qi
+                dst[:, 3] += np.tensordot(j.axis, dst[:, :3], axes=([0], [1])) * qi
         return frames
 
     def joint_poses(self, q: np.ndarray) -> np.ndarray:
@@ -184,6 +187,47 @@ class BatchKinematics:
             else:
                 jac[:3, j.index] += z
         return jac
+
+    def _jacobian_rows(
+        self, frames: np.ndarray, point_joint: int, point: np.ndarray, rows: list[int]
+    ) -> np.ndarray:
+        """The rows ``rows`` (indices into (v_x, v_y, v_z, ω_x, ω_y, ω_z)) of
+        :meth:`frame_jacobian`, (len(rows), nq, N), for a manipulability measure. When they
+        make a square matrix (len(rows) = nq, the measure :math:`|\\det J_t|`), only those
+        rows are formed, and a joint axis along an axis of its frame reads that column of
+        the frame (±1 × x instead of the dot product x + 0·y + 0·z: the same values, but a
+        zero may differ in sign, which the absolute value of a determinant does not see)."""
+        if len(rows) != self.nq:  # a Gram determinant: exactly frame_jacobian's rows
+            return self.frame_jacobian(frames, point_joint, point)[rows]
+        jac = np.zeros((len(rows), self.nq, frames.shape[-1]))
+        for i, j in enumerate(self._joints, start=1):
+            if not self._ancestor[point_joint, i]:
+                continue
+            column = self._axis_column[i - 1]
+            if column is None:
+                z = np.tensordot(j.axis, frames[i, :, :3], axes=([0], [1]))  # (3, N)
+            else:
+                z = frames[i, :, column[0]] if column[1] > 0 else -frames[i, :, column[0]]
+            z = z if j.scale == 1.0 else j.scale * z
+            r = point - frames[i, :, 3] if j.revolute else None
+            for out, row in enumerate(rows):
+                if not j.revolute:
+                    if row < 3:
+                        jac[out, j.index] += z[row]
+                elif row >= 3:
+                    jac[out, j.index] += z[row - 3]
+                else:  # z × r, as in frame_jacobian
+                    a, b = (row + 1) % 3, (row + 2) % 3
+                    jac[out, j.index] += z[a] * r[b] - z[b] * r[a]
+        return jac
+
+
+def _axis_column(axis: np.ndarray) -> tuple[int, float] | None:
+    """``(c, ±1)`` when the unit ``axis`` (3,) is ±e_c exactly, else None."""
+    nonzero = np.flatnonzero(axis)
+    if len(nonzero) == 1 and abs(axis[nonzero[0]]) == 1.0:
+        return int(nonzero[0]), float(axis[nonzero[0]])
+    return None
 
 
 def _one_dof_joint(model: pin.Model, i: int, s: np.ndarray) -> _Joint:

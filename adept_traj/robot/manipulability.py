@@ -52,8 +52,15 @@ def _det(a: np.ndarray) -> np.ndarray:
         pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
         for (i, j), sign in zip(pairs, (1, -1, 1, 1, -1, 1)):
             k0, k1 = (c for c in range(4) if c not in (i, j))
-            top = r[0][i] * r[1][j] - r[0][j] * r[1][i]
-            bottom = r[2][k0] * r[3][k1] - r[2][k1] * r[3][k0]
-            det = det + sign * top * bottom
+            top = r[0][i] * r[1][j]
+            top -= r[0][j] * r[1][i]
+            bottom = r[2][k0] * r[3][k1]
+            bottom -= r[2][k1] * r[3][k0]
+            top *= bottom
+            # det + (−1 · top) · bottom is det − top · bottom exactly: in place, no copies
+            if sign > 0:
+                det += top
+            else:
+                det -= top
         return det
     return np.linalg.det(a)

@@ -391,8 +391,8 @@ class Robot:
         (3, 4, N), component-major (the determinant reads contiguous entries)."""
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
         parent = self.model.frames[self._tool_id].parentJoint
-        jac = self.kinematics.frame_jacobian(frames, parent, tool[:, 3])  # (6, nq, N)
-        return manipulability_measure(np.moveaxis(jac[rows], -1, 0))
+        jac = self.kinematics._jacobian_rows(frames, parent, tool[:, 3], rows)  # (m, nq, N)
+        return manipulability_measure(np.moveaxis(jac, -1, 0))
 
 
 def coulomb_sign(v: np.ndarray) -> np.ndarray:

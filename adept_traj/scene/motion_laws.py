@@ -247,6 +247,9 @@ class PendulumMotion(MotionLaw):
         object.__setattr__(self, "omega", omega)
         object.__setattr__(self, "g", g)
         object.__setattr__(self, "swing_axis", readonly_copy(axis))
+        constant = np.zeros((4, 4))  # pose()'s columns y = e_n and the pivot, its last row
+        constant[:3, 1], constant[:3, 3], constant[3, 3] = np.cross(_EZ, axis), pivot, 1.0
+        object.__setattr__(self, "_pose_constant", readonly_copy(constant))  # not a field
 
     # ------------------------------------------------------------------ derived constants
     @property
@@ -348,13 +351,11 @@ class PendulumMotion(MotionLaw):
             z = −sin φ e_swing + cos φ e_z, translation = pivot.
         """
         phi = self.angle(t)
-        c, s, out = np.cos(phi), np.sin(phi), np.zeros((*phi.shape, 4, 4))
-        # row by row: a broadcast over a trailing axis of length 3 is several times slower
-        rows = zip(self.swing_axis.tolist(), _EZ.tolist(), self.normal_axis, self.pivot)
-        for i, (swing, ez, normal, pivot) in enumerate(rows):
-            out[..., i, 0], out[..., i, 1] = c * swing + s * ez, normal
-            out[..., i, 2], out[..., i, 3] = -s * swing + c * ez, pivot
-        out[..., 3, 3] = 1.0
+        c, s, out = np.cos(phi), np.sin(phi), np.empty((*phi.shape, 4, 4))
+        out[...] = self._pose_constant  # then columns x and z row by row (a broadcast: slower)
+        for i, (swing, ez) in enumerate(zip(self.swing_axis.tolist(), _EZ.tolist())):
+            out[..., i, 0] = c * swing + s * ez
+            out[..., i, 2] = -s * swing + c * ez
         return out
 
     @property
