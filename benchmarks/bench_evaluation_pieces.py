@@ -97,9 +97,20 @@ def _problem_and_populations(pop: int) -> tuple[TrajectoryProblem, dict[str, np.
     return problem, populations
 
 
+def _keep_heap() -> None:
+    """:func:`adept_traj.problem.keep_heap`, as the ``adept-traj`` command does in its own
+    process (the code of an older checkout may not have it: then nothing)."""
+    try:
+        from adept_traj.problem import keep_heap
+    except ImportError:
+        return
+    keep_heap()
+
+
 def _whole(pop: int, repeat: int) -> None:
     """Child of ``--against``: print, as JSON, the median CPU seconds per sample of
     ``evaluate_batch`` on each population (``repeat`` runs)."""
+    _keep_heap()
     problem, populations = _problem_and_populations(pop)
     problem.evaluate_batch(populations["random"][:5])  # warm-up
     out = {}
@@ -145,6 +156,7 @@ def _paired(other: str, pairs: int, pop: int, repeat: int) -> None:
 
 
 def main() -> None:
+    _keep_heap()
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--pop", type=int, default=500, help="population size")
     parser.add_argument("--repeat", type=int, default=7, help="runs (the median is printed)")

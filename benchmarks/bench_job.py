@@ -42,7 +42,7 @@ import numpy as np
 from cell_scene import cell_scene  # benchmarks/cell_scene.py
 
 from adept_traj import PlanningResult, Robot, Scene
-from adept_traj.problem import TrajectoryProblem, available_cores
+from adept_traj.problem import TrajectoryProblem, available_cores, keep_heap
 from adept_traj.testing.reference import evaluate_reference
 
 _FIGURES = """
@@ -111,6 +111,7 @@ def row(name: str, value: str, target: str, met: bool, extra: str = "") -> None:
 
 
 def main() -> None:
+    keep_heap()  # as the adept-traj command does in its own process
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="one run each, fewer evaluations")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each command (default 3)")

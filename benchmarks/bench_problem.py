@@ -26,12 +26,13 @@ import numpy as np
 from _timing import best_of  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
-from adept_traj.problem import TrajectoryProblem
+from adept_traj.problem import TrajectoryProblem, keep_heap
 from adept_traj.testing.paper_moves import lift_then_lower  # a hand-made collision-free move
 from adept_traj.testing.reference import evaluate_reference
 
 
 def main() -> None:
+    keep_heap()  # as the adept-traj command does in its own process
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--pop", type=int, default=500, help="population size")
     parser.add_argument("--reference", type=int, default=10, help="individuals for reference")

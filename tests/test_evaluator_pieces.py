@@ -204,3 +204,36 @@ def test_keep_heap_leaves_the_users_malloc_settings_alone() -> None:
     env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "1000000"}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert done.stdout.strip() == "False", done.stderr
+
+
+_WHO_KEEPS = textwrap.dedent(
+    """
+    import sys, tempfile
+    import numpy as np
+    from adept_traj import Robot, Scene
+    from adept_traj.problem import TrajectoryProblem, _heap
+
+    scene = Scene.paper()
+    problem = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+    problem.evaluate_batch(problem.trajectory.straight_line(1.5)[None])
+    library = _heap._kept
+    from adept_traj.cli.app import main
+
+    with tempfile.TemporaryDirectory() as out:
+        code = main(["plan", "--pop", "8", "--gens", "1", "--quiet", "--no-plots", "--no-html",
+                     "--polish", "off", "--out", out])
+    print(library, code, _heap._kept)
+    """
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc only")
+def test_the_command_keeps_its_heap_a_library_host_is_left_alone() -> None:
+    """A program that evaluates through the library keeps its malloc as it was; the
+    ``adept-traj`` command, adept_traj's own process, keeps its heap."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("MALLOC_", "GLIBC_"))}
+    done = subprocess.run(
+        [sys.executable, "-c", _WHO_KEEPS], env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1].split() == ["None", "0", "True"], done.stdout + done.stderr

@@ -15,7 +15,7 @@ import numpy as np
 from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
 from adept_traj.errors import ConfigurationError, InvalidInputError
-from adept_traj.problem import TrajectoryProblem, available_cores
+from adept_traj.problem import TrajectoryProblem, available_cores, keep_heap
 from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import as_scalar
 
@@ -113,6 +113,7 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
         if weights.sum() <= 0:
             raise InvalidInputError("--weights must not all be 0")
     check_rate(args.rate)
+    keep_heap()  # the command's own process: evaluation blocks reuse the freed heap
     robot = robot_from_arguments(args, args.scene)
     start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
     workers = available_cores() if args.workers is None else args.workers

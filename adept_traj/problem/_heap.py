@@ -17,6 +17,12 @@ still mapped and unmapped on their own).
 Where ``malloc`` is not glibc's, or the environment sets ``malloc`` parameters itself
 (``GLIBC_TUNABLES``, ``MALLOC_*_``), nothing is changed. Worker processes forked after
 the call inherit the parameters.
+
+Who calls it: the processes that are adept_traj's own — the ``adept-traj`` command (when
+it builds its problem) and the evaluation workers a problem forks
+(:class:`~adept_traj.problem.ParallelEvaluator`). A program that uses the library is left
+as it is (a library does not change its host's ``malloc`` behind its back): call
+:func:`keep_heap` once to get the same speed, if keeping the peak heap suits it.
 """
 
 from __future__ import annotations

@@ -51,6 +51,7 @@ from adept_traj.errors import (
     InputShapeError,
     error_from_process,
 )
+from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.evaluation import Evaluation, _concatenate
 from adept_traj.validation import as_batch, as_integer
 
@@ -129,6 +130,7 @@ def _serve(
     """A worker's loop: read a chunk, send back ``("", its Evaluation)`` or ``(the
     traceback, the pickled exception or None)``; return at the end of the pipe."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the main process' to handle
+    keep_heap()  # a process of ours: its blocks' freed temporaries serve the next block
     for other in inherited:  # the main process' ends of this and earlier workers' pipes
         other.close()
     while True:

@@ -52,7 +52,6 @@ from pymoo.core.problem import Problem
 
 from adept_traj.collision import CollisionChecker, SelfCollision
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
-from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
 from adept_traj.problem.evaluator import ParallelEvaluator
@@ -320,7 +319,6 @@ class TrajectoryProblem(Problem):
         return self._evaluator
 
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
-        keep_heap()  # a block's freed temporaries serve the next one (no page faults)
         step = max(1, _BLOCK_SAMPLES // len(self.s))  # equal blocks of at most ≈ 1.5 step
         blocks = [self._evaluate_block(b) for b in np.array_split(x, max(1, round(len(x) / step)))]
         return blocks[0] if len(blocks) == 1 else _concatenate(blocks)
