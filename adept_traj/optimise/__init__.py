@@ -25,6 +25,12 @@ from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
     BlockedDuplicateElimination,
 )
+from adept_traj.optimise.early_certificates import (
+    EARLY_SHARE,
+    EarlyCertificates,
+    feasible_front,
+    start_early_certificates,
+)
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
@@ -102,6 +108,7 @@ __all__ = [
     "BLOCK_PAIRS",
     "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
+    "EARLY_SHARE",
     "GRADIENT_COST",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
@@ -118,6 +125,7 @@ __all__ = [
     "ArrayVariant",
     "BlockedDuplicateElimination",
     "CapturedCheckpoint",
+    "EarlyCertificates",
     "FastEndSearch",
     "GenerationInfo",
     "KinematicTimeRepair",
@@ -134,6 +142,7 @@ __all__ = [
     "checkpoint_arrays",
     "crowding_distance",
     "epsilon_step",
+    "feasible_front",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -150,6 +159,7 @@ __all__ = [
     "population_values",
     "restore_algorithm",
     "save_checkpoint",
+    "start_early_certificates",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",

@@ -61,6 +61,7 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.analysis.weighted_sum import WeightedSum
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
+from adept_traj.optimise.early_certificates import feasible_front, start_early_certificates
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
 from adept_traj.optimise.polish_step import TIME_OPTIMAL, _polish_run, polish_mode, time_optimal_run
@@ -299,7 +300,15 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        state, polished = _polish_run(problem, state, rate_hz, polish, _weights(weights))
+        # the front's certificates made meanwhile on the idle core (docs/performance.md)
+        ahead = polish != "off" and max_certify is None and problem.settings.workers > 1
+        rows = feasible_front(state.F, state.G, _weights(weights)) if ahead else []
+        with start_early_certificates(problem, state.X, rows, rate_hz=rate_hz) as early:
+            state, polished = _polish_run(problem, state, rate_hz, polish, _weights(weights))
+            keys = {
+                state.X[k].tobytes() for k in feasible_front(state.F, state.G, _weights(weights))
+            }
+            polished = {**early.finish(keys), **polished}
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)
