@@ -155,23 +155,23 @@ class EarlyCertificates:
         try:
             while (i := _take(self._next, len(self._shares))) is not None:
                 taken.add(i)
-                mine.update(self._certify(self._shares[i], wanted))
                 note = self._drain(received, block=False) or note
+                mine.update(self._certify(self._shares[i], wanted))
             note = self._drain(received, block=True) or note
+            self._reap()
+            for i, share in enumerate(self._shares):
+                if i in received:
+                    mine.update(zip(share, received[i]))
+                elif i not in taken:  # the process' share it did not send (failed or died)
+                    mine.update(self._certify(share, wanted))
+        except Exception as exc:
+            self.cancel()
+            if note:
+                exc.add_note(f"the early certificates' process failed first:\n{note}")
+            raise
         except BaseException:  # Ctrl-C included: stop the process at once
             self.cancel()
             raise
-        self._reap()
-        for i, share in enumerate(self._shares):
-            if i in received:
-                mine.update(zip(share, received[i]))
-            elif i not in taken:  # the process' share it did not send (it failed or died)
-                try:
-                    mine.update(self._certify(share, wanted))
-                except Exception as exc:
-                    if note:
-                        exc.add_note(f"the early certificates' process failed first:\n{note}")
-                    raise
         return {self._x[k].tobytes(): summary for k, summary in mine.items()}
 
     def _certify(
@@ -211,7 +211,7 @@ class EarlyCertificates:
             return
         self._process.join()
         self._conn.close()
-        self._process, self.pid = None, None
+        self._process, self._conn, self.pid = None, None, None
         atexit.unregister(self.cancel)
 
     def __enter__(self) -> EarlyCertificates:
