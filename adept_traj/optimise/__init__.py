@@ -69,6 +69,12 @@ from adept_traj.optimise.polish_step import (
     polish_run,
     time_optimal_run,
 )
+from adept_traj.optimise.polisher import (
+    POLISHER_NICENESS,
+    Polisher,
+    polish_with_certificates,
+    start_polisher,
+)
 from adept_traj.optimise.population import (
     ArrayEvaluator,
     cache_violations,
@@ -112,6 +118,7 @@ __all__ = [
     "GRADIENT_COST",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
+    "POLISHER_NICENESS",
     "POLISH_MODES",
     "POLISH_SHARE",
     "SPREAD_MEMBERS",
@@ -131,6 +138,7 @@ __all__ = [
     "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
+    "Polisher",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
@@ -155,11 +163,13 @@ __all__ = [
     "polish_members",
     "polish_mode",
     "polish_run",
+    "polish_with_certificates",
     "population_bytes",
     "population_values",
     "restore_algorithm",
     "save_checkpoint",
     "start_early_certificates",
+    "start_polisher",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",
