@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import adept_traj.optimise.early_certificates as early_module
-from adept_traj import Robot, Scene, TrajectoryProblem, plan
+from adept_traj import TrajectoryProblem
 from adept_traj.analysis import certify_members
 from adept_traj.errors import InvalidInputError
 from adept_traj.optimise import (
@@ -159,18 +159,3 @@ def test_feasible_front_holds_the_feasible_non_dominated_rows() -> None:
     G = np.array([[0.0], [-1.0], [-0.5], [0.1]])  # row 3 infeasible, row 1 dominated by row 0
     assert sorted(feasible_front(F, G, np.ones(6)).tolist()) == [0, 2]
     assert len(feasible_front(F, np.ones((4, 1)), np.ones(6))) == 0
-
-
-def test_plan_on_two_workers_gives_the_one_worker_front() -> None:
-    """The early certificates run with workers > 1 only: the result is the serial path's."""
-    scene = Scene.paper()
-    robot = Robot.adept_one_xl()
-    results = []
-    for workers in (1, 2):
-        with TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=workers) as p:
-            results.append(plan(p, "nsga2", seed=1, pop_size=16, n_gen=4))
-    one, two = results
-    np.testing.assert_array_equal(one.front.x, two.front.x)
-    assert one.front.certificates == two.front.certificates
-    assert one.front.feasible.tolist() == two.front.feasible.tolist()
-    assert one.certificate.min_distance == two.certificate.min_distance

@@ -1,0 +1,163 @@
+"""start_polisher: the polish run by a helper process forked before the search gives the
+population and certificates of the polish in the caller (polish_run called directly);
+a helper that is not ready, fails or is killed leaves the polish to the caller; an error
+is raised in the caller; no helper outlives its block."""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+import adept_traj.optimise.polisher as polisher_module
+from adept_traj import Robot, Scene, TrajectoryProblem, plan
+from adept_traj.analysis import PAPER_WEIGHTS, certify_members
+from adept_traj.errors import ConfigurationError
+from adept_traj.optimise import (
+    make_algorithm,
+    optimise,
+    polish_run,
+    polish_with_certificates,
+    start_early_certificates,
+    start_polisher,
+)
+
+RATE = 400.0
+
+
+@pytest.fixture(scope="module")
+def searched(problem: TrajectoryProblem):
+    """A small NSGA-II search's final population (no polish yet)."""
+    alg, settings = make_algorithm("nsga2", 16, 4)
+    return optimise(problem, alg, settings.n_gen, 1)
+
+
+@pytest.fixture(scope="module")
+def serial(problem: TrajectoryProblem, searched):
+    """The polish of the fastest member in this process, and its certificate."""
+    state = polish_run(problem, searched, RATE, "fastest", PAPER_WEIGHTS)
+    new = state.X[len(searched.X) :]
+    assert len(new) == 1  # the polish kept a move: the test compares something
+    return state, {new[0].tobytes(): certify_members(problem, new, rate_hz=RATE)[0]}
+
+
+def _gone(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    return False
+
+
+def _same(state, certified, serial) -> None:
+    expected_state, expected_certified = serial
+    for name in ("X", "F", "G", "CV"):
+        np.testing.assert_array_equal(getattr(state, name), getattr(expected_state, name))
+    assert state.n_evaluations == expected_state.n_evaluations
+    assert state.history == expected_state.history
+    assert certified == expected_certified  # every field of every summary, exactly
+
+
+def _polish(problem, searched, polisher):
+    with start_early_certificates(problem, searched.X, [], rate_hz=RATE) as early:
+        return polish_with_certificates(
+            problem, searched, RATE, "fastest", PAPER_WEIGHTS, early=early, polisher=polisher
+        )
+
+
+def test_the_helper_polishes_as_the_caller(problem, searched, serial) -> None:
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert polisher.ready(60.0)
+        state, certified = _polish(problem, searched, polisher)
+        assert polisher.pid is None  # reaped once its polish is collected
+    _same(state, certified, serial)
+    assert _gone(pid)
+
+
+def test_a_helper_not_ready_leaves_the_polish_to_the_caller(problem, searched, serial) -> None:
+    polisher = start_polisher(problem)
+    polisher.cancel()  # stopped: never ready
+    assert not polisher.start(searched, RATE, "fastest", PAPER_WEIGHTS)
+    _same(*_polish(problem, searched, polisher), serial)
+
+
+@pytest.mark.parametrize("fault", ["raises", "killed"])
+def test_a_failing_helper_leaves_the_polish_to_the_caller(
+    problem, searched, serial, monkeypatch, fault
+) -> None:
+    caller = os.getpid()
+    real = polisher_module._polish_run
+
+    def faulty(*args, **kwargs):
+        if os.getpid() != caller:
+            if fault == "killed":
+                os.kill(os.getpid(), signal.SIGKILL)
+            raise RuntimeError("broken in the helper")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(polisher_module, "_polish_run", faulty)
+    with start_polisher(problem) as polisher:
+        assert polisher.ready(60.0)
+        _same(*_polish(problem, searched, polisher), serial)
+        assert ("broken in the helper" in polisher.note()) == (fault == "raises")
+
+
+def test_an_error_is_raised_in_the_caller_with_the_helper_traceback(
+    problem, searched, monkeypatch
+) -> None:
+    def fails(*args, **kwargs):
+        raise RuntimeError(f"polish broken in {os.getpid()}")
+
+    monkeypatch.setattr(polisher_module, "_polish_run", fails)
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert polisher.ready(60.0)
+        with pytest.raises(RuntimeError, match=f"broken in {os.getpid()}") as caught:
+            _polish(problem, searched, polisher)
+    assert any(f"broken in {pid}" in note for note in caught.value.__notes__)
+    assert _gone(pid)
+
+
+def test_leaving_the_block_stops_the_helper(problem) -> None:
+    polisher = start_polisher(problem)
+    pid = polisher.pid
+
+    def interrupted() -> None:
+        with polisher:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        interrupted()
+    assert polisher.pid is None
+    assert _gone(pid)
+
+
+def test_a_polisher_of_another_problem_is_refused(problem, searched) -> None:
+    scene = Scene.paper()
+    other = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+    with start_polisher(other) as polisher, pytest.raises(ConfigurationError, match="another"):
+        _polish(problem, searched, polisher)
+
+
+def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -> None:
+    """The polisher and the early certificates (workers > 1) change nothing in the result:
+    the same as one worker without a helper."""
+    kwargs = {"seed": 1, "pop_size": 16, "n_gen": 4, "polish": "front"}
+    alone = plan(problem, "nsga2", **kwargs)
+    scene = Scene.paper()
+    with (
+        TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal, workers=2) as two,
+        start_polisher(two) as polisher,
+    ):
+        assert polisher.ready(60.0)  # its imports done: plan hands it the polish
+        helped = plan(two, "nsga2", polisher=polisher, **kwargs)
+    assert helped.metrics.t_best_source == "polish"  # the polish kept a move
+    np.testing.assert_array_equal(helped.front.x, alone.front.x)
+    np.testing.assert_array_equal(helped.front.objectives, alone.front.objectives)
+    assert helped.front.certificates == alone.front.certificates
+    assert helped.certificate.min_distance == alone.certificate.min_distance
+    assert helped.timing.n_evaluations == alone.timing.n_evaluations
+    assert helped.metrics.ssm == alone.metrics.ssm
