@@ -5,15 +5,19 @@ is raised in the caller; no helper outlives its block."""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import adept_traj.cli.plan as plan_command
 import adept_traj.optimise.polisher as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 from adept_traj.analysis import PAPER_WEIGHTS, certify_members
+from adept_traj.cli.app import main
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     make_algorithm,
@@ -23,8 +27,10 @@ from adept_traj.optimise import (
     start_early_certificates,
     start_polisher,
 )
+from adept_traj.results import PlanningResult
 
 RATE = 400.0
+DATA = Path(__file__).parent / "data"
 
 
 @pytest.fixture(scope="module")
@@ -161,3 +167,43 @@ def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -
     assert helped.certificate.min_distance == alone.certificate.min_distance
     assert helped.timing.n_evaluations == alone.timing.n_evaluations
     assert helped.metrics.ssm == alone.metrics.ssm
+
+
+@pytest.mark.parametrize("end", ["done", "error", "ctrl-c"])
+def test_adept_traj_plan_leaves_no_helper_behind(
+    end: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The command starts the polisher before the search and reaps it however it ends."""
+    stored = PlanningResult.load(DATA / "result_v1")
+    seen = []
+
+    def fake_plan(*_args, polisher=None, **_kwargs):
+        seen.append(polisher.pid)
+        if end == "error":
+            raise RuntimeError("stop")
+        if end == "ctrl-c":
+            raise KeyboardInterrupt
+        return stored
+
+    monkeypatch.setattr(plan_command, "plan", fake_plan)
+    argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html"]
+    argv += ["--out", str(tmp_path / "run")]
+    if end == "error":
+        with pytest.raises(RuntimeError, match="stop"):
+            main(argv)
+    else:
+        assert main(argv) == (0 if end == "done" else 130)
+    assert seen[0] is not None
+    assert _gone(seen[0])
+    assert multiprocessing.active_children() == []
+
+
+def test_no_polisher_without_a_polish(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    stored = PlanningResult.load(DATA / "result_v1")
+    seen = []
+    monkeypatch.setattr(
+        plan_command, "plan", lambda *a, polisher=None, **k: seen.append(polisher) or stored
+    )
+    argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html", "--no-polish"]
+    assert main([*argv, "--out", str(tmp_path / "run")]) == 0
+    assert seen == [None]
