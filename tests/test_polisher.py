@@ -18,7 +18,7 @@ import adept_traj.optimise.polisher as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 from adept_traj.analysis import PAPER_WEIGHTS, certify_members
 from adept_traj.cli.app import main
-from adept_traj.errors import ConfigurationError
+from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
     make_algorithm,
     optimise,
@@ -141,11 +141,16 @@ def test_leaving_the_block_stops_the_helper(problem) -> None:
     assert _gone(pid)
 
 
-def test_a_polisher_of_another_problem_is_refused(problem, searched) -> None:
+def test_a_polisher_of_another_problem_is_refused_before_the_search(problem, searched) -> None:
     scene = Scene.paper()
     other = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
-    with start_polisher(other) as polisher, pytest.raises(ConfigurationError, match="another"):
-        _polish(problem, searched, polisher)
+    with start_polisher(other) as polisher:
+        with pytest.raises(ConfigurationError, match="another problem"):
+            _polish(problem, searched, polisher)
+        with pytest.raises(ConfigurationError, match="another problem"):
+            plan(problem, "nsga2", pop_size=10**9, polisher=polisher)  # no search starts
+    with pytest.raises(InvalidInputError, match="polisher"):
+        plan(problem, "nsga2", pop_size=10**9, polisher="helper")
 
 
 def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -> None:

@@ -72,6 +72,7 @@ from adept_traj.optimise.polish_step import (
 from adept_traj.optimise.polisher import (
     POLISHER_NICENESS,
     Polisher,
+    check_polisher,
     polish_with_certificates,
     start_polisher,
 )
@@ -146,6 +147,7 @@ __all__ = [
     "cache_violations",
     "capture_checkpoint",
     "certify_front_members",
+    "check_polisher",
     "check_population_memory",
     "checkpoint_arrays",
     "crowding_distance",

@@ -65,7 +65,7 @@ from adept_traj.optimise.early_certificates import feasible_front, start_early_c
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
 from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, time_optimal_run
-from adept_traj.optimise.polisher import Polisher, polish_with_certificates
+from adept_traj.optimise.polisher import Polisher, check_polisher, polish_with_certificates
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.optimise.weighted_move import weighted_run
 from adept_traj.problem import TrajectoryProblem, from_pymoo
@@ -276,6 +276,7 @@ def plan(
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     polish = polish_mode(polish)
+    check_polisher(polisher, problem)
     weighted = None  # the weighted sum of the weighted-sum mode
     if weights is not None:
         objective_weights(weights, 6)  # bad weights refused before any long work

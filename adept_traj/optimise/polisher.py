@@ -44,7 +44,13 @@ from adept_traj.optimise.polish_step import _polish_run, polish_mode
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_scalar, check_type
 
-__all__ = ["POLISHER_NICENESS", "Polisher", "polish_with_certificates", "start_polisher"]
+__all__ = [
+    "POLISHER_NICENESS",
+    "Polisher",
+    "check_polisher",
+    "polish_with_certificates",
+    "start_polisher",
+]
 
 #: Niceness of the helper's importing thread (the lowest priority).
 POLISHER_NICENESS = 19
@@ -67,6 +73,27 @@ def start_polisher(problem: TrajectoryProblem) -> Polisher:
     """
     check_type(problem, TrajectoryProblem, "problem")
     return Polisher(problem)
+
+
+def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
+    """Refuse a ``polisher`` that is neither ``None`` nor a :class:`Polisher` started for
+    ``problem`` (the same object).
+
+    Raises
+    ------
+    InvalidInputError
+        ``polisher`` of another type.
+    ConfigurationError
+        A polisher started for another problem.
+    """
+    if polisher is None:
+        return
+    check_type(polisher, Polisher, "polisher")
+    if polisher.problem is not problem:
+        raise ConfigurationError(
+            "the polisher was started for another problem (start_polisher(problem) with "
+            "the problem given to plan)"
+        )
 
 
 def polish_with_certificates(
@@ -103,8 +130,7 @@ def polish_with_certificates(
         (the polished state, the summaries of the certificates made by the polish and by
         ``early`` by the move's ``x.tobytes()``): the same with or without the helper.
     """
-    if polisher is not None and polisher.problem is not problem:
-        raise ConfigurationError("the polisher was started for another problem")
+    check_polisher(polisher, problem)
     handed = polisher is not None and polish_mode(mode) != "off"
     if handed and polisher.start(state, rate_hz, mode, weights):
         ahead = early.finish()  # meanwhile, on this process and early's
