@@ -79,6 +79,12 @@ def test_the_caller_certifies_only_the_members_still_wanted(problem, x, serial) 
     assert early.finish(wanted) == {k: serial[k] for k in wanted}
 
 
+def test_without_fork_the_caller_certifies_every_share(problem, x, serial) -> None:
+    early = start_early_certificates(problem, x, MEMBERS, rate_hz=400.0, fork=False)
+    assert early.pid is None
+    assert early.finish() == serial
+
+
 def test_a_failing_process_leaves_its_shares_to_the_caller(
     problem, x, serial, shares_of_two, monkeypatch
 ) -> None:

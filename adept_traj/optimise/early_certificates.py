@@ -13,6 +13,9 @@ the shares that are left from the same counter and certifies them in the caller 
 members still wanted only) while the process goes on with its own, then collects the
 process' summaries. Every certificate depends on its member alone, so the summaries are
 those :func:`~adept_traj.analysis.certify_members` makes in the caller, field for field.
+With one worker (``fork=False``) no process starts: the caller certifies every share in
+:meth:`EarlyCertificates.finish` (while the helper of
+:mod:`adept_traj.optimise.polisher` polishes, when there is one).
 
 The process never outlives the caller: it ignores Ctrl-C (the caller stops it),
 :meth:`EarlyCertificates.cancel` (or leaving the ``with`` block) terminates and reaps it,
@@ -52,7 +55,12 @@ _DONE = "done"
 
 
 def start_early_certificates(
-    problem: TrajectoryProblem, x: Any, members: Sequence[int], *, rate_hz: float
+    problem: TrajectoryProblem,
+    x: Any,
+    members: Sequence[int],
+    *,
+    rate_hz: float,
+    fork: bool = True,
 ) -> EarlyCertificates:
     """Fork a process that certifies ``members`` of ``x`` while the caller goes on.
 
@@ -63,13 +71,15 @@ def start_early_certificates(
     members: the rows of ``x`` to certify, in the order of their shares (e.g. the
         trade-off order).
     rate_hz: the dense grid's minimum rate [Hz] (> 0).
+    fork: start the process (``False``, e.g. for one worker: ``finish`` certifies every
+        share in the caller).
 
     Returns
     -------
     EarlyCertificates
-        The certificates under way; :meth:`EarlyCertificates.finish` gives them. Without
-        ``fork`` (or with no member) no process starts and ``finish`` certifies in the
-        caller.
+        The certificates under way; :meth:`EarlyCertificates.finish` gives them. With
+        ``fork=False``, without ``fork`` on the platform or with no member no process
+        starts and ``finish`` certifies in the caller.
     """
     check_type(problem, TrajectoryProblem, "problem")
     xs = as_batch(x, "x", problem.n_var)
@@ -77,7 +87,7 @@ def start_early_certificates(
         raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
-    return EarlyCertificates(problem, np.array(xs), rows, rate)
+    return EarlyCertificates(problem, np.array(xs), rows, rate, fork=bool(fork))
 
 
 def feasible_front(F: Any, G: Any, weights: Any) -> np.ndarray:
@@ -109,7 +119,13 @@ class EarlyCertificates:
     """
 
     def __init__(
-        self, problem: TrajectoryProblem, x: np.ndarray, rows: list[int], rate_hz: float
+        self,
+        problem: TrajectoryProblem,
+        x: np.ndarray,
+        rows: list[int],
+        rate_hz: float,
+        *,
+        fork: bool = True,
     ) -> None:
         self._problem, self._x, self._rate = problem, x, rate_hz
         self._shares = [rows[i : i + EARLY_SHARE] for i in range(0, len(rows), EARLY_SHARE)]
@@ -117,7 +133,7 @@ class EarlyCertificates:
         self._conn: Any = None
         self.pid: int | None = None
         context = None
-        if self._shares and "fork" in multiprocessing.get_all_start_methods():
+        if fork and self._shares and "fork" in multiprocessing.get_all_start_methods():
             context = multiprocessing.get_context("fork")
         if context is None:
             self._next: Any = _Counter()

@@ -306,10 +306,11 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        # the front's certificates made meanwhile on the idle core (docs/performance.md)
-        ahead = polish != "off" and max_certify is None and problem.settings.workers > 1
-        rows = feasible_front(state.F, state.G, _weights(weights)) if ahead else []
-        with start_early_certificates(problem, state.X, rows, rate_hz=rate_hz) as early:
+        # the front's certificates made meanwhile (docs/performance.md)
+        rows = feasible_front(state.F, state.G, _weights(weights))
+        rows = rows if polish != "off" and max_certify is None else []
+        fork = problem.settings.workers > 1  # one worker: certified in this process
+        with start_early_certificates(problem, state.X, rows, rate_hz=rate_hz, fork=fork) as early:
             state, polished = polish_with_certificates(
                 problem, state, rate_hz, polish, _weights(weights), early=early, polisher=polisher
             )
