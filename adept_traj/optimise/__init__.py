@@ -70,7 +70,6 @@ from adept_traj.optimise.polish_step import (
     time_optimal_run,
 )
 from adept_traj.optimise.polisher import (
-    POLISHER_NICENESS,
     Polisher,
     check_polisher,
     polish_with_certificates,
@@ -119,7 +118,6 @@ __all__ = [
     "GRADIENT_COST",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
-    "POLISHER_NICENESS",
     "POLISH_MODES",
     "POLISH_SHARE",
     "SPREAD_MEMBERS",

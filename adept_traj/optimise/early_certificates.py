@@ -27,7 +27,6 @@ a note), the same exception as without the process.
 
 from __future__ import annotations
 
-import atexit
 import multiprocessing
 import os
 import signal
@@ -42,6 +41,7 @@ from adept_traj.analysis.indicators import non_dominated
 from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
 from adept_traj.errors import InputShapeError
 from adept_traj.problem import TrajectoryProblem, from_pymoo
+from adept_traj.processes import ForkedHelper
 from adept_traj.validation import as_batch, as_finite_array, as_integer, as_scalar, check_type
 
 __all__ = ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"]
@@ -109,13 +109,10 @@ def feasible_front(F: Any, G: Any, weights: Any) -> np.ndarray:
     return rows[best_tradeoff(objectives[rows], weights).order]
 
 
-class EarlyCertificates:
+class EarlyCertificates(ForkedHelper):
     """The certificates started by :func:`start_early_certificates`; a context manager
-    that stops its process when the block is left.
-
-    Attributes
-    ----------
-    pid: the process' id (``None`` without ``fork``, or once it is reaped).
+    that stops its process when the block is left
+    (:class:`~adept_traj.processes.ForkedHelper`: ``cancel``, ``pid``).
     """
 
     def __init__(
@@ -129,24 +126,9 @@ class EarlyCertificates:
     ) -> None:
         self._problem, self._x, self._rate = problem, x, rate_hz
         self._shares = [rows[i : i + EARLY_SHARE] for i in range(0, len(rows), EARLY_SHARE)]
-        self._process: Any = None
-        self._conn: Any = None
-        self.pid: int | None = None
-        context = None
-        if fork and self._shares and "fork" in multiprocessing.get_all_start_methods():
-            context = multiprocessing.get_context("fork")
-        if context is None:
-            self._next: Any = _Counter()
-            return
-        self._next = context.Value("i", 0)
-        self._conn, child = context.Pipe(duplex=False)
-        process = context.Process(
-            target=_work, args=(child, self._conn, os.getpid(), self), daemon=True
-        )
-        process.start()
-        child.close()
-        self._process, self.pid = process, process.pid
-        atexit.register(self.cancel)
+        fork = fork and bool(self._shares) and "fork" in multiprocessing.get_all_start_methods()
+        self._next: Any = multiprocessing.get_context("fork").Value("i", 0) if fork else _Counter()
+        super().__init__(_work if fork else None, (self,))
 
     def finish(self, wanted: Collection[bytes] | None = None) -> dict[bytes, MemberCertificate]:
         """Certify the shares no process has taken (only the members whose
@@ -214,27 +196,6 @@ class EarlyCertificates:
                 return text
             received[i] = summaries
         return ""
-
-    def cancel(self) -> None:
-        """Stop the process (a no-op once it is reaped): terminated, then waited for."""
-        if self._process is None:
-            return
-        self._process.terminate()
-        self._reap()
-
-    def _reap(self) -> None:
-        if self._process is None:
-            return
-        self._process.join()
-        self._conn.close()
-        self._process, self._conn, self.pid = None, None, None
-        atexit.unregister(self.cancel)
-
-    def __enter__(self) -> EarlyCertificates:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
 
 class _Counter:

@@ -5,8 +5,9 @@ The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize`` (≈
 CPU), after the search, on the command's critical path. :func:`start_polisher` forks a
 helper process from the caller once the problem exists (before the evaluator's worker
 processes); a thread of the helper imports ``scipy.optimize`` and ``threadpoolctl`` and
-makes the problem's certifying problem at the lowest priority (nice 19: it runs while a
-core idles and never takes one from the search), and the helper then waits.
+makes the problem's certifying problem at the lowest priority (nice 19,
+:func:`~adept_traj.processes.prepare_quietly`: it runs while a core idles and never takes
+one from the search), and the helper then waits.
 :meth:`Polisher.start` hands it the search's final population (its arrays and counts,
 pickled: about 0.1 MB for the paper run); the helper polishes it as
 :func:`~adept_traj.optimise.polish_run` does, on the problem it inherited, while the
@@ -27,13 +28,11 @@ attempt, with the helper's traceback as a note (:meth:`Polisher.note`).
 
 from __future__ import annotations
 
-import atexit
 import dataclasses
-import multiprocessing
 import os
 import signal
-import threading
 import traceback
+from functools import partial
 from typing import Any
 
 from adept_traj.analysis.member_certificate import MemberCertificate, certifying_problem
@@ -42,19 +41,16 @@ from adept_traj.optimise.early_certificates import EarlyCertificates, feasible_f
 from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.polish_step import _polish_run, polish_mode
 from adept_traj.problem import TrajectoryProblem
+from adept_traj.processes import READY, ForkedHelper, prepare_quietly
 from adept_traj.validation import as_scalar, check_type
 
 __all__ = [
-    "POLISHER_NICENESS",
     "Polisher",
     "check_polisher",
     "polish_with_certificates",
     "start_polisher",
 ]
 
-#: Niceness of the helper's importing thread (the lowest priority).
-POLISHER_NICENESS = 19
-_READY = "ready"
 #: How often the waiting helper checks that its parent lives [s].
 _PARENT_CHECK = 0.5
 
@@ -148,44 +144,21 @@ def polish_with_certificates(
     return polished, {**early.finish(keys), **certified}
 
 
-class Polisher:
+class Polisher(ForkedHelper):
     """The helper process forked by :func:`start_polisher`; a context manager that stops
-    it when the block is left.
+    it when the block is left (:class:`~adept_traj.processes.ForkedHelper`: ``ready``,
+    ``cancel``, ``pid``).
 
     Attributes
     ----------
     problem: the problem it polishes for (the caller's object).
-    pid: the helper's process id (``None`` without ``fork``, or once it is reaped).
     """
 
     def __init__(self, problem: TrajectoryProblem) -> None:
         self.problem = problem
-        self._process: Any = None
-        self._conn: Any = None
-        self._ready = False
         self._order: dict[str, Any] | None = None
         self._note = ""
-        self.pid: int | None = None
-        if "fork" not in multiprocessing.get_all_start_methods():
-            return
-        context = multiprocessing.get_context("fork")
-        self._conn, child = context.Pipe(duplex=True)
-        process = context.Process(target=_helper, args=(child, self._conn, os.getpid(), problem))
-        process.start()
-        child.close()
-        self._process, self.pid = process, process.pid
-        atexit.register(self.cancel)
-
-    def ready(self, timeout: float = 0.0) -> bool:
-        """Whether the helper has finished its imports (waiting up to ``timeout`` [s]);
-        ``False`` for a helper that died or was stopped."""
-        if not self._ready and self._process is not None:
-            try:
-                if self._conn.poll(timeout):
-                    self._ready = self._conn.recv() == _READY
-            except (EOFError, OSError):  # died while importing
-                self._ready = False
-        return self._ready
+        super().__init__(_helper, (problem,))
 
     def start(self, state: RunState, rate_hz: float, mode: str, weights: Any) -> bool:
         """Hand the search's final ``state`` to the helper, if it is ready, and return at
@@ -221,9 +194,9 @@ class Polisher:
         -------
         tuple or None
             (the polished state, the polish's certificates by the polished move's
-            ``x.tobytes()``), as :func:`~adept_traj.optimise.polish_step._polish_run`
-            returns them in the caller; ``None`` if the helper failed (its traceback is
-            then :meth:`note`) or died: the caller polishes itself.
+            ``x.tobytes()``), as the polish in the caller makes them; ``None`` if the
+            helper failed (its traceback is then :meth:`note`) or died: the caller
+            polishes itself.
         """
         if self._order is None:
             raise ConfigurationError("Polisher.result needs a successful Polisher.start first")
@@ -249,39 +222,13 @@ class Polisher:
         """The traceback of the helper's failure (``""``: it did not fail)."""
         return self._note
 
-    def cancel(self) -> None:
-        """Stop the helper (a no-op once it is reaped): terminated, then waited for."""
-        if self._process is None:
-            return
-        self._process.terminate()
-        self._reap()
 
-    def _reap(self) -> None:
-        if self._process is None:
-            return
-        self._process.join()
-        self._conn.close()
-        self._process, self.pid = None, None
-        atexit.unregister(self.cancel)
+def _prepare(problem: TrajectoryProblem) -> None:
+    """What the polish needs before its first solve (run at the lowest priority)."""
+    import scipy.optimize  # noqa: F401  (the polish's SLSQP)
+    import threadpoolctl  # noqa: F401  (its BLAS limit)
 
-    def __enter__(self) -> Polisher:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
-
-
-def _prepare(problem: TrajectoryProblem, failed: list[str]) -> None:
-    """The importing thread, at the lowest priority (Linux niceness is per thread): what
-    the polish needs before its first solve."""
-    try:
-        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), POLISHER_NICENESS)
-        import scipy.optimize  # noqa: F401  (the polish's SLSQP)
-        import threadpoolctl  # noqa: F401  (its BLAS limit)
-
-        certifying_problem(problem)
-    except BaseException:  # reported by not being ready: the caller polishes
-        failed.append(traceback.format_exc())
+    certifying_problem(problem)
 
 
 def _helper(conn: Any, callers_end: Any, parent: int, problem: TrajectoryProblem) -> None:
@@ -296,14 +243,10 @@ def _helper(conn: Any, callers_end: Any, parent: int, problem: TrajectoryProblem
         callers_end.close()
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
-        failed: list[str] = []
-        thread = threading.Thread(target=_prepare, args=(problem, failed), daemon=True)
-        thread.start()
-        thread.join()
-        if failed:
+        if prepare_quietly(partial(_prepare, problem)):  # failed: not ready, the caller polishes
             code = 1
             return
-        conn.send(_READY)
+        conn.send(READY)
         while not conn.poll(_PARENT_CHECK):
             if os.getppid() != parent:
                 return
