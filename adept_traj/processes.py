@@ -72,6 +72,19 @@ class ForkedHelper:
                 self._ready = False
         return self._ready
 
+    def _answer(self) -> Any:
+        """Wait for the helper's answer and reap it; ``None`` if it ended without a word
+        (killed). Ctrl-C (or any error) while waiting stops the helper and is raised."""
+        try:
+            message = self._conn.recv()
+        except EOFError:  # the helper ended without a word (killed)
+            message = None
+        except BaseException:  # e.g. Ctrl-C while waiting
+            self.cancel()
+            raise
+        self._reap()
+        return message
+
     def cancel(self) -> None:
         """Stop the helper (a no-op once it is reaped): terminated, then waited for."""
         if self._process is None:

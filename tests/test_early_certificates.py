@@ -135,20 +135,6 @@ def test_a_killed_process_has_its_shares_done_by_the_caller(
         assert early.finish() == serial
 
 
-def test_leaving_the_block_stops_the_process(problem, x) -> None:
-    early = start_early_certificates(problem, x, MEMBERS, rate_hz=400.0)
-    pid = early.pid
-
-    def interrupted() -> None:
-        with early:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        interrupted()
-    assert early.pid is None
-    assert _gone(pid)
-
-
 def test_bad_input_is_refused_before_any_process_starts(problem, x) -> None:
     with pytest.raises(InvalidInputError, match="member"):
         start_early_certificates(problem, x, [0, 7], rate_hz=400.0)

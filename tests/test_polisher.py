@@ -127,20 +127,6 @@ def test_an_error_is_raised_in_the_caller_with_the_helper_traceback(
     assert _gone(pid)
 
 
-def test_leaving_the_block_stops_the_helper(problem) -> None:
-    polisher = start_polisher(problem)
-    pid = polisher.pid
-
-    def interrupted() -> None:
-        with polisher:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        interrupted()
-    assert polisher.pid is None
-    assert _gone(pid)
-
-
 def test_a_polisher_of_another_problem_is_refused_before_the_search(problem, searched) -> None:
     scene = Scene.paper()
     other = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)

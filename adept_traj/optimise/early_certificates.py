@@ -39,10 +39,10 @@ import numpy as np
 from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
-from adept_traj.errors import InputShapeError
+from adept_traj.optimise.front_certificates import _checked
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.processes import ForkedHelper
-from adept_traj.validation import as_batch, as_finite_array, as_integer, as_scalar, check_type
+from adept_traj.validation import as_finite_array
 
 __all__ = ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"]
 
@@ -81,12 +81,7 @@ def start_early_certificates(
         ``fork=False``, without ``fork`` on the platform or with no member no process
         starts and ``finish`` certifies in the caller.
     """
-    check_type(problem, TrajectoryProblem, "problem")
-    xs = as_batch(x, "x", problem.n_var)
-    if xs.ndim != 2:
-        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
-    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
-    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
+    xs, rows, rate = _checked(problem, x, members, rate_hz)
     return EarlyCertificates(problem, np.array(xs), rows, rate, fork=bool(fork))
 
 

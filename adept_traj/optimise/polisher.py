@@ -200,16 +200,9 @@ class Polisher(ForkedHelper):
         """
         if self._order is None:
             raise ConfigurationError("Polisher.result needs a successful Polisher.start first")
-        try:
-            message = self._conn.recv()
-        except EOFError:  # the helper ended without a word (killed)
-            message = None
-        except BaseException:  # e.g. Ctrl-C while waiting
-            self.cancel()
-            raise
-        self._reap()
+        message = self._answer()
         order, self._order = self._order, None
-        if message is None:
+        if message is None:  # the helper ended without a word (killed)
             return None
         text, polished = message
         if text:

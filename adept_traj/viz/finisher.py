@@ -138,16 +138,9 @@ class Finisher(ForkedHelper):
         """
         if self._order is None:
             raise InvalidInputError("Finisher.wait needs a successful Finisher.start first")
-        try:
-            message = self._conn.recv()
-        except EOFError:  # the helper ended without a word (killed): done again here
-            message = None
-        except BaseException:  # e.g. Ctrl-C while waiting
-            self.cancel()
-            raise
-        self._reap()
+        message = self._answer()
         order, self._order = self._order, None
-        if message is None:
+        if message is None:  # the helper ended without a word (killed): done again here
             return _write(*order, self._robot, self._scene)
         text, pickled, paths = message
         if text:
