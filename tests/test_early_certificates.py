@@ -5,7 +5,6 @@ killed process leaves its shares to the caller; no process outlives the call."""
 from __future__ import annotations
 
 import os
-import signal
 import time
 
 import numpy as np
@@ -45,14 +44,6 @@ def shares_of_two(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(early_module, "EARLY_SHARE", 2)
 
 
-def _gone(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    return False
-
-
 def _ended(pid: int) -> bool:
     """Whether the process has ended (a zombie not yet reaped, or gone)."""
     try:
@@ -62,14 +53,14 @@ def _ended(pid: int) -> bool:
         return True
 
 
-def test_the_summaries_are_the_serial_ones(problem, x, serial, shares_of_two) -> None:
+def test_the_summaries_are_the_serial_ones(problem, x, serial, shares_of_two, process_gone) -> None:
     with start_early_certificates(problem, x, MEMBERS, rate_hz=400.0) as early:
         pid = early.pid
         assert pid is not None
         out = early.finish()
     assert out == serial  # every field of every summary, exactly
     assert early.pid is None
-    assert _gone(pid)
+    assert process_gone(pid)
 
 
 def test_the_caller_certifies_only_the_members_still_wanted(problem, x, serial) -> None:
@@ -85,24 +76,18 @@ def test_without_fork_the_caller_certifies_every_share(problem, x, serial) -> No
     assert early.finish() == serial
 
 
-def test_a_failing_process_leaves_its_shares_to_the_caller(
-    problem, x, serial, shares_of_two, monkeypatch
+@pytest.mark.parametrize("fault", ["raises", "killed"])
+def test_a_failing_or_killed_process_leaves_its_shares_to_the_caller(
+    problem, x, serial, shares_of_two, monkeypatch, child_fault, fault
 ) -> None:
-    caller = os.getpid()
-    real = early_module.certify_members
-
-    def fails_in_the_child(*args, **kwargs):
-        if os.getpid() != caller:
-            raise RuntimeError("broken in the child")
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(early_module, "certify_members", fails_in_the_child)
+    faulty = child_fault(early_module.certify_members, fault)
+    monkeypatch.setattr(early_module, "certify_members", faulty)
     with start_early_certificates(problem, x, MEMBERS, rate_hz=400.0) as early:
         assert early.finish() == serial
 
 
 def test_an_error_is_raised_in_the_caller_with_the_process_traceback(
-    problem, x, shares_of_two, monkeypatch
+    problem, x, shares_of_two, monkeypatch, process_gone
 ) -> None:
     def fails(*args, **kwargs):
         raise RuntimeError(f"certificate broken in {os.getpid()}")
@@ -116,23 +101,7 @@ def test_an_error_is_raised_in_the_caller_with_the_process_traceback(
         with pytest.raises(RuntimeError, match=f"broken in {os.getpid()}") as caught:
             early.finish()
     assert any(f"broken in {pid}" in note for note in caught.value.__notes__)
-    assert _gone(pid)
-
-
-def test_a_killed_process_has_its_shares_done_by_the_caller(
-    problem, x, serial, shares_of_two, monkeypatch
-) -> None:
-    caller = os.getpid()
-    real = early_module.certify_members
-
-    def killed_in_the_child(*args, **kwargs):
-        if os.getpid() != caller:
-            os.kill(os.getpid(), signal.SIGKILL)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(early_module, "certify_members", killed_in_the_child)
-    with start_early_certificates(problem, x, MEMBERS, rate_hz=400.0) as early:
-        assert early.finish() == serial
+    assert process_gone(pid)
 
 
 def test_bad_input_is_refused_before_any_process_starts(problem, x) -> None:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-import signal
 from pathlib import Path
 
 import numpy as np
@@ -49,14 +48,6 @@ def serial(problem: TrajectoryProblem, searched):
     return state, {new[0].tobytes(): certify_members(problem, new, rate_hz=RATE)[0]}
 
 
-def _gone(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    return False
-
-
 def _same(state, certified, serial) -> None:
     expected_state, expected_certified = serial
     for name in ("X", "F", "G", "CV"):
@@ -73,14 +64,14 @@ def _polish(problem, searched, polisher):
         )
 
 
-def test_the_helper_polishes_as_the_caller(problem, searched, serial) -> None:
+def test_the_helper_polishes_as_the_caller(problem, searched, serial, process_gone) -> None:
     with start_polisher(problem) as polisher:
         pid = polisher.pid
         assert polisher.ready(60.0)
         state, certified = _polish(problem, searched, polisher)
         assert polisher.pid is None  # reaped once its polish is collected
     _same(state, certified, serial)
-    assert _gone(pid)
+    assert process_gone(pid)
 
 
 def test_a_helper_not_ready_leaves_the_polish_to_the_caller(problem, searched, serial) -> None:
@@ -92,27 +83,21 @@ def test_a_helper_not_ready_leaves_the_polish_to_the_caller(problem, searched, s
 
 @pytest.mark.parametrize("fault", ["raises", "killed"])
 def test_a_failing_helper_leaves_the_polish_to_the_caller(
-    problem, searched, serial, monkeypatch, fault
+    problem, searched, serial, monkeypatch, child_fault, fault
 ) -> None:
-    caller = os.getpid()
-    real = polisher_module._polish_run
-
-    def faulty(*args, **kwargs):
-        if os.getpid() != caller:
-            if fault == "killed":
-                os.kill(os.getpid(), signal.SIGKILL)
-            raise RuntimeError("broken in the helper")
-        return real(*args, **kwargs)
-
+    faulty = child_fault(polisher_module._polish_run, fault)
     monkeypatch.setattr(polisher_module, "_polish_run", faulty)
     with start_polisher(problem) as polisher:
         assert polisher.ready(60.0)
         _same(*_polish(problem, searched, polisher), serial)
-        assert ("broken in the helper" in polisher.note()) == (fault == "raises")
+        assert ("broken in the child" in polisher.note()) == (fault == "raises")
 
 
 def test_an_error_is_raised_in_the_caller_with_the_helper_traceback(
-    problem, searched, monkeypatch
+    problem,
+    searched,
+    monkeypatch,
+    process_gone,
 ) -> None:
     def fails(*args, **kwargs):
         raise RuntimeError(f"polish broken in {os.getpid()}")
@@ -124,7 +109,7 @@ def test_an_error_is_raised_in_the_caller_with_the_helper_traceback(
         with pytest.raises(RuntimeError, match=f"broken in {os.getpid()}") as caught:
             _polish(problem, searched, polisher)
     assert any(f"broken in {pid}" in note for note in caught.value.__notes__)
-    assert _gone(pid)
+    assert process_gone(pid)
 
 
 def test_a_polisher_of_another_problem_is_refused_before_the_search(problem, searched) -> None:
@@ -162,7 +147,10 @@ def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -
 
 @pytest.mark.parametrize("end", ["done", "error", "ctrl-c"])
 def test_adept_traj_plan_leaves_no_helper_behind(
-    end: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    end: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    process_gone,
 ) -> None:
     """The command starts the polisher before the search and reaps it however it ends."""
     stored = PlanningResult.load(DATA / "result_v1")
@@ -185,7 +173,7 @@ def test_adept_traj_plan_leaves_no_helper_behind(
     else:
         assert main(argv) == (0 if end == "done" else 130)
     assert seen[0] is not None
-    assert _gone(seen[0])
+    assert process_gone(seen[0])
     assert multiprocessing.active_children() == []
 
 

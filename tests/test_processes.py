@@ -14,14 +14,6 @@ import pytest
 from adept_traj.processes import LOWEST_PRIORITY, READY, ForkedHelper, prepare_quietly
 
 
-def _gone(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    return False
-
-
 def _echo(conn, callers_end, parent, how: str) -> None:
     """A helper: say ready, then answer its parent's pid and the preparing thread's
     niceness, be killed before answering, or wait forever."""
@@ -37,13 +29,13 @@ def _echo(conn, callers_end, parent, how: str) -> None:
     os._exit(0)
 
 
-def test_a_helper_is_ready_answers_and_is_reaped() -> None:
+def test_a_helper_is_ready_answers_and_is_reaped(process_gone) -> None:
     with ForkedHelper(_echo, ("answers",)) as helper:
         pid = helper.pid
         assert helper.ready(30.0)
         assert helper._answer() == (os.getpid(), LOWEST_PRIORITY)
         assert helper.pid is None
-    assert _gone(pid)
+    assert process_gone(pid)
 
 
 def test_a_killed_helper_answers_none() -> None:
@@ -52,7 +44,7 @@ def test_a_killed_helper_answers_none() -> None:
         assert helper._answer() is None
 
 
-def test_leaving_the_block_stops_the_helper() -> None:
+def test_leaving_the_block_stops_the_helper(process_gone) -> None:
     helper = ForkedHelper(_echo, ("waits",))
     pid = helper.pid
 
@@ -63,7 +55,7 @@ def test_leaving_the_block_stops_the_helper() -> None:
     with pytest.raises(KeyboardInterrupt):
         interrupted()
     assert helper.pid is None
-    assert _gone(pid)
+    assert process_gone(pid)
     assert not helper.ready()
 
 
