@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +80,22 @@ def test_a_helper_not_ready_leaves_the_polish_to_the_caller(problem, searched, s
     polisher.cancel()  # stopped: never ready
     assert not polisher.start(searched, RATE, "fastest", PAPER_WEIGHTS)
     _same(*_polish(problem, searched, polisher), serial)
+
+
+def test_a_helper_still_preparing_is_killed_without_waiting_for_its_end(
+    problem, searched, serial, monkeypatch, process_gone
+) -> None:
+    """Its preparing thread at nice 19 may wait long for a core on a busy machine: the
+    caller kills the helper and polishes at once, the helper is reaped at the block's end."""
+    monkeypatch.setattr(polisher_module, "_prepare", lambda _problem: time.sleep(60.0))
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert not polisher.start(searched, RATE, "fastest", PAPER_WEIGHTS)
+        assert polisher.pid == pid  # not waited for
+        assert not polisher.ready()
+        _same(*_polish(problem, searched, polisher), serial)
+    assert polisher.pid is None
+    assert process_gone(pid)
 
 
 @pytest.mark.parametrize("fault", ["raises", "killed"])

@@ -176,7 +176,7 @@ class Polisher(ForkedHelper):
         if self._order is not None:
             raise ConfigurationError("the polisher polishes one population; it has one already")
         if not self.ready():
-            self.cancel()
+            self._give_up()
             return False
         arrays = dataclasses.replace(state, history=[], fronts=[])  # what the polish reads
         try:

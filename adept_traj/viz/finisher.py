@@ -116,7 +116,7 @@ class Finisher(ForkedHelper):
         if (order[1] is not None and not self._figures) or (order[2] and not self._html):
             raise InvalidInputError("the helper was started without the output asked for")
         if not self.ready(READY_TIMEOUT):
-            self.cancel()
+            self._give_up()
             return False
         try:
             self._conn.send(order)
