@@ -80,6 +80,7 @@ def plan_once(pythonpath: str, folder: Path, options: list[str]) -> dict[str, fl
     command = [sys.executable, "-c", _WRAPPED, str(marks_file), "plan", "--quiet", *options]
     subprocess.run(
         [*command, "--out", str(folder)],
+        cwd=folder.parent,  # not a checkout: ``python -c`` puts the working folder first
         env={**os.environ, "PYTHONPATH": pythonpath},
         check=True,
         stdout=subprocess.DEVNULL,
