@@ -42,7 +42,6 @@ from adept_traj.analysis.member_certificate import MemberCertificate, certify_me
 from adept_traj.optimise.front_certificates import _checked
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.processes import ForkedHelper
-from adept_traj.validation import as_finite_array
 
 __all__ = ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"]
 
@@ -96,7 +95,7 @@ def feasible_front(F: Any, G: Any, weights: Any) -> np.ndarray:
     G: (n, m) constraint values (≤ 0: satisfied).
     weights: the six weights of f_c.
     """
-    objectives = from_pymoo(as_finite_array(F, "F"))
+    objectives = from_pymoo(np.asarray(F, dtype=float))  # as plan reads them
     feasible = np.flatnonzero(np.all(np.asarray(G, dtype=float) <= 0.0, axis=1))
     if len(feasible) == 0:
         return feasible
@@ -128,7 +127,7 @@ class EarlyCertificates(ForkedHelper):
     def finish(self, wanted: Collection[bytes] | None = None) -> dict[bytes, MemberCertificate]:
         """Certify the shares no process has taken (only the members whose
         ``x[k].tobytes()`` is in ``wanted``; ``None``: all), collect the process' summaries
-        and reap it.
+        and reap it (once: a second call certifies every share again, in the caller).
 
         Returns
         -------
