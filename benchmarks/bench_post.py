@@ -98,8 +98,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("other", help="another checkout, timed alternately with this one")
     parser.add_argument("--repeat", type=int, default=6, help="runs of each (default 6)")
-    parser.add_argument("options", nargs="*", help="more plan options (after --)")
-    args = parser.parse_args()
+    args, options = parser.parse_known_args()
+    args.options = [o for o in options if o != "--"]
     versions = {
         "other": str(Path(args.other).resolve()),
         "this checkout": str(Path(__file__).resolve().parent.parent),
