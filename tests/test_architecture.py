@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "adept_traj"
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
     "errors": 0, "data": 0, "urdf": 0,
-    "validation": 1, "files": 1, "memory": 1,
+    "validation": 1, "files": 1, "memory": 1, "processes": 1,
     "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,

@@ -235,9 +235,11 @@ def test_a_helper_dies_with_its_killed_caller(ready: bool, tmp_path: Path) -> No
     )
     caller.start()
     stop = time.monotonic() + 30.0
-    while not (tmp_path / "started").is_file() and time.monotonic() < stop:
+    started = tmp_path / "started"
+    # not empty: the file exists before its text is written (read in between, it failed)
+    while not (started.is_file() and started.read_text()) and time.monotonic() < stop:
         time.sleep(0.01)
-    helper = int((tmp_path / "started").read_text())
+    helper = int(started.read_text())
     assert not _gone(helper, within=0.0)
     os.kill(caller.pid, signal.SIGKILL)
     caller.join()

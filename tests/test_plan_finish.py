@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 import adept_traj.cli.plan as plan_command
+import adept_traj.cli.report as report
 from adept_traj.cli.app import main
 from adept_traj.results import PlanningResult
 from adept_traj.viz.plots import all_figures
@@ -96,6 +97,9 @@ def test_the_result_is_saved_when_the_figures_cannot_start(
         raise OSError(12, "Cannot allocate memory (fork)")
 
     monkeypatch.setattr(all_figures, "BackgroundFigures", no_fork)
+    # no finish helper either (no fork): else a helper whose imports are done (all of
+    # them already imported by earlier tests) writes the figures, and nothing fails
+    monkeypatch.setattr(report, "start_finisher", no_fork)
     assert _plan(monkeypatch, stored, tmp_path / "run") == 2
     saved = (tmp_path / "run" / "result.json").read_bytes()
     assert saved == (plain / "result.json").read_bytes()

@@ -20,6 +20,7 @@ refused before the run starts.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 from pathlib import Path
@@ -50,9 +51,11 @@ from adept_traj.optimise import (
     POLISH_MODES,
     TIME_OPTIMAL,
     PlanningInterrupted,
+    Polisher,
     has_checkpoint,
     make_algorithm,
     plan,
+    start_polisher,
 )
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
@@ -247,10 +250,25 @@ def run(args: argparse.Namespace) -> int:
                 saved = {k: getattr(opts, k) for k in _SAVED}
                 saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
                 write_arguments(folder, saved)
-            with finisher_for(problem, figures=not opts.no_plots, html=not opts.no_html) as f:
-                return _run(opts, problem, folder, resume, f)
+            with (
+                finisher_for(problem, figures=not opts.no_plots, html=not opts.no_html) as f,
+                _polisher_for(problem, opts) as polisher,
+            ):
+                return _run(opts, problem, folder, resume, f, polisher)
     finally:
         problem.close()
+
+
+def _polisher_for(problem: TrajectoryProblem, opts: argparse.Namespace) -> Any:
+    """The helper process that will polish the search's result while this one certifies
+    (:func:`adept_traj.optimise.start_polisher`), in a context that stops it; an empty
+    context (``None``) without a polish or a search, or when no process can be forked."""
+    if opts.no_polish or opts.polish == "off" or opts.algorithm == TIME_OPTIMAL:
+        return contextlib.nullcontext(None)
+    try:
+        return start_polisher(problem)
+    except OSError:  # e.g. no memory to fork: the polish runs in this process
+        return contextlib.nullcontext(None)
 
 
 def _run(
@@ -259,6 +277,7 @@ def _run(
     folder: Path,
     resume: bool,
     finisher: Finisher | None = None,
+    polisher: Polisher | None = None,
 ) -> int:
     """Plan, save and mark the run complete; on Ctrl-C say how to resume."""
     checkpoint = folder / CHECKPOINT
@@ -277,6 +296,7 @@ def _run(
                 progress=progress,
                 rate_hz=opts.rate,
                 polish="off" if opts.no_polish else opts.polish,
+                polisher=polisher,
             )
         return _finish(result, problem, folder, opts, finisher)
     except PlanningInterrupted as exc:

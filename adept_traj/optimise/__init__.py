@@ -28,6 +28,12 @@ from adept_traj.optimise.duplicates import (
     BLOCK_PAIRS,
     BlockedDuplicateElimination,
 )
+from adept_traj.optimise.early_certificates import (
+    EARLY_SHARE,
+    EarlyCertificates,
+    feasible_front,
+    start_early_certificates,
+)
 from adept_traj.optimise.fast_end import (
     FastEndSearch,
 )
@@ -68,6 +74,12 @@ from adept_traj.optimise.polish_step import (
     polish_mode,
     polish_run,
     time_optimal_run,
+)
+from adept_traj.optimise.polisher import (
+    Polisher,
+    check_polisher,
+    polish_with_certificates,
+    start_polisher,
 )
 from adept_traj.optimise.population import (
     ArrayEvaluator,
@@ -111,6 +123,7 @@ __all__ = [
     "BLOCK_PAIRS",
     "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
+    "EARLY_SHARE",
     "GRADIENT_COST",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
@@ -127,11 +140,13 @@ __all__ = [
     "ArrayVariant",
     "BlockedDuplicateElimination",
     "CapturedCheckpoint",
+    "EarlyCertificates",
     "FastEndSearch",
     "GenerationInfo",
     "KinematicTimeRepair",
     "PlanningInterrupted",
     "PolishOutcome",
+    "Polisher",
     "RampSampling",
     "RankAndCrowdingSurvival",
     "RunState",
@@ -140,10 +155,12 @@ __all__ = [
     "cache_violations",
     "capture_checkpoint",
     "certify_front_members",
+    "check_polisher",
     "check_population_memory",
     "checkpoint_arrays",
     "crowding_distance",
     "epsilon_step",
+    "feasible_front",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -157,6 +174,7 @@ __all__ = [
     "polish_members",
     "polish_mode",
     "polish_run",
+    "polish_with_certificates",
     "population_bytes",
     "population_values",
     "ranked_optimum",
@@ -164,6 +182,8 @@ __all__ = [
     "save_checkpoint",
     "sbx_children",
     "select_parents",
+    "start_early_certificates",
+    "start_polisher",
     "time_optimal",
     "time_optimal_run",
     "warn_missing_limits",

@@ -62,12 +62,7 @@ def certify_front_members(
         (n,) a :class:`~adept_traj.analysis.MemberCertificate` per certified row, ``None``
         for the others — the same as :func:`~adept_traj.analysis.certify_members`.
     """
-    check_type(problem, TrajectoryProblem, "problem")
-    xs = as_batch(x, "x", problem.n_var)
-    if xs.ndim != 2:
-        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
-    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
-    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
+    xs, rows, rate = _checked(problem, x, members, rate_hz)
     n_proc = problem.settings.workers if workers is None else workers
     n_proc = min(as_integer(n_proc, "workers", minimum=1), len(rows))
     if n_proc <= 1 or "fork" not in multiprocessing.get_all_start_methods():
@@ -90,6 +85,19 @@ def certify_front_members(
         for k, certificate in zip(share, part):
             out[k] = certificate
     return tuple(out)
+
+
+def _checked(
+    problem: Any, x: Any, members: Sequence[int], rate_hz: Any
+) -> tuple[np.ndarray, list[int], float]:
+    """The members' checked input: (n, n_var) ``x``, the rows, the rate [Hz] (> 0)."""
+    check_type(problem, TrajectoryProblem, "problem")
+    xs = as_batch(x, "x", problem.n_var)
+    if xs.ndim != 2:
+        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
+    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
+    return xs, rows, rate
 
 
 def _start(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> None:

@@ -61,9 +61,11 @@ from adept_traj.analysis.paper_measures import (
 from adept_traj.analysis.weighted_sum import WeightedSum
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.algorithms import make_algorithm
+from adept_traj.optimise.early_certificates import feasible_front, start_early_certificates
 from adept_traj.optimise.front_certificates import certify_front_members
 from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.optimise.polish_step import TIME_OPTIMAL, _polish_run, polish_mode, time_optimal_run
+from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, time_optimal_run
+from adept_traj.optimise.polisher import Polisher, check_polisher, polish_with_certificates
 from adept_traj.optimise.sampling import check_population_memory
 from adept_traj.optimise.weighted_move import weighted_run
 from adept_traj.problem import TrajectoryProblem, from_pymoo
@@ -223,6 +225,7 @@ def plan(
     rate_hz: float = 1000.0,
     max_certify: int | None = None,
     polish: bool | str = True,
+    polisher: Polisher | None = None,
     **params: Any,
 ) -> PlanningResult:
     """Plan with ``algorithm`` (``"nsga2"``, ``"mode"`` or another pymoo name), or find one
@@ -249,6 +252,9 @@ def plan(
         over the front, by an ε-constraint step) or ``"all"`` (every front member); its
         time and evaluations are counted in ``result.timing``, its name is recorded as
         ``result.algorithm_settings["polish"]``. Ignored by ``"time-optimal"``.
+    polisher: a helper process of :func:`~adept_traj.optimise.start_polisher` (started
+        for ``problem`` before the search) that polishes while this process certifies
+        the front (``None``: the polish runs here); the result is the same.
 
     With ``algorithm="time-optimal"`` the parameters ``pop_size``, ``n_gen``,
     ``checkpoint``, ``resume`` and ``progress`` are not used; ``params`` may give
@@ -270,6 +276,7 @@ def plan(
     if max_certify is not None:
         max_certify = as_integer(max_certify, "max_certify", minimum=1, error=ConfigurationError)
     polish = polish_mode(polish)
+    check_polisher(polisher, problem)
     weighted = None  # the weighted sum of the weighted-sum mode
     if weights is not None:
         objective_weights(weights, 6)  # bad weights refused before any long work
@@ -299,7 +306,14 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        state, polished = _polish_run(problem, state, rate_hz, polish, _weights(weights))
+        # the front's certificates made meanwhile (docs/performance.md)
+        rows = feasible_front(state.F, state.G, _weights(weights))
+        rows = rows if polish != "off" and max_certify is None else []
+        fork = problem.settings.workers > 1  # one worker: certified in this process
+        with start_early_certificates(problem, state.X, rows, rate_hz=rate_hz, fork=fork) as early:
+            state, polished = polish_with_certificates(
+                problem, state, rate_hz, polish, _weights(weights), early=early, polisher=polisher
+            )
     # The final population's values as the run computed them (z4 back to positive).
     objectives = from_pymoo(state.F)
     constraints = np.asarray(state.G, dtype=float)

@@ -26,18 +26,15 @@ stops it and returns ``False``, and the caller writes the files itself.
 
 from __future__ import annotations
 
-import atexit
-import multiprocessing
 import os
 import signal
-import threading
-import traceback
 from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.processes import LOWEST_PRIORITY, READY, ForkedHelper, prepare_quietly
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
@@ -47,13 +44,12 @@ from adept_traj.viz.inputs import as_result
 __all__ = ["Finisher", "start_finisher"]
 
 #: Niceness of the helper's importing thread (the lowest priority).
-IMPORT_NICENESS = 19
+IMPORT_NICENESS = LOWEST_PRIORITY
 #: How long :meth:`Finisher.start` waits for the helper's imports to end [s] (0: the
 #: helper is used only if it is ready when the run ends).
 READY_TIMEOUT = 0.0
 #: Cost weight of ``playback.html`` on the scale of the figures' weights [0.1 s CPU].
 _HTML_WEIGHT = 0.3
-_READY = "ready"
 
 
 def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> Finisher:
@@ -82,47 +78,17 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     return Finisher(robot, scene, figures=bool(figures), html=bool(html))
 
 
-class Finisher:
+class Finisher(ForkedHelper):
     """The helper process forked by :func:`start_finisher`; a context manager that stops
-    it when the block is left.
-
-    Attributes
-    ----------
-    pid: the helper's process id (``None`` without ``fork``, or once it is reaped).
+    it when the block is left (:class:`~adept_traj.processes.ForkedHelper`: ``ready``,
+    ``cancel``, ``pid``).
     """
 
     def __init__(self, robot: Robot, scene: Scene, *, figures: bool, html: bool) -> None:
         self._robot, self._scene = robot, scene
         self._figures, self._html = figures, html
-        self._process: Any = None
-        self._conn: Any = None
-        self._ready = False
         self._order: tuple | None = None
-        self.pid: int | None = None
-        if "fork" not in multiprocessing.get_all_start_methods():
-            return
-        context = multiprocessing.get_context("fork")
-        self._conn, child = context.Pipe(duplex=True)
-        process = context.Process(
-            target=_helper, args=(child, self._conn, os.getpid(), robot, scene, figures, html)
-        )
-        process.start()  # (flushes sys.stdout and sys.stderr before the fork)
-        child.close()
-        self._process, self.pid = process, process.pid
-        # A caller that never cancels: stopped at the interpreter's exit, before
-        # multiprocessing's own exit hook (registered earlier, run later) joins it.
-        atexit.register(self.cancel)
-
-    def ready(self, timeout: float = 0.0) -> bool:
-        """Whether the helper has finished its imports (waiting up to ``timeout`` [s]);
-        ``False`` for a helper that died or was stopped."""
-        if not self._ready and self._process is not None:
-            try:
-                if self._conn.poll(timeout):
-                    self._ready = self._conn.recv() == _READY
-            except (EOFError, OSError):  # died while importing
-                self._ready = False
-        return self._ready
+        super().__init__(_helper, (robot, scene, figures, html))
 
     def start(
         self,
@@ -150,7 +116,7 @@ class Finisher:
         if (order[1] is not None and not self._figures) or (order[2] and not self._html):
             raise InvalidInputError("the helper was started without the output asked for")
         if not self.ready(READY_TIMEOUT):
-            self.cancel()
+            self._give_up()
             return False
         try:
             self._conn.send(order)
@@ -172,16 +138,9 @@ class Finisher:
         """
         if self._order is None:
             raise InvalidInputError("Finisher.wait needs a successful Finisher.start first")
-        try:
-            message = self._conn.recv()
-        except EOFError:  # the helper ended without a word (killed): done again here
-            message = None
-        except BaseException:  # e.g. Ctrl-C while waiting
-            self.cancel()
-            raise
-        self._reap()
+        message = self._answer()
         order, self._order = self._order, None
-        if message is None:
+        if message is None:  # the helper ended without a word (killed): done again here
             return _write(*order, self._robot, self._scene)
         text, pickled, paths = message
         if text:
@@ -189,28 +148,6 @@ class Finisher:
 
             raise _error(text, pickled)
         return paths
-
-    def cancel(self) -> None:
-        """Stop the helper (a no-op once it is reaped): terminated, then waited for."""
-        if self._process is None:
-            return
-        self._process.terminate()
-        self._process.join(10.0)
-        if self._process.is_alive():  # pragma: no cover - stuck in uninterruptible C code
-            self._process.kill()
-        self._reap()
-
-    def _reap(self) -> None:
-        self._process.join()
-        self._conn.close()
-        self._process, self.pid = None, None
-        atexit.unregister(self.cancel)
-
-    def __enter__(self) -> Finisher:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
 
 def _order(results: Any, figures: Any, html: Any) -> tuple:
@@ -283,15 +220,6 @@ def _die_with(parent: int) -> None:
         os._exit(0)
 
 
-def _import_quietly(figures: bool, html: bool, failed: list[str]) -> None:
-    """The importing thread: at the lowest priority (Linux niceness is per thread)."""
-    try:
-        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), IMPORT_NICENESS)
-        _preload(figures, html)
-    except BaseException:  # reported by not being ready: the caller writes the files
-        failed.append(traceback.format_exc())
-
-
 def _helper(
     conn: Any, callers_end: Any, parent: int, robot: Robot, scene: Scene, figures: bool, html: bool
 ) -> None:
@@ -308,15 +236,10 @@ def _helper(
         signal.signal(signal.SIGTERM, _terminated)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
         _die_with(parent)
-        failed: list[str] = []
-        thread = threading.Thread(target=_import_quietly, args=(figures, html, failed))
-        thread.daemon = True
-        thread.start()
-        thread.join()
-        if failed:
+        if prepare_quietly(partial(_preload, figures, html)):  # failed: not ready
             code = 1
             return
-        conn.send(_READY)
+        conn.send(READY)
         try:
             results, figures_dir, html_path = conn.recv()
         except EOFError:  # the caller stopped without work for the helper

@@ -1,0 +1,260 @@
+"""The polish after the search run by a helper process prepared while the search goes on:
+:func:`start_polisher`, :class:`Polisher`.
+
+The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize`` (≈ 0.3 s of
+CPU), after the search, on the command's critical path. :func:`start_polisher` forks a
+helper process from the caller once the problem exists (before the evaluator's worker
+processes); a thread of the helper imports ``scipy.optimize`` and ``threadpoolctl`` and
+makes the problem's certifying problem at the lowest priority (nice 19,
+:func:`~adept_traj.processes.prepare_quietly`: it runs while a core idles and never takes
+one from the search), and the helper then waits.
+:meth:`Polisher.start` hands it the search's final population (its arrays and counts,
+pickled: about 0.1 MB for the paper run); the helper polishes it as
+:func:`~adept_traj.optimise.polish_run` does, on the problem it inherited, while the
+caller certifies the front (:mod:`adept_traj.optimise.early_certificates`), and
+:meth:`Polisher.result` collects the polished population and the polish's certificates.
+The same code on the same numbers: the population is the one the caller would make, bit
+for bit (only the measured times differ).
+
+The helper never outlives the caller: it ignores Ctrl-C (the caller stops it),
+:meth:`Polisher.cancel` (or leaving the ``with`` block) terminates and reaps it, and it
+ends when the caller's end of the pipe closes. A helper that has not finished its imports
+when the search ends (a machine too busy to lend it a core) is not used:
+:meth:`Polisher.start` stops it and returns ``False``, and the caller polishes itself. A
+helper that fails or dies has its polish done again by the caller (:meth:`Polisher.result`
+returns ``None``): an error it met is then raised in the caller by the caller's own
+attempt, with the helper's traceback as a note (:meth:`Polisher.note`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import signal
+import traceback
+from functools import partial
+from typing import Any
+
+from adept_traj.analysis.member_certificate import MemberCertificate, certifying_problem
+from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.early_certificates import EarlyCertificates, feasible_front
+from adept_traj.optimise.loop import RunState
+from adept_traj.optimise.polish_step import _polish_run, polish_mode
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.processes import READY, ForkedHelper, prepare_quietly
+from adept_traj.validation import as_scalar, check_type
+
+__all__ = [
+    "Polisher",
+    "check_polisher",
+    "polish_with_certificates",
+    "start_polisher",
+]
+
+#: How often the waiting helper checks that its parent lives [s].
+_PARENT_CHECK = 0.5
+
+
+def start_polisher(problem: TrajectoryProblem) -> Polisher:
+    """Fork the helper that will polish ``problem``'s search result (see the module).
+
+    Call it once the problem exists and before its evaluator's worker processes start
+    (forked after them, the helper would hold copies of their pipes); pass it to
+    :func:`~adept_traj.plan` as ``polisher``.
+
+    Raises
+    ------
+    InvalidInputError
+        ``problem`` is not a :class:`~adept_traj.problem.TrajectoryProblem`.
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    return Polisher(problem)
+
+
+def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
+    """Refuse a ``polisher`` that is neither ``None`` nor a :class:`Polisher` started for
+    ``problem`` (the same object).
+
+    Raises
+    ------
+    InvalidInputError
+        ``polisher`` of another type.
+    ConfigurationError
+        A polisher started for another problem.
+    """
+    if polisher is None:
+        return
+    check_type(polisher, Polisher, "polisher")
+    if polisher.problem is not problem:
+        raise ConfigurationError(
+            "the polisher was started for another problem (start_polisher(problem) with "
+            "the problem given to plan)"
+        )
+
+
+def polish_with_certificates(
+    problem: TrajectoryProblem,
+    state: RunState,
+    rate_hz: float,
+    mode: str,
+    weights: Any,
+    *,
+    early: EarlyCertificates,
+    polisher: Polisher | None = None,
+) -> tuple[RunState, dict[bytes, MemberCertificate]]:
+    """:func:`~adept_traj.optimise.polish_run` of the search's final ``state`` and the
+    front's certificates made meanwhile.
+
+    The polish runs in ``polisher``'s helper when it is given and ready (the caller then
+    certifies ``early``'s members with its process), else in the caller (``early``'s
+    process certifying meanwhile; the caller then certifies the shares left of the
+    members still in the front).
+
+    Parameters
+    ----------
+    problem: the problem of the search (``polisher``'s problem, if given).
+    state: the search's final population.
+    rate_hz, mode, weights: the certificates' rate [Hz], the polish mode and the six
+        weights of f_c, as for :func:`~adept_traj.optimise.polish_run`.
+    early: the certificates started before the polish
+        (:func:`~adept_traj.optimise.start_early_certificates`).
+    polisher: the helper of :func:`start_polisher` (``None``: the caller polishes).
+
+    Returns
+    -------
+    tuple
+        (the polished state, the summaries of the certificates made by the polish and by
+        ``early`` by the move's ``x.tobytes()``): the same with or without the helper.
+    """
+    check_polisher(polisher, problem)
+    handed = polisher is not None and polish_mode(mode) != "off"
+    if handed and polisher.start(state, rate_hz, mode, weights):
+        ahead = early.finish()  # meanwhile, on this process and early's
+        done = polisher.result()
+        if done is None:  # the helper failed or died: polished here
+            try:
+                done = _polish_run(problem, state, rate_hz, mode, weights)
+            except Exception as exc:
+                if polisher.note():
+                    exc.add_note(f"the polisher's process failed first:\n{polisher.note()}")
+                raise
+        return done[0], {**ahead, **done[1]}
+    polished, certified = _polish_run(problem, state, rate_hz, mode, weights)
+    keys = {polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)}
+    return polished, {**early.finish(keys), **certified}
+
+
+class Polisher(ForkedHelper):
+    """The helper process forked by :func:`start_polisher`; a context manager that stops
+    it when the block is left (:class:`~adept_traj.processes.ForkedHelper`: ``ready``,
+    ``cancel``, ``pid``).
+
+    Attributes
+    ----------
+    problem: the problem it polishes for (the caller's object).
+    """
+
+    def __init__(self, problem: TrajectoryProblem) -> None:
+        self.problem = problem
+        self._order: dict[str, Any] | None = None
+        self._note = ""
+        super().__init__(_helper, (problem,))
+
+    def start(self, state: RunState, rate_hz: float, mode: str, weights: Any) -> bool:
+        """Hand the search's final ``state`` to the helper, if it is ready, and return at
+        once; the arguments are those of :func:`~adept_traj.optimise.polish_run` (``rate_hz``
+        [Hz] of the certificates, the polish ``mode``, the six ``weights`` of f_c).
+
+        Returns
+        -------
+        ``True`` if the helper polishes (collect with :meth:`result`); ``False`` if it was
+        not ready (it is then stopped) or is gone: the caller polishes itself.
+        """
+        check_type(state, RunState, "state")
+        rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+        mode = polish_mode(mode)
+        if self._order is not None:
+            raise ConfigurationError("the polisher polishes one population; it has one already")
+        if not self.ready():
+            self._give_up()
+            return False
+        arrays = dataclasses.replace(state, history=[], fronts=[])  # what the polish reads
+        try:
+            self._conn.send((arrays, rate, mode, weights))
+        except OSError:  # died meanwhile: the caller polishes
+            self.cancel()
+            return False
+        self._order = {"history": state.history, "fronts": state.fronts}
+        return True
+
+    def result(self) -> tuple[RunState, dict[bytes, MemberCertificate]] | None:
+        """Wait for the polish handed over by :meth:`start` and reap the helper.
+
+        Returns
+        -------
+        tuple or None
+            (the polished state, the polish's certificates by the polished move's
+            ``x.tobytes()``), as the polish in the caller makes them; ``None`` if the
+            helper failed (its traceback is then :meth:`note`) or died: the caller
+            polishes itself.
+        """
+        if self._order is None:
+            raise ConfigurationError("Polisher.result needs a successful Polisher.start first")
+        message = self._answer()
+        order, self._order = self._order, None
+        if message is None:  # the helper ended without a word (killed)
+            return None
+        text, polished = message
+        if text:
+            self._note = text
+            return None
+        state, certified = polished
+        return dataclasses.replace(state, **order), certified
+
+    def note(self) -> str:
+        """The traceback of the helper's failure (``""``: it did not fail)."""
+        return self._note
+
+
+def _prepare(problem: TrajectoryProblem) -> None:
+    """What the polish needs before its first solve (run at the lowest priority)."""
+    import scipy.optimize  # noqa: F401  (the polish's SLSQP)
+    import threadpoolctl  # noqa: F401  (its BLAS limit)
+
+    certifying_problem(problem)
+
+
+def _helper(conn: Any, callers_end: Any, parent: int, problem: TrajectoryProblem) -> None:
+    """The helper process: prepare (a thread at nice 19), say ``"ready"``, wait for the
+    order, polish, send ``(traceback or "", (state, certificates) or None)`` and end at
+    once (``os._exit``: none of the parent's exit handlers runs here). ``callers_end``
+    (the caller's end of the pipe, inherited by the fork) is closed first; the wait for
+    the order ends when the pipe closes or the ``parent`` process is gone (processes
+    forked later by the caller may hold copies of its end)."""
+    code = 0
+    try:
+        callers_end.close()
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
+        if prepare_quietly(partial(_prepare, problem)):  # failed: not ready, the caller polishes
+            code = 1
+            return
+        conn.send(READY)
+        while not conn.poll(_PARENT_CHECK):
+            if os.getppid() != parent:
+                return
+        try:
+            state, rate_hz, mode, weights = conn.recv()
+        except EOFError:  # the caller stopped without work for the helper
+            return
+        try:
+            message = ("", _polish_run(problem, state, rate_hz, mode, weights))
+        except Exception:  # the caller polishes again and raises it, with this as a note
+            code = 1
+            message = (traceback.format_exc(), None)
+        conn.send(message)
+        conn.close()
+    except BaseException:  # SIGTERM's default ends the process; a broken pipe lands here
+        code = code or 1
+    finally:
+        os._exit(code)

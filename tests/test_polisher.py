@@ -1,0 +1,205 @@
+"""start_polisher: the polish run by a helper process forked before the search gives the
+population and certificates of the polish in the caller (polish_run called directly);
+a helper that is not ready, fails or is killed leaves the polish to the caller; an error
+is raised in the caller; no helper outlives its block."""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import adept_traj.cli.plan as plan_command
+import adept_traj.optimise.polisher as polisher_module
+from adept_traj import Robot, Scene, TrajectoryProblem, plan
+from adept_traj.analysis import PAPER_WEIGHTS, certify_members
+from adept_traj.cli.app import main
+from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.optimise import (
+    make_algorithm,
+    optimise,
+    polish_run,
+    polish_with_certificates,
+    start_early_certificates,
+    start_polisher,
+)
+from adept_traj.results import PlanningResult
+
+RATE = 400.0
+DATA = Path(__file__).parent / "data"
+
+
+@pytest.fixture(scope="module")
+def searched(problem: TrajectoryProblem):
+    """A small NSGA-II search's final population (no polish yet)."""
+    alg, settings = make_algorithm("nsga2", 16, 4)
+    return optimise(problem, alg, settings.n_gen, 1)
+
+
+@pytest.fixture(scope="module")
+def serial(problem: TrajectoryProblem, searched):
+    """The polish of the fastest member in this process, and its certificate."""
+    state = polish_run(problem, searched, RATE, "fastest", PAPER_WEIGHTS)
+    new = state.X[len(searched.X) :]
+    assert len(new) == 1  # the polish kept a move: the test compares something
+    return state, {new[0].tobytes(): certify_members(problem, new, rate_hz=RATE)[0]}
+
+
+def _same(state, certified, serial) -> None:
+    expected_state, expected_certified = serial
+    for name in ("X", "F", "G", "CV"):
+        np.testing.assert_array_equal(getattr(state, name), getattr(expected_state, name))
+    assert state.n_evaluations == expected_state.n_evaluations
+    assert state.history == expected_state.history
+    assert certified == expected_certified  # every field of every summary, exactly
+
+
+def _polish(problem, searched, polisher):
+    with start_early_certificates(problem, searched.X, [], rate_hz=RATE) as early:
+        return polish_with_certificates(
+            problem, searched, RATE, "fastest", PAPER_WEIGHTS, early=early, polisher=polisher
+        )
+
+
+def test_the_helper_polishes_as_the_caller(problem, searched, serial, process_gone) -> None:
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert polisher.ready(60.0)
+        state, certified = _polish(problem, searched, polisher)
+        assert polisher.pid is None  # reaped once its polish is collected
+    _same(state, certified, serial)
+    assert process_gone(pid)
+
+
+def test_a_helper_not_ready_leaves_the_polish_to_the_caller(problem, searched, serial) -> None:
+    polisher = start_polisher(problem)
+    polisher.cancel()  # stopped: never ready
+    assert not polisher.start(searched, RATE, "fastest", PAPER_WEIGHTS)
+    _same(*_polish(problem, searched, polisher), serial)
+
+
+def test_a_helper_still_preparing_is_killed_without_waiting_for_its_end(
+    problem, searched, serial, monkeypatch, process_gone
+) -> None:
+    """Its preparing thread at nice 19 may wait long for a core on a busy machine: the
+    caller kills the helper and polishes at once, the helper is reaped at the block's end."""
+    monkeypatch.setattr(polisher_module, "_prepare", lambda _problem: time.sleep(60.0))
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert not polisher.start(searched, RATE, "fastest", PAPER_WEIGHTS)
+        assert polisher.pid == pid  # not waited for
+        assert not polisher.ready()
+        _same(*_polish(problem, searched, polisher), serial)
+    assert polisher.pid is None
+    assert process_gone(pid)
+
+
+@pytest.mark.parametrize("fault", ["raises", "killed"])
+def test_a_failing_helper_leaves_the_polish_to_the_caller(
+    problem, searched, serial, monkeypatch, child_fault, fault
+) -> None:
+    faulty = child_fault(polisher_module._polish_run, fault)
+    monkeypatch.setattr(polisher_module, "_polish_run", faulty)
+    with start_polisher(problem) as polisher:
+        assert polisher.ready(60.0)
+        _same(*_polish(problem, searched, polisher), serial)
+        assert ("broken in the child" in polisher.note()) == (fault == "raises")
+
+
+def test_an_error_is_raised_in_the_caller_with_the_helper_traceback(
+    problem,
+    searched,
+    monkeypatch,
+    process_gone,
+) -> None:
+    def fails(*args, **kwargs):
+        raise RuntimeError(f"polish broken in {os.getpid()}")
+
+    monkeypatch.setattr(polisher_module, "_polish_run", fails)
+    with start_polisher(problem) as polisher:
+        pid = polisher.pid
+        assert polisher.ready(60.0)
+        with pytest.raises(RuntimeError, match=f"broken in {os.getpid()}") as caught:
+            _polish(problem, searched, polisher)
+    assert any(f"broken in {pid}" in note for note in caught.value.__notes__)
+    assert process_gone(pid)
+
+
+def test_a_polisher_of_another_problem_is_refused_before_the_search(problem, searched) -> None:
+    scene = Scene.paper()
+    other = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+    with start_polisher(other) as polisher:
+        with pytest.raises(ConfigurationError, match="another problem"):
+            _polish(problem, searched, polisher)
+        with pytest.raises(ConfigurationError, match="another problem"):
+            plan(problem, "nsga2", pop_size=10**9, polisher=polisher)  # no search starts
+    with pytest.raises(InvalidInputError, match="polisher"):
+        plan(problem, "nsga2", pop_size=10**9, polisher="helper")
+
+
+def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -> None:
+    """The polisher and the early certificates (workers > 1) change nothing in the result:
+    the same as one worker without a helper."""
+    kwargs = {"seed": 1, "pop_size": 16, "n_gen": 4, "polish": "front"}
+    alone = plan(problem, "nsga2", **kwargs)
+    scene = Scene.paper()
+    with (
+        TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal, workers=2) as two,
+        start_polisher(two) as polisher,
+    ):
+        assert polisher.ready(60.0)  # its imports done: plan hands it the polish
+        helped = plan(two, "nsga2", polisher=polisher, **kwargs)
+    assert helped.metrics.t_best_source == "polish"  # the polish kept a move
+    np.testing.assert_array_equal(helped.front.x, alone.front.x)
+    np.testing.assert_array_equal(helped.front.objectives, alone.front.objectives)
+    assert helped.front.certificates == alone.front.certificates
+    assert helped.certificate.min_distance == alone.certificate.min_distance
+    assert helped.timing.n_evaluations == alone.timing.n_evaluations
+    assert helped.metrics.ssm == alone.metrics.ssm
+
+
+@pytest.mark.parametrize("end", ["done", "error", "ctrl-c"])
+def test_adept_traj_plan_leaves_no_helper_behind(
+    end: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    process_gone,
+) -> None:
+    """The command starts the polisher before the search and reaps it however it ends."""
+    stored = PlanningResult.load(DATA / "result_v1")
+    seen = []
+
+    def fake_plan(*_args, polisher=None, **_kwargs):
+        seen.append(polisher.pid)
+        if end == "error":
+            raise RuntimeError("stop")
+        if end == "ctrl-c":
+            raise KeyboardInterrupt
+        return stored
+
+    monkeypatch.setattr(plan_command, "plan", fake_plan)
+    argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html"]
+    argv += ["--out", str(tmp_path / "run")]
+    if end == "error":
+        with pytest.raises(RuntimeError, match="stop"):
+            main(argv)
+    else:
+        assert main(argv) == (0 if end == "done" else 130)
+    assert seen[0] is not None
+    assert process_gone(seen[0])
+    assert multiprocessing.active_children() == []
+
+
+def test_no_polisher_without_a_polish(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    stored = PlanningResult.load(DATA / "result_v1")
+    seen = []
+    monkeypatch.setattr(
+        plan_command, "plan", lambda *a, polisher=None, **k: seen.append(polisher) or stored
+    )
+    argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html", "--no-polish"]
+    assert main([*argv, "--out", str(tmp_path / "run")]) == 0
+    assert seen == [None]
