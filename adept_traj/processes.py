@@ -64,8 +64,9 @@ class ForkedHelper:
 
     def ready(self, timeout: float = 0.0) -> bool:
         """Whether the helper has said :data:`READY` (waiting up to ``timeout`` [s]);
-        ``False`` for a helper that died or was stopped."""
-        if self._given_up:
+        ``False`` for a helper that died or was stopped, or that has done its work and
+        was reaped (a helper serves once)."""
+        if self._given_up or self._process is None:
             return False
         if not self._ready and self._process is not None:
             try:

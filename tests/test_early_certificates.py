@@ -104,6 +104,31 @@ def test_an_error_is_raised_in_the_caller_with_the_process_traceback(
     assert process_gone(pid)
 
 
+def test_failed_shares_are_kept_for_later_and_raised_only_if_still_wanted(
+    problem, x, serial, shares_of_two, monkeypatch
+) -> None:
+    """With the polish in another process the caller does not know yet which members stay
+    on the front: a member whose certificate fails is raised only if it is still wanted."""
+    real = early_module.certify_members
+
+    def fails_on_six(problem, x, rows, **kwargs):
+        if 6 in list(rows):
+            raise RuntimeError("member 6 cannot be certified")
+        return real(problem, x, rows, **kwargs)
+
+    monkeypatch.setattr(early_module, "certify_members", fails_on_six)
+    with start_early_certificates(problem, x, MEMBERS, rate_hz=400.0) as early:
+        failed: list[int] = []
+        out = early.finish(failed=failed)
+        assert failed == [6, 2]  # the share of members 6 and 2 (shares of two)
+        assert out == {k: v for k, v in serial.items() if k not in (x[2].tobytes(), x[6].tobytes())}
+        assert early.certify_again(failed, {x[2].tobytes()}) == {
+            x[2].tobytes(): serial[x[2].tobytes()]
+        }
+        with pytest.raises(RuntimeError, match="member 6"):
+            early.certify_again(failed, {x[2].tobytes(), x[6].tobytes()})
+
+
 def test_bad_input_is_refused_before_any_process_starts(problem, x) -> None:
     with pytest.raises(InvalidInputError, match="member"):
         start_early_certificates(problem, x, [0, 7], rate_hz=400.0)

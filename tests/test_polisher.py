@@ -5,6 +5,7 @@ is raised in the caller; no helper outlives its block."""
 
 from __future__ import annotations
 
+import dataclasses
 import multiprocessing
 import os
 import time
@@ -14,12 +15,14 @@ import numpy as np
 import pytest
 
 import adept_traj.cli.plan as plan_command
+import adept_traj.optimise.early_certificates as early_module
 import adept_traj.optimise.polisher as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 from adept_traj.analysis import PAPER_WEIGHTS, certify_members
 from adept_traj.cli.app import main
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import (
+    feasible_front,
     make_algorithm,
     optimise,
     polish_run,
@@ -139,6 +142,55 @@ def test_a_polisher_of_another_problem_is_refused_before_the_search(problem, sea
             plan(problem, "nsga2", pop_size=10**9, polisher=polisher)  # no search starts
     with pytest.raises(InvalidInputError, match="polisher"):
         plan(problem, "nsga2", pop_size=10**9, polisher="helper")
+
+
+def test_a_used_polisher_leaves_the_next_polish_to_the_caller(problem, searched, serial) -> None:
+    """A helper serves one search: handed a second one, the caller polishes it (it raised
+    AttributeError after the search before)."""
+    with start_polisher(problem) as polisher:
+        assert polisher.ready(60.0)
+        _same(*_polish(problem, searched, polisher), serial)
+        assert not polisher.ready()
+        _same(*_polish(problem, searched, polisher), serial)
+
+
+def test_a_polisher_of_a_problem_changed_since_is_refused(searched) -> None:
+    """Its helper would polish and certify the problem as it was when it was forked (e.g.
+    the old margin): refused before the search."""
+    scene = Scene.paper()
+    changed = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+    with start_polisher(changed) as polisher:
+        changed.settings = dataclasses.replace(changed.settings, margin=0.02)
+        with pytest.raises(ConfigurationError, match="replaced after the polisher was started"):
+            _polish(changed, searched, polisher)
+        with pytest.raises(ConfigurationError, match="replaced after the polisher"):
+            plan(changed, "nsga2", pop_size=10**9, polisher=polisher)  # no search starts
+
+
+def test_a_failing_certificate_of_a_member_still_on_the_front_is_raised(
+    problem, searched, monkeypatch
+) -> None:
+    """The early certificates keep a failure until the polish says which members stay on
+    the front: one that stays is raised (not swallowed)."""
+    rows = feasible_front(searched.F, searched.G, PAPER_WEIGHTS)
+    stays = int(rows[-1])  # the polish of the fastest member leaves the others on the front
+    real = early_module.certify_members
+
+    def fails(problem, x, members, **kwargs):
+        if stays in list(members):
+            raise RuntimeError("this member cannot be certified")
+        return real(problem, x, members, **kwargs)
+
+    monkeypatch.setattr(early_module, "certify_members", fails)
+    with (
+        start_polisher(problem) as polisher,
+        start_early_certificates(problem, searched.X, rows, rate_hz=RATE, fork=False) as early,
+    ):
+        assert polisher.ready(60.0)
+        with pytest.raises(RuntimeError, match="cannot be certified"):
+            polish_with_certificates(
+                problem, searched, RATE, "fastest", PAPER_WEIGHTS, early=early, polisher=polisher
+            )
 
 
 def test_plan_with_a_polisher_and_two_workers_gives_the_serial_result(problem) -> None:

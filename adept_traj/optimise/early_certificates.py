@@ -124,10 +124,17 @@ class EarlyCertificates(ForkedHelper):
         self._next: Any = multiprocessing.get_context("fork").Value("i", 0) if fork else _Counter()
         super().__init__(_work if fork else None, (self,))
 
-    def finish(self, wanted: Collection[bytes] | None = None) -> dict[bytes, MemberCertificate]:
+    def finish(
+        self, wanted: Collection[bytes] | None = None, *, failed: list[int] | None = None
+    ) -> dict[bytes, MemberCertificate]:
         """Certify the shares no process has taken (only the members whose
         ``x[k].tobytes()`` is in ``wanted``; ``None``: all), collect the process' summaries
         and reap it (once: a second call certifies every share again, in the caller).
+
+        With a list ``failed``, a share whose certificates raise in the caller is not
+        raised: its members (rows of ``x``) are appended to ``failed``, for a caller that
+        does not know yet which members it wants (:meth:`certify_again` later, for those
+        still wanted).
 
         Returns
         -------
@@ -148,14 +155,14 @@ class EarlyCertificates(ForkedHelper):
             while (i := _take(self._next, len(self._shares))) is not None:
                 taken.add(i)
                 note = self._drain(received, block=False) or note
-                mine.update(self._certify(self._shares[i], wanted))
+                mine.update(self._certify(self._shares[i], wanted, failed))
             note = self._drain(received, block=True) or note
             self._reap()
             for i, share in enumerate(self._shares):
                 if i in received:
                     mine.update(zip(share, received[i]))
                 elif i not in taken:  # the process' share it did not send (failed or died)
-                    mine.update(self._certify(share, wanted))
+                    mine.update(self._certify(share, wanted, failed))
         except Exception as exc:
             self.cancel()
             if note:
@@ -166,11 +173,27 @@ class EarlyCertificates(ForkedHelper):
             raise
         return {self._x[k].tobytes(): summary for k, summary in mine.items()}
 
+    def certify_again(
+        self, rows: list[int], wanted: Collection[bytes]
+    ) -> dict[bytes, MemberCertificate]:
+        """The certificates of the members ``rows`` (from :meth:`finish`'s ``failed``) whose
+        ``x[k].tobytes()`` is in ``wanted``, made in the caller; an error is raised."""
+        return {self._x[k].tobytes(): c for k, c in self._certify(rows, wanted).items()}
+
     def _certify(
-        self, share: list[int], wanted: Collection[bytes] | None
+        self,
+        share: list[int],
+        wanted: Collection[bytes] | None,
+        failed: list[int] | None = None,
     ) -> dict[int, MemberCertificate]:
         rows = [k for k in share if wanted is None or self._x[k].tobytes() in wanted]
-        out = certify_members(self._problem, self._x, rows, rate_hz=self._rate)
+        try:
+            out = certify_members(self._problem, self._x, rows, rate_hz=self._rate)
+        except Exception:
+            if failed is None:
+                raise
+            failed.extend(rows)  # raised later if one of them is still wanted
+            return {}
         return {k: out[k] for k in rows}
 
     def _drain(self, received: dict[int, list[MemberCertificate]], *, block: bool) -> str:

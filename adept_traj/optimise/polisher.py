@@ -73,14 +73,18 @@ def start_polisher(problem: TrajectoryProblem) -> Polisher:
 
 def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
     """Refuse a ``polisher`` that is neither ``None`` nor a :class:`Polisher` started for
-    ``problem`` (the same object).
+    ``problem`` (the same object, with the same settings, robot, scene, start and goal as
+    when the polisher was forked: its helper polishes the copy it inherited then). A
+    polisher already used, or stopped, is accepted: it is not ready, and the caller
+    polishes itself (a helper serves one search).
 
     Raises
     ------
     InvalidInputError
         ``polisher`` of another type.
     ConfigurationError
-        A polisher started for another problem.
+        A polisher started for another problem, or for this problem before one of its
+        parts was replaced.
     """
     if polisher is None:
         return
@@ -90,6 +94,17 @@ def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
             "the polisher was started for another problem (start_polisher(problem) with "
             "the problem given to plan)"
         )
+    if any(a is not b for a, b in zip(polisher.made_from, _parts(problem), strict=True)):
+        raise ConfigurationError(
+            "the problem's settings, robot, scene, start or goal were replaced after the "
+            "polisher was started (its process polishes the problem as it was then): "
+            "start_polisher(problem) again"
+        )
+
+
+def _parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
+    """What a polisher's helper inherits of ``problem`` and uses (compared by identity)."""
+    return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
 
 
 def polish_with_certificates(
@@ -129,7 +144,10 @@ def polish_with_certificates(
     check_polisher(polisher, problem)
     handed = polisher is not None and polish_mode(mode) != "off"
     if handed and polisher.start(state, rate_hz, mode, weights):
-        ahead = early.finish()  # meanwhile, on this process and early's
+        # meanwhile, on this process and early's: every member of the front before the
+        # polish; one whose certificate fails is raised only if it is still on the front
+        failed: list[int] = []
+        ahead = early.finish(failed=failed)
         done = polisher.result()
         if done is None:  # the helper failed or died: polished here
             try:
@@ -138,6 +156,12 @@ def polish_with_certificates(
                 if polisher.note():
                     exc.add_note(f"the polisher's process failed first:\n{polisher.note()}")
                 raise
+        if failed:
+            polished = done[0]
+            keys = {
+                polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)
+            }
+            ahead.update(early.certify_again(failed, keys))
         return done[0], {**ahead, **done[1]}
     polished, certified = _polish_run(problem, state, rate_hz, mode, weights)
     keys = {polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)}
@@ -152,10 +176,12 @@ class Polisher(ForkedHelper):
     Attributes
     ----------
     problem: the problem it polishes for (the caller's object).
+    made_from: ``problem``'s settings, robot, scene, start and goal when it was forked.
     """
 
     def __init__(self, problem: TrajectoryProblem) -> None:
         self.problem = problem
+        self.made_from = _parts(problem)
         self._order: dict[str, Any] | None = None
         self._note = ""
         super().__init__(_helper, (problem,))
