@@ -10,6 +10,13 @@ import pytest
 from adept_traj import Robot, Scene
 from adept_traj.problem import TrajectoryProblem
 
+# A test run started in the background (`nohup … &`, a shell without job control) inherits
+# SIGINT ignored, and so would every command the tests start (an ignored signal stays
+# ignored across exec): the Ctrl-C tests would then see a command that Ctrl-C cannot stop.
+# A Ctrl-C at a terminal reaches the foreground command: the tests run as under one.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
 
 @pytest.fixture(scope="session")
 def problem() -> TrajectoryProblem:
