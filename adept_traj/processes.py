@@ -1,5 +1,8 @@
-"""Helper processes forked from the caller: :class:`ForkedHelper` (the caller's side) and
-:func:`prepare_quietly` (a helper's preparation at the lowest priority).
+"""Helper processes forked from the caller: :class:`ForkedHelper` (the caller's side),
+:func:`prepare_quietly` (a helper's preparation at the lowest priority), and what every
+forked process of the package does the same way: :func:`end_with_parent` (SIGTERM when
+the caller dies), :func:`stop_on_sigterm` (its SIGTERM handler) and :func:`error_report`
+(an error sent to the caller).
 
 The helpers of ``adept-traj plan`` (the finish's :class:`~adept_traj.viz.Finisher`, the
 polish's :class:`~adept_traj.optimise.Polisher`, the front's
@@ -16,12 +19,23 @@ from __future__ import annotations
 import atexit
 import multiprocessing
 import os
+import pickle
+import signal
+import sys
 import threading
 import traceback
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["LOWEST_PRIORITY", "READY", "ForkedHelper", "prepare_quietly"]
+__all__ = [
+    "LOWEST_PRIORITY",
+    "READY",
+    "ForkedHelper",
+    "end_with_parent",
+    "error_report",
+    "prepare_quietly",
+    "stop_on_sigterm",
+]
 
 #: Niceness of a helper's preparing thread (the lowest priority).
 LOWEST_PRIORITY = 19
@@ -141,3 +155,34 @@ def prepare_quietly(work: Callable[[], None]) -> str:
     thread.start()
     thread.join()
     return failed[0] if failed else ""
+
+
+def error_report(exc: BaseException) -> tuple[str, bytes | None]:
+    """In a forked process, while ``exc`` is handled: its traceback and ``exc`` pickled
+    (``None`` if it does not pickle, e.g. an attribute that does not: then it is sent as
+    text only), for the caller to raise (:func:`~adept_traj.errors.error_from_process`)."""
+    text = traceback.format_exc()
+    try:
+        return text, pickle.dumps(exc)
+    except Exception:  # an exception that does not pickle: its traceback text only
+        return text, None
+
+
+def end_with_parent() -> None:
+    """Ask Linux for SIGTERM when this forked process' parent dies
+    (``PR_SET_PDEATHSIG``): a parent stopped outright cannot terminate it. Elsewhere
+    nothing (the process then ends when its pipe to the parent closes)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
+
+
+def stop_on_sigterm(*_: object) -> None:
+    """SIGTERM handler of a forked process (``cancel``, its caller's death): stop the
+    processes it forked and end at once. No exception is raised: a ``SystemExit`` raised
+    where the signal lands (e.g. in a fork handler of :mod:`logging`) would be printed as
+    "Exception ignored" and the process would go on."""
+    for child in multiprocessing.active_children():
+        child.terminate()
+    os._exit(128 + signal.SIGTERM)

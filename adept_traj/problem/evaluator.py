@@ -37,7 +37,6 @@ import multiprocessing
 import os
 import pickle
 import signal
-import traceback
 import weakref
 from collections.abc import Callable
 from concurrent.futures.process import BrokenProcessPool
@@ -53,6 +52,7 @@ from adept_traj.errors import (
 )
 from adept_traj.problem._heap import keep_heap
 from adept_traj.problem.evaluation import Evaluation, _concatenate
+from adept_traj.processes import error_report
 from adept_traj.validation import as_batch, as_integer
 
 __all__ = ["ParallelEvaluator", "available_cores"]
@@ -143,18 +143,11 @@ def _serve(
         try:
             reply = pickle.dumps(("", evaluate(x)), protocol=pickle.HIGHEST_PROTOCOL)
         except Exception as exc:  # sent to the main process, which raises it
-            reply = pickle.dumps((traceback.format_exc(), _pickled(exc)))
+            reply = pickle.dumps(error_report(exc))
         try:
             connection.send_bytes(reply)
         except OSError:  # the main process is gone
             return
-
-
-def _pickled(exc: BaseException) -> bytes | None:
-    try:
-        return pickle.dumps(exc)
-    except Exception:  # an exception that does not pickle: its traceback text only
-        return None
 
 
 class ParallelEvaluator:

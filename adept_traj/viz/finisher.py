@@ -34,7 +34,15 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.processes import LOWEST_PRIORITY, READY, ForkedHelper, prepare_quietly
+from adept_traj.processes import (
+    LOWEST_PRIORITY,
+    READY,
+    ForkedHelper,
+    end_with_parent,
+    error_report,
+    prepare_quietly,
+    stop_on_sigterm,
+)
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
@@ -213,9 +221,7 @@ def _preload(figures: bool, html: bool) -> None:
 def _die_with(parent: int) -> None:
     """Ask Linux for SIGTERM when the parent dies (``PR_SET_PDEATHSIG``); end now if it
     is gone already."""
-    from adept_traj.viz.plots.all_figures import _end_with_parent
-
-    _end_with_parent()
+    end_with_parent()
     if os.getppid() != parent:
         os._exit(0)
 
@@ -231,9 +237,7 @@ def _helper(
     code = 0
     try:
         callers_end.close()
-        from adept_traj.viz.plots.all_figures import _terminated
-
-        signal.signal(signal.SIGTERM, _terminated)
+        signal.signal(signal.SIGTERM, stop_on_sigterm)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
         _die_with(parent)
         if prepare_quietly(partial(_preload, figures, html)):  # failed: not ready
@@ -248,10 +252,8 @@ def _helper(
         try:
             paths = _write(results, figures_dir, html_path, robot, scene)
         except Exception as exc:  # every error is sent to the caller, which raises it
-            from adept_traj.viz.plots.all_figures import _report
-
             code = 1
-            text, pickled = _report(exc)
+            text, pickled = error_report(exc)
         conn.send((text, pickled, paths))
         conn.close()
     except BaseException:  # SIGTERM (cancel, the caller's death) or a broken pipe

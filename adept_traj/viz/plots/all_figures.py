@@ -19,8 +19,6 @@ import multiprocessing
 import os
 import pickle
 import signal
-import sys
-import traceback
 from collections.abc import Callable, Mapping
 from functools import partial
 from pathlib import Path
@@ -28,6 +26,7 @@ from typing import Any
 
 from adept_traj.errors import FigureError, InvalidInputError
 from adept_traj.problem import available_cores
+from adept_traj.processes import end_with_parent, error_report, stop_on_sigterm
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.validation import as_integer, check_type
 from adept_traj.viz.inputs import replay_for
@@ -155,7 +154,7 @@ def _draw_share(draws: list[Callable[[], Path]]) -> None:
     """Run in a forked process: draw these figures; any error ends it with status 1 (the
     caller draws its figures again and reports the error). It ends with its parent (a
     parent stopped outright cannot terminate it)."""
-    _end_with_parent()
+    end_with_parent()
     try:
         for draw in draws:
             draw()
@@ -278,46 +277,17 @@ def _error(text: str, pickled: bytes | None) -> BaseException:
     return error
 
 
-def _report(exc: BaseException) -> tuple[str, bytes | None]:
-    """In a forked process, while ``exc`` is handled: its traceback and ``exc`` pickled
-    (``None`` if it does not pickle: sent as text only), for :func:`_error` in the caller."""
-    text = traceback.format_exc()
-    try:
-        return text, pickle.dumps(exc)
-    except Exception:  # e.g. an attribute that does not pickle
-        return text, None
-
-
-def _end_with_parent() -> None:
-    """Ask Linux for SIGTERM when this forked process' parent dies
-    (``PR_SET_PDEATHSIG``): a parent stopped outright cannot terminate it."""
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
-
-
-def _terminated(*_: object) -> None:
-    """SIGTERM handler of a process that draws (``cancel``, its caller's death): stop the
-    processes it forked and end at once. No exception is raised: a ``SystemExit`` raised
-    where the signal lands (e.g. in a fork handler of :mod:`logging`) would be printed as
-    "Exception ignored" and the process would go on."""
-    for child in multiprocessing.active_children():
-        child.terminate()
-    os._exit(128 + signal.SIGTERM)
-
-
 def _child(jobs: list[_Job], processes: int, sender: Any) -> None:
     """In the forked process: draw, send ``("", None)`` or (the error's traceback, the
     pickled error or ``None``), and end at once (``os._exit``: none of the parent's exit
     handlers runs here)."""
-    signal.signal(signal.SIGTERM, _terminated)  # cancel
+    signal.signal(signal.SIGTERM, stop_on_sigterm)  # cancel
     code, text, pickled = 0, "", None
     try:
         _draw(jobs, processes)
     except BaseException as exc:  # every error is sent to the caller, which raises it
         code = 1
-        text, pickled = _report(exc)
+        text, pickled = error_report(exc)
     try:
         sender.send((text, pickled))
         sender.close()
