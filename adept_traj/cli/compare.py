@@ -55,7 +55,7 @@ from adept_traj.cycle import (
     study_statistics,
     write_study_report,
 )
-from adept_traj.errors import ConfigurationError
+from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.optimise import PlanningInterrupted, plan
 from adept_traj.results import PlanningResult, Replay
 
@@ -105,9 +105,10 @@ def compare_files(folder: Path) -> list[Path]:
 
 def _check_out(folder: Path, overwrite: bool) -> None:
     """Refuse ``folder`` before any work if it holds an earlier compare's files and
-    ``overwrite`` is false (:class:`~adept_traj.errors.ConfigurationError`)."""
+    ``overwrite`` is false (:class:`~adept_traj.errors.ConfigurationError`; a file in its
+    place: :class:`~adept_traj.errors.InvalidInputError`, as ``plan`` says it)."""
     if folder.exists() and not folder.is_dir():
-        raise ConfigurationError(f"--out {folder} is a file, not a folder")
+        raise InvalidInputError(f"--out {folder} is a file, not a folder")
     found = compare_files(folder)
     if found and not overwrite:
         names = ", ".join(str(p.relative_to(folder)) for p in found)
