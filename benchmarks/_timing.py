@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 
@@ -29,3 +29,10 @@ def compared_codes(here: Path, baseline: Path | None) -> dict[str, Path]:
 def load_average() -> str:
     """The machine's load averages over 1, 5 and 15 minutes, as text."""
     return ", ".join(f"{x:.1f}" for x in os.getloadavg())
+
+
+def pair_order(labels: Sequence[str], i: int) -> list[str]:
+    """The order in which pair ``i`` of a paired benchmark runs the compared codes: as
+    given for an even ``i``, reversed for an odd one (neither version always runs first,
+    in the warmer or the cooler state of the machine)."""
+    return list(labels) if i % 2 == 0 else list(reversed(labels))

@@ -33,6 +33,7 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+from _timing import pair_order  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
 from adept_traj.problem import TrajectoryProblem
@@ -137,7 +138,7 @@ def _paired(other: str, pairs: int, pop: int, repeat: int) -> None:
     runs: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
     pads = np.random.default_rng(0).integers(0, 4096, size=pairs)
     for i in range(pairs):
-        for label in ("this", "other") if i % 2 == 0 else ("other", "this"):
+        for label in pair_order(("this", "other"), i):
             env = {**os.environ, "PYTHONPATH": trees[label], "BENCH_PAD": "x" * int(pads[i])}
             cmd = [sys.executable, __file__, "--whole", "--pop", str(pop), "--repeat", str(repeat)]
             done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)

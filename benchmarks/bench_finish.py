@@ -34,6 +34,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _timing import load_average  # benchmarks/_timing.py
+
 _FINISH = """
 import argparse, json, resource, sys, time
 from pathlib import Path
@@ -95,7 +97,7 @@ def main() -> None:
         versions["this checkout, helper"] = here
     if args.compare:
         versions["--compare"] = str(Path(args.compare).resolve())
-    print(f"load average at start: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    print(f"load average at start: {load_average()}")
     runs: dict[str, list[dict]] = {name: [] for name in versions}
     with tempfile.TemporaryDirectory(prefix="bench_finish_") as tmp:
         for _ in range(args.repeat):
@@ -104,7 +106,7 @@ def main() -> None:
                 out = Path(tmp) / f"{len(runs[name])}_{label}"
                 helper = name.endswith("helper")
                 runs[name].append(finish_once(path, args.result_dir, out, helper))
-    print(f"load average at end: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    print(f"load average at end: {load_average()}")
     print("| version | wall [s] | CPU [s] | CPU of the process [s] | CPU forked [s] | wall runs |")
     print("|---|---|---|---|---|---|")
     medians = {}

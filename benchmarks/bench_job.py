@@ -39,6 +39,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _timing import load_average  # benchmarks/_timing.py
 from cell_scene import cell_scene  # benchmarks/cell_scene.py
 
 from adept_traj import PlanningResult, Robot, Scene
@@ -67,11 +68,10 @@ def machine() -> str:
                 break
     except OSError:
         pass
-    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     return (
         f"{model}; {available_cores()} cores available of {os.cpu_count()}; "
         f"Python {platform.python_version()}; {platform.system()} {platform.release()}; "
-        f"load average at start {load} (other jobs on the machine slow every figure)"
+        f"load average at start {load_average()} (other jobs on the machine slow every figure)"
     )
 
 

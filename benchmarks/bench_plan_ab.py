@@ -30,6 +30,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _timing import load_average, pair_order  # benchmarks/_timing.py
+
 
 def command() -> list[str]:
     """The console script beside this Python, else ``python -m adept_traj.cli``."""
@@ -78,17 +80,15 @@ def main() -> None:
         "this checkout": here,
         "other": here if args.other == "no-helper" else str(Path(args.other).resolve()),
     }
-    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
-    print(f"load average at start: {load}")
+    print(f"load average at start: {load_average()}")
     runs: dict[str, list[dict[str, float]]] = {name: [] for name in versions}
     with tempfile.TemporaryDirectory(prefix="bench_plan_ab_") as tmp:
         for k in range(args.repeat):
-            order = list(versions) if k % 2 == 0 else list(reversed(versions))
-            for name in order:
+            for name in pair_order(list(versions), k):
                 out = Path(tmp) / f"{k}_{name.replace(' ', '_')}"
                 helper = name != "other" or args.other != "no-helper"
                 runs[name].append(plan_once(versions[name], out, args.options, helper))
-    print(f"load average at end: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    print(f"load average at end: {load_average()}")
     print("| version | wall [s] | CPU [s] | run (timing.total_s) [s] | wall runs |")
     print("|---|---|---|---|---|")
     medians = {}

@@ -31,6 +31,7 @@ import sys
 import time
 
 import numpy as np
+from _timing import pair_order  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
 from adept_traj.problem import Evaluation, ParallelEvaluator, TrajectoryProblem
@@ -142,7 +143,7 @@ def main() -> None:
     cmd = [sys.executable, __file__, "--json", "--pops", args.pops, "--calls", str(args.calls)]
     cmd += ["--workers", str(args.workers)]
     for i in range(args.pairs):
-        for label in ("this", "other") if i % 2 == 0 else ("other", "this"):
+        for label in pair_order(("this", "other"), i):
             env = {**os.environ, "PYTHONPATH": trees[label]}
             done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
             runs[label].append(json.loads(done.stdout.strip().splitlines()[-1]))

@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from _timing import load_average  # benchmarks/_timing.py
+from _timing import load_average, pair_order  # benchmarks/_timing.py
 
 _WRAPPED = """
 import json, sys, time
@@ -108,8 +108,7 @@ def main() -> None:
     runs: dict[str, list[dict[str, float]]] = {name: [] for name in versions}
     with tempfile.TemporaryDirectory(prefix="bench_post_") as tmp:
         for k in range(args.repeat):
-            order = list(versions) if k % 2 == 0 else list(reversed(versions))
-            for name in order:
+            for name in pair_order(list(versions), k):
                 folder = Path(tmp) / f"{k}_{name.replace(' ', '_')}"
                 runs[name].append(plan_once(versions[name], folder, args.options))
     print(f"load average at end: {load_average()}")
