@@ -50,6 +50,8 @@ from adept_traj.analysis.member_certificate import (
     MemberCertificate,
     certify_members,
     certifying_problem,
+    problem_parts,
+    same_parts,
 )
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
@@ -104,7 +106,9 @@ __all__ = [
     "objective_weights",
     "obstacle_speeds",
     "optimizer_overhead",
+    "problem_parts",
     "ratio_non_dominated",
+    "same_parts",
     "self_distance",
     "solid_lever_arms",
     "spread",

@@ -232,7 +232,7 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
 
 #: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
 #: itself, not held here, so that the key can die), its influence [m] and what it was made
-#: from (:func:`_made_from`), made once: it takes ≈ 0.1 s (the broad phase's distance
+#: from (:func:`problem_parts`), made once: it takes ≈ 0.1 s (the broad phase's distance
 #: tables), as much as seven certificates, and the polish certifies its moves one call at a
 #: time.
 _CERTIFYING: weakref.WeakKeyDictionary[
@@ -240,10 +240,19 @@ _CERTIFYING: weakref.WeakKeyDictionary[
 ] = weakref.WeakKeyDictionary()
 
 
-def _made_from(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """The objects a certifying problem is made from (compared by identity: a problem whose
-    settings, robot, scene, start or goal were replaced gets a new one)."""
+def problem_parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
+    """The objects an object derived from ``problem`` is made from — its settings, robot,
+    scene, start and goal — to be compared by identity (:func:`same_parts`): a certifying
+    problem, or a helper process forked with a copy of ``problem``, is stale once one of
+    them was replaced (e.g. ``problem.settings`` with another margin)."""
     return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
+
+
+def same_parts(parts: tuple[Any, ...], problem: TrajectoryProblem) -> bool:
+    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts now, object
+    for object."""
+    now = problem_parts(problem)
+    return len(parts) == len(now) and all(a is b for a, b in zip(parts, now))
 
 
 def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
@@ -260,15 +269,11 @@ def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, f
     they share it.
     """
     check_type(problem, TrajectoryProblem, "problem")
-    sources = _made_from(problem)
     made = _CERTIFYING.get(problem)
-    if (
-        made is None
-        or len(made[2]) != len(sources)
-        or any(a is not b for a, b in zip(made[2], sources))
-    ):
+    if made is None or not same_parts(made[2], problem):
         fast, influence = _certifying_problem(problem)
-        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence, sources)
+        parts = problem_parts(problem)
+        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence, parts)
     fast, influence, _ = made
     return (problem if fast is None else fast), influence
 

@@ -35,7 +35,12 @@ import traceback
 from functools import partial
 from typing import Any
 
-from adept_traj.analysis.member_certificate import MemberCertificate, certifying_problem
+from adept_traj.analysis import (
+    MemberCertificate,
+    certifying_problem,
+    problem_parts,
+    same_parts,
+)
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.early_certificates import EarlyCertificates, feasible_front
 from adept_traj.optimise.loop import RunState
@@ -94,17 +99,12 @@ def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
             "the polisher was started for another problem (start_polisher(problem) with "
             "the problem given to plan)"
         )
-    if any(a is not b for a, b in zip(polisher.made_from, _parts(problem), strict=True)):
+    if not same_parts(polisher.made_from, problem):
         raise ConfigurationError(
             "the problem's settings, robot, scene, start or goal were replaced after the "
             "polisher was started (its process polishes the problem as it was then): "
             "start_polisher(problem) again"
         )
-
-
-def _parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """What a polisher's helper inherits of ``problem`` and uses (compared by identity)."""
-    return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
 
 
 def polish_with_certificates(
@@ -181,7 +181,7 @@ class Polisher(ForkedHelper):
 
     def __init__(self, problem: TrajectoryProblem) -> None:
         self.problem = problem
-        self.made_from = _parts(problem)
+        self.made_from = problem_parts(problem)
         self._order: dict[str, Any] | None = None
         self._note = ""
         super().__init__(_helper, (problem,))
