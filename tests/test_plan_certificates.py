@@ -1,5 +1,6 @@
-"""plan() certifies every front member once: the polish's certificates of the moves it
-keeps are the front's (issue #15), the same summaries as certifying the front afresh."""
+"""plan() certifies every front member once (but the local solver's starts, issue #24):
+the polish's certificates of the moves it keeps are the front's (issue #15), the same
+summaries as certifying the front afresh."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import pytest
 
 from adept_traj import TrajectoryProblem, plan
 from adept_traj.analysis import MemberCertificate, certify_members
+from adept_traj.optimise import MAX_BASINS
 
 
 @pytest.fixture(scope="module")
@@ -36,9 +38,16 @@ def test_no_move_is_certified_twice(counted_run) -> None:
     polished = result.front.x[np.argmin(result.front.x[:, 0])]
     assert result.metrics.t_best_source == "polish"  # the polish kept its move: it is in the front
     assert calls[polished.tobytes()] == 1
-    assert max(calls.values()) == 1
+    # the local solver certifies its start (a search member, also certified with the
+    # front meanwhile): the only moves certified twice are such starts, one per basin
+    twice = [x for x, n in calls.items() if n > 1]
+    assert max(calls.values()) <= 2
+    assert len(twice) <= MAX_BASINS
+    assert polished.tobytes() not in twice
     certified = [k for k, c in enumerate(result.front.certificates) if c is not None]
-    assert sorted(calls) == sorted(result.front.x[k].tobytes() for k in certified)
+    # every front member's summary was made (once); the others made are of the local
+    # solver's starts and of its rounds (issue #24), none of them a second time
+    assert {result.front.x[k].tobytes() for k in certified} <= set(calls)
 
 
 def test_front_summaries_are_those_of_a_fresh_certification(problem, counted_run) -> None:

@@ -13,7 +13,7 @@ from adept_traj import TrajectoryProblem, plan
 from adept_traj.cli.front import front_table
 from adept_traj.cli.report import summary
 from adept_traj.errors import InvalidInputError
-from adept_traj.optimise import minimum_time
+from adept_traj.optimise import refine_minimum_time
 from adept_traj.results import Metrics, PlanningResult, audit
 
 OLD = Path(__file__).parent / "data" / "result_v1"
@@ -32,11 +32,12 @@ def runs(problem: TrajectoryProblem) -> dict[str, PlanningResult]:
 
 
 def test_polished_run_records_the_polished_fastest_move(problem, runs) -> None:
-    """T_best is the T of minimum_time from the unpolished run's fastest feasible member
-    (called directly), and the run's fastest certified member."""
+    """T_best is the T of the certified refinement of the unpolished run's fastest feasible
+    member (called directly), and the run's fastest certified member."""
     raw, polished = runs["off"], runs["fastest"]
     ok = np.flatnonzero(np.all(raw.front.constraints <= 0.0, axis=1))
-    expected = minimum_time(problem, raw.front.x[ok[np.argmin(raw.front.x[ok, 0])]], max_iter=30)
+    start = raw.front.x[ok[np.argmin(raw.front.x[ok, 0])]]
+    expected = refine_minimum_time(problem, start)
     assert polished.metrics.t_best == expected.x[0]
     assert polished.metrics.t_best_source == "polish"
     assert polished.metrics.t_best == polished.front.x[polished.front.feasible, 0].min()

@@ -48,6 +48,7 @@ from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, LimitCheck
 from adept_traj.analysis.member_certificate import (
     FRONT_INFLUENCE_ABOVE_MARGIN,
     MemberCertificate,
+    certify_member,
     certify_members,
     certifying_problem,
     problem_parts,
@@ -90,6 +91,7 @@ __all__ = [
     "best_tradeoff",
     "certificate_bytes",
     "certify",
+    "certify_member",
     "certify_members",
     "certifying_problem",
     "check_certificate_memory",

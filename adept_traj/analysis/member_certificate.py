@@ -56,6 +56,7 @@ from adept_traj.validation import as_batch, as_integer, as_scalar, check_type, d
 __all__ = [
     "FRONT_INFLUENCE_ABOVE_MARGIN",
     "MemberCertificate",
+    "certify_member",
     "certify_members",
     "certifying_problem",
 ]
@@ -212,6 +213,47 @@ def certify_members(
             certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
             out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
+
+
+def certify_member(
+    problem: TrajectoryProblem,
+    x: Any,
+    *,
+    rate_hz: float = DEFAULT_RATE_HZ,
+    tolerance: float = DEFAULT_TOLERANCE,
+) -> tuple[MemberCertificate, Certificate]:
+    """The summary of one move's certificate, as :func:`certify_members` makes it (the
+    same numbers), and the certificate itself: its dense profile (the distance at every
+    sample, the torques) tells a local solver where the move comes closest to failing.
+
+    Parameters
+    ----------
+    problem: the problem the move was planned on.
+    x: (n_var,) decision vector ``[T [s], free control points]``, T > 0.
+    rate_hz: the dense grid's minimum rate [Hz] (> 0).
+    tolerance: slack on the limit values (dimensionless, ≥ 0).
+
+    Returns
+    -------
+    tuple
+        The :class:`MemberCertificate` and the :class:`~adept_traj.analysis.Certificate`
+        of the certifying problem (:func:`certifying_problem`: its distances above the
+        influence are lower bounds).
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    xa = as_batch(x, "x", problem.n_var)
+    if xa.ndim != 1:
+        raise InputShapeError(f"x must have shape ({problem.n_var},); got {xa.shape}")
+    if not xa[0] > 0.0:
+        raise InvalidInputError(f"x[0] (travel time T [s]) must be > 0; got {xa[0]!r}")
+    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    tol = as_scalar(tolerance, "tolerance", minimum=0.0)
+    fast, influence = certifying_problem(problem)
+    _limits(fast.robot.limits)
+    check_certificate_memory(fast, rate, float(xa[0]))
+    dense = _dense_states(fast, xa[None], rate, False)[0]
+    certificate = _certify(fast, xa, rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+    return MemberCertificate.of(certificate, influence), certificate
 
 
 def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list[list[int]]:

@@ -10,6 +10,8 @@ from adept_traj.optimise.algorithms import (
     AlgorithmSettings,
     make_algorithm,
 )
+from adept_traj.optimise.basins import THRESHOLD as BASIN_THRESHOLD
+from adept_traj.optimise.basins import basin_labels
 from adept_traj.optimise.checkpoint import (
     CHECKPOINT_VERSION,
     CapturedCheckpoint,
@@ -64,11 +66,14 @@ from adept_traj.optimise.polish import (
     time_optimal,
 )
 from adept_traj.optimise.polish_step import (
+    GLOBAL_SEED,
     GRADIENT_COST,
+    MAX_BASINS,
     POLISH_MODES,
     POLISH_SHARE,
     SPREAD_MEMBERS,
     TIME_OPTIMAL,
+    fastest_of_basins,
     polish_fastest,
     polish_members,
     polish_mode,
@@ -88,6 +93,7 @@ from adept_traj.optimise.population import (
     population_values,
     ranked_optimum,
 )
+from adept_traj.optimise.refinement import Refinement, refine_minimum_time
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -109,6 +115,12 @@ from adept_traj.optimise.tournament import (
 from adept_traj.optimise.variant import (
     ArrayVariant,
 )
+from adept_traj.optimise.via_points import (
+    GLOBAL_GAP,
+    ViaPointSampling,
+    near_lower_bound,
+    via_point_starts,
+)
 from adept_traj.optimise.weighted_move import (
     MAX_EVALUATIONS_PER_START,
     STEP_EVALUATIONS,
@@ -120,11 +132,15 @@ from adept_traj.optimise.weighted_move import (
 
 __all__ = [
     "ALGORITHMS",
+    "BASIN_THRESHOLD",
     "BLOCK_PAIRS",
     "CHECKPOINT_INTERVAL",
     "CHECKPOINT_VERSION",
     "EARLY_SHARE",
+    "GLOBAL_GAP",
+    "GLOBAL_SEED",
     "GRADIENT_COST",
+    "MAX_BASINS",
     "MAX_EVALUATIONS",
     "MAX_EVALUATIONS_PER_START",
     "POLISH_MODES",
@@ -149,8 +165,11 @@ __all__ = [
     "Polisher",
     "RampSampling",
     "RankAndCrowdingSurvival",
+    "Refinement",
     "RunState",
     "TournamentArrays",
+    "ViaPointSampling",
+    "basin_labels",
     "binary_tournament",
     "cache_violations",
     "capture_checkpoint",
@@ -160,6 +179,7 @@ __all__ = [
     "checkpoint_arrays",
     "crowding_distance",
     "epsilon_step",
+    "fastest_of_basins",
     "feasible_front",
     "has_checkpoint",
     "kinematic_time",
@@ -167,6 +187,7 @@ __all__ = [
     "make_algorithm",
     "minimum_time",
     "mutate",
+    "near_lower_bound",
     "optimise",
     "optimum",
     "plan",
@@ -178,6 +199,7 @@ __all__ = [
     "population_bytes",
     "population_values",
     "ranked_optimum",
+    "refine_minimum_time",
     "restore_algorithm",
     "save_checkpoint",
     "sbx_children",
@@ -186,6 +208,7 @@ __all__ = [
     "start_polisher",
     "time_optimal",
     "time_optimal_run",
+    "via_point_starts",
     "warn_missing_limits",
     "weighted_descent",
     "weighted_run",

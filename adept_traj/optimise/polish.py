@@ -30,17 +30,18 @@ is deterministic: the same problem and seed give the same vectors.
 
 from __future__ import annotations
 
-import dataclasses
+import functools
 import time
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.member_certificate import certify_members
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.refinement import Refinement, refine_minimum_time
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.via_points import near_lower_bound, via_point_starts
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
 from adept_traj.validation import as_integer, as_scalar, as_vector
 
@@ -62,11 +63,6 @@ _DETOUR_RAMPS = 2000
 _DETOUR_SPEEDS = (1.0,)
 #: Most batches of detour ramps drawn (a feasible ramp is rare: 0–3 in 2 000 there).
 _DETOUR_BATCHES = 3
-
-#: Extra distance buffers [m] of the solves from detour starts, tried in turn until the
-#: move passes its certificate (a fast move cuts corners between the samples: measured on
-#: the detour scene, 0.4 mm past the 2 mm search buffer at T = 1.12 s).
-_DETOUR_BUFFERS = (0.005, 0.01)
 
 
 @dataclass(frozen=True)
@@ -151,32 +147,46 @@ def minimum_time(
 
 
 def time_optimal(
-    problem: Any, seed: int = 1, n_starts: int = 4, **options: Any
-) -> list[PolishOutcome]:
-    """:func:`minimum_time` from the straight move and the ``n_starts − 1`` kinematically
-    fastest of ``8 (n_starts − 1)`` seeded ramps (each at its kinematic minimum T); one
-    outcome per start, in start order; when none is feasible, followed by the outcomes of
-    at most ``n_starts`` detour starts (module docstring).
+    problem: Any, seed: int = 1, n_starts: int = 4, *, rate_hz: float = 1000.0, **options: Any
+) -> list[Refinement]:
+    """:func:`~adept_traj.optimise.refine_minimum_time` from the straight move and the
+    ``n_starts − 1`` kinematically fastest of ``8 (n_starts − 1)`` seeded ramps (each at
+    its kinematic minimum T); one refinement per start, in start order. When no
+    refinement ends **certified** within
+    :data:`~adept_traj.optimise.GLOBAL_GAP` of the kinematic lower bound, followed by the
+    refinements of the global stage's starts (:func:`~adept_traj.optimise.via_point_starts`)
+    and of at most ``n_starts`` detour ramps (the fastest evaluator-feasible ones).
 
     Parameters
     ----------
     problem:
         The :class:`~adept_traj.problem.TrajectoryProblem`.
     seed:
-        Seed of the ramps' generator (≥ 0).
+        Seed of the ramps' and the via points' generators (≥ 0).
     n_starts:
         Number of starts (≥ 1).
+    rate_hz:
+        Rate [Hz] of the certificates (> 0).
     options:
-        ``max_iter``, ``tol`` of :func:`minimum_time`.
+        ``max_boxes``, ``max_rounds`` of :func:`~adept_traj.optimise.refine_minimum_time`.
     """
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
-    outcomes = [minimum_time(problem, x, **options) for x in _starts(problem, seed, n_starts)]
-    if any(o.feasible for o in outcomes):
+    refine = functools.partial(refine_minimum_time, problem, rate_hz=rate_hz, **options)
+    starts = _starts(problem, seed, n_starts)
+    outcomes = [refine(x) for x in _feasible_first(problem, starts)]
+    if near_lower_bound(problem, outcomes):
         return outcomes
-    return outcomes + [
-        _detour(problem, x, options) for x in _detour_starts(problem, seed, n_starts)
-    ]
+    more = [via_point_starts(problem, seed, n_starts=n_starts)]
+    more.append(_detour_starts(problem, seed, n_starts))
+    return outcomes + [refine(x) for x in _feasible_first(problem, np.concatenate(more))]
+
+
+def _feasible_first(problem: Any, starts: np.ndarray) -> np.ndarray:
+    """``starts`` (k, n_var) with the evaluator-feasible ones first (each group in its
+    order): a refinement from inside the constraints is cheap and seldom fails."""
+    ok = np.all(problem.evaluate_batch(starts).constraints <= 0.0, axis=1) if len(starts) else []
+    return np.concatenate([starts[ok], starts[~np.asarray(ok, dtype=bool)]])
 
 
 def _detour_starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
@@ -197,28 +207,6 @@ def _detour_starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
             rows = rows * len(speeds) + np.argmax(ok[rows], axis=1)  # each ramp's fastest
             return x[rows[np.argsort(x[rows, 0], kind="stable")][:n_starts]]
     return np.empty((0, problem.n_var))
-
-
-def _detour(problem: Any, x0: np.ndarray, options: dict[str, Any]) -> PolishOutcome:
-    """:func:`minimum_time` from the feasible detour ``x0`` with the extra distance buffers
-    of :data:`_DETOUR_BUFFERS` in turn, until the move passes its certificate (1 kHz,
-    :func:`~adept_traj.analysis.certify_members`); the last outcome otherwise. The
-    evaluations and time of every solve are counted in the outcome."""
-    spent = [0, 0.0, 0.0]  # evaluations, seconds, evaluation seconds of earlier solves
-    for buffer in _DETOUR_BUFFERS:
-        outcome = minimum_time(problem, x0, buffer=buffer, **options)
-        tic = time.perf_counter()
-        ok = outcome.feasible and certify_members(problem, outcome.x[None])[0].feasible
-        outcome = dataclasses.replace(
-            outcome,
-            n_evaluations=outcome.n_evaluations + spent[0],
-            seconds=outcome.seconds + spent[1] + time.perf_counter() - tic,
-            evaluation_s=outcome.evaluation_s + spent[2],
-        )
-        if ok:
-            break
-        spent = [outcome.n_evaluations, outcome.seconds, outcome.evaluation_s]
-    return outcome
 
 
 def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:

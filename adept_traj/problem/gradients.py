@@ -109,8 +109,10 @@ class LocalConstraints:
     kind: np.ndarray
 
 
-def local_constraints(problem: Any, x: Any, *, points_per_segment: int = 4) -> LocalConstraints:
-    """The smooth per-sample constraints of decision vectors ``x`` (pop, n_var) or
+def local_constraints(
+    problem: Any, x: Any, *, points_per_segment: int = 4, extra_samples: Any = None
+) -> LocalConstraints:
+    r"""The smooth per-sample constraints of decision vectors ``x`` (pop, n_var) or
     (n_var,) and their Jacobians (see the module docstring).
 
     Parameters
@@ -121,6 +123,11 @@ def local_constraints(problem: Any, x: Any, *, points_per_segment: int = 4) -> L
         Decision vectors ``[T [s], free control points [rad | m]]``.
     points_per_segment:
         Velocity samples per spline segment (≥ 1; plus the last knot).
+    extra_samples:
+        (k,) normalised times :math:`s \in [0, 1]` where the torque and distance rows are
+        also imposed, after those at ``problem.s`` (``None``: none): the adaptive samples
+        of the certified local solver (:mod:`adept_traj.optimise.refinement`), placed where
+        a certificate found the distance dipping between the problem's samples.
 
     Returns
     -------
@@ -131,10 +138,20 @@ def local_constraints(problem: Any, x: Any, *, points_per_segment: int = 4) -> L
     n = as_integer(points_per_segment, "points_per_segment", minimum=1, error=ConfigurationError)
     if not np.all(xa[:, 0] > 0.0):
         raise ConfigurationError(f"travel times x[:, 0] must be > 0 [s]; got {xa[:, 0]}")
-    return _local_constraints(problem, xa, n)
+    s = problem.s
+    if extra_samples is not None:
+        extra = np.asarray(extra_samples, dtype=float).ravel()
+        if not np.all((extra >= 0.0) & (extra <= 1.0)):
+            raise ConfigurationError(
+                f"extra_samples must be normalised times in [0, 1]; got {extra}"
+            )
+        s = np.concatenate([s, extra])
+    return _local_constraints(problem, xa, n, s)
 
 
-def _local_constraints(problem: Any, x: np.ndarray, n_per_segment: int) -> LocalConstraints:
+def _local_constraints(
+    problem: Any, x: np.ndarray, n_per_segment: int, s_rows: np.ndarray
+) -> LocalConstraints:
     traj = problem.trajectory
     S = traj.n_segments
     grids = (
@@ -147,8 +164,8 @@ def _local_constraints(problem: Any, x: np.ndarray, n_per_segment: int) -> Local
         _kinematic(T, P, S, s, order, problem.robot.limits.bound(kind.name))
         for order, (s, kind) in enumerate(zip(grids, LIMITS[1:4]), start=1)
     ]
-    blocks.append(_torque(problem, T, P))
-    blocks.append(_distance(problem, T, P))
+    blocks.append(_torque(problem, T, P, s_rows))
+    blocks.append(_distance(problem, T, P, s_rows))
     kind = np.concatenate([np.full(b[0].shape[1], i) for i, b in enumerate(blocks)])
     return LocalConstraints(
         values=np.concatenate([b[0] for b in blocks], axis=1),
@@ -259,9 +276,9 @@ def _central_dynamics_derivatives(robot: Any, q: np.ndarray, v: np.ndarray, a: n
     return d[..., 0, :, :], d[..., 1, :, :], d[..., 2, :, :]
 
 
-def _torque(problem: Any, T: np.ndarray, P: np.ndarray):
-    """Torque rows at the problem's samples."""
-    robot, S, s = problem.robot, problem.trajectory.n_segments, problem.s
+def _torque(problem: Any, T: np.ndarray, P: np.ndarray, s: np.ndarray):
+    """Torque rows at the samples ``s`` (n_s,)."""
+    robot, S = problem.robot, problem.trajectory.n_segments
     q, qd, qdd = (_samples(P, T, S, s, order) for order in range(3))
     u = robot.inverse_dynamics(q, qd, qdd)  # (pop, n_s, nq)
     dq, dv, da = _inverse_dynamics_derivatives(robot, q, qd, qdd)
@@ -275,11 +292,11 @@ def _torque(problem: Any, T: np.ndarray, P: np.ndarray):
     return _two_sided(u, d_free, d_T / T[:, None, None], robot.limits.bound(LIMITS[4].name))
 
 
-def _distance(problem: Any, T: np.ndarray, P: np.ndarray):
-    """Distance rows at the problem's samples, one per sample and obstacle, with coal's
+def _distance(problem: Any, T: np.ndarray, P: np.ndarray, s: np.ndarray):
+    """Distance rows at the samples ``s`` (n_s,), one per sample and obstacle, with coal's
     witness-point derivatives (:func:`~adept_traj.collision.distance_gradients`: zero
     where the clipped distance is at ``influence``)."""
-    st, S, s = problem.settings, problem.trajectory.n_segments, problem.s
+    st, S = problem.settings, problem.trajectory.n_segments
     q = _samples(P, T, S, s, 0)
     grad = distance_gradients(problem.checker, q, T[:, None] * s)
     d0 = np.minimum(grad.distance, st.influence)  # (pop, n_s, n_obs)
