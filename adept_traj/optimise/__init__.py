@@ -61,19 +61,20 @@ from adept_traj.optimise.planner import (
     warn_missing_limits,
 )
 from adept_traj.optimise.polish import (
+    MAX_BASINS,
+    STRETCHES,
     PolishOutcome,
+    fastest_of_basins,
+    global_starts,
     minimum_time,
     time_optimal,
 )
 from adept_traj.optimise.polish_step import (
-    GLOBAL_SEED,
     GRADIENT_COST,
-    MAX_BASINS,
     POLISH_MODES,
     POLISH_SHARE,
     SPREAD_MEMBERS,
     TIME_OPTIMAL,
-    fastest_of_basins,
     polish_fastest,
     polish_members,
     polish_mode,
@@ -93,7 +94,12 @@ from adept_traj.optimise.population import (
     population_values,
     ranked_optimum,
 )
-from adept_traj.optimise.refinement import Refinement, refine_minimum_time
+from adept_traj.optimise.refinement import (
+    Refinement,
+    refine_minimum_time,
+    refine_starts,
+    screen_starts,
+)
 from adept_traj.optimise.repair import (
     KinematicTimeRepair,
     kinematic_time,
@@ -117,6 +123,7 @@ from adept_traj.optimise.variant import (
 )
 from adept_traj.optimise.via_points import (
     GLOBAL_GAP,
+    GLOBAL_SEED,
     ViaPointSampling,
     near_lower_bound,
     via_point_starts,
@@ -148,6 +155,7 @@ __all__ = [
     "SPREAD_MEMBERS",
     "STEP_EVALUATIONS",
     "STOP_DECREASE",
+    "STRETCHES",
     "TIME_OPTIMAL",
     "WEIGHTED_BOX",
     "AlgorithmSettings",
@@ -181,6 +189,7 @@ __all__ = [
     "epsilon_step",
     "fastest_of_basins",
     "feasible_front",
+    "global_starts",
     "has_checkpoint",
     "kinematic_time",
     "load_checkpoint",
@@ -200,9 +209,11 @@ __all__ = [
     "population_values",
     "ranked_optimum",
     "refine_minimum_time",
+    "refine_starts",
     "restore_algorithm",
     "save_checkpoint",
     "sbx_children",
+    "screen_starts",
     "select_parents",
     "start_early_certificates",
     "start_polisher",

@@ -42,25 +42,21 @@ from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.basins import basin_labels
 from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
-from adept_traj.optimise.polish import PolishOutcome, time_optimal
-from adept_traj.optimise.refinement import Refinement, refine_minimum_time
-from adept_traj.optimise.via_points import near_lower_bound, via_point_starts
+from adept_traj.optimise.polish import PolishOutcome, fastest_of_basins, time_optimal
+from adept_traj.optimise.refinement import (
+    SCREEN_BOXES,
+)
 from adept_traj.problem import from_pymoo, to_pymoo
 from adept_traj.robot.limits import LIMITS
-from adept_traj.validation import as_integer
 
 __all__ = [
-    "GLOBAL_SEED",
     "GRADIENT_COST",
-    "MAX_BASINS",
     "POLISH_MODES",
     "POLISH_SHARE",
     "SPREAD_MEMBERS",
     "TIME_OPTIMAL",
-    "fastest_of_basins",
     "polish_fastest",
     "polish_members",
     "polish_mode",
@@ -88,20 +84,8 @@ GRADIENT_COST = 40
 #: member only.
 POLISH_SHARE = 0.25
 
-#: Basins refined by :func:`polish_fastest` (the fastest move of each of the fastest
-#: basins), and most starts of the global stage.
-MAX_BASINS = 3
-
-#: Seed of the global stage's via points: a function of the problem alone, the same for
-#: every run (the fastest move found does not depend on the search's seed).
-GLOBAL_SEED = 0
-
 #: The name of the single-objective mode of :func:`~adept_traj.plan`.
 TIME_OPTIMAL = "time-optimal"
-
-#: SLSQP iterations of the polish (a start near an optimum converges in 3–10; from a slow
-#: detour SLSQP may not converge at all).
-_POLISH_ITERATIONS = 30
 
 
 def polish_fastest(problem: Any, state: RunState, rate_hz: float) -> RunState:
@@ -146,45 +130,6 @@ def _polish_fastest(
             kept.append(o)
             certified[o.x.tobytes()] = o.certificate
     return _with_members(counted, kept) if kept else counted
-
-
-def fastest_of_basins(
-    problem: Any,
-    x: Any,
-    *,
-    rate_hz: float = 1000.0,
-    max_basins: int = MAX_BASINS,
-    seed: int = GLOBAL_SEED,
-) -> list[Refinement]:
-    """The certified refinements (:func:`~adept_traj.optimise.refine_minimum_time`) of
-    the fastest move of each of the ``max_basins`` fastest basins
-    (:func:`~adept_traj.optimise.basin_labels`) of the moves ``x`` (n, n_var), fastest
-    basin first, until one comes within :data:`~adept_traj.optimise.GLOBAL_GAP` of the
-    kinematic lower bound (no other basin can then be faster by more than that); when none
-    does, followed by the refinements of the global stage's starts
-    (:func:`~adept_traj.optimise.via_point_starts` with ``seed``).
-
-    Parameters
-    ----------
-    problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
-    x: (n, n_var) moves (e.g. the feasible members of a final population).
-    rate_hz: rate [Hz] of the certificates.
-    max_basins: most basins refined (≥ 1), and most global-stage starts.
-    seed: seed of the global stage (≥ 0).
-    """
-    xs = np.atleast_2d(np.asarray(x, dtype=float))
-    max_basins = as_integer(max_basins, "max_basins", minimum=1, error=ConfigurationError)
-    outcomes: list[Refinement] = []
-    if len(xs):
-        xs = xs[np.argsort(xs[:, 0], kind="stable")]
-        _, first = np.unique(basin_labels(problem, xs), return_index=True)
-        for k in np.sort(first)[:max_basins]:
-            outcomes.append(refine_minimum_time(problem, xs[k], rate_hz=rate_hz))
-            if near_lower_bound(problem, outcomes):
-                return outcomes  # no other basin can be faster by more than GLOBAL_GAP
-    for start in via_point_starts(problem, seed, n_starts=max_basins):
-        outcomes.append(refine_minimum_time(problem, start, rate_hz=rate_hz))
-    return outcomes
 
 
 def polish_mode(polish: Any) -> str:
@@ -351,9 +296,10 @@ def _polish_members(
 def time_optimal_run(problem: Any, seed: int, **params: Any) -> tuple[RunState, dict[str, Any]]:
     """The population of ``plan(problem, algorithm="time-optimal")`` and its settings: the
     certified refinements of :func:`~adept_traj.optimise.time_optimal` from ``n_starts``
-    starts (≥ 1) with at most ``max_iter`` trust boxes in each solve (≥ 1). A move equal
-    to an earlier one (every entry within 1e-9 of it) is left out. ``params``:
-    ``n_starts`` (default 3) and ``max_iter`` (default 30); any other name is refused
+    starts (≥ 1) with at most ``max_iter`` trust boxes in each screening (≥ 1). A move
+    equal to an earlier one (every entry within 1e-9 of it) is left out. ``params``:
+    ``n_starts`` (default 3) and ``max_iter`` (default
+    :data:`~adept_traj.optimise.SCREEN_BOXES`); any other name is refused
     (:class:`ConfigurationError`)."""
     unknown = sorted(set(params) - {"n_starts", "max_iter"})
     if unknown:
@@ -362,7 +308,7 @@ def time_optimal_run(problem: Any, seed: int, **params: Any) -> tuple[RunState, 
             "and max_iter"
         )
     n_starts = params.get("n_starts", 3)
-    max_iter = params.get("max_iter", _POLISH_ITERATIONS)
+    max_iter = params.get("max_iter", SCREEN_BOXES)
     started = time.perf_counter()
     outcomes = time_optimal(problem, seed, n_starts=n_starts, max_boxes=max_iter)
     empty = RunState(

@@ -60,8 +60,13 @@ __all__ = [
     "BUFFERS",
     "DIP_TOLERANCE",
     "MAX_EXTRA_SAMPLES",
+    "NO_MOVE_INSIDE",
+    "SCREEN_BOXES",
+    "SCREEN_KEEP",
     "Refinement",
     "refine_minimum_time",
+    "refine_starts",
+    "screen_starts",
 ]
 
 #: Distance [m] above the margin below which a dip of the certificate's dense distance
@@ -71,6 +76,13 @@ DIP_TOLERANCE = 0.002
 #: Extra distance buffers [m] of the solves, raised in turn only when a failing move
 #: shows no new place to sample (the last resort).
 BUFFERS: tuple[float, ...] = (0.0, 0.002, 0.005, 0.01)
+
+#: The message of a refinement that found no point inside the sampled constraints.
+NO_MOVE_INSIDE = "no move inside the sampled constraints found"
+
+#: Trust boxes of a screening refinement (:func:`screen_starts`), and how many of the
+#: screened moves :func:`refine_starts` refines to the end.
+SCREEN_BOXES, SCREEN_KEEP = 3, 2
 
 #: Most adaptive samples of one refinement (each adds one distance row per obstacle and
 #: two torque rows per joint).
@@ -168,6 +180,41 @@ def refine_minimum_time(
         return _refine(problem, x0, rate, rounds, boxes, start_certificate)
 
 
+def screen_starts(
+    problem: Any,
+    starts: Any,
+    *,
+    rate_hz: float = 1000.0,
+    stop: Any = None,
+    max_boxes: int = SCREEN_BOXES,
+) -> list[Refinement]:
+    """A short refinement (one round, ``max_boxes`` trust boxes) of each of ``starts``
+    (k, n_var), in order; ``stop(outcomes)`` (optional) is asked after each and ends the
+    screening when true."""
+    screened: list[Refinement] = []
+    for x in np.atleast_2d(np.asarray(starts, dtype=float)):
+        one = refine_minimum_time(problem, x, rate_hz=rate_hz, max_rounds=1, max_boxes=max_boxes)
+        screened.append(one)
+        if stop is not None and stop(screened):
+            break
+    return screened
+
+
+def refine_starts(
+    problem: Any, screened: list[Refinement], *, rate_hz: float = 1000.0
+) -> list[Refinement]:
+    """The full refinements (:func:`refine_minimum_time`) of the :data:`SCREEN_KEEP`
+    fastest screened moves (:func:`screen_starts`) that reached a point inside the
+    constraints, from where their screening ended: a multi-start that spends its
+    iterations on the most promising starts."""
+    inside = [o for o in screened if o.message != NO_MOVE_INSIDE]
+    inside.sort(key=lambda o: float(o.x[0]))
+    return [
+        refine_minimum_time(problem, o.x, rate_hz=rate_hz, start_certificate=o.certificate)
+        for o in inside[:SCREEN_KEEP]
+    ]
+
+
 def _refine(
     problem: Any,
     x0: np.ndarray,
@@ -196,7 +243,7 @@ def _refine(
     for n_rounds in range(1, max_rounds + 1):  # noqa: B007 (reported)
         x, inside = trust_box_solve(problem, x, extra, buffer, max_boxes, counts)
         if not inside:
-            message = "no move inside the sampled constraints found"
+            message = NO_MOVE_INSIDE
             break
         x, ev = _evaluated(problem, x)
         counts.evaluations += 1

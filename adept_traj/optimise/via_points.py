@@ -18,13 +18,14 @@ The travel time is the move's kinematic minimum (:func:`~adept_traj.optimise.kin
 times a factor drawn from :data:`SPEEDS` — against a moving obstacle the same path at
 another speed passes it at another phase.
 
-:func:`via_point_starts` evaluates batches of such moves with the problem's evaluator (one
-batched call each) and returns the fastest evaluator-feasible move of each basin
-(:func:`~adept_traj.optimise.basin_labels`), fastest first — or, when no move of any batch
-is feasible, the least-infeasible ones: starts for
-:func:`~adept_traj.optimise.refine_minimum_time`, whose elastic solve may still reach the
-feasible set from them. Nothing about a scene is assumed; every number comes from the
-seeded generator, so the same problem and seed give the same starts.
+:func:`via_point_starts` evaluates batches of such moves, and as many seeded ramps at
+their kinematic minimum T (:class:`~adept_traj.optimise.RampSampling`), with the
+problem's evaluator (one batched call each) and returns the fastest evaluator-feasible move
+of each basin (:func:`~adept_traj.optimise.basin_labels`), fastest first, and the
+least-infeasible ones: starts for :func:`~adept_traj.optimise.refine_minimum_time`, whose
+elastic solve may still reach the feasible set from them. Nothing about a scene is
+assumed; every number comes from the seeded generator, so the same problem and seed give
+the same starts.
 """
 
 from __future__ import annotations
@@ -36,10 +37,12 @@ import numpy as np
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.basins import basin_labels
 from adept_traj.optimise.repair import kinematic_time
+from adept_traj.optimise.sampling import RampSampling
 from adept_traj.validation import as_integer
 
 __all__ = [
     "GLOBAL_GAP",
+    "GLOBAL_SEED",
     "LIMIT_INSET",
     "SPEEDS",
     "ViaPointSampling",
@@ -52,17 +55,22 @@ __all__ = [
 #: move can be faster by more than 0.4 %, and the stage is skipped).
 GLOBAL_GAP = 0.01
 
+#: Seed of the global stage in the polish and the time-optimal mode: its starts are a
+#: function of the problem alone, the same for every run, so the fastest move a run finds
+#: does not hinge on the search's seed.
+GLOBAL_SEED = 0
+
 #: Fraction of each joint's range kept clear of its limits by the via configurations.
 LIMIT_INSET = 0.05
 
 #: Factors of the kinematic minimum T drawn for the travel time.
 SPEEDS: tuple[float, ...] = (1.0, 1.0, 1.15, 1.35, 1.6)
 
-#: Moves of one batch of :func:`via_point_starts` (one evaluation of the batch by the
-#: problem; about a second on one core for the AdeptOne XL in a five-obstacle scene).
+#: Moves of each kind (via points, ramps) of one batch of :func:`via_point_starts` (one
+#: evaluation of the batch by the problem).
 _BATCH = 1500
 
-#: Least-infeasible moves returned when no move is feasible.
+#: Least-infeasible moves returned after the feasible ones.
 _LEAST_INFEASIBLE = 2
 
 
@@ -115,43 +123,48 @@ class ViaPointSampling:
 def via_point_starts(
     problem: Any, seed: int, *, n_starts: int = 3, n_batches: int = 2, n_moves: int = _BATCH
 ) -> np.ndarray:
-    """(k, n_var), k ≤ ``n_starts``: the fastest evaluator-feasible via-point move of each
-    basin, fastest first, from up to ``n_batches`` batches of ``n_moves`` moves (the next
-    batch only while fewer than ``n_starts`` basins were found); when none is feasible,
-    the :data:`_LEAST_INFEASIBLE` moves of least total violation (module docstring).
+    """(k, n_var): the global stage's starts — the fastest evaluator-feasible move of each
+    of at most ``n_starts`` basins, fastest first, then the :data:`_LEAST_INFEASIBLE`
+    infeasible moves of least total violation (an elastic solve may reach the feasible
+    set from them), from up to ``n_batches`` batches (the next only while fewer than
+    ``n_starts`` basins were found) of ``n_moves`` via-point moves and ``n_moves``
+    seeded ramps (:class:`~adept_traj.optimise.RampSampling`, each at its kinematic
+    minimum T: the shape of time-optimal moves).
 
     Parameters
     ----------
     problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
-    seed: seed of the generator (≥ 0).
-    n_starts: most starts returned (≥ 1).
+    seed: seed of the generators (≥ 0).
+    n_starts: most feasible starts returned (≥ 1).
     n_batches: most batches (≥ 1).
-    n_moves: moves per batch (≥ 1).
+    n_moves: moves of each kind per batch (≥ 1).
     """
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
     n_batches = as_integer(n_batches, "n_batches", minimum=1, error=ConfigurationError)
     n_moves = as_integer(n_moves, "n_moves", minimum=1, error=ConfigurationError)
     sampler = ViaPointSampling()
-    feasible, violation, tried = [], [], []
+    tried, violation = [], []
     for batch in range(n_batches):
-        x = sampler.moves(problem, n_moves, np.random.default_rng([seed, 7, batch]))
+        rng = np.random.default_rng([seed, 7, batch])
+        ramps = RampSampling().ramps(problem, n_moves, rng, fast_times=False)
+        t = kinematic_time(problem, ramps) * (1.0 + 1e-9)
+        ramps[:, 0] = np.clip(t, problem.xl[0], problem.xu[0])
+        x = np.concatenate([sampler.moves(problem, n_moves, rng), ramps])
         g = problem.evaluate_batch(x).constraints
-        ok = np.all(g <= 0.0, axis=1)
-        feasible.append(x[ok])
         tried.append(x)
         violation.append(np.maximum(g, 0.0).sum(axis=1))
-        found = np.concatenate(feasible)
+        ok = np.concatenate(violation) == 0.0
+        found = np.concatenate(tried)[ok]
         if len(found) and len(np.unique(basin_labels(problem, found))) >= n_starts:
             break
-    found = np.concatenate(feasible)
-    if len(found) == 0:
-        order = np.argsort(np.concatenate(violation), kind="stable")[:_LEAST_INFEASIBLE]
-        return np.concatenate(tried)[order]
+    x, v = np.concatenate(tried), np.concatenate(violation)
+    found = x[v == 0.0]
     found = found[np.argsort(found[:, 0], kind="stable")]
-    labels = basin_labels(problem, found)
-    _, first = np.unique(labels, return_index=True)  # the fastest member of each basin
-    return found[np.sort(first)][:n_starts]
+    _, first = np.unique(basin_labels(problem, found), return_index=True)
+    worst = np.flatnonzero(v > 0.0)
+    least = worst[np.argsort(v[worst], kind="stable")][:_LEAST_INFEASIBLE]
+    return np.concatenate([found[np.sort(first)][:n_starts], x[least]])
 
 
 def near_lower_bound(problem: Any, outcomes: Any) -> bool:
