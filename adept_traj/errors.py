@@ -12,6 +12,7 @@ from pathlib import Path
 
 __all__ = [
     "AdeptTrajError",
+    "CheckpointFormatError",
     "ConfigurationError",
     "CycleError",
     "FigureError",
@@ -62,6 +63,30 @@ class SceneError(AdeptTrajError):
 
 class ConfigurationError(InvalidInputError):
     """Settings of a problem, an algorithm or a run are inconsistent."""
+
+
+class CheckpointFormatError(ConfigurationError):
+    """A checkpoint file is damaged: truncated, not an ``.npz`` archive, or an array of it
+    missing, unexpected, or of the wrong shape or dtype (or its metadata malformed).
+    Raised before any generation runs: a damaged checkpoint is never resumed.
+
+    Attributes
+    ----------
+    file: path of the checkpoint file.
+    array: name of the offending array (e.g. ``"X"``, ``"data.rank"``, ``"meta"``), or
+        ``None`` when the whole file is at fault.
+    reason: what is wrong, without the file's name.
+    """
+
+    def __init__(self, file: str | os.PathLike[str], array: str | None, reason: str) -> None:
+        self.file = str(file)
+        self.array = array
+        self.reason = reason
+        where = f" (array '{array}')" if array else ""
+        super().__init__(f"{self.file}: damaged checkpoint{where}: {reason}; it cannot be resumed")
+
+    def __reduce__(self) -> tuple[type, tuple[str, str | None, str]]:
+        return type(self), (self.file, self.array, self.reason)
 
 
 class PlanningInterrupted(AdeptTrajError):

@@ -13,8 +13,17 @@ generation's checkpoint or the new one, never a mix. It holds
 - ``loop.<key>``: arrays the loop adds (the feasible fronts of every generation so far);
 - ``meta`` (0-d text): JSON with ``format`` = ``"adept_traj.checkpoint"``, ``version`` = 2,
   ``n_iter``, ``n_eval`` (the evaluation counter), ``rng`` (the state of the algorithm's
-  ``numpy`` generator), and what the loop adds: ``fingerprint``, ``total_s`` [s],
-  ``evaluation_s`` [s], ``history``.
+  ``numpy`` generator), ``arrays`` (every other array's name: its dtype and shape), and what
+  the loop adds: ``fingerprint``, ``total_s`` [s], ``evaluation_s`` [s], ``history``.
+
+A damaged file is refused by :func:`load_checkpoint` (and :func:`restore_algorithm`, which
+checks the arrays against the algorithm's problem) with
+:class:`~adept_traj.errors.CheckpointFormatError` naming the file and the array, before
+anything is restored: truncated or not an ``.npz`` archive, an array missing or not
+listed in ``arrays``, of another dtype or shape than listed, or than the population's
+layout (``X``, ``F``, ``G``, ``CV`` float64 of one row per member, ``n_iter`` a 0-d
+integer, ``data.<key>`` one row per member, ``absent.<key>`` bool (pop,)). A checkpoint
+written before ``arrays`` was kept (and version 1) is checked against the layout only.
 
 Version 1 (the same arrays, the metadata in a second file ``checkpoint.json``) is still
 read, so a run interrupted by an earlier release resumes.
@@ -44,11 +53,19 @@ from typing import Any
 import numpy as np
 from pymoo.core.population import Population
 
-from adept_traj.errors import ConfigurationError
+from adept_traj.errors import CheckpointFormatError, ConfigurationError
 from adept_traj.files import parse_json, read_bytes_bounded, write_atomic
+from adept_traj.optimise.checkpoint_checks import (
+    check_layout,
+    check_listed,
+    check_meta,
+    described,
+    read_arrays,
+)
 from adept_traj.optimise.population import population_values
 
 __all__ = [
+    "CHECKPOINT_FILE",
     "CHECKPOINT_VERSION",
     "CapturedCheckpoint",
     "capture_checkpoint",
@@ -63,7 +80,10 @@ __all__ = [
 #: Version of the checkpoint file (``meta`` key ``version``); version 1 is still read.
 CHECKPOINT_VERSION = 2
 
-_ARRAYS, _META_V1 = "checkpoint.npz", "checkpoint.json"
+#: The checkpoint's file in its folder.
+CHECKPOINT_FILE = "checkpoint.npz"
+
+_ARRAYS, _META_V1 = CHECKPOINT_FILE, "checkpoint.json"
 
 _FORMAT = "adept_traj.checkpoint"
 #: Keys the loop stores in ``checkpoint.json`` besides the algorithm's counters.
@@ -180,6 +200,7 @@ class CapturedCheckpoint:
             "rng": json.loads(json.dumps(self._rng, default=int)),
             **meta,
         }
+        state["arrays"] = {name: [a.dtype.str, list(a.shape)] for name, a in arrays.items()}
         arrays["meta"] = np.array(json.dumps(state))
         return arrays
 
@@ -211,24 +232,31 @@ def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]
 
     Raises
     ------
+    CheckpointFormatError
+        A damaged file (see the module's docstring): truncated, not an ``.npz`` archive, an
+        array missing, unexpected, or of the wrong shape or dtype, malformed metadata.
     ConfigurationError
-        No checkpoint in ``folder``, unreadable or incomplete files, another format or
-        version, or (version 1) files of two different generations.
+        No checkpoint in ``folder``, another format or version, or (version 1) files of
+        two different generations.
     """
     npz_path = folder / _ARRAYS
     if not npz_path.is_file():
         raise ConfigurationError(f"{folder}: no checkpoint to resume ({_ARRAYS})")
-    try:
-        with np.load(npz_path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise ConfigurationError(f"{folder}: unreadable checkpoint: {exc}") from None
+    arrays = read_arrays(npz_path)
     # Version 2 keeps its metadata inside; version 1 beside it in checkpoint.json. Both are
     # parsed by the bounded parser (size, nesting, no NaN or infinity: none is ever written).
     version = CHECKPOINT_VERSION if "meta" in arrays else 1
     if version > 1:
-        raw = str(arrays.pop("meta")).encode("utf-8")
-        meta = parse_json(raw, f"{npz_path} (meta)", ConfigurationError)
+        text = arrays.pop("meta")
+        if text.shape != () or text.dtype.kind != "U":
+            raise CheckpointFormatError(
+                npz_path, "meta", f"{described(text)} where 0-d text (JSON) is stored"
+            )
+        meta = parse_json(str(text).encode("utf-8"), f"{npz_path} (meta)", ConfigurationError)
+    elif not (folder / _META_V1).is_file():
+        raise CheckpointFormatError(
+            npz_path, "meta", f"missing, and no {_META_V1} (of version 1) beside it"
+        )
     else:
         meta = parse_json(_read_meta_v1(folder), str(folder / _META_V1), ConfigurationError)
     if not isinstance(meta, dict) or (meta.get("format"), meta.get("version")) != (
@@ -236,10 +264,16 @@ def load_checkpoint(folder: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]
         version,
     ):
         raise ConfigurationError(f"{folder}: not an adept_traj checkpoint of version {version}")
+    meta_file, meta_name = (npz_path, "meta") if version > 1 else (folder / _META_V1, None)
     needed = {"n_iter", "n_eval", "rng"} | _LOOP_KEYS
-    missing = sorted(needed - set(meta)) + sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays))
-    if missing:
-        raise ConfigurationError(f"{folder}: incomplete checkpoint, missing {missing}")
+    if missing := sorted(needed - set(meta)):
+        raise CheckpointFormatError(meta_file, meta_name, f"missing the values {missing}")
+    if missing := sorted({"X", "F", "G", "CV", "n_iter"} - set(arrays)):
+        raise CheckpointFormatError(npz_path, None, f"missing the arrays {missing}")
+    check_meta(meta_file, meta_name, meta)
+    if "arrays" in meta:
+        check_listed(npz_path, arrays, meta["arrays"])
+    check_layout(npz_path, arrays)
     if int(arrays["n_iter"]) != meta["n_iter"]:
         # Version 1, interrupted between its two renames: the files are of two generations.
         raise ConfigurationError(
@@ -258,11 +292,42 @@ def _read_meta_v1(folder: Path) -> bytes:
     return read_bytes_bounded(path, ConfigurationError, what="checkpoint metadata")
 
 
-def restore_algorithm(algorithm: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+def restore_algorithm(
+    algorithm: Any,
+    meta: dict[str, Any],
+    arrays: dict[str, np.ndarray],
+    file: str | Path = _ARRAYS,
+) -> None:
     """Put a freshly set-up ``algorithm`` into the state of a checkpoint (from
     :func:`load_checkpoint`): population, generation and evaluation counters, random
     generator and current optimum. The next ``ask`` continues exactly where the
-    checkpointed run stopped."""
+    checkpointed run stopped.
+
+    Raises
+    ------
+    CheckpointFormatError
+        (named ``file``) The arrays do not fit the algorithm's problem: ``X`` not
+        (pop, n_var) or not finite, ``F`` not (pop, n_obj), ``G`` not (pop, n_ieq_constr), or the
+        generator's state of another bit generator than the algorithm's. Checked before
+        anything of ``algorithm`` changes.
+    """
+    problem = algorithm.problem
+    for name, n, what in (
+        ("X", problem.n_var, "n_var"),
+        ("F", problem.n_obj, "n_obj"),
+        ("G", problem.n_ieq_constr, "n_ieq_constr"),
+    ):
+        if arrays[name].shape[1:] != (n,):
+            raise CheckpointFormatError(
+                file, name, f"{described(arrays[name])} where the problem has {what} = {n}"
+            )
+    if not np.isfinite(arrays["X"]).all():
+        raise CheckpointFormatError(file, "X", "NaN or infinite decision variables")
+    kind = type(algorithm.random_state.bit_generator).__name__
+    if meta["rng"].get("bit_generator") != kind:
+        raise CheckpointFormatError(
+            file, "meta", f"'rng' is a state of {meta['rng'].get('bit_generator')}, not {kind}"
+        )
     algorithm._initialize()
     algorithm.pop = _restore_population(arrays)
     algorithm.is_initialized = True

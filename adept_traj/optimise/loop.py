@@ -30,8 +30,9 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis.indicators import non_dominated
-from adept_traj.errors import ConfigurationError, PlanningInterrupted
+from adept_traj.errors import CheckpointFormatError, ConfigurationError, PlanningInterrupted
 from adept_traj.optimise.checkpoint import (
+    CHECKPOINT_FILE,
     CapturedCheckpoint,
     capture_checkpoint,
     load_checkpoint,
@@ -162,10 +163,11 @@ def optimise(
                 f"{folder}: the checkpoint belongs to another run (problem, algorithm, seed "
                 "or budget differ); start a new run or pass the same settings"
             )
-        restore_algorithm(algorithm, meta, arrays)
+        file = folder / CHECKPOINT_FILE
+        fronts = _restored_fronts(arrays, meta, problem.n_obj, file)  # checked first
+        restore_algorithm(algorithm, meta, arrays, file)
         spent_total, spent_eval = meta["total_s"], meta["evaluation_s"]
         history = meta["history"]
-        fronts = _restored_fronts(arrays, len(history))
     start = time.perf_counter() - spent_total
     evaluation_s = spent_eval
     # The checkpoint of the last finished generation not yet on disk (captured, with its
@@ -262,15 +264,39 @@ def _stored_fronts(fronts: list[np.ndarray]) -> dict[str, np.ndarray]:
     return {"fronts": np.concatenate(fronts), "front_sizes": np.array([len(F) for F in fronts])}
 
 
-def _restored_fronts(arrays: dict[str, np.ndarray], n_generations: int) -> list[np.ndarray]:
-    """The per-generation fronts of a checkpoint: of its last generations (all of them, or
-    none for a version-1 checkpoint, or those after a version-1 checkpoint was resumed)."""
-    if "loop.front_sizes" not in arrays:
+def _restored_fronts(
+    arrays: dict[str, np.ndarray], meta: dict[str, Any], n_obj: int, file: Path
+) -> list[np.ndarray]:
+    """The per-generation fronts of a checkpoint (``file``): of its last generations (all
+    of them, or none for a version-1 checkpoint, or those after a version-1 checkpoint was
+    resumed). ``loop.fronts`` must be float64 (k, n_obj), ``loop.front_sizes`` integers
+    (at most one per generation) summing to k; a version-2 checkpoint has both."""
+    have = [key in arrays for key in ("loop.fronts", "loop.front_sizes")]
+    if not any(have) and meta["version"] == 1:
         return []
-    sizes = arrays["loop.front_sizes"]
-    if len(sizes) > n_generations or sizes.sum() != len(arrays["loop.fronts"]):
-        raise ConfigurationError(
-            f"checkpoint: {len(sizes)} fronts of {sizes.sum()} rows stored for "
-            f"{n_generations} generations and {len(arrays['loop.fronts'])} rows"
+    if not all(have):
+        name = "loop.front_sizes" if have[0] else "loop.fronts"
+        raise CheckpointFormatError(file, name, "missing")
+    rows, sizes = arrays["loop.fronts"], arrays["loop.front_sizes"]
+    if rows.dtype != np.float64 or rows.ndim != 2 or rows.shape[1] != n_obj:
+        raise CheckpointFormatError(
+            file,
+            "loop.fronts",
+            f"dtype {rows.dtype.str}, shape {rows.shape} where float64 (k, {n_obj}) is stored",
         )
-    return np.split(arrays["loop.fronts"], np.cumsum(sizes)[:-1])
+    n_generations = len(meta["history"])
+    if (
+        sizes.dtype.kind not in "iu"
+        or sizes.ndim != 1
+        or len(sizes) > n_generations
+        or (sizes < 0).any()
+        or sizes.sum() != len(rows)
+    ):
+        raise CheckpointFormatError(
+            file,
+            "loop.front_sizes",
+            f"dtype {sizes.dtype.str}, shape {sizes.shape} where the sizes of at most "
+            f"{n_generations} fronts (integers ≥ 0, their sum the {len(rows)} rows of "
+            "loop.fronts) are stored",
+        )
+    return np.split(rows, np.cumsum(sizes)[:-1]) if len(sizes) else []
