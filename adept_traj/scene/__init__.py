@@ -1,8 +1,10 @@
-"""The scene: obstacle shapes, obstacle motion laws, :class:`Scene` and scene files."""
+"""The scene: obstacle shapes (primitives, meshes), obstacle motion laws, :class:`Scene` and
+scene files."""
 
 from __future__ import annotations
 
 from adept_traj.errors import SceneFileNotFoundError
+from adept_traj.scene.meshes import MAX_MESH_TRIANGLES, MESH_SUFFIXES, Mesh, read_mesh_arrays
 from adept_traj.scene.motion_laws import (
     FixedPose,
     MotionLaw,
@@ -36,12 +38,15 @@ from adept_traj.scene.shapes import (
 )
 
 __all__ = [
+    "MAX_MESH_TRIANGLES",
     "MAX_OBSTACLES",
+    "MESH_SUFFIXES",
     "SHIPPED_SCENES",
     "Box",
     "Capsule",
     "Cylinder",
     "FixedPose",
+    "Mesh",
     "MotionLaw",
     "Obstacle",
     "PendulumMotion",
@@ -52,6 +57,7 @@ __all__ = [
     "check_obstacle_count",
     "coal_transform",
     "pendulum_obstacles",
+    "read_mesh_arrays",
     "read_paper_scene",
     "read_robot_files",
     "read_scene_file",

@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 import tomli_w
 
-from adept_traj.errors import SceneError, SceneFileNotFoundError
+from adept_traj.errors import MeshFileError, SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
 from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
+from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.scene import (
     _BOB_SUFFIX,
@@ -73,7 +74,7 @@ def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
-    return _parse_scene(data, str(p), p.stem or "scene")
+    return _parse_scene(data, str(p), p.stem or "scene", p.parent)
 
 
 def read_robot_files(path: str | os.PathLike[str]) -> RobotSource:
@@ -87,7 +88,7 @@ def read_robot_files(path: str | os.PathLike[str]) -> RobotSource:
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
-    _parse_scene(data, str(p), p.stem or "scene")  # the whole file is checked
+    _parse_scene(data, str(p), p.stem or "scene", p.parent)  # the whole file is checked
     return RobotSource.from_table(Node(data, str(p), _ERROR)["robot"], p.parent)
 
 
@@ -101,7 +102,8 @@ def read_shipped_scene(name: str) -> Scene:
         raw = resources.files("adept_traj.data").joinpath("scenes", f"{name}.toml").read_bytes()
     except OSError as exc:
         raise SceneError(f"{source}: cannot read: {exc}") from None
-    return _parse_scene(parse_toml(raw, source, SceneError), source, name)
+    folder = Path(str(resources.files("adept_traj.data").joinpath("scenes")))
+    return _parse_scene(parse_toml(raw, source, SceneError), source, name, folder)
 
 
 def read_paper_scene() -> Scene:
@@ -109,12 +111,15 @@ def read_paper_scene() -> Scene:
     return read_shipped_scene("paper")
 
 
-def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+def scene_from_dict(
+    data: Mapping[str, Any], source: str = "<dict>", folder: str | os.PathLike[str] = "."
+) -> Scene:
     """A scene from the parsed content of a scene file (what ``tomllib`` returns); ``source``
-    names it in error messages. More than :data:`~adept_traj.scene.MAX_OBSTACLES`
-    obstacles are refused before any is built."""
+    names it in error messages; relative mesh and motion file paths are taken from
+    ``folder`` (default: the working directory). More than
+    :data:`~adept_traj.scene.MAX_OBSTACLES` obstacles are refused before any is built."""
     check_obstacle_count(_count_entries(data), source)
-    return _parse_scene(data, source, "scene")
+    return _parse_scene(data, source, "scene", Path(folder))
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
@@ -185,8 +190,15 @@ def _floats(values: Any) -> list[float]:
 
 def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
     shape = ob.shape
-    if type(shape) is Box:
-        fields: dict[str, Any] = {"size": _floats(shape.size)}
+    if type(shape) is Mesh:
+        fields: dict[str, Any] = {"file": shape.source, "scale": _floats(shape.scale)}
+        if not shape.source:
+            raise SceneError(
+                f"obstacle {ob.name!r}: a mesh built from arrays (no file) cannot be written "
+                "to a scene file"
+            )
+    elif type(shape) is Box:
+        fields = {"size": _floats(shape.size)}
     elif type(shape) is Sphere:
         fields = {"radius": shape.radius}
     elif type(shape) in (Cylinder, Capsule):
@@ -258,6 +270,7 @@ _SHAPE_KEYS = {
     "sphere": ("radius",),
     "cylinder": ("radius", "length"),
     "capsule": ("radius", "length"),
+    "mesh": ("file", "scale"),
 }
 _OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy")
 _PENDULUM_KEYS = (
@@ -265,12 +278,32 @@ _PENDULUM_KEYS = (
 )  # fmt: skip
 
 
-def _parse_obstacle(name: str, node: Node) -> Obstacle:
+def _parse_mesh(node: Node, folder: Path) -> Mesh:
+    """The ``mesh`` shape of an obstacle entry: its ``file`` (relative to ``folder``) read
+    with its ``scale``; a missing or unreadable file is a MeshFileError naming both files."""
+    file = node["file"].string(nonempty=True)
+    scale_node = node["scale"]
+    if scale_node.present and isinstance(scale_node.value, list):
+        scale: Any = scale_node.array((3,), "[-]", minimum=0.0, strict=True)
+    else:
+        scale = scale_node.number("[-]", minimum=0.0, strict=True, default=1.0)
+    path = Path(file) if Path(file).is_absolute() else folder / file
+    try:
+        return Mesh.from_file(path, scale)
+    except MeshFileError as exc:
+        raise MeshFileError(str(node["file"].error(str(exc)))) from None
+
+
+def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
     kind = node["shape"].string(choices=tuple(_SHAPE_KEYS))
     node.check_keys(_OBSTACLE_COMMON + _SHAPE_KEYS[kind])
     positive = {"minimum": 0.0, "strict": True}
     shape: Shape
-    if kind == "box" and (node["min"].present or node["max"].present):
+    if kind == "mesh":
+        shape = _parse_mesh(node, folder)
+        xyz = node["xyz"].array((3,), "[m] (the mesh frame's origin)", default=np.zeros(3))
+        rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
+    elif kind == "box" and (node["min"].present or node["max"].present):
         for other in ("size", "xyz", "rpy"):
             if node[other].present:
                 raise node[other].error(
@@ -321,7 +354,7 @@ def _parse_pendulum(name: str, node: Node) -> tuple[Obstacle, Obstacle]:
     )
 
 
-def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
+def _parse_scene(data: Any, source: str, default_name: str, folder: Path) -> Scene:
     top = Node(data, source, _ERROR).check_keys(_TOP_KEYS)
     name = top["name"].string(nonempty=True, default=default_name)
 
@@ -345,7 +378,7 @@ def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
 
     obstacles: list[Obstacle] = []
     for entry_name, node in top["obstacle"].named_tables():
-        obstacles.append(_parse_obstacle(entry_name, node))
+        obstacles.append(_parse_obstacle(entry_name, node, folder))
     for entry_name, node in top["pendulum"].named_tables():
         obstacles.extend(_parse_pendulum(entry_name, node))
     allowed = tuple(
