@@ -4,12 +4,14 @@ scene files."""
 from __future__ import annotations
 
 from adept_traj.errors import SceneFileNotFoundError
+from adept_traj.scene.machine_motions import LinearMotion, RotationMotion, rotation_about
 from adept_traj.scene.meshes import MAX_MESH_TRIANGLES, MESH_SUFFIXES, Mesh, read_mesh_arrays
 from adept_traj.scene.motion_laws import (
     FixedPose,
     MotionLaw,
     PendulumMotion,
 )
+from adept_traj.scene.recorded_motion import MAX_RECORDED_POSES, RecordedMotion, read_pose_csv
 from adept_traj.scene.scene import (
     MAX_OBSTACLES,
     Obstacle,
@@ -40,16 +42,20 @@ from adept_traj.scene.shapes import (
 __all__ = [
     "MAX_MESH_TRIANGLES",
     "MAX_OBSTACLES",
+    "MAX_RECORDED_POSES",
     "MESH_SUFFIXES",
     "SHIPPED_SCENES",
     "Box",
     "Capsule",
     "Cylinder",
     "FixedPose",
+    "LinearMotion",
     "Mesh",
     "MotionLaw",
     "Obstacle",
     "PendulumMotion",
+    "RecordedMotion",
+    "RotationMotion",
     "Scene",
     "SceneFileNotFoundError",
     "Shape",
@@ -59,9 +65,11 @@ __all__ = [
     "pendulum_obstacles",
     "read_mesh_arrays",
     "read_paper_scene",
+    "read_pose_csv",
     "read_robot_files",
     "read_scene_file",
     "read_shipped_scene",
+    "rotation_about",
     "scene_from_dict",
     "scene_to_dict",
     "scene_to_toml",

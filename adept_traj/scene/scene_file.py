@@ -19,9 +19,15 @@ from typing import Any
 import numpy as np
 import tomli_w
 
-from adept_traj.errors import MeshFileError, SceneError, SceneFileNotFoundError
+from adept_traj.errors import SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
 from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
+from adept_traj.scene.machine_entries import (
+    MACHINE_LAWS,
+    motion_table,
+    parse_mesh_entry,
+    parse_motion_entry,
+)
 from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.scene import (
@@ -152,6 +158,9 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         if isinstance(ob.motion, FixedPose):
             obstacles.append(_fixed_obstacle_dict(ob, ob.motion))
             done.add(ob.name)
+        elif isinstance(ob.motion, MACHINE_LAWS):
+            obstacles.append(_moving_obstacle_dict(ob))
+            done.add(ob.name)
         elif isinstance(ob.motion, PendulumMotion):
             entry, rod, bob = _pendulum_dict(ob, ob.motion, by_name)
             pendulums.append(entry)
@@ -186,6 +195,12 @@ def write_scene_file(scene: Scene, path: str | os.PathLike[str]) -> Path:
 
 def _floats(values: Any) -> list[float]:
     return [float(v) + 0.0 for v in np.asarray(values).ravel()]  # + 0.0 turns -0.0 into 0.0
+
+
+def _moving_obstacle_dict(ob: Obstacle) -> dict[str, Any]:
+    entry = _fixed_obstacle_dict(ob, FixedPose(np.eye(4)))  # xyz, rpy: the offset
+    entry["motion"] = motion_table(ob.motion)
+    return entry
 
 
 def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
@@ -272,26 +287,10 @@ _SHAPE_KEYS = {
     "capsule": ("radius", "length"),
     "mesh": ("file", "scale"),
 }
-_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy")
+_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy", "motion")
 _PENDULUM_KEYS = (
     "name", "pivot", "length", "v0", "omega", "g", "swing_axis", "rod_radius", "bob_radius",
 )  # fmt: skip
-
-
-def _parse_mesh(node: Node, folder: Path) -> Mesh:
-    """The ``mesh`` shape of an obstacle entry: its ``file`` (relative to ``folder``) read
-    with its ``scale``; a missing or unreadable file is a MeshFileError naming both files."""
-    file = node["file"].string(nonempty=True)
-    scale_node = node["scale"]
-    if scale_node.present and isinstance(scale_node.value, list):
-        scale: Any = scale_node.array((3,), "[-]", minimum=0.0, strict=True)
-    else:
-        scale = scale_node.number("[-]", minimum=0.0, strict=True, default=1.0)
-    path = Path(file) if Path(file).is_absolute() else folder / file
-    try:
-        return Mesh.from_file(path, scale)
-    except MeshFileError as exc:
-        raise MeshFileError(str(node["file"].error(str(exc)))) from None
 
 
 def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
@@ -300,7 +299,7 @@ def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
     positive = {"minimum": 0.0, "strict": True}
     shape: Shape
     if kind == "mesh":
-        shape = _parse_mesh(node, folder)
+        shape = parse_mesh_entry(node, folder)
         xyz = node["xyz"].array((3,), "[m] (the mesh frame's origin)", default=np.zeros(3))
         rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
     elif kind == "box" and (node["min"].present or node["max"].present):
@@ -329,8 +328,11 @@ def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
             shape = node.build(cls, radius, node["length"].number("[m]", **positive))
         xyz = node["xyz"].array((3,), "[m] (the centre)")
         rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
-    motion = node.build(FixedPose, transform_from_xyz_rpy(xyz, rpy))
-    return node.build(Obstacle, name, shape, motion)
+    pose = transform_from_xyz_rpy(xyz, rpy)
+    if node["motion"].present:  # xyz, rpy: the pose in the moving frame
+        motion = parse_motion_entry(node["motion"], folder)
+        return node.build(Obstacle, name, shape, motion, pose)
+    return node.build(Obstacle, name, shape, node.build(FixedPose, pose))
 
 
 def _parse_pendulum(name: str, node: Node) -> tuple[Obstacle, Obstacle]:
