@@ -27,11 +27,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _timing import load_average  # noqa: E402
-from cell_scene import cell_scene  # noqa: E402
+from _timing import load_average
+from cell_scene import cell_scene
 
-import adept_traj as at  # noqa: E402
-from adept_traj.scene import (  # noqa: E402
+import adept_traj as at
+from adept_traj.scene import (
     Box,
     FixedPose,
     LinearMotion,
@@ -41,8 +41,8 @@ from adept_traj.scene import (  # noqa: E402
     RotationMotion,
     Scene,
 )
-from adept_traj.testing.cad_meshes import box_mesh  # noqa: E402
-from adept_traj.transforms import transform_from_xyz_rpy  # noqa: E402
+from adept_traj.testing.cad_meshes import box_mesh
+from adept_traj.transforms import transform_from_xyz_rpy
 
 
 def mesh_cell(subdivisions: int = 7) -> Scene:
@@ -105,7 +105,7 @@ def main() -> None:
     cloud_note = ""
     if not args.no_cloud:
         try:
-            from bench_cloud import cloud_scene  # noqa: PLC0415
+            from bench_cloud import cloud_scene
 
             t1 = time.perf_counter()
             scene = cloud_scene(paper)
