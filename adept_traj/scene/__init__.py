@@ -11,6 +11,7 @@ from adept_traj.scene.motion_laws import (
     MotionLaw,
     PendulumMotion,
 )
+from adept_traj.scene.point_clouds import CLOUD_SUFFIXES, PointCloud, cloud_bytes, read_cloud_points
 from adept_traj.scene.recorded_motion import MAX_RECORDED_POSES, RecordedMotion, read_pose_csv
 from adept_traj.scene.scene import (
     MAX_OBSTACLES,
@@ -18,6 +19,7 @@ from adept_traj.scene.scene import (
     Scene,
     check_obstacle_count,
     pendulum_obstacles,
+    scene_notes,
 )
 from adept_traj.scene.scene_file import (
     SHIPPED_SCENES,
@@ -40,6 +42,7 @@ from adept_traj.scene.shapes import (
 )
 
 __all__ = [
+    "CLOUD_SUFFIXES",
     "MAX_MESH_TRIANGLES",
     "MAX_OBSTACLES",
     "MAX_RECORDED_POSES",
@@ -54,6 +57,7 @@ __all__ = [
     "MotionLaw",
     "Obstacle",
     "PendulumMotion",
+    "PointCloud",
     "RecordedMotion",
     "RotationMotion",
     "Scene",
@@ -61,8 +65,10 @@ __all__ = [
     "Shape",
     "Sphere",
     "check_obstacle_count",
+    "cloud_bytes",
     "coal_transform",
     "pendulum_obstacles",
+    "read_cloud_points",
     "read_mesh_arrays",
     "read_paper_scene",
     "read_pose_csv",
@@ -71,6 +77,7 @@ __all__ = [
     "read_shipped_scene",
     "rotation_about",
     "scene_from_dict",
+    "scene_notes",
     "scene_to_dict",
     "scene_to_toml",
     "write_scene_file",

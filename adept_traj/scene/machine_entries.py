@@ -10,14 +10,23 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.errors import MeshFileError, MotionFileError, SceneError
+from adept_traj.errors import MeshFileError, MotionFileError, ResourceLimitError, SceneError
 from adept_traj.scene.machine_motions import LinearMotion, RotationMotion
 from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import MotionLaw
+from adept_traj.scene.point_clouds import PointCloud
 from adept_traj.scene.recorded_motion import RecordedMotion
 from adept_traj.schema import Node
 
-__all__ = ["MACHINE_LAWS", "MOTION_KEYS", "motion_table", "parse_mesh_entry", "parse_motion_entry"]
+__all__ = [
+    "MACHINE_LAWS",
+    "MOTION_KEYS",
+    "file_shape_fields",
+    "motion_table",
+    "parse_cloud_entry",
+    "parse_mesh_entry",
+    "parse_motion_entry",
+]
 
 #: The motion laws a scene file writes as an obstacle's ``motion`` table.
 MACHINE_LAWS = (LinearMotion, RotationMotion, RecordedMotion)
@@ -96,3 +105,34 @@ def parse_motion_entry(node: Node, folder: Path) -> MotionLaw:
         return RecordedMotion.from_csv(path, periodic=periodic)
     except MotionFileError as exc:
         raise MotionFileError(str(node["file"].error(str(exc)))) from None
+
+
+def parse_cloud_entry(node: Node, folder: Path) -> PointCloud:
+    """The ``cloud`` shape of an obstacle entry: its ``file`` (relative to ``folder``) at
+    the octree ``resolution`` [m]; a missing, unreadable or too large file is an error
+    naming both files."""
+    file = node["file"].string(nonempty=True)
+    resolution = node["resolution"].number("[m]", minimum=0.0, strict=True)
+    path = Path(file) if Path(file).is_absolute() else folder / file
+    try:
+        return PointCloud.from_file(path, resolution)
+    except MeshFileError as exc:
+        raise MeshFileError(str(node["file"].error(str(exc)))) from None
+    except ResourceLimitError as exc:
+        raise ResourceLimitError(str(node["file"].error(str(exc)))) from None
+
+
+def file_shape_fields(ob: Any) -> dict[str, Any] | None:
+    """The shape fields of an obstacle whose shape is read from a file (a mesh's ``file``
+    and ``scale``, a point cloud's ``file`` and ``resolution``), else None."""
+    shape = ob.shape
+    if not isinstance(shape, (Mesh, PointCloud)):
+        return None
+    if not shape.source:
+        raise SceneError(
+            f"obstacle {ob.name!r}: a {shape.kind} built from arrays (no file) cannot be "
+            "written to a scene file"
+        )
+    if isinstance(shape, Mesh):
+        return {"file": shape.source, "scale": _floats(shape.scale)}
+    return {"file": shape.source, "resolution": shape.resolution}

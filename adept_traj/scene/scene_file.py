@@ -24,11 +24,12 @@ from adept_traj.files import parse_toml, read_toml, write_text_atomic
 from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
 from adept_traj.scene.machine_entries import (
     MACHINE_LAWS,
+    file_shape_fields,
     motion_table,
+    parse_cloud_entry,
     parse_mesh_entry,
     parse_motion_entry,
 )
-from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.scene import (
     _BOB_SUFFIX,
@@ -205,13 +206,9 @@ def _moving_obstacle_dict(ob: Obstacle) -> dict[str, Any]:
 
 def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
     shape = ob.shape
-    if type(shape) is Mesh:
-        fields: dict[str, Any] = {"file": shape.source, "scale": _floats(shape.scale)}
-        if not shape.source:
-            raise SceneError(
-                f"obstacle {ob.name!r}: a mesh built from arrays (no file) cannot be written "
-                "to a scene file"
-            )
+    file_fields = file_shape_fields(ob)
+    if file_fields is not None:
+        fields: dict[str, Any] = file_fields
     elif type(shape) is Box:
         fields = {"size": _floats(shape.size)}
     elif type(shape) is Sphere:
@@ -286,6 +283,7 @@ _SHAPE_KEYS = {
     "cylinder": ("radius", "length"),
     "capsule": ("radius", "length"),
     "mesh": ("file", "scale"),
+    "cloud": ("file", "resolution"),
 }
 _OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy", "motion")
 _PENDULUM_KEYS = (
@@ -298,8 +296,8 @@ def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
     node.check_keys(_OBSTACLE_COMMON + _SHAPE_KEYS[kind])
     positive = {"minimum": 0.0, "strict": True}
     shape: Shape
-    if kind == "mesh":
-        shape = parse_mesh_entry(node, folder)
+    if kind in ("mesh", "cloud"):
+        shape = (parse_mesh_entry if kind == "mesh" else parse_cloud_entry)(node, folder)
         xyz = node["xyz"].array((3,), "[m] (the mesh frame's origin)", default=np.zeros(3))
         rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
     elif kind == "box" and (node["min"].present or node["max"].present):
