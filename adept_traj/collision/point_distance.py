@@ -64,7 +64,9 @@ def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarr
     if isinstance(shape, (Mesh, PointCloud)):  # a lower bound: the distance to its box
         lo, hi = shape.local_box
         c, h = 0.5 * (lo + hi), 0.5 * (hi - lo)
-        return _half_box_distance(h.tolist(), x - c[0], y - c[1], z - c[2])
+        box = _half_box_distance(h.tolist(), x - c[0], y - c[1], z - c[2])
+        field = shape.lower_bound(x, y, z) if isinstance(shape, PointCloud) else None
+        return box if field is None else np.maximum(box, field)
     raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
 
 

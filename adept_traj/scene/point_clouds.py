@@ -8,6 +8,14 @@ clearance certified against the octree holds for the points**, at the resolution
 (:attr:`PointCloud.guarantee`). The cloud has no inside (it samples surfaces); a robot solid
 overlapping an occupied cell is a collision (distance ≤ 0).
 
+**Broad phase.** Besides its bounding box, a cloud has a coarse distance field
+(:meth:`PointCloud.lower_bound`: cells of at least r, at most a million over the box, each
+with the distance from its centre to the nearest occupied cell's), so a robot near a cloud
+that surrounds it (a scanned fence) is bounded away from it without a coal call. Where a
+solid comes within the checker's influence distance of the cells, coal's octree distance
+is called: 0.3–12 ms a call on 10⁶ points (``docs/scene-files.md``), 100× a primitive
+pair, so a dense cloud right at the path is slow to plan against.
+
 Files: ``.ply`` (ASCII or binary, the vertex element's x, y, z), ``.pcd`` (ASCII or binary,
 fields x, y, z), ``.xyz`` (text, the first three numbers of each line), ``.npy`` ((n, 3)
 floats). The number of points is read from the header before the data, and a cloud whose
@@ -40,6 +48,9 @@ CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".npy")
 #: octree (at most 480 B per point measured, for points each in a cell of its own).
 _BYTES_PER_POINT = 48 + 600
 
+#: Most cells of a cloud's coarse distance field (4 MB of float32).
+_FIELD_CELLS = 1_000_000
+
 
 def cloud_bytes(n_points: int) -> int:
     """Memory [B] a cloud of ``n_points`` points may need (arrays and octree)."""
@@ -71,6 +82,7 @@ class PointCloud(Shape):
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "_lo", p.min(axis=0) - r)  # cells reach r beyond a point
         object.__setattr__(self, "_hi", p.max(axis=0) + r)
+        object.__setattr__(self, "_field", _coarse_field(p, r, self._lo, self._hi))  # type: ignore[attr-defined]
 
     @classmethod
     def from_file(
@@ -104,9 +116,50 @@ class PointCloud(Shape):
         far = np.sqrt(np.einsum("ij,ij->i", self.points, self.points).max())
         return float(far + self.resolution * math.sqrt(3.0))
 
+    def lower_bound(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray | None:
+        """A lower bound [m] of the distance of points (x, y, z) (...) in the cloud frame to
+        the occupied cells, from the coarse distance field (module docstring); None when
+        the cloud has no field (it fits in a few coarse cells)."""
+        field = self._field  # type: ignore[attr-defined]
+        if field is None:
+            return None
+        origin, step, dist, slack = field
+        shape = np.array(dist.shape)
+        cell = [np.floor((c - o) / step) for c, o in zip((x, y, z), origin)]
+        inside = np.ones(np.shape(cell[0]), dtype=bool)
+        for c, n in zip(cell, shape):
+            inside &= (c >= 0) & (c < n)
+        idx = [np.clip(c, 0, n - 1).astype(np.int64) for c, n in zip(cell, shape)]
+        return np.where(inside, dist[idx[0], idx[1], idx[2]] - slack, -np.inf)
+
     def to_coal(self) -> coal.OcTree:
         """A new ``coal.OcTree`` of the points at the resolution (``coal.makeOctree``)."""
         return coal.makeOctree(np.array(self.points), self.resolution)
+
+
+def _coarse_field(points: np.ndarray, r: float, lo: np.ndarray, hi: np.ndarray) -> Any:
+    r"""The coarse distance field of a cloud: cubic cells of edge :math:`h` (the smallest
+    multiple of r for at most :data:`_FIELD_CELLS` cells over the box), marked occupied
+    where a point is, and each cell's Euclidean distance :math:`e` [m] between its centre
+    and the nearest occupied cell's centre (``scipy.ndimage.distance_transform_edt``). A
+    point p in cell c is at least :math:`e_c - h\sqrt 3 - r\sqrt 3` from every occupied
+    octree cell (p is within :math:`h\sqrt3/2` of c's centre, every occupied octree cell
+    within :math:`h\sqrt 3 / 2 + r\sqrt 3` of an occupied coarse cell's centre); the field
+    covers the box (a point outside it gets no bound from it, ``-inf``). ``(origin (3,), h,
+    e (nx, ny, nz) float32, slack)`` or None for a cloud of a few cells."""
+    extent = hi - lo
+    h = r * max(1.0, math.ceil((float(np.prod(extent)) / _FIELD_CELLS) ** (1.0 / 3.0) / r))
+    dims = np.maximum(np.ceil(extent / h).astype(np.int64), 1)
+    if int(np.prod(dims)) < 8:
+        return None
+    from scipy.ndimage import distance_transform_edt
+
+    cells = np.minimum(((points - lo) / h).astype(np.int64), dims - 1)
+    free = np.ones(tuple(dims.tolist()), dtype=bool)
+    free[cells[:, 0], cells[:, 1], cells[:, 2]] = False
+    dist = (distance_transform_edt(free) * h).astype(np.float32)
+    slack = h * math.sqrt(3.0) + r * math.sqrt(3.0) + 1e-6  # + float32 rounding of e
+    return lo.copy(), h, dist, slack
 
 
 def read_cloud_points(path: str | os.PathLike[str], *, budget: int | None = None) -> np.ndarray:
