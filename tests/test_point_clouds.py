@@ -170,3 +170,17 @@ def test_scene_file_cloud_and_the_stated_resolution(tmp_path, points):
     (tmp_path / "bad.toml").write_text(text.replace("scan.npy", "gone.npy"), "utf-8")
     with pytest.raises(MeshFileError, match=r"bad\.toml.*gone\.npy"):
         Scene.from_file(tmp_path / "bad.toml")
+
+
+def test_meshcat_draws_a_subsample_of_a_large_cloud():
+    import meshcat.geometry as mg
+
+    from adept_traj.viz.meshcat_geometry import MAX_DRAWN_POINTS, shape_parts
+
+    rng = np.random.default_rng(3)
+    cloud = PointCloud(rng.uniform(size=(250_001, 3)), 0.01)
+    (part,) = shape_parts(cloud, mg.MeshLambertMaterial())
+    drawn = np.asarray(part.obj.geometry.position)
+    assert drawn.shape == (3, 83_334)
+    assert drawn.shape[1] <= MAX_DRAWN_POINTS
+    np.testing.assert_allclose(drawn.T, cloud.points[::3], atol=1e-7)  # float32

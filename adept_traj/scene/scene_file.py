@@ -57,9 +57,10 @@ __all__ = [
 ]
 
 #: The scenes shipped in ``adept_traj/data/scenes/``: the paper's
-#: (``docs/paper-scenario.md``) and a harder one where the obstacles bind the fastest moves
-#: (``docs/detour-scene.md``).
-SHIPPED_SCENES = ("paper", "detour")
+#: (``docs/paper-scenario.md``), a harder one where the obstacles bind the fastest moves
+#: (``docs/detour-scene.md``) and a work cell of CAD meshes and moving machines
+#: (``docs/example-cell.md``).
+SHIPPED_SCENES = ("paper", "detour", "cell")
 
 #: First lines of a written scene file (TOML comments; tomli-w writes none).
 _HEADER = (
