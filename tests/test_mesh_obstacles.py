@@ -315,14 +315,13 @@ def test_mesh_and_box_agree_on_a_box_mesh():
 
 
 def test_meshcat_and_wireframe_of_a_mesh(star):
-    import meshcat.geometry as mg
-
+    from adept_traj.viz import meshcat_geometry  # its meshcat import filters a warning
     from adept_traj.viz.meshcat_geometry import shape_parts
     from adept_traj.viz.plots.wireframes import shape_wireframe
 
     v, tris = star
     mesh = Mesh(v, tris)
-    (part,) = shape_parts(mesh, mg.MeshLambertMaterial())
+    (part,) = shape_parts(mesh, meshcat_geometry.mg.MeshLambertMaterial())
     np.testing.assert_allclose(np.asarray(part.obj.geometry.vertices), v, atol=1e-7)  # float32
     np.testing.assert_array_equal(np.asarray(part.obj.geometry.faces), tris)
     lines = np.concatenate(shape_wireframe(mesh, np.eye(4)))  # its bounding box's edges

@@ -173,13 +173,12 @@ def test_scene_file_cloud_and_the_stated_resolution(tmp_path, points):
 
 
 def test_meshcat_draws_a_subsample_of_a_large_cloud():
-    import meshcat.geometry as mg
-
+    from adept_traj.viz import meshcat_geometry  # its meshcat import filters a warning
     from adept_traj.viz.meshcat_geometry import MAX_DRAWN_POINTS, shape_parts
 
     rng = np.random.default_rng(3)
     cloud = PointCloud(rng.uniform(size=(250_001, 3)), 0.01)
-    (part,) = shape_parts(cloud, mg.MeshLambertMaterial())
+    (part,) = shape_parts(cloud, meshcat_geometry.mg.MeshLambertMaterial())
     drawn = np.asarray(part.obj.geometry.position)
     assert drawn.shape == (3, 83_334)
     assert drawn.shape[1] <= MAX_DRAWN_POINTS
