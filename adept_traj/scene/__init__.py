@@ -13,6 +13,7 @@ from adept_traj.scene.motion_laws import (
 )
 from adept_traj.scene.point_clouds import CLOUD_SUFFIXES, PointCloud, cloud_bytes, read_cloud_points
 from adept_traj.scene.recorded_motion import MAX_RECORDED_POSES, RecordedMotion, read_pose_csv
+from adept_traj.scene.robot_motion import JointTrajectory, RobotSolidMotion, robot_obstacles
 from adept_traj.scene.scene import (
     MAX_OBSTACLES,
     Obstacle,
@@ -52,6 +53,7 @@ __all__ = [
     "Capsule",
     "Cylinder",
     "FixedPose",
+    "JointTrajectory",
     "LinearMotion",
     "Mesh",
     "MotionLaw",
@@ -59,6 +61,7 @@ __all__ = [
     "PendulumMotion",
     "PointCloud",
     "RecordedMotion",
+    "RobotSolidMotion",
     "RotationMotion",
     "Scene",
     "SceneFileNotFoundError",
@@ -75,6 +78,7 @@ __all__ = [
     "read_robot_files",
     "read_scene_file",
     "read_shipped_scene",
+    "robot_obstacles",
     "rotation_about",
     "scene_from_dict",
     "scene_notes",

@@ -11,12 +11,16 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import MeshFileError, MotionFileError, ResourceLimitError, SceneError
+from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
 from adept_traj.scene.machine_motions import LinearMotion, RotationMotion
 from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import MotionLaw
 from adept_traj.scene.point_clouds import PointCloud
 from adept_traj.scene.recorded_motion import RecordedMotion
+from adept_traj.scene.robot_motion import JointTrajectory, RobotSolidMotion, robot_obstacles
+from adept_traj.scene.scene import Obstacle
 from adept_traj.schema import Node
+from adept_traj.transforms import transform_from_xyz_rpy, xyz_rpy_from_transform
 
 __all__ = [
     "MACHINE_LAWS",
@@ -26,6 +30,8 @@ __all__ = [
     "parse_cloud_entry",
     "parse_mesh_entry",
     "parse_motion_entry",
+    "parse_robot_motion_entry",
+    "robot_motion_table",
 ]
 
 #: The motion laws a scene file writes as an obstacle's ``motion`` table.
@@ -136,3 +142,40 @@ def file_shape_fields(ob: Any) -> dict[str, Any] | None:
     if isinstance(shape, Mesh):
         return {"file": shape.source, "scale": _floats(shape.scale)}
     return {"file": shape.source, "resolution": shape.resolution}
+
+
+def parse_robot_motion_entry(name: str, node: Node, folder: Path) -> tuple[Obstacle, ...]:
+    """A ``[[robot_motion]]`` entry: another robot (its files as in ``[robot]``; default
+    the AdeptOne XL) at ``xyz``/``rpy`` following the joint ``trajectory`` CSV (relative
+    to ``folder``): its collision solids as moving obstacles ``<name>.<solid>``."""
+    node.check_keys(("name", "xyz", "rpy", "trajectory", *ROBOT_FILE_KEYS))
+    base = transform_from_xyz_rpy(
+        node["xyz"].array((3,), "[m]", default=np.zeros(3)),
+        node["rpy"].array((3,), "[rad]", default=np.zeros(3)),
+    )
+    file = node["trajectory"].string(nonempty=True)
+    path = Path(file) if Path(file).is_absolute() else folder / file
+    try:
+        trajectory = JointTrajectory.from_csv(path)
+    except MotionFileError as exc:
+        raise MotionFileError(str(node["trajectory"].error(str(exc)))) from None
+    source = RobotSource.from_table(node, folder)
+    return node.build(robot_obstacles, name, source, trajectory, base)
+
+
+def robot_motion_table(law: RobotSolidMotion) -> dict[str, Any]:
+    """The ``[[robot_motion]]`` table of the robot whose solid ``law`` moves."""
+    if not law.trajectory.source:
+        raise SceneError(f"robot {law.group!r}: a trajectory without a file cannot be written")
+    xyz, rpy = xyz_rpy_from_transform(law.base)
+    out: dict[str, Any] = {"name": law.group, "xyz": _floats(xyz), "rpy": _floats(rpy)}
+    out["trajectory"] = law.trajectory.source
+    src = law.source
+    for key in ("urdf", "params", "tool_frame", "srdf"):
+        if getattr(src, key) is not None:
+            out[key] = str(getattr(src, key))
+    if src.package_dirs:
+        out["package_dirs"] = [str(d) for d in src.package_dirs]
+    if src.locked_joints:
+        out["locked_joints"] = dict(src.locked_joints)
+    return out

@@ -29,8 +29,11 @@ from adept_traj.scene.machine_entries import (
     parse_cloud_entry,
     parse_mesh_entry,
     parse_motion_entry,
+    parse_robot_motion_entry,
+    robot_motion_table,
 )
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
+from adept_traj.scene.robot_motion import RobotSolidMotion
 from adept_traj.scene.scene import (
     _BOB_SUFFIX,
     _ROD_SUFFIX,
@@ -152,6 +155,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         out["allowed_contacts"] = [list(pair) for pair in scene.allowed_contacts]
     obstacles: list[dict[str, Any]] = []
     pendulums: list[dict[str, Any]] = []
+    robots: dict[str, dict[str, Any]] = {}
     by_name = {ob.name: ob for ob in scene.obstacles}
     done: set[str] = set()
     for ob in scene.obstacles:
@@ -159,6 +163,10 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
             continue
         if isinstance(ob.motion, FixedPose):
             obstacles.append(_fixed_obstacle_dict(ob, ob.motion))
+            done.add(ob.name)
+        elif isinstance(ob.motion, RobotSolidMotion):
+            if ob.motion.group not in robots:
+                robots[ob.motion.group] = robot_motion_table(ob.motion)
             done.add(ob.name)
         elif isinstance(ob.motion, MACHINE_LAWS):
             obstacles.append(_moving_obstacle_dict(ob))
@@ -176,6 +184,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         out["obstacle"] = obstacles
     if pendulums:
         out["pendulum"] = pendulums
+    if robots:
+        out["robot_motion"] = list(robots.values())
     return out
 
 
@@ -275,7 +285,7 @@ def _pendulum_dict(
 
 #: Errors of a scene file: SceneError naming the source (file) and the field path.
 _ERROR = error_factory(SceneError)
-_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "allowed_contacts")
+_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "robot_motion", "allowed_contacts")
 _ROBOT_KEYS = ("xyz", "rpy", *ROBOT_FILE_KEYS)
 _TASK_KEYS = ("start", "goal")
 _SHAPE_KEYS = {
@@ -382,6 +392,8 @@ def _parse_scene(data: Any, source: str, default_name: str, folder: Path) -> Sce
         obstacles.append(_parse_obstacle(entry_name, node, folder))
     for entry_name, node in top["pendulum"].named_tables():
         obstacles.extend(_parse_pendulum(entry_name, node))
+    for entry_name, node in top["robot_motion"].named_tables():
+        obstacles.extend(parse_robot_motion_entry(entry_name, node, folder))
     allowed = tuple(
         tuple(n.strings(min_items=2)) for n in top["allowed_contacts"].items(default=[])
     )
