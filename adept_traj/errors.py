@@ -19,7 +19,10 @@ __all__ = [
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
+    "MeshFileError",
     "MeshcatServerError",
+    "MotionFileError",
+    "OpenMeshWarning",
     "PlanningInterrupted",
     "ResourceLimitError",
     "ResultFormatError",
@@ -116,6 +119,23 @@ class ResultFormatError(AdeptTrajError, ValueError):
 
 class SceneFileNotFoundError(SceneError, FileNotFoundError):
     """A scene file does not exist (both a :class:`SceneError` and a FileNotFoundError)."""
+
+
+class MeshFileError(SceneError):
+    """A mesh or point-cloud file of a scene is missing, unreadable, empty or too large; the
+    message names the file and the problem."""
+
+
+class MotionFileError(SceneError):
+    """A recorded-motion (pose trajectory) CSV file of a scene is missing or malformed (a
+    non-monotonic time column, a bad number): the message names the file, the line and the
+    problem."""
+
+
+class OpenMeshWarning(UserWarning):
+    """A mesh obstacle is not closed (some edge is not shared by exactly two consistently
+    oriented triangles): it is treated as a thin surface, so a robot solid inside it is not
+    seen (``docs/scene-files.md``)."""
 
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):

@@ -41,13 +41,13 @@ def problems(detour: at.Scene) -> dict[str, at.TrajectoryProblem]:
 
 
 def test_shipped_scenes(detour: at.Scene) -> None:
-    assert SHIPPED_SCENES == ("paper", "detour")
+    assert SHIPPED_SCENES == ("paper", "detour", "cell")
     assert at.Scene.shipped("paper") == at.Scene.paper()
     assert detour.name == "detour"
     assert "post" in detour.names
     np.testing.assert_array_equal(detour.start, at.Scene.paper().start)
-    with pytest.raises(SceneError, match=r"one of paper, detour; got 'cell'"):
-        at.Scene.shipped("cell")
+    with pytest.raises(SceneError, match=r"one of paper, detour, cell; got 'shop'"):
+        at.Scene.shipped("shop")
 
 
 @pytest.mark.parametrize("factor", [1.0, 3.0])

@@ -24,10 +24,16 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
         ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
         ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
         ("ur5_around_a_box.py", ["--gens", "2", "--pop", "12"], "certified feasible"),
+        pytest.param(
+            "plan_cell.py",
+            ["--gens", "4", "--pop", "16"],
+            "distance continuous",
+            marks=pytest.mark.slow,  # ~8 s: plans, certifies and verifies the example cell
+        ),
     ],
 )
 def test_example_runs(script: str, args: list[str], expect: str, tmp_path: Path) -> None:
-    if script == "plan_paper.py":
+    if script in ("plan_paper.py", "plan_cell.py"):
         args = [*args, "--out", str(tmp_path / "out")]
     result = subprocess.run(
         [sys.executable, str(EXAMPLES / script), *args],
@@ -49,4 +55,6 @@ def test_every_example_is_tested() -> None:
         "custom_scene.py",
         "other_robot.py",
         "ur5_around_a_box.py",
+        "plan_cell.py",
+        "make_cell.py",  # writes the shipped meshes: tests/test_example_cell.py runs it
     }

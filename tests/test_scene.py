@@ -628,7 +628,7 @@ SIZE_1 = "field 'obstacle[0].size[1]': must be a finite number > 0 [m]; got"
             'shape = "cone"',
             [
                 "field 'obstacle[0].shape': must be one of 'box', 'sphere', 'cylinder', "
-                f"'capsule'; got the string 'cone' {IN_CUBE}"
+                f"'capsule', 'mesh', 'cloud'; got the string 'cone' {IN_CUBE}"
             ],
         ),
         ('shape = "box"\n', "", ["field 'obstacle[0].shape': missing; must be one of 'box'"]),

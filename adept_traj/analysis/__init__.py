@@ -15,6 +15,7 @@ from adept_traj.analysis.continuous import (
     DistanceGuarantee,
     continuous_distance,
     continuous_self_distance,
+    obstacle_jump_intervals,
     obstacle_speeds,
     solid_lever_arms,
 )
@@ -106,6 +107,7 @@ __all__ = [
     "normalised_hypervolume",
     "objective_bounds",
     "objective_weights",
+    "obstacle_jump_intervals",
     "obstacle_speeds",
     "optimizer_overhead",
     "problem_parts",

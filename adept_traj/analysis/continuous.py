@@ -36,6 +36,14 @@ follows from the exact acceleration bound :math:`A_j = \max_t |\ddot q_j|` of th
 obstacle's enclosing ball (0 for a fixed one; for the pendulum the largest swing rate times
 the distance from the swing axis plus the radius).
 
+**Obstacles whose pose jumps** (a conveyor's part wrapping around:
+:attr:`~adept_traj.scene.MotionLaw.jump_interval` finite): on an interval holding one jump
+at :math:`\tau`, the distance on :math:`[t_a, \tau)` is at least :math:`d(t_a) - L h` and
+on :math:`[\tau, t_b]` at least :math:`d(t_b) - L h`; so for those pairs the bound is the
+one-sided :math:`\min(d_a, d_b) - L h` on every interval (valid with or without a jump in
+it), and :math:`-\infty` on an interval longer than the jump interval (two jumps could
+hide a pose never sampled).
+
 **Refinement.** Intervals whose bound is below the margin while both ends clear it are
 bisected (one exact distance evaluation per pair at each midpoint), only those, up to
 ``max_depth`` times (default :data:`DEFAULT_MAX_DEPTH`: spacing :math:`h / 2^{10}`). The
@@ -64,6 +72,7 @@ __all__ = [
     "DistanceGuarantee",
     "continuous_distance",
     "continuous_self_distance",
+    "obstacle_jump_intervals",
     "obstacle_speeds",
     "solid_lever_arms",
 ]
@@ -117,6 +126,13 @@ def obstacle_speeds(problem: TrajectoryProblem) -> np.ndarray:
     ).reshape(len(obstacles))
 
 
+def obstacle_jump_intervals(problem: TrajectoryProblem) -> np.ndarray:
+    """(n_obstacles,) shortest time [s] between two jumps of each obstacle's pose
+    (:attr:`~adept_traj.scene.MotionLaw.jump_interval`; ``inf``: continuous)."""
+    obstacles = problem.scene.obstacles
+    return np.array([ob.motion.jump_interval for ob in obstacles]).reshape(len(obstacles))
+
+
 #: (lever arms (n_solids, nq), obstacle speeds (n_obstacles,)) of each problem, read-only:
 #: they depend on the robot and the scene alone, and a front certifies hundreds of moves of
 #: one problem (computing them took ≈ 1 ms per certificate).
@@ -146,16 +162,25 @@ def _interval_bounds(
     arms: np.ndarray,
     acc: np.ndarray,
     speeds: np.ndarray,
+    jumps: np.ndarray | None = None,
 ) -> np.ndarray:
     """Per interval and pair, the lower bound (m, ns, no) [m] of the module docstring, from
-    the end distances (m, ns, no), joint speeds (m, nq) and lengths h (m,)."""
+    the end distances (m, ns, no), joint speeds (m, nq) and lengths h (m,); ``jumps``
+    (no,): each obstacle's :attr:`~adept_traj.scene.MotionLaw.jump_interval` [s] (None:
+    every pose continuous)."""
     qd_bar = 0.5 * (np.abs(qd_a) + np.abs(qd_b) + acc * h[:, None])  # (m, nq)
     v = qd_bar @ arms.T  # (m, ns)
     lipschitz = v[:, :, None] + speeds[None, None, :]
     lipschitz *= h[:, None, None]
     low = d_a + d_b
+    if jumps is not None:  # one-sided bounds for the obstacles whose pose jumps
+        j = np.flatnonzero(np.isfinite(jumps))
+        one_sided = np.minimum(d_a[..., j], d_b[..., j]) - lipschitz[..., j]
+        one_sided = np.where(h[:, None, None] > jumps[j], -np.inf, one_sided)  # ≥ 2 jumps
     low -= lipschitz
     low *= 0.5  # the same operations in the same order as ½(d_a + d_b − L h), in place
+    if jumps is not None:
+        low[..., j] = one_sided
     return low
 
 
@@ -211,7 +236,11 @@ def _continuous_distance(
         return checker.distances(q[None], t_m[None], exact=exact).distance[0]
 
     arms, speeds = _rates(problem)
-    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
+    jumps = obstacle_jump_intervals(problem)
+    return _bisect(
+        problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc,
+        jumps if np.isfinite(jumps).any() else None,
+    )  # fmt: skip
 
 
 def continuous_self_distance(
@@ -270,6 +299,7 @@ def _bisect(
     speeds: np.ndarray,
     distances: Callable[[np.ndarray, np.ndarray], np.ndarray],
     acc: np.ndarray,
+    jumps: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """The refinement of :func:`continuous_distance` for distances ``pairs`` (n, ns, no) at
     ``t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,), the exact acceleration
@@ -285,7 +315,7 @@ def _bisect(
     lower = math.inf
     depth = n_refined = 0
     while len(t_a):
-        low = _interval_bounds(d_a, d_b, v_a, v_b, t_b - t_a, arms, acc, speeds)
+        low = _interval_bounds(d_a, d_b, v_a, v_b, t_b - t_a, arms, acc, speeds, jumps)
         per = low.reshape(len(low), -1).min(axis=1)
         ok = per >= margin
         if ok.any():

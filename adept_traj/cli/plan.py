@@ -59,7 +59,7 @@ from adept_traj.optimise import (
 )
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
-from adept_traj.scene import SHIPPED_SCENES
+from adept_traj.scene import SHIPPED_SCENES, scene_notes
 from adept_traj.validation import as_integer
 from adept_traj.viz.finisher import Finisher
 
@@ -349,6 +349,8 @@ def _finish(
     else:
         _write_outputs(result, folder, opts, replay)
     print(summary(result, folder))
+    for note in scene_notes(problem.scene):
+        print(f"  obstacle {note}")
     code = status.OK
     if opts.ros is not None:
         code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)

@@ -33,6 +33,7 @@ from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.results import PlanningResult, audit
 from adept_traj.robot import JointLimits
+from adept_traj.scene import scene_notes
 
 __all__ = ["add_parser", "run"]
 
@@ -99,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
         print(f"  violation: {violation}")
+    for note in scene_notes(problem.scene):
+        print(f"  obstacle {note}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")
     for mismatch in found.mismatches:

@@ -56,6 +56,7 @@ import coal
 import numpy as np
 
 from adept_traj.collision.distance_table import DistanceTable, table_bounds
+from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.point_distance import (
     obstacle_signed_distance,
     point_signed_distance,
@@ -217,11 +218,10 @@ class BroadPhase:
         if self.closed_form[k, o]:
             return float(self.closed_form_distance(solid_pose[None], obstacle_pose, k, o)[0])
         request, result = distance_request(), coal.DistanceResult()
+        functor = distance_functor(geometry, self.obstacle_geometry[o], self.obstacle_shape[o])
         return float(
-            coal.distance(
-                geometry,
+            functor(
                 coal.Transform3s(solid_pose[:3, :3], solid_pose[:3, 3]),
-                self.obstacle_geometry[o],
                 coal.Transform3s(obstacle_pose[:3, :3], obstacle_pose[:3, 3]),
                 request,
                 result,

@@ -22,6 +22,7 @@ import numpy as np
 
 from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
+from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
 from adept_traj.errors import InputShapeError, InvalidInputError
@@ -119,8 +120,9 @@ class CollisionChecker:
         ]
         self.allowed = np.array(pairs, dtype=bool).reshape(len(objects), len(self.obstacle_names))
         self._robot_geoms = [g.geometry for g in objects]
+        shapes = self._broad.obstacle_shape  # a closed mesh's functor tests the inside too
         self._functors = [
-            [coal.ComputeDistance(g, o) for o in self._broad.obstacle_geometry]
+            [distance_functor(g, o, sh) for o, sh in zip(self._broad.obstacle_geometry, shapes)]
             for g in self._robot_geoms
         ]
         self._request = distance_request()

@@ -7,7 +7,8 @@ own frame; :func:`signed_distance_xyz` is the same with the coordinates as separ
 :func:`obstacle_signed_distance` with the points in the robot base frame and the obstacle
 at a (possibly moving) pose. :func:`points_in_joint` maps points fixed in a joint frame to
 the base frame at many samples at once. The broad phase bounds solid–obstacle distances
-with them (enclosing balls, covering spheres) and computes sphere obstacles exactly. Each
+with them (enclosing balls, covering spheres) and computes sphere obstacles exactly; a mesh
+or a point cloud gets the signed distance to its bounding box, a lower bound. Each
 is a few elementwise numpy operations on whole arrays, exact to rounding (~1e-16 m).
 """
 
@@ -16,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
+from adept_traj.scene.meshes import Mesh
+from adept_traj.scene.point_clouds import PointCloud
 from adept_traj.scene.shapes import Box, Capsule, Cylinder, Sphere
 
 __all__ = [
@@ -58,13 +61,24 @@ def signed_distance_xyz(shape: object, x: np.ndarray, y: np.ndarray, z: np.ndarr
         half = 0.5 * shape.length
         dz = z - np.clip(z, -half, half)
         return _norm3(x, y, dz) - shape.radius
+    if isinstance(shape, (Mesh, PointCloud)):  # a lower bound: the distance to its box
+        lo, hi = shape.local_box
+        c, h = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        box = _half_box_distance(h.tolist(), x - c[0], y - c[1], z - c[2])
+        field = shape.lower_bound(x, y, z) if isinstance(shape, PointCloud) else None
+        return box if field is None else np.maximum(box, field)
     raise InvalidInputError(f"no point distance for obstacle shape {type(shape).__name__}")
 
 
 def _box_distance(shape: Box, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Signed distance [m] of points (x, y, z) (...) in the box's frame; the same
     operations as the formula of :func:`point_signed_distance`, on few temporaries."""
-    hx, hy, hz = (0.5 * float(v) for v in shape.size)
+    return _half_box_distance([0.5 * float(v) for v in shape.size], x, y, z)
+
+
+def _half_box_distance(half: list[float], x: np.ndarray, y: np.ndarray, z: np.ndarray):
+    """:func:`_box_distance` of the centred box of half sides ``half`` (3,) [m]."""
+    hx, hy, hz = half
     shape_xyz = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z))
     ex, ey, ez = (np.abs(v, out=np.empty(shape_xyz)) for v in (x, y, z))
     ex -= hx

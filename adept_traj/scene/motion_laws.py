@@ -28,12 +28,14 @@ __all__ = [
     "FixedPose",
     "MotionLaw",
     "PendulumMotion",
+    "as_times",
+    "check_ball",
 ]
 
 _EZ = np.array([0.0, 0.0, 1.0])
 
 
-def _as_times(t: Any) -> np.ndarray:
+def as_times(t: Any) -> np.ndarray:
     """Return times ``t`` (any shape) [s] as a new finite float64 array."""
     return as_finite_array(t, "t")
 
@@ -88,7 +90,7 @@ class MotionLaw(_ValueObject, ABC):
         if pts.ndim < 1 or pts.shape[-1] != 3:
             raise InvalidInputError(f"points must have shape (..., 3) [m]; got shape {pts.shape}")
         try:
-            times = np.broadcast_to(_as_times(t), pts.shape[:-1])
+            times = np.broadcast_to(as_times(t), pts.shape[:-1])
         except ValueError:
             raise InvalidInputError(f"t must broadcast to points' shape {pts.shape[:-1]}") from None
         return self._point_velocity(times, pts)
@@ -101,6 +103,15 @@ class MotionLaw(_ValueObject, ABC):
             for f in (self.pose(t + h), self.pose(t - h))
         )
         return (p - m) / (2.0 * h)
+
+    @property
+    def jump_interval(self) -> float:
+        """Shortest time [s] between two instants where the pose jumps (``inf``: the pose is
+        continuous in t, as for every law but a wrapping
+        :class:`~adept_traj.scene.LinearMotion`). Between jumps every point moves at most
+        at :meth:`max_point_speed`; the continuous certificate bounds an interval holding
+        one jump from each end separately."""
+        return math.inf
 
     @abstractmethod
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
@@ -116,7 +127,8 @@ class MotionLaw(_ValueObject, ABC):
         """
 
 
-def _check_ball(point: Any, radius: Any) -> tuple[np.ndarray, float]:
+def check_ball(point: Any, radius: Any) -> tuple[np.ndarray, float]:
+    """A ball's centre (3,) [m] and radius [m] ≥ 0, checked."""
     return as_vector(point, "point", 3, "[m]"), as_scalar(radius, "radius", "[m]", minimum=0.0)
 
 
@@ -145,7 +157,7 @@ class FixedPose(MotionLaw):
 
     def pose(self, t: Any) -> np.ndarray:
         """The constant transform, repeated: (..., 4, 4) for times ``t`` of shape (...) [s]."""
-        times = _as_times(t)
+        times = as_times(t)
         return np.broadcast_to(self.transform, (*times.shape, 4, 4)).copy()
 
     @property
@@ -157,7 +169,7 @@ class FixedPose(MotionLaw):
         self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0
     ) -> tuple[np.ndarray, float]:
         """The attached ball itself, in world coordinates: ((3,) centre [m], radius [m])."""
-        p, r = _check_ball(point, radius)
+        p, r = check_ball(point, radius)
         return self.transform[:3, :3] @ p + self.transform[:3, 3], r
 
     def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -165,7 +177,7 @@ class FixedPose(MotionLaw):
 
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
         """0 [m/s]: nothing moves (the arguments are checked as for every law)."""
-        _check_ball(point, radius)
+        check_ball(point, radius)
         return 0.0
 
 
@@ -304,13 +316,13 @@ class PendulumMotion(MotionLaw):
         Returns:
             (...) angles [rad], ``φ = sign(cos ω t) · arccos(1 − h/l) = 2 arcsin(a cos ω t)``.
         """
-        times = _as_times(t)
+        times = as_times(t)
         s = np.clip(self._amplitude_factor * np.cos(self.omega * times), -1.0, 1.0)
         return 2.0 * np.arcsin(s)
 
     def speed(self, t: Any) -> np.ndarray:
         """Prescribed bob speed ``v(t) = v0 · sin(ω t)`` [m/s] for times ``t`` (...) [s]."""
-        return self.v0 * np.sin(self.omega * _as_times(t))
+        return self.v0 * np.sin(self.omega * as_times(t))
 
     def height(self, t: Any) -> np.ndarray:
         """Height of the bob above its lowest point, ``(v0² − v²) / (2 g)`` [m]; (...)."""
@@ -323,7 +335,7 @@ class PendulumMotion(MotionLaw):
         .. math::
             \dot\varphi = \frac{-2 a \omega \sin \omega t}{\sqrt{1 - a^2 \cos^2 \omega t}}.
         """
-        wt = self.omega * _as_times(t)
+        wt = self.omega * as_times(t)
         a = min(1.0, self._amplitude_factor)
         c = np.cos(wt)
         root = np.sqrt(np.maximum(1.0 - a * a * c * c, np.finfo(float).tiny))
@@ -375,7 +387,7 @@ class PendulumMotion(MotionLaw):
         and radius ``ρ · sin φ_max``; beyond, the circle's centre and radius ρ are used.
         Valid for all t since ``|φ(t)| ≤ φ_max`` always.
         """
-        p, r = _check_ball(point, radius)
+        p, r = check_ball(point, radius)
         a, b, c = p
         axis_point = self.pivot + b * self.normal_axis
         rest = a * self.swing_axis + c * _EZ  # rest position relative to axis_point
@@ -396,5 +408,5 @@ class PendulumMotion(MotionLaw):
 
         for the ball of centre ``(a, b, c)`` and radius ``r`` (:attr:`max_angular_speed`).
         """
-        p, r = _check_ball(point, radius)
+        p, r = check_ball(point, radius)
         return self.max_angular_speed * (math.hypot(p[0], p[2]) + r)

@@ -18,12 +18,21 @@ import numpy as np
 import pinocchio as pin
 
 from adept_traj.errors import InputShapeError, InvalidInputError, ResourceLimitError, SceneError
+from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
+from adept_traj.scene.point_clouds import PointCloud
 from adept_traj.scene.shapes import Cylinder, Shape, Sphere, _ValueObject
 from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
 from adept_traj.validation import as_finite_array, check_type, readonly_copy
 
-__all__ = ["MAX_OBSTACLES", "Obstacle", "Scene", "check_obstacle_count", "pendulum_obstacles"]
+__all__ = [
+    "MAX_OBSTACLES",
+    "Obstacle",
+    "Scene",
+    "check_obstacle_count",
+    "pendulum_obstacles",
+    "scene_notes",
+]
 
 #: Most obstacles a scene may hold (a pendulum counts as its two obstacles). Every
 #: evaluation computes robot–obstacle distances for every pair (and the dense certificate
@@ -132,6 +141,19 @@ def pendulum_obstacles(
         transform_from_xyz_rpy((0.0, 0.0, -length)),
     )
     return rod, bob
+
+
+def scene_notes(scene: Scene) -> tuple[str, ...]:
+    """What a distance certificate means for the scene's obstacles that are not exact solids,
+    one line each: a point cloud's octree resolution (its guarantee), an open mesh (a thin
+    surface, no inside test). Printed with every certificate by ``adept-traj verify``."""
+    notes = []
+    for ob in scene.obstacles:
+        if isinstance(ob.shape, PointCloud):
+            notes.append(f"{ob.name!r} ({ob.shape.n_points} points): {ob.shape.guarantee}")
+        elif isinstance(ob.shape, Mesh) and not ob.shape.closed:
+            notes.append(f"{ob.name!r}: open mesh, a thin surface (a solid inside it is not seen)")
+    return tuple(notes)
 
 
 def check_obstacle_count(n: int, source: str = "scene") -> int:

@@ -22,7 +22,18 @@ import tomli_w
 from adept_traj.errors import SceneError, SceneFileNotFoundError
 from adept_traj.files import parse_toml, read_toml, write_text_atomic
 from adept_traj.robot import ROBOT_FILE_KEYS, RobotSource
+from adept_traj.scene.machine_entries import (
+    MACHINE_LAWS,
+    file_shape_fields,
+    motion_table,
+    parse_cloud_entry,
+    parse_mesh_entry,
+    parse_motion_entry,
+    parse_robot_motion_entry,
+    robot_motion_table,
+)
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
+from adept_traj.scene.robot_motion import RobotSolidMotion
 from adept_traj.scene.scene import (
     _BOB_SUFFIX,
     _ROD_SUFFIX,
@@ -49,9 +60,10 @@ __all__ = [
 ]
 
 #: The scenes shipped in ``adept_traj/data/scenes/``: the paper's
-#: (``docs/paper-scenario.md``) and a harder one where the obstacles bind the fastest moves
-#: (``docs/detour-scene.md``).
-SHIPPED_SCENES = ("paper", "detour")
+#: (``docs/paper-scenario.md``), a harder one where the obstacles bind the fastest moves
+#: (``docs/detour-scene.md``) and a work cell of CAD meshes and moving machines
+#: (``docs/example-cell.md``).
+SHIPPED_SCENES = ("paper", "detour", "cell")
 
 #: First lines of a written scene file (TOML comments; tomli-w writes none).
 _HEADER = (
@@ -73,7 +85,7 @@ def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
-    return _parse_scene(data, str(p), p.stem or "scene")
+    return _parse_scene(data, str(p), p.stem or "scene", p.parent)
 
 
 def read_robot_files(path: str | os.PathLike[str]) -> RobotSource:
@@ -87,7 +99,7 @@ def read_robot_files(path: str | os.PathLike[str]) -> RobotSource:
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
-    _parse_scene(data, str(p), p.stem or "scene")  # the whole file is checked
+    _parse_scene(data, str(p), p.stem or "scene", p.parent)  # the whole file is checked
     return RobotSource.from_table(Node(data, str(p), _ERROR)["robot"], p.parent)
 
 
@@ -101,7 +113,8 @@ def read_shipped_scene(name: str) -> Scene:
         raw = resources.files("adept_traj.data").joinpath("scenes", f"{name}.toml").read_bytes()
     except OSError as exc:
         raise SceneError(f"{source}: cannot read: {exc}") from None
-    return _parse_scene(parse_toml(raw, source, SceneError), source, name)
+    folder = Path(str(resources.files("adept_traj.data").joinpath("scenes")))
+    return _parse_scene(parse_toml(raw, source, SceneError), source, name, folder)
 
 
 def read_paper_scene() -> Scene:
@@ -109,12 +122,15 @@ def read_paper_scene() -> Scene:
     return read_shipped_scene("paper")
 
 
-def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+def scene_from_dict(
+    data: Mapping[str, Any], source: str = "<dict>", folder: str | os.PathLike[str] = "."
+) -> Scene:
     """A scene from the parsed content of a scene file (what ``tomllib`` returns); ``source``
-    names it in error messages. More than :data:`~adept_traj.scene.MAX_OBSTACLES`
-    obstacles are refused before any is built."""
+    names it in error messages; relative mesh and motion file paths are taken from
+    ``folder`` (default: the working directory). More than
+    :data:`~adept_traj.scene.MAX_OBSTACLES` obstacles are refused before any is built."""
     check_obstacle_count(_count_entries(data), source)
-    return _parse_scene(data, source, "scene")
+    return _parse_scene(data, source, "scene", Path(folder))
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
@@ -139,6 +155,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         out["allowed_contacts"] = [list(pair) for pair in scene.allowed_contacts]
     obstacles: list[dict[str, Any]] = []
     pendulums: list[dict[str, Any]] = []
+    robots: dict[str, dict[str, Any]] = {}
     by_name = {ob.name: ob for ob in scene.obstacles}
     done: set[str] = set()
     for ob in scene.obstacles:
@@ -146,6 +163,13 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
             continue
         if isinstance(ob.motion, FixedPose):
             obstacles.append(_fixed_obstacle_dict(ob, ob.motion))
+            done.add(ob.name)
+        elif isinstance(ob.motion, RobotSolidMotion):
+            if ob.motion.group not in robots:
+                robots[ob.motion.group] = robot_motion_table(ob.motion)
+            done.add(ob.name)
+        elif isinstance(ob.motion, MACHINE_LAWS):
+            obstacles.append(_moving_obstacle_dict(ob))
             done.add(ob.name)
         elif isinstance(ob.motion, PendulumMotion):
             entry, rod, bob = _pendulum_dict(ob, ob.motion, by_name)
@@ -160,6 +184,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         out["obstacle"] = obstacles
     if pendulums:
         out["pendulum"] = pendulums
+    if robots:
+        out["robot_motion"] = list(robots.values())
     return out
 
 
@@ -183,10 +209,19 @@ def _floats(values: Any) -> list[float]:
     return [float(v) + 0.0 for v in np.asarray(values).ravel()]  # + 0.0 turns -0.0 into 0.0
 
 
+def _moving_obstacle_dict(ob: Obstacle) -> dict[str, Any]:
+    entry = _fixed_obstacle_dict(ob, FixedPose(np.eye(4)))  # xyz, rpy: the offset
+    entry["motion"] = motion_table(ob.motion)
+    return entry
+
+
 def _fixed_obstacle_dict(ob: Obstacle, motion: FixedPose) -> dict[str, Any]:
     shape = ob.shape
-    if type(shape) is Box:
-        fields: dict[str, Any] = {"size": _floats(shape.size)}
+    file_fields = file_shape_fields(ob)
+    if file_fields is not None:
+        fields: dict[str, Any] = file_fields
+    elif type(shape) is Box:
+        fields = {"size": _floats(shape.size)}
     elif type(shape) is Sphere:
         fields = {"radius": shape.radius}
     elif type(shape) in (Cylinder, Capsule):
@@ -250,7 +285,7 @@ def _pendulum_dict(
 
 #: Errors of a scene file: SceneError naming the source (file) and the field path.
 _ERROR = error_factory(SceneError)
-_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "allowed_contacts")
+_TOP_KEYS = ("name", "robot", "task", "obstacle", "pendulum", "robot_motion", "allowed_contacts")
 _ROBOT_KEYS = ("xyz", "rpy", *ROBOT_FILE_KEYS)
 _TASK_KEYS = ("start", "goal")
 _SHAPE_KEYS = {
@@ -258,19 +293,25 @@ _SHAPE_KEYS = {
     "sphere": ("radius",),
     "cylinder": ("radius", "length"),
     "capsule": ("radius", "length"),
+    "mesh": ("file", "scale"),
+    "cloud": ("file", "resolution"),
 }
-_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy")
+_OBSTACLE_COMMON = ("name", "shape", "xyz", "rpy", "motion")
 _PENDULUM_KEYS = (
     "name", "pivot", "length", "v0", "omega", "g", "swing_axis", "rod_radius", "bob_radius",
 )  # fmt: skip
 
 
-def _parse_obstacle(name: str, node: Node) -> Obstacle:
+def _parse_obstacle(name: str, node: Node, folder: Path) -> Obstacle:
     kind = node["shape"].string(choices=tuple(_SHAPE_KEYS))
     node.check_keys(_OBSTACLE_COMMON + _SHAPE_KEYS[kind])
     positive = {"minimum": 0.0, "strict": True}
     shape: Shape
-    if kind == "box" and (node["min"].present or node["max"].present):
+    if kind in ("mesh", "cloud"):
+        shape = (parse_mesh_entry if kind == "mesh" else parse_cloud_entry)(node, folder)
+        xyz = node["xyz"].array((3,), "[m] (the mesh frame's origin)", default=np.zeros(3))
+        rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
+    elif kind == "box" and (node["min"].present or node["max"].present):
         for other in ("size", "xyz", "rpy"):
             if node[other].present:
                 raise node[other].error(
@@ -296,8 +337,11 @@ def _parse_obstacle(name: str, node: Node) -> Obstacle:
             shape = node.build(cls, radius, node["length"].number("[m]", **positive))
         xyz = node["xyz"].array((3,), "[m] (the centre)")
         rpy = node["rpy"].array((3,), "[rad]", default=np.zeros(3))
-    motion = node.build(FixedPose, transform_from_xyz_rpy(xyz, rpy))
-    return node.build(Obstacle, name, shape, motion)
+    pose = transform_from_xyz_rpy(xyz, rpy)
+    if node["motion"].present:  # xyz, rpy: the pose in the moving frame
+        motion = parse_motion_entry(node["motion"], folder)
+        return node.build(Obstacle, name, shape, motion, pose)
+    return node.build(Obstacle, name, shape, node.build(FixedPose, pose))
 
 
 def _parse_pendulum(name: str, node: Node) -> tuple[Obstacle, Obstacle]:
@@ -321,7 +365,7 @@ def _parse_pendulum(name: str, node: Node) -> tuple[Obstacle, Obstacle]:
     )
 
 
-def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
+def _parse_scene(data: Any, source: str, default_name: str, folder: Path) -> Scene:
     top = Node(data, source, _ERROR).check_keys(_TOP_KEYS)
     name = top["name"].string(nonempty=True, default=default_name)
 
@@ -345,9 +389,11 @@ def _parse_scene(data: Any, source: str, default_name: str) -> Scene:
 
     obstacles: list[Obstacle] = []
     for entry_name, node in top["obstacle"].named_tables():
-        obstacles.append(_parse_obstacle(entry_name, node))
+        obstacles.append(_parse_obstacle(entry_name, node, folder))
     for entry_name, node in top["pendulum"].named_tables():
         obstacles.extend(_parse_pendulum(entry_name, node))
+    for entry_name, node in top["robot_motion"].named_tables():
+        obstacles.extend(parse_robot_motion_entry(entry_name, node, folder))
     allowed = tuple(
         tuple(n.strings(min_items=2)) for n in top["allowed_contacts"].items(default=[])
     )

@@ -21,9 +21,21 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     import meshcat.geometry as mg
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.scene import Box, Capsule, Cylinder, Shape, Sphere
+from adept_traj.scene import Box, Capsule, Cylinder, Mesh, PointCloud, Shape, Sphere
 
-__all__ = ["Y_TO_Z", "Part", "hex_colour", "shape_parts", "solid_parts", "translation"]
+__all__ = [
+    "MAX_DRAWN_POINTS",
+    "Y_TO_Z",
+    "Part",
+    "hex_colour",
+    "shape_parts",
+    "solid_parts",
+    "translation",
+]
+
+#: Most points of a point-cloud obstacle drawn (an evenly strided subset beyond: the page
+#: stays small); the planner uses every point.
+MAX_DRAWN_POINTS = 100_000
 
 #: (4, 4) turns a meshcat cylinder, axis along local y, onto coal's z axis (90° about x).
 Y_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
@@ -80,8 +92,18 @@ def shape_parts(shape: Shape, material: mg.Material) -> tuple[Part, ...]:
         return (_cylinder(shape.radius, shape.length, material),)
     if isinstance(shape, Capsule):
         return _capsule(shape.radius, shape.length, material)
+    if isinstance(shape, Mesh):  # its triangles, in the mesh frame
+        geometry = mg.TriangularMeshGeometry(np.array(shape.vertices), np.array(shape.triangles))
+        return (Part(mg.Mesh(geometry, material), np.eye(4)),)
+    if isinstance(shape, PointCloud):
+        step = max(1, -(-shape.n_points // MAX_DRAWN_POINTS))
+        points = np.array(shape.points[::step].T, dtype=np.float32)
+        colour = np.tile(np.array([[0.55], [0.45], [0.35]], dtype=np.float32), points.shape[1])
+        cloud = mg.PointCloud(points, colour, size=shape.resolution)
+        return (Part(cloud, np.eye(4)),)
     raise InvalidInputError(
-        f"cannot draw obstacle shape {type(shape).__name__} (box, sphere, cylinder, capsule)"
+        f"cannot draw obstacle shape {type(shape).__name__} (box, sphere, cylinder, capsule, "
+        "mesh, point cloud)"
     )
 
 

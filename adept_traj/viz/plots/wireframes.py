@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.collision import coal_kind, shape_of
-from adept_traj.scene import Box, Capsule, Cylinder, Sphere
+from adept_traj.scene import Box, Capsule, Cylinder, Mesh, PointCloud, Sphere
 
 __all__ = ["shape_wireframe", "solid_wireframe", "wireframe"]
 
@@ -56,7 +56,8 @@ def wireframe(kind: str, dims: Sequence[float], pose: np.ndarray) -> list[np.nda
 
 
 def shape_wireframe(shape: Any, pose: np.ndarray) -> list[np.ndarray]:
-    """Wireframe of an obstacle shape (Box, Sphere, Cylinder, Capsule) at ``pose`` (4, 4)."""
+    """Wireframe of an obstacle shape (Box, Sphere, Cylinder, Capsule; a Mesh or a
+    PointCloud: its bounding box) at ``pose`` (4, 4)."""
     if isinstance(shape, Box):
         return wireframe("box", 0.5 * shape.size, pose)
     if isinstance(shape, Sphere):
@@ -65,6 +66,11 @@ def shape_wireframe(shape: Any, pose: np.ndarray) -> list[np.ndarray]:
         return wireframe("cylinder", (shape.radius, 0.5 * shape.length), pose)
     if isinstance(shape, Capsule):
         return wireframe("capsule", (shape.radius, 0.5 * shape.length), pose)
+    if isinstance(shape, (Mesh, PointCloud)):  # its bounding box
+        lo, hi = shape.local_box
+        centre = np.eye(4)
+        centre[:3, 3] = 0.5 * (lo + hi)
+        return wireframe("box", 0.5 * (hi - lo), pose @ centre)
     return []
 
 
