@@ -60,7 +60,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
     trade-off's objectives z1 [s] … z6 and its gaps to the kinematic lower bound and to
     T_best (``metrics.t_best``, the best T the local solver reached; "not computed"), how many
     front members are certified, its dense certificate and the guarantee it gives
-    (violations listed), the result's warning and where it was saved."""
+    (violations listed), what it did not check (``result.unchecked``), the result's
+    warning and where it was saved."""
     z = result.best_objectives
     cert, front = result.certificate, result.front
     workers = result.problem_settings.workers
@@ -84,6 +85,7 @@ def summary(result: PlanningResult, folder: Path) -> str:
     ]
     lines += weighted_sum_text(result)
     lines += [f"  violation: {v}" for v in cert.violations]
+    lines += [f"unchecked: {item}" for item in result.unchecked]
     if result.warning:
         lines.append(f"warning: {result.warning}")
     lines.append(f"saved to {folder}/result.json")

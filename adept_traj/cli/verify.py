@@ -99,6 +99,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
         print(f"  violation: {violation}")
+    for item in result.unchecked:
+        print(f"  unchecked: {item}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")
     for mismatch in found.mismatches:

@@ -141,6 +141,8 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     }
     if r.front.n_certified is not None:  # optional key (absent in files of older versions)
         out["n_certified"] = r.front.n_certified
+    if r.unchecked:  # optional key (absent: everything checked, or an older version's file)
+        out["unchecked"] = list(r.unchecked)
     return out
 
 
@@ -292,7 +294,10 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
     with what the rest of the file gives: the file re-encoded from the decoded result must be
     the file read. The walk is iterative (the nesting is already bounded)."""
     # json.dumps (C) gives the same data as the file's own layout (_dumps), 4× faster
-    stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(json.dumps(_encode(result))), "")]
+    derived_top = json.loads(json.dumps(_encode(result)))
+    if "unchecked" not in top.value:  # written before the field (the record derives it)
+        derived_top.pop("unchecked", None)
+    stack: list[tuple[Any, Any, str]] = [(top.value, derived_top, "")]
     while stack:
         stored, derived, path = stack.pop()
         if stored == derived:  # whole subtrees at C speed; the walk below only finds where

@@ -45,6 +45,7 @@ from adept_traj.results.parts import (
     Timing,
     software_versions,
 )
+from adept_traj.results.unchecked import unchecked
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import JointLimits
 from adept_traj.scene.scene import Scene
@@ -263,6 +264,12 @@ class PlanningResult:
     def nq(self) -> int:
         """Number of joints."""
         return len(self.robot.joint_names)
+
+    @property
+    def unchecked(self) -> tuple[str, ...]:
+        """What the certificate did not check (limits the robot lacks, self-collision
+        off): :func:`~adept_traj.results.unchecked.unchecked`; ``()``: nothing."""
+        return unchecked(self.limits, self.problem_settings)
 
     @property
     def feasible(self) -> bool:

@@ -1,0 +1,142 @@
+"""Any robot from the command line, safely (issue 26): robots with missing limits, negative
+numbers as option values, reversed URDF limits, a start or goal checked before any search,
+the exit status of a run without a certified move.
+
+References are independent of the code under test: closed forms (the kinematic bound with
+a velocity limit only), the figure's own artists, the URDF text.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from adept_traj.cli import main
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.robot import Robot
+from adept_traj.scene import Scene
+
+ROOT = Path(__file__).resolve().parents[1]
+PLANAR = ROOT / "tests" / "data" / "planar_2link.urdf"
+FAR_BOX = {"name": "box", "shape": "box", "min": [2.0, 2.0, 2.0], "max": [2.1, 2.1, 2.1]}
+TINY = ["--pop", "8", "--gens", "2", "--no-html", "--quiet", "--no-polish"]
+
+
+def _planar_files(tmp_path: Path, joints: str = "") -> tuple[Path, Path]:
+    """The planar 2-link arm's URDF and a parameter file with the tool frame, the task rows
+    and ``joints`` (no acceleration or jerk limit unless given), and a scene file."""
+    params = tmp_path / "planar.toml"
+    params.write_text(f'tool_frame = "hand"\ntask_rows = ["vx", "vz"]\n{joints}')
+    scene = tmp_path / "far.toml"
+    scene.write_text(
+        'name = "far"\n[task]\nstart = [0.0, 0.0]\ngoal = [1.0, 1.0]\n'
+        '[[obstacle]]\nname = "box"\nshape = "box"\nmin = [2.0, 2.0, 2.0]\nmax = [2.1, 2.1, 2.1]\n'
+    )
+    return params, scene
+
+
+# ---------------------------------------------------------------- case 1: missing limits
+def test_a_robot_without_acceleration_and_jerk_limits_plans_draws_and_verifies(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    params, scene = _planar_files(tmp_path)
+    out = tmp_path / "run"
+    argv = ["plan", *TINY, "--robot", str(PLANAR), "--params", str(params), "--scene", str(scene)]
+    assert main([*argv, "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert sorted(p.name for p in (out / "figures").iterdir())  # the figures were drawn
+    assert (out / "figures" / "joint_motion_nsga2.png").is_file()
+    stored = json.loads((out / "result.json").read_text())["unchecked"]
+    assert stored[:2] == [
+        "acceleration (WC): no limit for shoulder, elbow: not constrained, not certified",
+        "jerk (JC): no limit for shoulder, elbow: not constrained, not certified",
+    ]
+    for line in stored:  # said once in the summary, as stored
+        assert text.count(f"unchecked: {line}") == 1
+    assert main(["verify", str(out)]) == 0
+    verified = capsys.readouterr().out
+    for line in stored:
+        assert f"  unchecked: {line}" in verified
+
+
+def test_a_joint_without_limits_beside_limited_joints_is_named(
+    tmp_path: Path,
+) -> None:
+    params, _ = _planar_files(
+        tmp_path, '[[joint]]\nname = "shoulder"\nacceleration = 20.0\njerk = 200.0\n'
+    )
+    robot = Robot.from_urdf(PLANAR, params)
+    scene = Scene.from_dict({"name": "far", "obstacle": [FAR_BOX]})
+    problem = TrajectoryProblem(robot, scene, [0.0, 0.0], [1.0, 1.0], self_collision=False)
+    from adept_traj.results.unchecked import unchecked
+
+    assert unchecked(robot.limits, problem.settings)[:2] == (
+        "acceleration (WC): no limit for elbow: not constrained, not certified",
+        "jerk (JC): no limit for elbow: not constrained, not certified",
+    )
+    problem.close()
+
+
+def test_the_motion_figure_draws_no_line_for_a_missing_limit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pytest.importorskip("matplotlib")
+    from adept_traj.optimise import plan
+    from adept_traj.viz.plots import motion
+
+    params, _ = _planar_files(tmp_path)
+    robot = Robot.from_urdf(PLANAR, params)
+    scene = Scene.from_dict({"name": "far", "obstacle": [FAR_BOX]})
+    problem = TrajectoryProblem(robot, scene, [0.0, 0.0], [1.0, 1.0])
+    try:
+        result = plan(problem, "nsga2", seed=1, pop_size=8, n_gen=2, polish="off")
+    finally:
+        problem.close()
+    seen = []
+    monkeypatch.setattr(motion, "save_figure", lambda fig, out: seen.append(fig) or out)
+    motion.joint_motion(result, tmp_path / "motion.png")
+    (fig,) = seen
+    from matplotlib.collections import LineCollection
+
+    ax = fig.axes[0]
+    dashed = [c for c in ax.collections if isinstance(c, LineCollection) and c.get_linestyle()
+              and c.get_linestyle()[0][1] is not None]  # fmt: skip
+    (limit_lines,) = dashed
+    # position (lower, upper), velocity (±), torque (±) per joint; none for acceleration, jerk
+    assert len(limit_lines.get_segments()) == 3 * 2 * robot.nq
+    notes = [t.get_text() for t in ax.texts]
+    assert notes.count("no limit") == 2 * robot.nq
+
+
+def test_without_a_jerk_limit_z5_is_unchanged_and_the_bound_uses_the_known_limits(
+    tmp_path: Path,
+) -> None:
+    params, _ = _planar_files(tmp_path)
+    free = Robot.from_urdf(PLANAR, params)  # velocity limits only
+    limited = Robot.from_urdf(
+        PLANAR,
+        _planar_files(
+            tmp_path,
+            '[[joint]]\nname = "shoulder"\nacceleration = 20.0\njerk = 200.0\n'
+            '[[joint]]\nname = "elbow"\nacceleration = 30.0\njerk = 300.0\n',
+        )[0],
+    )
+    scene = Scene.from_dict({"name": "far", "obstacle": [FAR_BOX]})
+    start, goal = np.array([0.0, 0.0]), np.array([1.0, 1.0])
+    a = TrajectoryProblem(free, scene, start, goal, t_bounds=(0.5, 3.0))
+    b = TrajectoryProblem(limited, scene, start, goal, t_bounds=(0.5, 3.0))
+    x = a.trajectory.straight_line(1.2)
+    ea, eb = a.evaluate_batch(x[None]), b.evaluate_batch(x[None])
+    assert np.array_equal(ea.objectives, eb.objectives)  # z5 (and every other) the same
+    # the bound: h / v with a velocity limit only (closed form)
+    v = free.limits.velocity
+    assert a.lower_bound.T_min == pytest.approx(np.max(np.abs(goal - start) / v), rel=1e-12)
+    assert set(a.lower_bound.cases) == {"vel"}
+    # the acceleration and jerk constraints of the unlimited robot: always met
+    g = ea.constraints.reshape(-1)
+    assert np.all(np.isfinite(g))
+    a.close()
+    b.close()
