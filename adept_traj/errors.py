@@ -12,6 +12,7 @@ from pathlib import Path
 
 __all__ = [
     "AdeptTrajError",
+    "CollidingConfigurationError",
     "ConfigurationError",
     "CycleError",
     "FigureError",
@@ -108,6 +109,12 @@ class ResourceLimitError(InvalidInputError):
 
     The message names the option (or file), its value, the estimate and the limit.
     """
+
+
+class CollidingConfigurationError(InvalidInputError):
+    """A start or goal configuration of a move is closer than the safety margin to an
+    obstacle or to another of the robot's links: no move from or to it can be certified,
+    so it is refused before any search (the message names the pair and the distance)."""
 
 
 class UnreachableLocationError(InvalidInputError):

@@ -140,3 +140,83 @@ def test_without_a_jerk_limit_z5_is_unchanged_and_the_bound_uses_the_known_limit
     assert np.all(np.isfinite(g))
     a.close()
     b.close()
+
+
+# ---------------------------------------------------- case 7: negative numbers as values
+def test_negative_numbers_are_option_values(tmp_path: Path) -> None:
+    from adept_traj.cli.app import negative_values_attached
+
+    argv = ["plan", "--start", "-1.2,0.3", "--goal", "-1e-3,-.5", "--seed", "-1", "--quiet"]
+    assert negative_values_attached(argv) == [
+        "plan", "--start=-1.2,0.3", "--goal=-1e-3,-.5", "--seed=-1", "--quiet"
+    ]  # fmt: skip
+    params, scene = _planar_files(tmp_path)
+    out = tmp_path / "run"
+    argv = ["plan", *TINY, "--no-plots", "--robot", str(PLANAR), "--params", str(params)]
+    argv += ["--scene", str(scene), "--start", "-0.5,0.2", "--goal", "0.5,-0.25"]
+    assert main([*argv, "--out", str(out)]) == 0
+    stored = json.loads((out / "result.json").read_text())
+    assert (stored["start"], stored["goal"]) == ([-0.5, 0.2], [0.5, -0.25])
+
+
+# ------------------------------------------------------------ case 9: reversed limits
+def test_reversed_urdf_limits_are_refused_naming_joint_file_and_values(tmp_path: Path) -> None:
+    from adept_traj.errors import RobotModelError
+
+    text = PLANAR.read_text()
+    import re
+
+    first = re.search(r'lower="([^"]+)" upper="([^"]+)"', text)
+    reversed_text = text.replace(first.group(0), 'lower="1.0" upper="-1.0"', 1)
+    path = tmp_path / "reversed.urdf"
+    path.write_text(reversed_text)
+    with pytest.raises(RobotModelError) as info:
+        Robot.from_urdf(path)
+    message = str(info.value)
+    assert str(path) in message
+    assert "'shoulder'" in message
+    assert "lower = 1 > upper = -1" in message
+    params = tmp_path / "reversed.toml"
+    params.write_text('[[joint]]\nname = "elbow"\nlower = 3.5\n')  # above the URDF's upper
+    with pytest.raises(RobotModelError, match=r"reversed.toml: joint 'elbow' .*3.5 > upper = 3\b"):
+        Robot.from_urdf(PLANAR, params)
+
+
+def test_every_out_of_range_joint_of_a_start_is_named(tmp_path: Path) -> None:
+    from adept_traj.errors import JointLimitError
+
+    params, _ = _planar_files(tmp_path)
+    robot = Robot.from_urdf(PLANAR, params)
+    lo, hi = robot.limits.lower, robot.limits.upper
+    with pytest.raises(JointLimitError) as info:
+        robot.limits.check_position([hi[0] + 1.0, lo[1] - 1.0], "start")
+    message = str(info.value)
+    assert "joint 'shoulder'" in message
+    assert "joint 'elbow'" in message
+
+
+# ------------------------------------------- case 4: start and goal checked before a search
+def test_a_start_near_an_obstacle_is_refused_before_any_search(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    params, _ = _planar_files(tmp_path)
+    # At q = 0 the forearm (a cylinder of radius 0.02 m) lies on the x axis from 0.6 to
+    # 1.0 m; a ball of radius 0.02 m centred 0.045 m above x = 0.8 m: 0.005 m apart.
+    scene = tmp_path / "touch.toml"
+    scene.write_text(
+        'name = "touch"\n[task]\nstart = [0.0, 0.0]\ngoal = [1.0, 1.0]\n'
+        '[[obstacle]]\nname = "ball"\nshape = "sphere"\nradius = 0.02\nxyz = [0.8, 0.0, 0.045]\n'
+    )
+    out = tmp_path / "run"
+    argv = ["plan", *TINY, "--robot", str(PLANAR), "--params", str(params), "--scene", str(scene)]
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1  # one line, no traceback
+    assert "start: fore/rod – obstacle ball 0.005 m" in err[0]
+    assert "goal" not in err[0].split("at rest:")[1]  # the goal, lifted, is clear
+    assert not (out / "run.json").exists()  # nothing run, nothing written
+    # the same ball at the goal's forearm is named for the goal
+    swapped = "start = [1.0, 1.0]\ngoal = [0.0, 0.0]"
+    scene.write_text(scene.read_text().replace("start = [0.0, 0.0]\ngoal = [1.0, 1.0]", swapped))
+    assert main([*argv, "--out", str(out)]) == 2
+    assert "goal: fore/rod – obstacle ball 0.005 m" in capsys.readouterr().err

@@ -59,6 +59,7 @@ from adept_traj.analysis.paper_measures import (
     ratio_non_dominated,
     spread,
 )
+from adept_traj.analysis.rest_poses import check_rest_poses, rest_pose_contacts
 from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
@@ -93,6 +94,7 @@ __all__ = [
     "certify_members",
     "certifying_problem",
     "check_certificate_memory",
+    "check_rest_poses",
     "combined_objective",
     "continuous_distance",
     "continuous_self_distance",
@@ -108,6 +110,7 @@ __all__ = [
     "optimizer_overhead",
     "problem_parts",
     "ratio_non_dominated",
+    "rest_pose_contacts",
     "same_parts",
     "self_distance",
     "solid_lever_arms",

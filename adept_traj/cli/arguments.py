@@ -12,9 +12,9 @@ import argparse
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.analysis import PAPER_WEIGHTS, check_rest_poses
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.errors import CollidingConfigurationError, ConfigurationError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem, available_cores, keep_heap
 from adept_traj.scene import SHIPPED_SCENES, Scene
 from adept_traj.validation import as_scalar
@@ -95,7 +95,12 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     ConfigurationError
         The scene has no start/goal and none was given.
     InvalidInputError
-        Bad weights or rate, or a start/goal outside the joint limits.
+        Bad weights or rate, or a start/goal outside the joint limits (every joint
+        outside named).
+    CollidingConfigurationError
+        A start or goal closer than the margin to an obstacle or (self-collision on) to
+        another link (:func:`~adept_traj.analysis.check_rest_poses`): checked before any
+        search.
     """
     scene = scene_from_argument(args.scene)
     start = args.start if args.start is not None else scene.start
@@ -117,4 +122,10 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     robot = robot_from_arguments(args, args.scene)
     start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
     workers = available_cores() if args.workers is None else args.workers
-    return TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    problem = TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    try:
+        check_rest_poses(problem)
+    except CollidingConfigurationError:
+        problem.close()
+        raise
+    return problem

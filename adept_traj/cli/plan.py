@@ -219,8 +219,10 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done (or
-    ``--resume`` of a complete run), 1 the ``--ros`` export refused, 130 interrupted)."""
+    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done with a
+    certified best trade-off (or ``--resume`` of a complete run), 1 the run finished and
+    its result folder is written but no certified move was found (the best trade-off's
+    certificate failed; the ``--ros`` export refused), 130 interrupted)."""
     resume = as_path(args.resume, "--resume")
     if resume is not None and is_complete(resume):
         print(
@@ -349,9 +351,9 @@ def _finish(
     else:
         _write_outputs(result, folder, opts, replay)
     print(summary(result, folder))
-    code = status.OK
+    code = status.OK if result.feasible else status.NOT_CERTIFIED
     if opts.ros is not None:
-        code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)
+        code = max(code, _export_ros(result, opts.ros, opts.allow_infeasible, replay))
     commit(folder)
     return code
 
