@@ -220,3 +220,66 @@ def test_a_start_near_an_obstacle_is_refused_before_any_search(
     scene.write_text(scene.read_text().replace("start = [0.0, 0.0]\ngoal = [1.0, 1.0]", swapped))
     assert main([*argv, "--out", str(out)]) == 2
     assert "goal: fore/rod – obstacle ball 0.005 m" in capsys.readouterr().err
+
+
+# -------------------------------- case 3: package:// robots, locked joints, Cartesian poses
+def _problem(argv: list[str]) -> TrajectoryProblem:
+    """The problem the planning options ``argv`` describe (the parser of ``plan``)."""
+    import argparse
+
+    from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
+
+    parser = argparse.ArgumentParser()
+    add_problem_arguments(parser)
+    from adept_traj.cli.app import negative_values_attached
+
+    return problem_from_arguments(parser.parse_args(negative_values_attached(argv)))
+
+
+def test_robot_as_a_package_uri_and_a_locked_joint_from_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    params, scene = _planar_files(tmp_path)
+    package = tmp_path / "pkgs" / "planar_pkg" / "urdf"
+    package.mkdir(parents=True)
+    (package / "planar.urdf").write_text(PLANAR.read_text())
+    uri = "package://planar_pkg/urdf/planar.urdf"
+    out = tmp_path / "run"
+    argv = ["plan", *TINY, "--no-plots", "--robot", uri, "--package-dir", str(tmp_path / "pkgs")]
+    argv += ["--params", str(params), "--scene", str(scene), "--locked-joint", "elbow=-0.3"]
+    argv += ["--start", "0", "--goal", "1"]
+    assert main([*argv, "--out", str(out)]) == 0, capsys.readouterr().err
+    stored = json.loads((out / "result.json").read_text())["robot"]
+    assert Path(stored["urdf"]) == (package / "planar.urdf").resolve()
+    assert stored["joint_names"] == ["shoulder"]
+    assert stored["locked_joints"] == {"elbow": -0.3}
+    assert main(["verify", str(out)]) == 0  # the recorded robot rebuilds, lock included
+    with pytest.raises(Exception, match="--locked-joint must be NAME=VALUE"):
+        _problem(["--robot", uri, "--locked-joint", "elbow"])
+
+
+@pytest.mark.parametrize("elbow", ["lefty", "righty"])
+def test_a_cartesian_goal_for_the_scara_with_its_elbow(elbow: str) -> None:
+    robot = Robot.adept_one_xl()
+    scene = Scene.paper()
+    pose = robot.tool_pose(scene.goal)  # Pinocchio's forward kinematics: the reference
+    yaw = float(np.arctan2(pose[1, 0], pose[0, 0]))
+    text = ",".join(f"{v:.12g}" for v in [*pose[:3, 3], yaw])
+    problem = _problem(["--goal-pose", text, "--elbow", elbow, "--workers", "1"])
+    try:
+        q = problem.goal
+        reached = robot.tool_pose(q)
+        np.testing.assert_allclose(reached[:3, 3], pose[:3, 3], atol=1e-9)
+        assert np.arctan2(reached[1, 0], reached[0, 0]) == pytest.approx(yaw, abs=1e-9)
+        # the two elbows: the inner-arm angle θ2 of opposite signs, one of them the scene's
+        same = np.allclose(q, scene.goal, atol=1e-9)
+        assert same == (np.sign(q[1]) == np.sign(scene.goal[1]))
+    finally:
+        problem.close()
+
+
+def test_a_start_given_as_joints_and_as_a_pose_is_refused() -> None:
+    from adept_traj.errors import ConfigurationError
+
+    with pytest.raises(ConfigurationError, match="give --start or --start-pose, not both"):
+        _problem(["--start", "0,0,0,0", "--start-pose", "0.5,0,0.3,0"])

@@ -67,10 +67,11 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
-    "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
+    "scene", "start", "goal", "start_pose", "goal_pose", "elbow", "seed", "weights", "rate",
+    "algorithm", "pop", "gens",
     "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
     "polish",
-    "robot", "params", "tool_frame", "srdf", "package_dir",
+    "robot", "params", "tool_frame", "srdf", "package_dir", "locked_joint",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
@@ -134,11 +135,13 @@ def _comparable(key: str, value: Any) -> Any:
     """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
     if value is None or (key == "scene" and value in SHIPPED_SCENES):
         return value
+    if key in ("robot", "srdf") and str(value).startswith("package://"):
+        return str(value)  # found in the package folders, wherever the run starts
     if key in ("scene", "ros", "robot", "params", "srdf"):
         return str(Path(value).resolve())
     if key == "package_dir":
         return [str(Path(v).resolve()) for v in value]
-    if key in ("start", "goal", "weights"):
+    if key in ("start", "goal", "weights", "start_pose", "goal_pose"):
         return [float(x) for x in value]
     return value
 

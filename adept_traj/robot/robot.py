@@ -367,7 +367,8 @@ class Robot:
             pool = pin.ModelPool(self.model, 1)
             tau = pin.rneaInParallel(
                 1, pool, np.asfortranarray(qf.T), np.asfortranarray(vf.T), np.asfortranarray(af.T)
-            ).T
+            )
+            tau = tau.reshape(self.nq, n).T  # (a one-joint robot's (1, n) comes back as (n,))
         tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
         return tau.reshape(shape)
 
