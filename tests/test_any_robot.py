@@ -283,3 +283,48 @@ def test_a_start_given_as_joints_and_as_a_pose_is_refused() -> None:
 
     with pytest.raises(ConfigurationError, match="give --start or --start-pose, not both"):
         _problem(["--start", "0,0,0,0", "--start-pose", "0.5,0,0.3,0"])
+
+
+# ---------------------------------------- case 5: numbers that look like mm or degrees
+_MM_SCENE = """name = "mm"
+[robot]
+xyz = [1450, 390, -250]
+rpy = [0.0, 0.0, 180]
+[task]
+start = [0.1682, 1.3849, 0.08, -0.7555]
+goal = [-0.7610, 0.2450, 0.20, 1.0095]
+[[obstacle]]
+name = "cube1"
+shape = "box"
+size = [200, 200, 200]
+xyz = [900, 700, 150]
+rpy = [0, 0, 180]
+"""
+
+
+def test_a_scene_in_millimetres_and_degrees_is_warned_about(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from adept_traj.analysis import robot_reach
+
+    scene = tmp_path / "mm.toml"
+    scene.write_text(_MM_SCENE)
+    _problem(["--scene", str(scene), "--workers", "1"]).close()
+    err = capsys.readouterr().err.splitlines()
+    assert all(line.startswith("adept-traj: warning: ") for line in err)
+    text = "\n".join(err)
+    assert "every obstacle is farther than 10 × the robot's reach" in text
+    assert "obstacle 'cube1' is 346.4 m across" in text  # √3 × 200 m
+    assert "robot.rpy = [0.0, 0.0, 180] has an angle above 2π" in text
+    assert "obstacle[0].rpy = [0, 0, 180] has an angle above 2π" in text
+    # the AdeptOne XL's reach: 0.425 + 0.375 m of arms plus the solids' enclosing balls
+    reach = robot_reach(Robot.adept_one_xl())
+    assert 0.8 < reach < 2.0
+    # the same scene in metres and radians: no warning
+    metres = _MM_SCENE.replace("[1450, 390, -250]", "[1.45, 0.39, -0.25]")
+    metres = metres.replace("180]", "3.141592653589793]").replace(
+        "[200, 200, 200]", "[0.2, 0.2, 0.2]"
+    )
+    scene.write_text(metres.replace("[900, 700, 150]", "[0.9, 0.7, 0.15]"))
+    _problem(["--scene", str(scene), "--workers", "1"]).close()
+    assert capsys.readouterr().err == ""

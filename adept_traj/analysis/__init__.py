@@ -59,6 +59,7 @@ from adept_traj.analysis.paper_measures import (
     ratio_non_dominated,
     spread,
 )
+from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
 from adept_traj.analysis.rest_poses import check_rest_poses, rest_pose_contacts
 from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
@@ -75,6 +76,7 @@ __all__ = [
     "FRONT_INFLUENCE_ABOVE_MARGIN",
     "LIMIT_KINDS",
     "PAPER_WEIGHTS",
+    "REACH_FACTOR",
     "WEIGHTED_SUM_REFERENCE",
     "BestTradeoff",
     "Certificate",
@@ -111,10 +113,12 @@ __all__ = [
     "problem_parts",
     "ratio_non_dominated",
     "rest_pose_contacts",
+    "robot_reach",
     "same_parts",
     "self_distance",
     "solid_lever_arms",
     "spread",
     "to_unit_minimisation",
+    "unit_warnings",
     "weighted_sum",
 ]

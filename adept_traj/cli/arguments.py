@@ -9,17 +9,20 @@ scene file's robot, else the AdeptOne XL); :func:`check_rate` checks a verificat
 from __future__ import annotations
 
 import argparse
+import sys
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS, check_rest_poses
+from adept_traj.analysis import PAPER_WEIGHTS, check_rest_poses, unit_warnings
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
 from adept_traj.errors import (
     CollidingConfigurationError,
     ConfigurationError,
     InvalidInputError,
     RobotModelError,
+    SceneError,
 )
+from adept_traj.files import read_toml
 from adept_traj.problem import TrajectoryProblem, available_cores, keep_heap
 from adept_traj.robot import ELBOWS, Robot, ScaraGeometry, solve_location
 from adept_traj.scene import SHIPPED_SCENES, Scene
@@ -190,6 +193,9 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     workers = available_cores() if args.workers is None else args.workers
     problem = TrajectoryProblem(robot, scene, start, goal, workers=workers)
     try:
+        raw = None if args.scene in SHIPPED_SCENES else read_toml(args.scene, SceneError)
+        for warning in unit_warnings(problem, raw):
+            print(f"adept-traj: warning: {warning}", file=sys.stderr)
         check_rest_poses(problem)
     except CollidingConfigurationError:
         problem.close()
