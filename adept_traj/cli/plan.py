@@ -68,9 +68,8 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
     "scene", "start", "goal", "start_pose", "goal_pose", "elbow", "seed", "weights", "rate",
-    "algorithm", "pop", "gens",
-    "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
-    "polish",
+    "algorithm", "pop", "gens", "workers", "no_html", "no_plots", "ros", "allow_infeasible",
+    "no_polish", "polish",
     "robot", "params", "tool_frame", "srdf", "package_dir", "locked_joint",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
