@@ -328,3 +328,125 @@ def test_a_scene_in_millimetres_and_degrees_is_warned_about(
     scene.write_text(metres.replace("[900, 700, 150]", "[0.9, 0.7, 0.15]"))
     _problem(["--scene", str(scene), "--workers", "1"]).close()
     assert capsys.readouterr().err == ""
+
+
+# ------------------------------- cases 2, 8: self-collision on by default, without an SRDF
+def _ur5_urdf() -> Path:
+    from adept_traj.robot import installed_data_dirs
+
+    for d in installed_data_dirs():
+        path = d / "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
+        if path.is_file():
+            return path
+    pytest.skip("example-robot-data is not installed")
+
+
+_UR5_REFERENCE = [-1.0, -1.2, 1.2, -1.5, -1.57, 0.0]  # the start of examples/data/ur5_box.toml
+_UR5_FOLDED = [0.0, -1.57, 3.0, -1.57, 0.0, 0.0]  # the forearm folded onto the upper arm
+
+
+def _coal_reference(urdf: Path, q: list[float]) -> dict[frozenset[str], tuple[bool, float]]:
+    """Per pair of links with a collision mesh: (collide, distance [m]) of the raw meshes
+    (not their hulls) by coal, placed by Pinocchio's own model of the URDF."""
+    import coal
+    import pinocchio as pin
+
+    share = urdf.parents[4]
+    model = pin.buildModelFromUrdf(str(urdf))
+    geom = pin.buildGeomFromUrdf(model, str(urdf), pin.COLLISION, package_dirs=[str(share)])
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    q_ref = np.asarray(q)  # revolute joints: Pinocchio's q is the angles themselves
+    pin.forwardKinematics(model, data, q_ref)
+    pin.updateGeometryPlacements(model, data, geom, gdata, q_ref)
+    out = {}
+    objects = geom.geometryObjects
+    for i in range(len(objects)):
+        for j in range(i + 1, len(objects)):
+            a, b = objects[i], objects[j]
+            la, lb = model.frames[a.parentFrame].name, model.frames[b.parentFrame].name
+            ta = coal.Transform3s(gdata.oMg[i].rotation, gdata.oMg[i].translation)
+            tb = coal.Transform3s(gdata.oMg[j].rotation, gdata.oMg[j].translation)
+            hit = coal.collide(a.geometry, ta, b.geometry, tb, coal.CollisionRequest(),
+                               coal.CollisionResult())  # fmt: skip
+            d = coal.distance(a.geometry, ta, b.geometry, tb, coal.DistanceRequest(),
+                              coal.DistanceResult())  # fmt: skip
+            out[frozenset((la, lb))] = (bool(hit), float(d))
+    return out
+
+
+def test_self_collision_is_on_without_an_srdf_and_agrees_with_coal_on_the_raw_meshes() -> None:
+    from adept_traj.analysis import rest_pose_contacts
+
+    urdf = _ur5_urdf()
+    robot = Robot.from_urdf(urdf)  # no SRDF, no parameter file
+    scene = Scene.from_dict({"name": "far", "obstacle": [FAR_BOX]})
+    problem = TrajectoryProblem(robot, scene, _UR5_REFERENCE, _UR5_FOLDED, workers=1)
+    try:
+        assert problem.settings.self_collision is True
+        check = problem.self_check
+        checked = {frozenset(p) for p in check.link_pairs}
+        assert frozenset(("upper_arm_link", "wrist_1_link")) in checked
+        left = {frozenset(p[:2]): p[2] for p in problem.self_pairs.left_out}
+        assert set(left.values()) == {"adjacent links"}  # nothing touches at every pose
+        assert checked.isdisjoint(left)
+        # the reference: coal on the raw meshes, every checked pair apart
+        reference = _coal_reference(urdf, _UR5_REFERENCE)
+        assert not any(reference[p][0] for p in checked)
+        assert min(reference[p][1] for p in checked) > 0.01
+        folded = _coal_reference(urdf, _UR5_FOLDED)
+        hits = {p for p in checked if folded[p][0]}
+        assert frozenset(("upper_arm_link", "wrist_1_link")) in hits
+        # our check (convex hulls, never farther than the meshes) flags the same pair
+        ours = check.distances(np.array(_UR5_FOLDED), exact=True)
+        for k, (a, b) in enumerate(check.pairs.tolist()):
+            pair = frozenset((check.links[a], check.links[b]))
+            assert ours[k] <= folded[pair][1] + 1e-9  # a hull contains its mesh
+        assert ours.min() < 0
+        assert check.distances(np.array(_UR5_REFERENCE), exact=True).min() > 0.01
+        # checked before any search: the folded goal is named, with its pair and distance
+        found = rest_pose_contacts(problem)
+        assert found
+        assert all(line.startswith("goal: ") for line in found)
+        assert any("upper_arm_link" in line and "wrist_1_link" in line for line in found)
+    finally:
+        problem.close()
+
+
+def test_a_folded_ur5_start_is_refused_and_the_collision_matrix_is_saved(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    urdf = _ur5_urdf()
+    scene = tmp_path / "far.toml"
+    scene.write_text(
+        'name = "far"\n[[obstacle]]\nname = "box"\nshape = "box"\nsize = [0.1, 0.1, 0.1]\n'
+        "xyz = [2.0, 2.0, 2.0]\n"
+    )
+    folded = ",".join(map(str, _UR5_FOLDED))
+    argv = ["plan", *TINY, "--no-plots", "--robot", str(urdf), "--scene", str(scene)]
+    argv += ["--goal", ",".join(map(str, _UR5_REFERENCE))]
+    assert main([*argv, "--start", folded, "--out", str(tmp_path / "folded")]) == 2
+    err = capsys.readouterr().err
+    assert "start: upper_arm_link_0 – wrist_1_link_0 (self-collision) -0.04" in err
+    # the collision matrix: written by the robot command, and beside a result
+    matrix = tmp_path / "ur5.srdf"
+    assert main(["robot", "--robot", str(urdf), "--collision-matrix", str(matrix)]) == 0
+    from adept_traj.robot.urdf_loading import read_srdf_disabled_pairs
+
+    pairs = {frozenset(p) for p in read_srdf_disabled_pairs(matrix)}
+    assert frozenset(("base_link", "shoulder_link")) in pairs
+    assert frozenset(("upper_arm_link", "wrist_1_link")) not in pairs
+    start = ",".join(map(str, [1.0, -1.2, 1.2, -1.5, -1.57, 0.0]))
+    out = tmp_path / "run"
+    main([*argv, "--start", start, "--out", str(out)])
+    assert (out / "collision_matrix.srdf").read_text() == matrix.read_text()
+    stored = json.loads((out / "result.json").read_text())
+    assert stored["problem_settings"]["self_collision"] is True
+    sc = stored["self_collision"]
+    assert ["upper_arm_link", "wrist_1_link"] in sc["checked"]
+    assert {"pair": ["base_link", "shoulder_link"], "reason": "adjacent links"} in sc["left_out"]
+    text = capsys.readouterr().out
+    assert "self-collision: 20 link pairs checked" in text
+    # a user SRDF replaces the matrix: its pairs are left out, nothing is saved
+    argv2 = [*argv, "--srdf", str(matrix), "--start", start, "--out", str(tmp_path / "srdf")]
+    main(argv2)
+    assert not (tmp_path / "srdf" / "collision_matrix.srdf").exists()

@@ -7,7 +7,7 @@ instant: :mod:`adept_traj.cli._run_folder` says how a folder tells its state). B
 removed when the run completes; ``--resume`` of a complete run says so and changes nothing.
 
 ``--out DIR`` refuses a folder that holds files of an earlier run unless ``--overwrite`` is
-given, which removes those files (only those ``plan`` writes) before the run. Every option
+given, which removes those files (only those ``plan`` writes) before the run; every option
 and output path is checked before anything is written.
 
 ``--ros FILE`` exports the best trade-off for a robot controller only when its dense
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -31,9 +30,9 @@ from adept_traj.cli._run_folder import (
     CHECKPOINT,
     HTML_FILE,
     RUN_FILE,
-    TOP_FILES,
     as_path,
     check_folder,
+    check_ros_path,
     commit,
     folder_lock,
     is_complete,
@@ -44,8 +43,14 @@ from adept_traj.cli._run_folder import (
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import finish_figures, finisher_for, start_figures, summary
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.cli.report import (
+    finish_figures,
+    finisher_for,
+    save_collision_matrix,
+    start_figures,
+    summary,
+)
+from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     ALGORITHMS,
     POLISH_MODES,
@@ -173,22 +178,6 @@ def _resumed_options(saved: dict[str, Any], given: dict[str, Any], folder: Path)
     return options
 
 
-def _check_ros_path(path: Path, folder: Path) -> None:
-    """Refuse a ``--ros`` file that cannot be written, before the run starts."""
-    if path.is_dir():
-        raise InvalidInputError(f"--ros {path} is a folder; give a file, e.g. {path}/best.json")
-    parent = path.parent
-    while not parent.exists():  # the export creates missing folders
-        parent = parent.parent
-    if not parent.is_dir():
-        raise InvalidInputError(f"--ros {path}: {parent} is not a folder")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise InvalidInputError(f"--ros {path}: cannot write in {parent}")
-    target, root = path.resolve(), folder.resolve()
-    if target in {root / name for name in TOP_FILES} or root / CHECKPOINT in target.parents:
-        raise InvalidInputError(f"--ros {path} is a file of the result folder {folder}")
-
-
 def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
     """(the run's options, its folder, whether it resumes), checked; nothing is written."""
     given = {k: getattr(args, k) for k in _SAVED if getattr(args, k) is not None}
@@ -234,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
         return status.OK
     opts, folder, resume = _options(args)
     if opts.ros is not None:
-        _check_ros_path(opts.ros, folder)
+        check_ros_path(opts.ros, folder)
     if not resume:
         check_folder(
             folder, overwrite=args.overwrite, html=not opts.no_html, figures=not opts.no_plots
@@ -353,6 +342,7 @@ def _finish(
     else:
         _write_outputs(result, folder, opts, replay)
     print(summary(result, folder))
+    save_collision_matrix(problem, folder)  # made for a robot without SRDF: reusable
     code = status.OK if result.feasible else status.NOT_CERTIFIED
     if opts.ros is not None:
         code = max(code, _export_ros(result, opts.ros, opts.allow_infeasible, replay))

@@ -99,6 +99,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
         print(f"  violation: {violation}")
+    if result.self_pairs is not None:
+        for line in result.self_pairs.lines():
+            print(f"  self-collision: {line}")
     for item in result.unchecked:
         print(f"  unchecked: {item}")
     if cert.feasible != result.certificate.feasible:

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory
+from adept_traj.collision import SelfPairs
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import (
     OBJECTIVE_NAMES,
@@ -113,6 +114,9 @@ class PlanningResult:
     warning: a warning for the reader; defaults to :data:`NO_FEASIBLE_WARNING` when no
         solution of the front is feasible.
     versions: software versions (default: :func:`software_versions` now).
+    self_pairs: the link pairs the self-collision check covered and those it left out,
+        with why (:class:`~adept_traj.collision.SelfPairs`); ``None``: self-collision off
+        (or a file written before the field).
     """
 
     start: np.ndarray
@@ -133,8 +137,11 @@ class PlanningResult:
     history: tuple[GenerationRecord, ...] | None = None
     warning: str | None = None
     versions: dict[str, str] = field(default_factory=software_versions)
+    self_pairs: SelfPairs | None = None
 
     def __post_init__(self) -> None:
+        if self.self_pairs is not None:
+            check_type(self.self_pairs, SelfPairs, "self_pairs")
         check_type(self.robot, RobotInfo, "robot")
         check_type(self.problem_settings, ProblemSettings, "problem_settings")
         check_type(self.limits, JointLimits, "limits")
@@ -236,6 +243,7 @@ class PlanningResult:
             metrics=metrics if metrics is not None else Metrics(),
             history=None if history is None else tuple(history),
             warning=warning,
+            self_pairs=problem.self_pairs,
         )
 
     def problem(self, robot: Robot | None = None) -> TrajectoryProblem:
