@@ -450,3 +450,76 @@ def test_a_folded_ur5_start_is_refused_and_the_collision_matrix_is_saved(
     argv2 = [*argv, "--srdf", str(matrix), "--start", start, "--out", str(tmp_path / "srdf")]
     main(argv2)
     assert not (tmp_path / "srdf" / "collision_matrix.srdf").exists()
+
+
+# ----------------------------------------- case 6: large hulls simplified conservatively
+def _sphere_obj(path: Path, n: int = 4100, radius: float = 0.05) -> np.ndarray:
+    """An OBJ mesh of ``n`` points on a sphere (their convex hull: a triangle mesh with
+    every point a vertex, more than MAX_HULL_POINTS); returns the vertices (n, 3) [m]."""
+    from scipy.spatial import ConvexHull
+
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + 5.0**0.5) * k * 1.0001  # off the polytope's own lattice
+    r = np.sqrt(1.0 - z * z)
+    points = radius * np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    faces = ConvexHull(points).simplices + 1
+    lines = [f"v {x:.9f} {y:.9f} {z:.9f}" for x, y, z in points]
+    lines += [f"f {a} {b} {c}" for a, b, c in faces]
+    path.write_text("\n".join(lines) + "\n")
+    return points
+
+
+def test_the_bounding_polytope_contains_the_points_and_states_its_extra_clearance() -> None:
+    import coal
+    from scipy.spatial import ConvexHull
+
+    from adept_traj.robot.collision_meshes import MAX_HULL_POINTS, bounding_polytope
+
+    rng = np.random.default_rng(5)
+    points = rng.normal(size=(2000, 3)) * [0.08, 0.03, 0.02]  # an ellipsoidal cloud [m]
+    vertices = coal.StdVec_Vec3s()
+    for p in points:
+        vertices.append(p)
+    hull = coal.ConvexBase.convexHull(vertices, False, "Qt")
+    polytope, extra = bounding_polytope(points, hull, n_directions=300)
+    corners = np.asarray(polytope.points(), dtype=float)
+    assert len(corners) <= MAX_HULL_POINTS
+    facets = ConvexHull(corners).equations  # scipy's own facets: a·x + b ≤ 0 inside
+    assert (points @ facets[:, :3].T + facets[:, 3]).max() <= 1e-12
+    # extra bounds how far a corner is from the hull: scipy's hull facets of the points
+    inner = ConvexHull(points).equations
+    out_of_hull = (corners @ inner[:, :3].T + inner[:, 3]).max(axis=1)  # ≤ the distance
+    assert out_of_hull.max() <= extra + 1e-12  # (equal where the nearest point is on a facet)
+    assert extra < 0.02  # 10.1 mm for this sparse cloud and 300 planes; 0.2 mm for a 5 cm ball
+
+
+@pytest.mark.slow
+def test_a_hull_with_too_many_vertices_is_replaced_by_a_polytope_that_contains_it(
+    tmp_path: Path,
+) -> None:
+    from scipy.spatial import ConvexHull
+
+    from adept_traj.robot.collision_meshes import MAX_HULL_POINTS
+
+    points = _sphere_obj(tmp_path / "ball.obj")
+    text = PLANAR.read_text().replace(
+        '<geometry><cylinder radius="0.02" length="0.4"/></geometry>',
+        f'<geometry><mesh filename="{tmp_path / "ball.obj"}"/></geometry>',
+    )
+    urdf = tmp_path / "ball_arm.urdf"
+    urdf.write_text(text)
+    with pytest.warns(UserWarning, match=r"fore/rod' has 4100 vertices .* up to \d\.\d\d mm"):
+        robot = Robot.from_urdf(urdf)
+    (report,) = robot.mesh_hulls
+    assert report.simplified_from == 4100
+    assert report.hull_points <= MAX_HULL_POINTS
+    solid = robot.collision_model.geometryObjects[1].geometry
+    corners = np.asarray(solid.points(), dtype=float)
+    # it contains the mesh: every vertex of the mesh inside the polytope (scipy's facets)
+    facets = ConvexHull(corners).equations  # a·x + b ≤ 0 inside
+    assert (points @ facets[:, :3].T + facets[:, 3]).max() <= 1e-12
+    # the extra clearance it costs: at least how far its corners stick out of the ball
+    # that holds the hull, and small
+    sticks_out = float(np.linalg.norm(corners, axis=1).max() - 0.05)
+    assert sticks_out <= report.extra < 2e-3
