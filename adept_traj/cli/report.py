@@ -12,6 +12,7 @@ import numpy as np
 
 from adept_traj.analysis import WeightedSum
 from adept_traj.results import PlanningResult, Replay
+from adept_traj.results.unchecked import unchecked_of
 from adept_traj.viz.finisher import start_finisher
 
 __all__ = [
@@ -112,7 +113,7 @@ def summary(result: PlanningResult, folder: Path) -> str:
     lines += [f"  violation: {v}" for v in cert.violations]
     if result.self_pairs is not None:
         lines += [f"self-collision: {line}" for line in result.self_pairs.lines()]
-    lines += [f"unchecked: {item}" for item in result.unchecked]
+    lines += [f"unchecked: {item}" for item in unchecked_of(result)]
     if result.warning:
         lines.append(f"warning: {result.warning}")
     lines.append(f"saved to {folder}/result.json")

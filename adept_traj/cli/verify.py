@@ -32,6 +32,7 @@ from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.results import PlanningResult, audit
+from adept_traj.results.unchecked import unchecked_of
 from adept_traj.robot import JointLimits
 
 __all__ = ["add_parser", "run"]
@@ -102,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     if result.self_pairs is not None:
         for line in result.self_pairs.lines():
             print(f"  self-collision: {line}")
-    for item in result.unchecked:
+    for item in unchecked_of(result):
         print(f"  unchecked: {item}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")

@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 import weakref
 from dataclasses import dataclass
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -50,6 +49,15 @@ MATRIX_SAMPLES = 1000
 MATRIX_SEED = 0
 #: Samples looked at first: a pair apart at one of them is checked, the rest need not be.
 _FIRST = 16
+
+
+def quoteattr(text: str) -> str:
+    """``text`` as a double-quoted XML attribute value (``&``, ``<``, ``>``, ``"`` escaped;
+    xml.sax is not imported by the planning command)."""
+    for char, entity in (("&", "&amp;"), ("<", "&lt;"), (">", "&gt;"), ('"', "&quot;")):
+        text = text.replace(char, entity)
+    return f'"{text}"'
+
 
 _MADE: weakref.WeakKeyDictionary[Robot, CollisionMatrix] = weakref.WeakKeyDictionary()
 

@@ -49,6 +49,7 @@ from adept_traj.results.parts import (
 )
 from adept_traj.results.reader import _open_json
 from adept_traj.results.record import FORMAT, READ_VERSIONS, VERSION, PlanningResult, _jsonable
+from adept_traj.results.unchecked import unchecked
 from adept_traj.robot.limits import LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.schema import Node
@@ -287,6 +288,7 @@ def _decode(top: Node) -> PlanningResult:
         warning=top["warning"].string(null=None, default=None),
         versions={k: vd[k].string() for k in vd.table()},
         self_pairs=_decode_self_pairs(top["self_collision"]),
+        unchecked=_decode_unchecked(top["unchecked"], limits, ProblemSettings(**settings)),
     )
     stored = top["certificate"]["feasible"]
     if stored.boolean() != certificate.feasible:
@@ -301,10 +303,7 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
     with what the rest of the file gives: the file re-encoded from the decoded result must be
     the file read. The walk is iterative (the nesting is already bounded)."""
     # json.dumps (C) gives the same data as the file's own layout (_dumps), 4× faster
-    derived_top = json.loads(json.dumps(_encode(result)))
-    if "unchecked" not in top.value:  # written before the field (the record derives it)
-        derived_top.pop("unchecked", None)
-    stack: list[tuple[Any, Any, str]] = [(top.value, derived_top, "")]
+    stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(json.dumps(_encode(result))), "")]
     while stack:
         stored, derived, path = stack.pop()
         if stored == derived:  # whole subtrees at C speed; the walk below only finds where
@@ -320,6 +319,22 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
             stack.extend((s, d, f"{path}[{i}]") for i, (s, d) in enumerate(zip(stored, derived)))
         else:
             raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
+
+
+def _decode_unchecked(
+    node: Node, limits: JointLimits, settings: ProblemSettings
+) -> tuple[str, ...] | None:
+    """The ``unchecked`` statements (absent: a file written before the field, or nothing
+    unchecked), which must be those the file's limits and settings give."""
+    if not node.present:
+        return None
+    stored = node.strings()
+    derived = unchecked(limits, settings)
+    if stored != derived:
+        raise node.error(
+            f"is {list(stored)} but the file's limits and settings give {list(derived)}"
+        )
+    return stored
 
 
 def _decode_self_pairs(node: Node) -> SelfPairs | None:

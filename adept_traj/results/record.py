@@ -117,6 +117,10 @@ class PlanningResult:
     self_pairs: the link pairs the self-collision check covered and those it left out,
         with why (:class:`~adept_traj.collision.SelfPairs`); ``None``: self-collision off
         (or a file written before the field).
+    unchecked: what the certificate did not check (limits the robot lacks, self-collision
+        off: :func:`~adept_traj.results.unchecked.unchecked`; ``None``: nothing unchecked,
+        or not recorded (a result saved before the field) —
+        :func:`~adept_traj.results.unchecked.unchecked_of` derives it).
     """
 
     start: np.ndarray
@@ -138,8 +142,12 @@ class PlanningResult:
     warning: str | None = None
     versions: dict[str, str] = field(default_factory=software_versions)
     self_pairs: SelfPairs | None = None
+    unchecked: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.unchecked is not None:  # () is stored as None: nothing to say either way
+            statements = tuple(str(u) for u in self.unchecked)
+            object.__setattr__(self, "unchecked", statements or None)
         if self.self_pairs is not None:
             check_type(self.self_pairs, SelfPairs, "self_pairs")
         check_type(self.robot, RobotInfo, "robot")
@@ -244,6 +252,7 @@ class PlanningResult:
             history=None if history is None else tuple(history),
             warning=warning,
             self_pairs=problem.self_pairs,
+            unchecked=unchecked(problem.robot.limits, problem.settings),
         )
 
     def problem(self, robot: Robot | None = None) -> TrajectoryProblem:
@@ -272,12 +281,6 @@ class PlanningResult:
     def nq(self) -> int:
         """Number of joints."""
         return len(self.robot.joint_names)
-
-    @property
-    def unchecked(self) -> tuple[str, ...]:
-        """What the certificate did not check (limits the robot lacks, self-collision
-        off): :func:`~adept_traj.results.unchecked.unchecked`; ``()``: nothing."""
-        return unchecked(self.limits, self.problem_settings)
 
     @property
     def feasible(self) -> bool:

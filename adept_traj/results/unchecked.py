@@ -24,7 +24,7 @@ import numpy as np
 from adept_traj.problem import ProblemSettings
 from adept_traj.robot.limits import LIMITS, JointLimits
 
-__all__ = ["unchecked"]
+__all__ = ["unchecked", "unchecked_of"]
 
 
 def unchecked(limits: JointLimits, settings: ProblemSettings) -> tuple[str, ...]:
@@ -49,3 +49,13 @@ def unchecked(limits: JointLimits, settings: ProblemSettings) -> tuple[str, ...]
     if not settings.self_collision:
         out.append("self-collision: off: the robot's links were not checked against each other")
     return tuple(out)
+
+
+def unchecked_of(result: object) -> tuple[str, ...]:
+    """The statements of :func:`unchecked` a :class:`~adept_traj.results.PlanningResult`
+    records (``result.unchecked``), or, for a result without them (made directly, or saved
+    before the field), those its limits and settings give."""
+    stored = getattr(result, "unchecked", None)
+    if stored is not None:
+        return tuple(stored)
+    return unchecked(result.limits, result.problem_settings)  # type: ignore[attr-defined]
