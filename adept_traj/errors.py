@@ -13,6 +13,7 @@ from pathlib import Path
 __all__ = [
     "AdeptTrajError",
     "CheckpointFormatError",
+    "CollidingConfigurationError",
     "ConfigurationError",
     "CycleError",
     "FigureError",
@@ -153,6 +154,12 @@ class ResourceLimitError(InvalidInputError):
 
     The message names the option (or file), its value, the estimate and the limit.
     """
+
+
+class CollidingConfigurationError(InvalidInputError):
+    """A start or goal configuration of a move is closer than the safety margin to an
+    obstacle or to another of the robot's links: no move from or to it can be certified,
+    so it is refused before any search (the message names the pair and the distance)."""
 
 
 class UnreachableLocationError(InvalidInputError):

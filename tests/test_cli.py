@@ -66,12 +66,13 @@ def test_bad_input_is_one_line_without_traceback(
 
 def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
-    assert main(["plan", "--pop", "12", "--gens", "3", "--out", str(out), "--quiet"]) == 0
+    # this tiny run's best (fixed seed) is not certified: exit 1, the folder written all the same
+    assert main(["plan", "--pop", "12", "--gens", "3", "--out", str(out), "--quiet"]) == 1
     text = capsys.readouterr().out
     assert "verified at 1000 Hz" in text
     assert (out / "result.json").is_file()
-    assert not (out / "checkpoint").exists()  # cleaned up after success
-    assert not PlanningResult.load(out).feasible  # this tiny run's best (fixed seed)
+    assert not (out / "checkpoint").exists()  # cleaned up after the run completed
+    assert not PlanningResult.load(out).feasible
     assert main(["verify", str(out)]) == 1
     assert "re-verified at 1000 Hz" in capsys.readouterr().out
     # An interrupted run (simulated: a checkpoint and run.json left behind) resumes.
@@ -89,10 +90,11 @@ def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[st
         argv = ["plan", "--pop", "12", "--gens", "4", *light, "--out", str(interrupted)]
         assert main(argv) == 130
     assert "--resume" in capsys.readouterr().err
-    assert main(["plan", "--resume", str(interrupted), "--quiet"]) == 0
+    code = main(["plan", "--resume", str(interrupted), "--quiet"])
     resumed = PlanningResult.load(interrupted)
+    assert code == (0 if resumed.feasible else 1)  # 0 only for a certified best trade-off
     argv = ["plan", "--pop", "12", "--gens", "4", *light, "--out", str(tmp_path / "u")]
-    assert main([*argv, "--quiet"]) == 0
+    assert main([*argv, "--quiet"]) == code
     uninterrupted = PlanningResult.load(tmp_path / "u")
     np.testing.assert_array_equal(resumed.front.x, uninterrupted.front.x)
 
@@ -303,8 +305,14 @@ _TINY = ["plan", "--pop", "8", "--gens", "2", "--no-html", "--no-plots", "--quie
 def test_plan_exports_an_uncertified_trajectory_only_when_allowed(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    scene = tmp_path / "blocked.toml"
-    scene.write_text(_BLOCKED_SCENE)
+    blocked = tmp_path / "blocked.toml"
+    blocked.write_text(_BLOCKED_SCENE)  # the wall holds the start: refused before a search
+    assert main([*_TINY, "--scene", str(blocked), "--out", str(tmp_path / "blocked")]) == 2
+    err = capsys.readouterr().err
+    assert "no move can be certified" in err
+    assert re.search(r"start: link\S+ – obstacle wall -\d\.\d+ m", err)
+    assert not (tmp_path / "blocked").exists()
+    scene = "detour"  # 16 evaluations find no detour (seed 1): nothing certified
     ros = tmp_path / "ros" / "best.json"
     out = tmp_path / "refused"
     assert main([*_TINY, "--scene", str(scene), "--out", str(out), "--ros", str(ros)]) == 1
@@ -320,7 +328,8 @@ def test_plan_exports_an_uncertified_trajectory_only_when_allowed(
     assert str(ros) in err[0]
     assert "--allow-infeasible" in err[0]
     argv = [*_TINY, "--scene", str(scene), "--out", str(tmp_path / "allowed")]
-    assert main([*argv, "--ros", str(ros), "--allow-infeasible"]) == 0
+    # exported as allowed, but the best trade-off is not certified: still exit 1
+    assert main([*argv, "--ros", str(ros), "--allow-infeasible"]) == 1
     assert "ROS JointTrajectory written" in capsys.readouterr().out
     message = json.loads(ros.read_text())
     assert message["joint_names"] == ["joint1", "joint2", "joint3", "joint4"]

@@ -25,6 +25,7 @@ import pytest
 import adept_traj as at
 import adept_traj.cli.plan as plan_command
 import adept_traj.cli.report as report
+from adept_traj.cli import status
 from adept_traj.cli.app import main
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, Replay
@@ -37,7 +38,9 @@ _DRAWINGS = ("pareto_matrix", "best_tradeoffs", "hypervolume_history", "joint_mo
 
 @pytest.fixture(scope="module")
 def stored() -> PlanningResult:
-    return PlanningResult.load(DATA / "result_v1")
+    result = PlanningResult.load(DATA / "result_v1")
+    assert not result.feasible  # so plan's exit status is NOT_CERTIFIED (1), not 0
+    return result
 
 
 def _nice() -> int:
@@ -98,7 +101,7 @@ def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_
     marker = tmp_path / "preload"
     monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
     monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
-    assert _plan(monkeypatch, stored, tmp_path / "run") == 0
+    assert _plan(monkeypatch, stored, tmp_path / "run") == status.NOT_CERTIFIED
     helper, import_nice = map(int, marker.read_text().split())
     assert helper != os.getpid()
     assert import_nice == finisher.IMPORT_NICENESS
@@ -156,7 +159,7 @@ def test_a_helper_killed_while_drawing_has_its_work_done_by_the_caller(
 
     out = tmp_path / "run"
     code = _plan(monkeypatch, stored, out, "--no-html", tool_path_3d=dies_unless_in_the_caller)
-    assert code == 0
+    assert code == status.NOT_CERTIFIED
     assert (out / "figures" / "tool_path_nsga2.png").read_text() == f"tool {caller}"
     assert len(list((out / "figures").iterdir())) == 5
     assert not (out / "run.json").exists()  # marked complete
@@ -191,7 +194,7 @@ def test_no_helper_with_no_plots_and_no_html(
 ) -> None:
     started = []
     monkeypatch.setattr(report, "start_finisher", lambda *a, **k: started.append(a))
-    assert _plan(monkeypatch, stored, tmp_path / "run", "--no-plots", "--no-html") == 0
+    assert _plan(monkeypatch, stored, tmp_path / "run", "--no-plots", "--no-html") == 1
     assert started == []
     assert (tmp_path / "run" / "result.json").is_file()
 
@@ -208,7 +211,7 @@ def test_a_helper_not_ready_when_the_run_ends_is_stopped_and_the_caller_writes(
         return stored
 
     out = tmp_path / "run"
-    assert _plan(monkeypatch, stored, out, "--no-html", plan=run_ends_while_importing) == 0
+    assert _plan(monkeypatch, stored, out, "--no-html", plan=run_ends_while_importing) == 1
     helper = int(marker.read_text().split()[0])
     assert _gone(helper, within=0.0)
     writers = {int(p.read_text().split()[1]) for p in (out / "figures").iterdir()}
@@ -294,8 +297,8 @@ def test_the_helper_writes_the_same_files_as_the_caller(
         (tmp_path / name).mkdir()
     with finisher.start_finisher(robot, scene, figures=True, html=True) as helper:
         assert helper.ready(120.0)
-        assert plan_command._finish(stored, problem, tmp_path / "helper", opts, helper) == 0
-    assert plan_command._finish(stored, problem, tmp_path / "caller", opts) == 0
+        assert plan_command._finish(stored, problem, tmp_path / "helper", opts, helper) == 1
+    assert plan_command._finish(stored, problem, tmp_path / "caller", opts) == 1
     caller, helped = (_files(tmp_path / name) for name in ("caller", "helper"))
     assert len([f for f in caller if f.endswith(".png")]) == 5
     assert "playback.html" in caller

@@ -59,7 +59,8 @@ def _plan(monkeypatch: pytest.MonkeyPatch, result: PlanningResult, out: Path, **
 def test_the_figures_are_drawn_by_another_process_and_result_json_is_unchanged(
     stored: PlanningResult, plain: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    assert _plan(monkeypatch, stored, tmp_path / "run") == 0
+    assert not stored.feasible  # exit 1: the run's best trade-off is not certified
+    assert _plan(monkeypatch, stored, tmp_path / "run") == 1
     figures = sorted((tmp_path / "run" / "figures").iterdir())
     assert [p.name for p in figures] == [
         "best_tradeoffs.png",

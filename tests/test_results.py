@@ -389,8 +389,16 @@ def test_null_limit_is_infinite(saved: Path) -> None:
     """null in a limit means an infinite (unknown) limit: legal, the file still loads."""
     data = load_json(saved)
     data["limits"]["qd"][0] = None
+    name = data["limits"]["joint_names"][0]
+    # the statement of what was not checked is derived from the limits: said with them
+    said = f"velocity (VC): no limit for {name}: not constrained, not certified"
+    data["unchecked"] = [said, *data.get("unchecked", [])]
     dump_json(saved, data)
     assert PlanningResult.load(saved).limits.velocity[0] == math.inf
+    del data["unchecked"][0]
+    dump_json(saved, data)
+    with pytest.raises(ResultFormatError, match="field 'unchecked'"):
+        PlanningResult.load(saved)
 
 
 def test_csv_tampered(saved: Path) -> None:

@@ -77,13 +77,15 @@ def test_the_scara_quill_through_the_outer_arm_is_not_a_checked_pair() -> None:
 
 
 def test_the_paper_problem_is_unchanged_with_self_collision_on(problem) -> None:
-    """Off by default (the shipped robot has no SRDF); on, the paper problem evaluates
-    and certifies bit-identically: its 10 checked pairs never come within δ."""
-    assert problem.settings.self_collision is False
-    assert problem.self_check is None
-    off = problem
-    problem = TrajectoryProblem(off.robot, off.scene, off.start, off.goal, self_collision=True)
+    """On by default (the shipped robot has no SRDF: its sampled collision matrix leaves
+    only the adjacent pairs out); on, the paper problem evaluates and certifies
+    bit-identically to off: its 10 checked pairs never come within δ."""
+    assert problem.settings.self_collision is True
     assert problem.self_check.n_pairs == 10
+    assert problem.settings.disabled_pairs == ()
+    off = TrajectoryProblem(problem.robot, problem.scene, problem.start, problem.goal,
+                            self_collision=False)  # fmt: skip
+    assert off.self_check is None
     rng = np.random.default_rng(3)
     x = problem.xl + (problem.xu - problem.xl) * rng.random((60, problem.n_var))
     x = np.vstack([x, lift_then_lower(problem)])
@@ -103,8 +105,8 @@ def test_the_paper_problem_is_unchanged_with_self_collision_on(problem) -> None:
 @needs_ur5
 def test_adjacent_and_srdf_pairs_are_left_out_and_recorded(ur5: Robot) -> None:
     bare = Robot.from_urdf(ROBOTS / "ur_description/urdf/ur5_robot.urdf", PARAMS)
-    assert TrajectoryProblem(bare, FAR, HOME, FOLDED).self_check is None  # no SRDF: off
-    assert TrajectoryProblem(bare, FAR, HOME, FOLDED, self_collision=True).self_check.n_pairs
+    assert TrajectoryProblem(bare, FAR, HOME, FOLDED).self_check.n_pairs  # no SRDF: on too
+    assert TrajectoryProblem(bare, FAR, HOME, FOLDED, self_collision=False).self_check is None
     problem = TrajectoryProblem(ur5, FAR, HOME, FOLDED, disabled_pairs=[("base_link", "ee_link")])
     names = {frozenset(p) for p in problem.self_check.pair_names}
     assert frozenset(("upper_arm_link_0", "forearm_link_0")) not in names  # adjacent

@@ -61,6 +61,8 @@ from adept_traj.analysis.paper_measures import (
     ratio_non_dominated,
     spread,
 )
+from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
+from adept_traj.analysis.rest_poses import check_rest_poses, rest_pose_contacts
 from adept_traj.analysis.self_distance import SelfDistance, self_distance
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
@@ -76,6 +78,7 @@ __all__ = [
     "FRONT_INFLUENCE_ABOVE_MARGIN",
     "LIMIT_KINDS",
     "PAPER_WEIGHTS",
+    "REACH_FACTOR",
     "WEIGHTED_SUM_REFERENCE",
     "BestTradeoff",
     "Certificate",
@@ -96,6 +99,7 @@ __all__ = [
     "certify_members",
     "certifying_problem",
     "check_certificate_memory",
+    "check_rest_poses",
     "combined_objective",
     "continuous_distance",
     "continuous_self_distance",
@@ -112,10 +116,13 @@ __all__ = [
     "optimizer_overhead",
     "problem_parts",
     "ratio_non_dominated",
+    "rest_pose_contacts",
+    "robot_reach",
     "same_parts",
     "self_distance",
     "solid_lever_arms",
     "spread",
     "to_unit_minimisation",
+    "unit_warnings",
     "weighted_sum",
 ]

@@ -44,6 +44,7 @@ __all__ = [
     "TOP_FILES",
     "as_path",
     "check_folder",
+    "check_ros_path",
     "commit",
     "is_complete",
     "read_arguments",
@@ -61,7 +62,7 @@ HTML_FILE = "playback.html"
 #: The folder of the figures.
 FIGURES = "figures"
 #: The files ``plan`` writes at the top of its folder.
-TOP_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, HTML_FILE, RUN_FILE)
+TOP_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, HTML_FILE, RUN_FILE, "collision_matrix.srdf")
 #: The names of the figures ``plan`` writes (``<name>``: the algorithm).
 _FIGURE_NAMES = (
     "pareto_matrix.png",
@@ -219,3 +220,19 @@ def folder_lock(folder: Path) -> Iterator[None]:
         yield
     finally:
         os.close(fd)
+
+
+def check_ros_path(path: Path, folder: Path) -> None:
+    """Refuse a ``--ros`` file that cannot be written, before the run starts."""
+    if path.is_dir():
+        raise InvalidInputError(f"--ros {path} is a folder; give a file, e.g. {path}/best.json")
+    parent = path.parent
+    while not parent.exists():  # the export creates missing folders
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InvalidInputError(f"--ros {path}: {parent} is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InvalidInputError(f"--ros {path}: cannot write in {parent}")
+    target, root = path.resolve(), folder.resolve()
+    if target in {root / name for name in TOP_FILES} or root / CHECKPOINT in target.parents:
+        raise InvalidInputError(f"--ros {path} is a file of the result folder {folder}")

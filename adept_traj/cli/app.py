@@ -20,6 +20,8 @@ Sub-commands, one module each:
 - ``adept-traj build-urdf PARAMS --output URDF`` (:mod:`adept_traj.cli.build_urdf`) —
   regenerate a URDF from a parameter file.
 
+A negative number may follow its option as a word of its own (``--start -1.2,0.3,…``).
+
 Bad input never prints a traceback: the command exits with status 2 and a one-line reason.
 Ctrl-C that a command does not handle itself (e.g. while the problem is built) exits with
 status 130 and one line, without a traceback.
@@ -30,6 +32,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import re
 import sys
 from collections.abc import Callable, Sequence
 
@@ -54,6 +57,32 @@ _COMMANDS = {
     "robot": ("robot", "robot-model demo: torques and manipulability"),
     "build-urdf": ("build_urdf", "write a URDF from a robot parameter file"),
 }
+
+
+#: A negative number or a comma-separated list of numbers starting with one (``-1.2,0.3``,
+#: ``-1e-3``): argparse takes such a word for an option unless it is a plain number.
+_NEGATIVE_NUMBERS = re.compile(
+    r"-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?:,\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)*"
+)
+
+
+def negative_values_attached(argv: Sequence[str]) -> list[str]:
+    """``argv`` with every long option followed by a negative number (list) written as one
+    word, ``--start -1.2,0.3`` → ``--start=-1.2,0.3``, so that argparse reads the numbers as
+    the option's value (it reads ``-1.2,0.3`` as an unknown option otherwise)."""
+    out: list[str] = []
+    for arg in argv:
+        if (
+            out
+            and _NEGATIVE_NUMBERS.fullmatch(arg)
+            and out[-1].startswith("--")
+            and "=" not in out[-1]
+            and out[-1] != "--"
+        ):
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+    return out
 
 
 def _selected(argv: Sequence[str]) -> str | None:
@@ -94,7 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     The exit status (:mod:`adept_traj.cli.status`): 0 success, 2 bad input (one line on
     standard error), 130 interrupted, and the command's own statuses.
     """
-    argv = sys.argv[1:] if argv is None else list(argv)
+    argv = negative_values_attached(sys.argv[1:] if argv is None else list(argv))
     parser, runs = _parser(_selected(argv))
     args = parser.parse_args(argv)
     try:

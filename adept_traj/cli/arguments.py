@@ -9,14 +9,24 @@ scene file's robot, else the AdeptOne XL); :func:`check_rate` checks a verificat
 from __future__ import annotations
 
 import argparse
+import sys
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.analysis import PAPER_WEIGHTS, check_rest_poses, unit_warnings
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.errors import (
+    CollidingConfigurationError,
+    ConfigurationError,
+    InvalidInputError,
+    RobotModelError,
+    SceneError,
+)
+from adept_traj.files import read_toml
 from adept_traj.problem import TrajectoryProblem, available_cores, keep_heap
+from adept_traj.robot import ELBOWS, Robot, ScaraGeometry, solve_location
 from adept_traj.scene import SHIPPED_SCENES, Scene
+from adept_traj.transforms import transform_from_xyz_rpy
 from adept_traj.validation import as_scalar
 
 __all__ = [
@@ -52,6 +62,21 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--start", type=floats, help="q1,...,qn [rad|m] (default: the scene's)")
     parser.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: the scene's)")
+    for end in ("start", "goal"):
+        parser.add_argument(
+            f"--{end}-pose",
+            type=floats,
+            metavar="POSE",
+            help=f"the {end} as a tool pose in the robot base frame, solved by inverse "
+            "kinematics as a cycle file's location: x,y,z [m],yaw [rad] for a SCARA, "
+            "x,y,z [m],roll,pitch,yaw [rad] for another robot (instead of --" + end + ")",
+        )
+    parser.add_argument(
+        "--elbow",
+        choices=ELBOWS,
+        help="SCARA: the elbow of --start-pose/--goal-pose (default: righty if it reaches "
+        "the pose, else lefty)",
+    )
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     parser.add_argument(
         "--weights",
@@ -69,6 +94,39 @@ def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
         help="processes evaluating in parallel (default: the cores available to the process; "
         "1 evaluates in the main process; the results are the same)",
     )
+
+
+def _pose_joints(
+    robot: Robot,
+    pose: list[float] | None,
+    end: str,
+    joints: np.ndarray | None,
+    hint: np.ndarray | None,
+    args: argparse.Namespace,
+) -> np.ndarray:
+    """``joints`` (nq,), or those of ``--{end}-pose`` ``pose`` solved as a cycle file's
+    location (:func:`~adept_traj.robot.solve_location`: SCARA closed form with
+    ``--elbow``, else numeric IK from ``hint``, the start's joints for the goal)."""
+    if pose is None:
+        return joints
+    try:
+        ScaraGeometry.of(robot)
+        size, text = 4, "x,y,z [m],yaw [rad]"
+    except RobotModelError:
+        size, text = 6, "x,y,z [m],roll,pitch,yaw [rad]"
+    values = np.asarray(pose, dtype=float)
+    if values.shape != (size,) or not np.all(np.isfinite(values)):
+        raise InvalidInputError(
+            f"--{end}-pose must be {size} finite numbers ({text}) for robot '{robot.name}'; "
+            f"got {','.join(map(str, pose))}"
+        )
+    if size == 6 and args.elbow is not None:
+        raise ConfigurationError(
+            f"--elbow is only for SCARA robots; robot '{robot.name}' is not one"
+        )
+    target = values if size == 4 else transform_from_xyz_rpy(values[:3], values[3:])
+    joints, _ = solve_location(robot, target, elbow=args.elbow, name=f"--{end}-pose", hint=hint)
+    return joints
 
 
 def check_rate(rate: float) -> float:
@@ -95,15 +153,28 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     ConfigurationError
         The scene has no start/goal and none was given.
     InvalidInputError
-        Bad weights or rate, or a start/goal outside the joint limits.
+        Bad weights or rate, or a start/goal outside the joint limits (every joint
+        outside named).
+    CollidingConfigurationError
+        A start or goal closer than the margin to an obstacle or (self-collision on) to
+        another link (:func:`~adept_traj.analysis.check_rest_poses`): checked before any
+        search.
     """
     scene = scene_from_argument(args.scene)
-    start = args.start if args.start is not None else scene.start
-    goal = args.goal if args.goal is not None else scene.goal
-    if start is None or goal is None:
+    start, goal = args.start, args.goal
+    for end in ("start", "goal"):
+        if getattr(args, end) is not None and getattr(args, f"{end}_pose", None) is not None:
+            raise ConfigurationError(f"give --{end} or --{end}-pose, not both")
+    if start is None and getattr(args, "start_pose", None) is None:
+        start = scene.start
+    if goal is None and getattr(args, "goal_pose", None) is None:
+        goal = scene.goal
+    if (start is None and args.start_pose is None) or (goal is None and args.goal_pose is None):
         raise ConfigurationError(
             f"scene '{scene.name}' has no [task] start/goal: give --start and --goal"
         )
+    if getattr(args, "elbow", None) is not None and args.start_pose is None is args.goal_pose:
+        raise ConfigurationError("--elbow goes with --start-pose or --goal-pose")
     if args.weights is not None:  # None: plan's default (the paper's weights of f_c)
         weights = np.asarray(args.weights, dtype=float)
         if weights.shape != (6,) or not np.all(np.isfinite(weights)) or (weights < 0).any():
@@ -115,6 +186,18 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     check_rate(args.rate)
     keep_heap()  # the command's own process: evaluation blocks reuse the freed heap
     robot = robot_from_arguments(args, args.scene)
-    start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
+    start = check_task(robot, start, "start") if start is not None else None
+    start = _pose_joints(robot, getattr(args, "start_pose", None), "start", start, None, args)
+    goal = check_task(robot, goal, "goal") if goal is not None else None
+    goal = _pose_joints(robot, getattr(args, "goal_pose", None), "goal", goal, start, args)
     workers = available_cores() if args.workers is None else args.workers
-    return TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    problem = TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    try:
+        raw = None if args.scene in SHIPPED_SCENES else read_toml(args.scene, SceneError)
+        for warning in unit_warnings(problem, raw):
+            print(f"adept-traj: warning: {warning}", file=sys.stderr)
+        check_rest_poses(problem)
+    except CollidingConfigurationError:
+        problem.close()
+        raise
+    return problem

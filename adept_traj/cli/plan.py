@@ -7,7 +7,7 @@ instant: :mod:`adept_traj.cli._run_folder` says how a folder tells its state). B
 removed when the run completes; ``--resume`` of a complete run says so and changes nothing.
 
 ``--out DIR`` refuses a folder that holds files of an earlier run unless ``--overwrite`` is
-given, which removes those files (only those ``plan`` writes) before the run. Every option
+given, which removes those files (only those ``plan`` writes) before the run; every option
 and output path is checked before anything is written.
 
 ``--ros FILE`` exports the best trade-off for a robot controller only when its dense
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -31,9 +30,9 @@ from adept_traj.cli._run_folder import (
     CHECKPOINT,
     HTML_FILE,
     RUN_FILE,
-    TOP_FILES,
     as_path,
     check_folder,
+    check_ros_path,
     commit,
     folder_lock,
     is_complete,
@@ -44,8 +43,14 @@ from adept_traj.cli._run_folder import (
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import finish_figures, finisher_for, start_figures, summary
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.cli.report import (
+    finish_figures,
+    finisher_for,
+    save_collision_matrix,
+    start_figures,
+    summary,
+)
+from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     ALGORITHMS,
     POLISH_MODES,
@@ -67,10 +72,10 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 
 #: The options saved in :data:`RUN_FILE` and restored by ``--resume``.
 _SAVED = (
-    "scene", "start", "goal", "seed", "weights", "rate", "algorithm", "pop", "gens",
-    "workers", "no_html", "no_plots", "ros", "allow_infeasible", "no_polish",
-    "polish",
-    "robot", "params", "tool_frame", "srdf", "package_dir",
+    "scene", "start", "goal", "start_pose", "goal_pose", "elbow", "seed", "weights", "rate",
+    "algorithm", "pop", "gens", "workers", "no_html", "no_plots", "ros", "allow_infeasible",
+    "no_polish", "polish",
+    "robot", "params", "tool_frame", "srdf", "package_dir", "locked_joint",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
 _FREE_ON_RESUME = ("workers", "allow_infeasible")
@@ -134,11 +139,13 @@ def _comparable(key: str, value: Any) -> Any:
     """``value`` of option ``key`` in the form run.json keeps (absolute paths)."""
     if value is None or (key == "scene" and value in SHIPPED_SCENES):
         return value
+    if key in ("robot", "srdf") and str(value).startswith("package://"):
+        return str(value)  # found in the package folders, wherever the run starts
     if key in ("scene", "ros", "robot", "params", "srdf"):
         return str(Path(value).resolve())
     if key == "package_dir":
         return [str(Path(v).resolve()) for v in value]
-    if key in ("start", "goal", "weights"):
+    if key in ("start", "goal", "weights", "start_pose", "goal_pose"):
         return [float(x) for x in value]
     return value
 
@@ -169,22 +176,6 @@ def _resumed_options(saved: dict[str, Any], given: dict[str, Any], folder: Path)
                 "run, or start a new one with --out"
             )
     return options
-
-
-def _check_ros_path(path: Path, folder: Path) -> None:
-    """Refuse a ``--ros`` file that cannot be written, before the run starts."""
-    if path.is_dir():
-        raise InvalidInputError(f"--ros {path} is a folder; give a file, e.g. {path}/best.json")
-    parent = path.parent
-    while not parent.exists():  # the export creates missing folders
-        parent = parent.parent
-    if not parent.is_dir():
-        raise InvalidInputError(f"--ros {path}: {parent} is not a folder")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise InvalidInputError(f"--ros {path}: cannot write in {parent}")
-    target, root = path.resolve(), folder.resolve()
-    if target in {root / name for name in TOP_FILES} or root / CHECKPOINT in target.parents:
-        raise InvalidInputError(f"--ros {path} is a file of the result folder {folder}")
 
 
 def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
@@ -219,8 +210,10 @@ def _options(args: argparse.Namespace) -> tuple[argparse.Namespace, Path, bool]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done (or
-    ``--resume`` of a complete run), 1 the ``--ros`` export refused, 130 interrupted)."""
+    """Run ``plan``; return the exit status (:mod:`adept_traj.cli.status`: 0 done with a
+    certified best trade-off (or ``--resume`` of a complete run), 1 the run finished and
+    its result folder is written but no certified move was found (the best trade-off's
+    certificate failed; the ``--ros`` export refused), 130 interrupted)."""
     resume = as_path(args.resume, "--resume")
     if resume is not None and is_complete(resume):
         print(
@@ -230,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
         return status.OK
     opts, folder, resume = _options(args)
     if opts.ros is not None:
-        _check_ros_path(opts.ros, folder)
+        check_ros_path(opts.ros, folder)
     if not resume:
         check_folder(
             folder, overwrite=args.overwrite, html=not opts.no_html, figures=not opts.no_plots
@@ -351,9 +344,10 @@ def _finish(
     print(summary(result, folder))
     for note in scene_notes(problem.scene):
         print(f"  obstacle {note}")
-    code = status.OK
+    save_collision_matrix(problem, folder)  # made for a robot without SRDF: reusable
+    code = status.OK if result.feasible else status.NOT_CERTIFIED
     if opts.ros is not None:
-        code = _export_ros(result, opts.ros, opts.allow_infeasible, replay)
+        code = max(code, _export_ros(result, opts.ros, opts.allow_infeasible, replay))
     commit(folder)
     return code
 

@@ -12,17 +12,43 @@ import numpy as np
 
 from adept_traj.analysis import WeightedSum
 from adept_traj.results import PlanningResult, Replay
+from adept_traj.results.unchecked import unchecked_of
 from adept_traj.viz.finisher import start_finisher
 
 __all__ = [
+    "MATRIX_FILE",
     "finish_figures",
     "finisher_for",
+    "save_collision_matrix",
     "save_figures",
     "start_figures",
     "summary",
     "t_best_text",
     "weighted_sum_text",
 ]
+
+
+#: The self-collision matrix ``plan`` saves beside a result when it made one for the robot.
+MATRIX_FILE = "collision_matrix.srdf"
+
+
+def save_collision_matrix(problem: Any, folder: Path) -> Path | None:
+    """Write the collision matrix made for ``problem``'s robot (no SRDF and no disabled
+    pairs given: :func:`~adept_traj.collision.robot_collision_matrix`) as
+    ``folder/collision_matrix.srdf`` (reusable with ``--srdf``) and say so; ``None`` (nothing
+    written) when the robot's pairs came from an SRDF or a parameter file, or
+    self-collision is off."""
+    robot = problem.robot
+    if problem.self_check is None or robot.srdf_path is not None or robot.disabled_pairs:
+        return None
+    from adept_traj.collision import robot_collision_matrix
+    from adept_traj.files import write_text_atomic
+
+    if set(problem.settings.disabled_pairs) != set(robot_collision_matrix(robot).always):
+        return None  # pairs given by the caller, not the matrix's
+    path = write_text_atomic(folder / MATRIX_FILE, robot_collision_matrix(robot).to_srdf())
+    print(f"self-collision matrix made for robot '{robot.name}' saved to {path} (--srdf)")
+    return path
 
 
 def t_best_text(result: PlanningResult) -> str:
@@ -60,7 +86,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
     trade-off's objectives z1 [s] … z6 and its gaps to the kinematic lower bound and to
     T_best (``metrics.t_best``, the best T the local solver reached; "not computed"), how many
     front members are certified, its dense certificate and the guarantee it gives
-    (violations listed), the result's warning and where it was saved."""
+    (violations listed), what it did not check (``result.unchecked``), the result's
+    warning and where it was saved."""
     z = result.best_objectives
     cert, front = result.certificate, result.front
     workers = result.problem_settings.workers
@@ -84,6 +111,9 @@ def summary(result: PlanningResult, folder: Path) -> str:
     ]
     lines += weighted_sum_text(result)
     lines += [f"  violation: {v}" for v in cert.violations]
+    if result.self_pairs is not None:
+        lines += [f"self-collision: {line}" for line in result.self_pairs.lines()]
+    lines += [f"unchecked: {item}" for item in unchecked_of(result)]
     if result.warning:
         lines.append(f"warning: {result.warning}")
     lines.append(f"saved to {folder}/result.json")

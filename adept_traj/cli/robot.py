@@ -4,20 +4,28 @@ Peak joint speeds, accelerations and torques, the torques' ratio to their limits
 paper's UC), the integral of the squared torques (z2) and the manipulability range (z4)
 along a rest-to-rest quintic move of the paper's task or of the one given; with ``--srdf``,
 the smallest self-collision distance along it (:class:`~adept_traj.collision.SelfCollision`).
+
+``--collision-matrix OUT.srdf`` instead writes the robot's self-collision matrix
+(:func:`~adept_traj.collision.collision_matrix`: adjacent pairs and pairs in contact at
+every one of 1 000 poses sampled within the limits left out, every other pair checked) as
+an SRDF, reusable with ``--srdf``.
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
 from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
-from adept_traj.collision import SelfCollision
+from adept_traj.collision import SelfCollision, collision_matrix
 from adept_traj.errors import InvalidInputError
+from adept_traj.files import write_text_atomic
 from adept_traj.memory import check_memory
+from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 
 __all__ = ["add_parser", "run", "samples_bytes"]
@@ -44,7 +52,27 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--goal", type=floats, help="q1,...,qn [rad|m] (default: paper's)")
     p.add_argument("--duration", type=float, default=1.1, help="move time T [s]")
     p.add_argument("--samples", type=int, default=1001, help="samples along the move")
+    p.add_argument(
+        "--collision-matrix",
+        metavar="OUT.srdf",
+        help="write the robot's self-collision matrix (made by sampling poses within the "
+        "limits) as an SRDF instead of the demo",
+    )
     return p
+
+
+def _write_matrix(robot: Robot, path: Path) -> int:
+    """Write ``robot``'s collision matrix as the SRDF ``path``; print what it holds."""
+    if path.is_dir():
+        raise InvalidInputError(f"--collision-matrix {path} is a folder; give a file")
+    matrix = collision_matrix(robot)
+    write_text_atomic(path, matrix.to_srdf())
+    print(
+        f"{robot.name}: {len(matrix.checked)} link pairs checked, {len(matrix.adjacent)} "
+        f"adjacent and {len(matrix.always)} in contact at every one of {matrix.samples} "
+        f"sampled poses left out; written to {path}"
+    )
+    return status.OK
 
 
 def _quintic_move(
@@ -62,6 +90,8 @@ def _quintic_move(
 def run(args: argparse.Namespace) -> int:
     """Run ``robot``; return the exit status (0)."""
     robot = robot_from_arguments(args)
+    if args.collision_matrix is not None:
+        return _write_matrix(robot, Path(args.collision_matrix))
     paper = Scene.paper()  # its [task]: the paper's start and goal (docs/paper-scenario.md)
     start = check_task(robot, paper.start if args.start is None else args.start, "--start")
     goal = check_task(robot, paper.goal if args.goal is None else args.goal, "--goal")

@@ -1,5 +1,6 @@
 """The robot a command works on: ``--robot URDF [--params TOML] [--tool-frame NAME]
-[--srdf FILE] [--package-dir DIR ...]``,
+[--srdf FILE] [--package-dir DIR ...] [--locked-joint NAME=VALUE ...]`` (the URDF and the
+SRDF may be ``package://`` URIs, as in a scene file),
 else the scene file's ``[robot]`` table, else the AdeptOne XL.
 
 :func:`add_robot_arguments` declares the options; :func:`source_from_arguments` gives
@@ -11,17 +12,19 @@ a start/goal against the robot's joint count.
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 import numpy as np
 
-from adept_traj.errors import InputShapeError
+from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.robot import Robot, RobotSource
 from adept_traj.scene import SHIPPED_SCENES, read_robot_files
 
 __all__ = [
     "add_robot_arguments",
     "check_task",
+    "locked_joints",
     "options_given",
     "robot_from_arguments",
     "source_from_arguments",
@@ -46,6 +49,30 @@ def add_robot_arguments(
         action="append",
         help="folder searched first for package:// meshes (repeatable)",
     )
+    parser.add_argument(
+        "--locked-joint",
+        action="append",
+        metavar="NAME=VALUE",
+        help="fix joint NAME at VALUE [rad | m] and remove it from q (repeatable)",
+    )
+
+
+def locked_joints(values: list[str] | None) -> tuple[tuple[str, float], ...]:
+    """The ``--locked-joint NAME=VALUE`` options as ``(name, value)`` pairs, else
+    :class:`~adept_traj.errors.InvalidInputError` naming the option given."""
+    out = []
+    for text in values or ():
+        name, sep, value = text.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not sep or not name.strip() or not math.isfinite(number):
+            raise InvalidInputError(
+                f"--locked-joint must be NAME=VALUE with a finite VALUE [rad | m]; got {text!r}"
+            )
+        out.append((name.strip(), number))
+    return tuple(out)
 
 
 def source_from_arguments(args: argparse.Namespace, scene: str | None = None) -> RobotSource:
@@ -73,6 +100,7 @@ def options_given(args: argparse.Namespace) -> dict[str, Any]:
         "tool_frame": getattr(args, "tool_frame", None),
         "srdf": getattr(args, "srdf", None),
         "package_dirs": tuple(getattr(args, "package_dir", None) or ()),
+        "locked_joints": locked_joints(getattr(args, "locked_joint", None)),
     }
 
 

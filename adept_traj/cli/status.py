@@ -8,8 +8,9 @@ __all__ = ["BAD_INPUT", "INTERRUPTED", "MISMATCH", "NOT_CERTIFIED", "OK", "TERMI
 
 #: Success (``show``: stopped with Ctrl-C).
 OK = 0
-#: ``verify``: the best trade-off is not feasible; ``plan --ros``: the run finished but its
-#: best trade-off is not certified, so the ROS file was not written.
+#: ``verify``: the best trade-off is not feasible; ``plan``: the run finished and its
+#: result folder is written, but its best trade-off is not certified (no certified move
+#: was found; with ``--ros`` the ROS file was not written).
 NOT_CERTIFIED = 1
 #: Bad input: one line ``adept-traj: error: …`` on standard error.
 BAD_INPUT = 2

@@ -32,6 +32,7 @@ from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.results import PlanningResult, audit
+from adept_traj.results.unchecked import unchecked_of
 from adept_traj.robot import JointLimits
 from adept_traj.scene import scene_notes
 
@@ -102,6 +103,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"  violation: {violation}")
     for note in scene_notes(problem.scene):
         print(f"  obstacle {note}")
+    if result.self_pairs is not None:
+        for line in result.self_pairs.lines():
+            print(f"  self-collision: {line}")
+    for item in unchecked_of(result):
+        print(f"  unchecked: {item}")
     if cert.feasible != result.certificate.feasible:
         print("  note: the saved certificate said otherwise")
     for mismatch in found.mismatches:

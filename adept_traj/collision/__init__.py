@@ -16,6 +16,14 @@ from adept_traj.collision.checker import (
     MinDistances,
     PairDistances,
 )
+from adept_traj.collision.collision_matrix import (
+    MATRIX_SAMPLES,
+    CollisionMatrix,
+    SelfPairs,
+    collision_matrix,
+    robot_collision_matrix,
+    self_collision_check,
+)
 from adept_traj.collision.distance_gradient import (
     WITNESS_TOLERANCES,
     DistanceGradients,
@@ -40,10 +48,12 @@ from adept_traj.collision.self_collision import SelfCollision, SelfDistances
 
 __all__ = [
     "DISTANCE_TOLERANCE",
+    "MATRIX_SAMPLES",
     "WITNESS_TOLERANCES",
     "Bounds",
     "BroadPhase",
     "CollisionChecker",
+    "CollisionMatrix",
     "DistanceGradients",
     "DistanceTable",
     "MinDistances",
@@ -51,7 +61,9 @@ __all__ = [
     "PairDistances",
     "SelfCollision",
     "SelfDistances",
+    "SelfPairs",
     "coal_kind",
+    "collision_matrix",
     "distance_gradients",
     "distance_request",
     "enclosing_capsule",
@@ -59,8 +71,10 @@ __all__ = [
     "point_signed_distance",
     "restrict_broad_phase",
     "restrict_checker",
+    "robot_collision_matrix",
     "search_pairs",
     "segment_distance",
+    "self_collision_check",
     "shape_of",
     "solid_lever_arms",
     "sweep_clearance",

@@ -39,9 +39,9 @@ from adept_traj.collision.capsules import enclosing_capsule, segment_distance
 from adept_traj.collision.lever_arms import pair_lever_arms
 from adept_traj.collision.point_distance import points_in_joint
 from adept_traj.collision.primitives import distance_request, enclosing_ball
-from adept_traj.errors import InputShapeError, RobotModelError
+from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
 from adept_traj.robot import Robot, solid_frames
-from adept_traj.validation import as_batch, as_finite_array, as_integer, as_scalar
+from adept_traj.validation import as_batch, as_integer, as_scalar
 
 __all__ = ["SelfCollision", "SelfDistances"]
 
@@ -81,6 +81,9 @@ class SelfCollision:
         ``Robot.from_urdf(..., srdf=...)``).
     influence:
         Distance [m] below which every distance is exact (default 0.05 m, ≥ 0).
+    robot_pairs:
+        Leave out the robot's own disabled pairs (SRDF, parameter file; default) —
+        ``False``: only adjacent pairs and ``disabled`` (a collision matrix is made so).
 
     Raises
     ------
@@ -94,6 +97,8 @@ class SelfCollision:
         robot: Robot,
         disabled: Iterable[tuple[str, str]] = (),
         influence: float = 0.05,
+        *,
+        robot_pairs: bool = True,
     ) -> None:
         self.robot = robot
         self.influence = as_scalar(influence, "influence", "[m]", minimum=0.0)
@@ -108,7 +113,7 @@ class SelfCollision:
                 f"robot '{robot.name}': disabled pair link(s) {unknown} have no collision "
                 f"solid; links with solids are {sorted(known)}"
             )
-        off = {frozenset(p) for p in given + list(robot.disabled_pairs)}
+        off = {frozenset(p) for p in given + list(robot.disabled_pairs if robot_pairs else ())}
         #: The disabled ``(link1, link2)`` pairs that name two links with solids (sorted).
         self.disabled = tuple(
             sorted(tuple(sorted(p)) for p in off if len(p) == 2 and p <= known)  # type: ignore[misc]
@@ -118,17 +123,21 @@ class SelfCollision:
             (int(p), np.flatnonzero(self._parents == p)) for p in np.unique(self._parents)
         ]
         near = _solid_parents(model.parents, set(self._parents.tolist()))
-        chosen = []
+        chosen, adjacent = [], set()
         for a in range(len(objects)):
             for b in range(a + 1, len(objects)):
                 ja, jb = int(self._parents[a]), int(self._parents[b])
                 if ja == jb or near[ja] == jb or near[jb] == ja:
+                    if self.links[a] != self.links[b]:
+                        adjacent.add(tuple(sorted((self.links[a], self.links[b]))))
                     continue
                 if frozenset((self.links[a], self.links[b])) in off:
                     continue
                 chosen.append((a, b))
         #: (n_pairs, 2) indices of the checked solid pairs.
         self.pairs = np.array(chosen, dtype=int).reshape(-1, 2)
+        #: The ``(link1, link2)`` pairs left out as adjacent (or on one joint body), sorted.
+        self.adjacent = tuple(sorted(adjacent))
         self.solid_names = tuple(g.name for g in objects)
         self._geoms = [g.geometry for g in objects]
         rot, shift = self._local[:, :3, :3], self._local[:, :3, 3]
@@ -155,6 +164,12 @@ class SelfCollision:
         (:func:`~adept_traj.collision.pair_lever_arms`): a pair's distance changes at most
         at :math:`\\sum_j \\rho_{abj} |\\dot q_j|` [m/s]."""
         return self._rho.copy()
+
+    @property
+    def link_pairs(self) -> tuple[tuple[str, str], ...]:
+        """The checked ``(link1, link2)`` pairs (each once, sorted)."""
+        found = {tuple(sorted((self.links[a], self.links[b]))) for a, b in self.pairs.tolist()}
+        return tuple(sorted(found))  # type: ignore[arg-type]
 
     @property
     def pair_names(self) -> tuple[tuple[str, str], ...]:
@@ -215,7 +230,9 @@ class SelfCollision:
                 f"got {np.shape(joint_frames)}"
             )
         batch, n_t = qa.shape[:-2], qa.shape[-2]
-        limit = np.full(batch, self.influence) if below is None else as_finite_array(below, "below")
+        limit = np.full(batch, self.influence) if below is None else np.asarray(below, float)
+        if np.isnan(limit).any():  # (+inf: no obstacle; the influence distance applies)
+            raise InvalidInputError(f"below must hold numbers or +inf [m]; got {below!r}")
         try:
             limit = np.minimum(np.broadcast_to(limit, batch), self.influence).reshape(-1)
         except ValueError:

@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 from pymoo.core.problem import Problem
 
-from adept_traj.collision import CollisionChecker, SelfCollision
+from adept_traj.collision import CollisionChecker, self_collision_check
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
@@ -105,10 +105,10 @@ class ProblemSettings:
     self_collision:
         Check the robot's own links against each other (the pairs of
         :class:`~adept_traj.collision.SelfCollision`) in the distance constraint and the
-        certificate, with the same margin. ``None`` (default): on when the robot has a
-        checked pair and its disabled pairs are known (an SRDF,
-        ``Robot.from_urdf(..., srdf=...)``, or ``disabled_pairs`` given): without them,
-        links that touch by design would make ordinary moves infeasible. The problem's
+        certificate, with the same margin. ``None`` (default): on for every robot with a
+        pair to check; without an SRDF, parameter-file pairs or ``disabled_pairs``, the
+        pairs in contact at every pose of its sampled collision matrix are left out
+        (:func:`~adept_traj.collision.self_collision_check`). The problem's
         :attr:`~TrajectoryProblem.settings` hold the resolved ``True``/``False``.
     disabled_pairs:
         ``(link1, link2)`` pairs left out of the self-collision check besides the robot's
@@ -214,12 +214,11 @@ class TrajectoryProblem(Problem):
             except TypeError as exc:
                 raise ConfigurationError(f"unknown problem setting: {exc}") from None
         self.robot, self.scene = robot, scene
-        self_check = SelfCollision(robot, settings.disabled_pairs, influence=settings.influence)
-        known = robot.srdf_path is not None or robot.disabled_pairs or settings.disabled_pairs
-        on = settings.self_collision
-        on = bool(self_check.n_pairs and known) if on is None else on
-        #: The robot–robot distances (``None``: self-collision off).
-        self.self_check = self_check if on else None
+        on, self_check, pairs = self_collision_check(
+            robot, settings.self_collision, settings.disabled_pairs, settings.influence
+        )
+        #: The robot–robot distances (``None``: self-collision off) and their pairs.
+        self.self_check, self.self_pairs = self_check, pairs
         self.settings = settings = replace(
             settings, self_collision=on, disabled_pairs=self_check.disabled if on else ()
         )

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.collision import SelfPairs
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
 from adept_traj.results.certificate_codec import (
@@ -48,6 +49,7 @@ from adept_traj.results.parts import (
 )
 from adept_traj.results.reader import _open_json
 from adept_traj.results.record import FORMAT, READ_VERSIONS, VERSION, PlanningResult, _jsonable
+from adept_traj.results.unchecked import unchecked
 from adept_traj.robot.limits import LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.schema import Node
@@ -141,6 +143,13 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     }
     if r.front.n_certified is not None:  # optional key (absent in files of older versions)
         out["n_certified"] = r.front.n_certified
+    if r.unchecked:  # optional key (absent: everything checked, or an older version's file)
+        out["unchecked"] = list(r.unchecked)
+    if r.self_pairs is not None:  # optional key (absent: self-collision off, or older files)
+        out["self_collision"] = {
+            "checked": [list(p) for p in r.self_pairs.checked],
+            "left_out": [{"pair": [a, b], "reason": why} for a, b, why in r.self_pairs.left_out],
+        }
     return out
 
 
@@ -278,6 +287,8 @@ def _decode(top: Node) -> PlanningResult:
         history=_decode_history(top["history"]),
         warning=top["warning"].string(null=None, default=None),
         versions={k: vd[k].string() for k in vd.table()},
+        self_pairs=_decode_self_pairs(top["self_collision"]),
+        unchecked=_decode_unchecked(top["unchecked"], limits, ProblemSettings(**settings)),
     )
     stored = top["certificate"]["feasible"]
     if stored.boolean() != certificate.feasible:
@@ -308,6 +319,36 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
             stack.extend((s, d, f"{path}[{i}]") for i, (s, d) in enumerate(zip(stored, derived)))
         else:
             raise top.error_at(path, f"is {stored!r} but the rest of the file gives {derived!r}")
+
+
+def _decode_unchecked(
+    node: Node, limits: JointLimits, settings: ProblemSettings
+) -> tuple[str, ...] | None:
+    """The ``unchecked`` statements (absent: a file written before the field, or nothing
+    unchecked), which must be those the file's limits and settings give."""
+    if not node.present:
+        return None
+    stored = node.strings()
+    derived = unchecked(limits, settings)
+    if stored != derived:
+        raise node.error(
+            f"is {list(stored)} but the file's limits and settings give {list(derived)}"
+        )
+    return stored
+
+
+def _decode_self_pairs(node: Node) -> SelfPairs | None:
+    """The ``self_collision`` object (absent: off, or a file written before the field)."""
+    if not node.present:
+        return None
+    node.check_keys(("checked", "left_out"))
+    checked = tuple(tuple(p.strings()) for p in node["checked"].items())
+    left = []
+    for entry in node["left_out"].items():
+        entry.check_keys(("pair", "reason"))
+        a, b = entry["pair"].strings()
+        left.append((a, b, entry["reason"].string()))
+    return node.build(SelfPairs, checked=checked, left_out=tuple(left))
 
 
 def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:

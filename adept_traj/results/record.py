@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory
+from adept_traj.collision import SelfPairs
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import (
     OBJECTIVE_NAMES,
@@ -45,6 +46,7 @@ from adept_traj.results.parts import (
     Timing,
     software_versions,
 )
+from adept_traj.results.unchecked import unchecked
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import JointLimits
 from adept_traj.scene.scene import Scene
@@ -112,6 +114,13 @@ class PlanningResult:
     warning: a warning for the reader; defaults to :data:`NO_FEASIBLE_WARNING` when no
         solution of the front is feasible.
     versions: software versions (default: :func:`software_versions` now).
+    self_pairs: the link pairs the self-collision check covered and those it left out,
+        with why (:class:`~adept_traj.collision.SelfPairs`); ``None``: self-collision off
+        (or a file written before the field).
+    unchecked: what the certificate did not check (limits the robot lacks, self-collision
+        off: :func:`~adept_traj.results.unchecked.unchecked`; ``None``: nothing unchecked,
+        or not recorded (a result saved before the field) —
+        :func:`~adept_traj.results.unchecked.unchecked_of` derives it).
     """
 
     start: np.ndarray
@@ -132,8 +141,15 @@ class PlanningResult:
     history: tuple[GenerationRecord, ...] | None = None
     warning: str | None = None
     versions: dict[str, str] = field(default_factory=software_versions)
+    self_pairs: SelfPairs | None = None
+    unchecked: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.unchecked is not None:  # () is stored as None: nothing to say either way
+            statements = tuple(str(u) for u in self.unchecked)
+            object.__setattr__(self, "unchecked", statements or None)
+        if self.self_pairs is not None:
+            check_type(self.self_pairs, SelfPairs, "self_pairs")
         check_type(self.robot, RobotInfo, "robot")
         check_type(self.problem_settings, ProblemSettings, "problem_settings")
         check_type(self.limits, JointLimits, "limits")
@@ -235,6 +251,8 @@ class PlanningResult:
             metrics=metrics if metrics is not None else Metrics(),
             history=None if history is None else tuple(history),
             warning=warning,
+            self_pairs=problem.self_pairs,
+            unchecked=unchecked(problem.robot.limits, problem.settings),
         )
 
     def problem(self, robot: Robot | None = None) -> TrajectoryProblem:

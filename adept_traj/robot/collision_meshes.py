@@ -25,12 +25,24 @@ over the hull samples :math:`s` and the mesh samples :math:`m` (points of the me
 the true clearance of the link, and at most :math:`g` smaller; :attr:`Robot.mesh_hulls
 <adept_traj.robot.Robot.mesh_hulls>` gives :math:`g` per link.
 
-Size budget: a hull with more than :data:`MAX_HULL_POINTS` vertices is refused (coal's
-support function is linear in them) with advice to simplify the collision mesh.
+Size budget: a hull with more than :data:`MAX_HULL_POINTS` vertices (coal's support
+function is linear in them) is **simplified conservatively**: it is replaced by the
+intersection of its supporting half-spaces in :data:`SIMPLIFY_DIRECTIONS` directions spread
+over the sphere (a Fibonacci lattice),
+
+.. math:: P = \{x : n_i \cdot x \le \max_{v \in \text{hull}} n_i \cdot v\},
+
+a polytope that contains the hull (each half-space does), hence the mesh, with at most
+about twice as many vertices as directions. It costs clearance: a distance to :math:`P` is
+smaller than to the hull by at most :attr:`HullReport.extra` [m], the largest distance of
+a vertex of :math:`P` to the hull (the distance to a convex set is convex: its largest value
+over :math:`P` is at a vertex); :attr:`HullReport.gap` bounds the whole gap of :math:`P`
+to the mesh. A warning names each simplified link with its extra clearance.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -40,13 +52,23 @@ import pinocchio as pin
 
 from adept_traj.errors import RobotModelError
 
-__all__ = ["GAP_SAMPLE_STEP", "MAX_HULL_POINTS", "HullReport", "convex_hull_solids"]
+__all__ = [
+    "GAP_SAMPLE_STEP",
+    "MAX_HULL_POINTS",
+    "SIMPLIFY_DIRECTIONS",
+    "HullReport",
+    "bounding_polytope",
+    "convex_hull_solids",
+]
 
 #: Largest spacing [m] of the samples on hull faces used to bound the gap.
 GAP_SAMPLE_STEP = 2e-3
 
-#: Most vertices a link's convex hull may have (the Jaco2's largest shipped hull has 1 498).
+#: Most vertices a link's convex hull may have (the Jaco2's largest shipped hull has 1 498);
+#: a larger hull is simplified (:func:`bounding_polytope`).
 MAX_HULL_POINTS = 4000
+#: Support directions of the polytope that replaces a hull with too many vertices.
+SIMPLIFY_DIRECTIONS = 1000
 
 
 @dataclass(frozen=True)
@@ -57,7 +79,11 @@ class HullReport:
     ----------
     solid: name of the collision solid (``"<link>_<k>"`` or ``"<link>/<name>"``).
     mesh_vertices, mesh_triangles: size of the mesh as loaded.
-    hull_points: vertices of its convex hull.
+    hull_points: vertices of the solid used (the convex hull, or the polytope that
+        replaced a hull with more than :data:`MAX_HULL_POINTS` vertices).
+    simplified_from: vertices of the convex hull that was simplified (``None``: not).
+    extra: bound [m] of the clearance the simplification costs against the exact hull
+        (0: not simplified).
     """
 
     solid: str
@@ -66,6 +92,8 @@ class HullReport:
     hull_points: int
     #: (the mesh as loaded, its hull), kept for :attr:`gap`.
     shapes: tuple[coal.BVHModelBase, coal.ConvexBase] = field(repr=False, compare=False)
+    simplified_from: int | None = None
+    extra: float = 0.0
 
     @cached_property
     def gap(self) -> float:
@@ -96,13 +124,23 @@ def convex_hull_solids(gm: pin.GeometryModel, source: object) -> tuple[HullRepor
         if mesh.num_tris == 0 or mesh.num_vertices < 4:
             raise RobotModelError(f"{source}: collision mesh of '{obj.name}' has no volume")
         mesh.buildConvexHull(False, "Qt")
-        hull = mesh.convex
+        hull, simplified, extra = mesh.convex, None, 0.0
         if hull.num_points > MAX_HULL_POINTS:
-            raise RobotModelError(
+            simplified = int(hull.num_points)
+            hull, extra = bounding_polytope(np.asarray(hull.points(), dtype=float), hull)
+            if hull.num_points > MAX_HULL_POINTS:  # (not with the default directions)
+                raise RobotModelError(
+                    f"{source}: the convex hull of the collision mesh of '{obj.name}' has "
+                    f"{simplified} vertices and its simplification {hull.num_points} (at "
+                    f"most {MAX_HULL_POINTS}): give the link primitive collision shapes"
+                )
+            warnings.warn(
                 f"{source}: the convex hull of the collision mesh of '{obj.name}' has "
-                f"{hull.num_points} vertices (at most {MAX_HULL_POINTS}): simplify the mesh "
-                "(e.g. a quadric decimation in MeshLab or Blender) or give the link primitive "
-                "collision shapes (box, cylinder, capsule) in the URDF"
+                f"{simplified} vertices (at most {MAX_HULL_POINTS}): replaced by a polytope "
+                f"of {hull.num_points} vertices that contains it; clearances to this link "
+                f"are up to {extra * 1e3:.2f} mm smaller than to the hull",
+                UserWarning,
+                stacklevel=3,
             )
         reports.append(
             HullReport(
@@ -111,10 +149,46 @@ def convex_hull_solids(gm: pin.GeometryModel, source: object) -> tuple[HullRepor
                 mesh_triangles=int(mesh.num_tris),
                 hull_points=int(hull.num_points),
                 shapes=(mesh, hull),
+                simplified_from=simplified,
+                extra=extra,
             )
         )
         obj.geometry = hull
     return tuple(reports)
+
+
+def bounding_polytope(
+    points: np.ndarray, hull: coal.ConvexBase, n_directions: int = SIMPLIFY_DIRECTIONS
+) -> tuple[coal.ConvexBase, float]:
+    """The polytope (coal convex) bounded by the supporting planes of ``points`` (k, 3)
+    [m] in ``n_directions`` directions of a Fibonacci lattice (it contains their convex
+    hull ``hull``), and the largest distance [m] of its vertices to ``hull`` (module doc).
+    """
+    from scipy.spatial import HalfspaceIntersection  # lazy: scipy is heavy to import
+
+    k = np.arange(n_directions) + 0.5
+    z = 1.0 - 2.0 * k / n_directions
+    phi = np.pi * (1.0 + 5.0**0.5) * k
+    r = np.sqrt(1.0 - z * z)
+    normals = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])  # (n, 3) unit
+    centre = points.mean(axis=0)
+    offsets = (points - centre) @ normals.T  # (k, n): support values about the centre
+    # n·(x − c) − h ≤ 0, each plane moved out by 1 µm so that rounding in the intersection
+    # and the hull of its corners cannot cut a vertex of the mesh off
+    halfspaces = np.column_stack([normals, -(offsets.max(axis=0) + 1e-6)])
+    corners = HalfspaceIntersection(halfspaces, np.zeros(3)).intersections + centre
+    vertices = coal.StdVec_Vec3s()
+    for p in corners:
+        vertices.append(p)
+    polytope = coal.ConvexBase.convexHull(vertices, False, "Qt")
+    # distance of each vertex to the hull (coal: a ball of radius 1 µm at the vertex)
+    ball, request, at = coal.Sphere(1e-6), coal.DistanceRequest(), coal.Transform3s()
+    extra = 0.0
+    for p in np.asarray(polytope.points(), dtype=float):
+        d = coal.distance(ball, coal.Transform3s(np.eye(3), p), hull, at, request,
+                          coal.DistanceResult())  # fmt: skip
+        extra = max(extra, d + 1e-6)
+    return polytope, extra
 
 
 def hull_gap(

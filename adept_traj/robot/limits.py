@@ -151,17 +151,19 @@ class JointLimits:
         return (q < self.lower) | (q > self.upper)
 
     def check_position(self, q: object, name: str = "q") -> np.ndarray:
-        """Return ``q`` (..., nq) as an array, raising :class:`JointLimitError` naming the
-        joint, the value and the valid range if any entry is outside the position limits."""
+        """Return ``q`` (..., nq) as an array, raising :class:`JointLimitError` naming
+        every joint outside its position limits (of the first configuration with one), its
+        value and its valid range."""
         arr = as_batch(q, name, self.nq)
         bad = self.violations(arr)
         if bad.any():
-            index = tuple(int(i) for i in np.argwhere(bad)[0])
-            k = index[-1]
-            where = f"{name}{list(index[:-1])}" if arr.ndim > 1 else name
-            raise JointLimitError(
-                f"{where}: joint '{self.names[k]}' = "
-                f"{arr[index]:.6g} {self.units[k]} is outside its limits "
+            first = tuple(int(i) for i in np.argwhere(bad)[0][:-1])
+            where = f"{name}{list(first)}" if arr.ndim > 1 else name
+            row = arr[first]
+            parts = [
+                f"joint '{self.names[k]}' = {row[k]:.6g} {self.units[k]} is outside its limits "
                 f"[{self.lower[k]:.6g}, {self.upper[k]:.6g}] {self.units[k]}"
-            )
+                for k in np.flatnonzero(bad[first])
+            ]
+            raise JointLimitError(f"{where}: " + "; ".join(parts))
         return arr

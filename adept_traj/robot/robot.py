@@ -365,9 +365,8 @@ class Robot:
             # A fresh pool each call: it copies the model, so later edits of
             # model.armature etc. are always seen (≈ 40 µs, negligible for a batch).
             pool = pin.ModelPool(self.model, 1)
-            tau = pin.rneaInParallel(
-                1, pool, np.asfortranarray(qf.T), np.asfortranarray(vf.T), np.asfortranarray(af.T)
-            ).T
+            qf_, vf_, af_ = (np.asfortranarray(x.T) for x in (qf, vf, af))
+            tau = pin.rneaInParallel(1, pool, qf_, vf_, af_).reshape(self.nq, n).T  # (n,): 1 joint
         tau = tau + self.model.damping * vf + self.model.friction * coulomb_sign(vf)
         return tau.reshape(shape)
 

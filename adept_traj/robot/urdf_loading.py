@@ -88,6 +88,7 @@ def load_urdf_models(
     if root.tag != "robot":
         raise RobotModelError(f"{path}: root element is <{root.tag}>, expected <robot>")
     dirs = resolve_package_uris(root, path, package_dirs)
+    _check_limit_order(root, path)
     text, unlimited = _continuous_as_revolute(root)
     try:
         full = pin.buildModelFromXML(text, mimic=True)
@@ -123,6 +124,27 @@ def read_srdf_disabled_pairs(path: Path) -> tuple[tuple[str, str], ...]:
     Raises :class:`~adept_traj.errors.RobotModelError` for a missing or malformed file."""
     root = _read_xml(path, "SRDF")
     return tuple((e.get("link1", ""), e.get("link2", "")) for e in root.iter("disable_collisions"))
+
+
+def _check_limit_order(root: ET.Element, path: Path) -> None:
+    """Refuse a joint whose ``<limit lower upper>`` are reversed (lower > upper), naming
+    the joint, the file and both values [rad | m] (urdfdom and Pinocchio accept them, and
+    every value of the joint would later be called outside its limits). Continuous
+    joints (whose position limits are ignored) and limits that are not numbers (Pinocchio
+    refuses those) are left alone."""
+    for joint in root.iter("joint"):
+        limit = joint.find("limit")
+        if limit is None or joint.get("type") == "continuous":
+            continue
+        try:
+            lower, upper = float(limit.get("lower", "0")), float(limit.get("upper", "0"))
+        except ValueError:
+            continue
+        if lower > upper:
+            raise RobotModelError(
+                f"{path}: joint {joint.get('name')!r} has reversed limits: lower = {lower:g} > "
+                f"upper = {upper:g} [rad | m]; swap them"
+            )
 
 
 def _read_xml(path: Path, what: str) -> ET.Element:
@@ -265,4 +287,10 @@ def _write_parameters(
             acceleration[k] = j.acceleration
         if j.jerk is not None:
             jerk[k] = j.jerk
+        if model.lowerPositionLimit[k] > model.upperPositionLimit[k]:
+            raise RobotModelError(
+                f"{params.source}: joint {j.name!r} of {path} has reversed limits: lower = "
+                f"{model.lowerPositionLimit[k]:g} > upper = {model.upperPositionLimit[k]:g} "
+                "[rad | m]; swap them"
+            )
     return acceleration, jerk

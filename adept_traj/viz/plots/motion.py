@@ -47,8 +47,9 @@ def _limit_lines(limits: Any, kind: str, j: int) -> list[float]:
 
 def _note(limits: Any, kind: str, j: int, values: np.ndarray) -> str:
     """A panel's note: the peak of ``values`` (n,) as a percentage of its limit, or for
-    positions the smallest margin to a limit as a percentage of the range ("" if the limit
-    is infinite)."""
+    positions the smallest margin to a limit as a percentage of the range; ``"no limit"``
+    where a bound is infinite (its panel has no limit line), ``""`` for an infinite
+    position range."""
     if kind == "position":
         span = float(limits.upper[j] - limits.lower[j])
         margin = min(float(limits.upper[j] - values.max()), float(values.min() - limits.lower[j]))
@@ -59,7 +60,7 @@ def _note(limits: Any, kind: str, j: int, values: np.ndarray) -> str:
         )
     lim = float(limits.bound(kind)[j])
     peak = float(np.abs(values).max())
-    return f"peak {100 * peak / lim:.0f} % of limit" if math.isfinite(lim) else ""
+    return f"peak {100 * peak / lim:.0f} % of limit" if math.isfinite(lim) else "no limit"
 
 
 def joint_motion(
@@ -122,7 +123,7 @@ def joint_motion(
             boxes.append(Rectangle((x0, y0), 1.0, 1.0))
             unit = units[0] if limits.units[j] == "rad" else units[1]
             lines = _limit_lines(limits, kind.name, j)
-            lo, hi = padded(min(data[:, j].min(), *lines), max(data[:, j].max(), *lines), 0.05)
+            lo, hi = padded(min([data[:, j].min(), *lines]), max([data[:, j].max(), *lines]), 0.05)
             curves.append(np.column_stack([x0 + u, y0 + (data[:, j] - lo) / (hi - lo)]))
             limit_lines += [
                 [(x0, y0 + (v - lo) / (hi - lo)), (x0 + 1.0, y0 + (v - lo) / (hi - lo))]
