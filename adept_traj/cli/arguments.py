@@ -41,10 +41,18 @@ def floats(text: str) -> list[float]:
         ) from None
 
 
-def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
+def add_problem_arguments(parser: argparse.ArgumentParser, *, start_time: bool = False) -> None:
     """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
-    workers (default ``None``: :func:`~adept_traj.problem.available_cores`) and
-    ``--quiet``."""
+    workers (default ``None``: :func:`~adept_traj.problem.available_cores`), ``--quiet``
+    and, with ``start_time``, ``--start-time T0`` (scene time [s] of the move's start)."""
+    if start_time:
+        parser.add_argument(
+            "--start-time",
+            type=float,
+            metavar="T0",
+            help="scene time [s] at which the move starts (default 0): moving obstacles are "
+            "checked, certified and shown at scene time T0 + t",
+        )
     parser.add_argument(
         "--scene",
         default="paper",
@@ -117,4 +125,8 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     robot = robot_from_arguments(args, args.scene)
     start, goal = check_task(robot, start, "start"), check_task(robot, goal, "goal")
     workers = available_cores() if args.workers is None else args.workers
-    return TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    start_time = getattr(args, "start_time", None)  # plan --start-time; None: 0
+    if start_time is None:
+        return TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    as_scalar(start_time, "--start-time", "[s] (a scene time)", minimum=0)
+    return TrajectoryProblem(robot, scene, start, goal, workers=workers, start_time=start_time)

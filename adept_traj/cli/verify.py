@@ -95,6 +95,9 @@ def run(args: argparse.Namespace) -> int:
         f"{'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f"; min distance {cert.min_distance:.4f} m (margin {cert.margin} m)"
     )
+    t_start = result.problem_settings.start_time
+    if t_start:
+        print(f"  scene clock: certified at scene times t0 + t, t0 = {t_start:g} s")
     for check in cert.checks:
         print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
