@@ -28,6 +28,7 @@ from adept_traj.cli._run_folder import as_path, folder_lock
 from adept_traj.cycle import (
     PLAYBACK_FILE,
     cycle_html,
+    plan_on_clock,
     read_cycle_file,
     run_cycle,
     write_cycle_report,
@@ -63,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
     """The moves of ``cycle`` and their report, with ``out`` held (:func:`run`)."""
+    if cycle.scene.moving:
+        return _run_on_clock(args, cycle, out)
     with tqdm(
         total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
     ) as bar:
@@ -79,5 +82,37 @@ def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
         names = [m.name for m in cycle.moves]
         robot, page = cycle.robot.load(), out / PLAYBACK_FILE
         cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
+    print((out / "cycle.md").read_text(encoding="utf-8"))
+    return status.OK if summary["all_certified"] else status.NOT_CERTIFIED
+
+
+def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
+    """A scene with moving obstacles: the moves planned in the order they run, each at its
+    start time on the scene clock (:func:`~adept_traj.cycle.plan_on_clock`)."""
+    with tqdm(
+        total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
+    ) as bar:
+        clock, passes = plan_on_clock(
+            cycle,
+            out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=lambda name: bar.update(1),
+        )
+    summary = write_cycle_report(cycle, passes[0], out, figure=not args.no_plots, clock=clock)
+    if not args.no_playback:
+        robot, page = cycle.robot.load(), out / PLAYBACK_FILE
+        names = [m.name for m in cycle.moves]
+        cycle_html(
+            passes[0],
+            names,
+            page,
+            robot=robot,
+            scene=cycle.scene,
+            title=cycle.name,
+            clock=clock,
+            passes=passes,
+        )
     print((out / "cycle.md").read_text(encoding="utf-8"))
     return status.OK if summary["all_certified"] else status.NOT_CERTIFIED
