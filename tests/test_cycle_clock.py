@@ -265,3 +265,63 @@ def test_dwell_on_a_fixed_scene_is_refused(tmp_path: Path) -> None:
     path = _files(tmp_path, scene='name = "empty"\n')
     with pytest.raises(CycleError, match="has no moving obstacle: its moves never dwell"):
         read_cycle_file(path)
+
+
+ONE_MOVE = """\
+name = "one"
+scene = "empty.toml"
+
+[plan]
+pop_size = 16
+n_gen = 4
+seed = 1
+
+[[location]]
+name = "home"
+joints = [0.1682, 1.3849, 0.08, -0.7555]
+
+[[location]]
+name = "place"
+joints = [-0.761, 0.245, 0.2, 1.0095]
+
+[[move]]
+from = "home"
+to = "place"
+choose = "fastest"
+"""
+
+
+def test_a_move_asks_for_what_its_weights_say(tmp_path: Path) -> None:
+    """``choose``: the best trade-off (the planner's), the fastest certified member, or the
+    certified member of least f_c alone (f_c written out here by hand)."""
+    from dataclasses import replace
+
+    from adept_traj.cycle import chosen_member, cycle_summary, cycle_tasks, plan_move
+
+    (tmp_path / "empty.toml").write_text('name = "empty"\n')
+    (tmp_path / "one.toml").write_text(ONE_MOVE)
+    cycle = read_cycle_file(tmp_path / "one.toml")
+    move = cycle.moves[0]
+    assert move.choose == "fastest"
+    result = plan_move(cycle_tasks(cycle)[0])
+    front = result.front
+    ok = np.flatnonzero(front.feasible)
+    assert len(ok) > 2
+    T = front.objectives[:, 0]
+    fastest = chosen_member(result, move)
+    assert T[fastest] == T[ok].min()
+    only_time = replace(move, choose="weighted-sum", weights=(1.0, 0, 0, 0, 0, 0))
+    assert T[chosen_member(result, only_time)] == T[ok].min()
+    assert chosen_member(result, replace(move, choose="trade-off")) == result.best.index
+    paper = replace(move, choose="weighted-sum", weights=(0.25, 0.25, 0.1, 0.1, 0.15, 0.15))
+    z = front.objectives
+    lo, hi = z.min(axis=0), z.max(axis=0)
+    span = np.where(hi > lo, hi - lo, 1.0)
+    score = np.where([False, False, False, True, False, False], (z - lo) / span, (hi - z) / span)
+    score = np.where(hi > lo, score, 1.0)
+    f_c = (1.0 - score) @ np.array(paper.weights)
+    assert chosen_member(result, paper) == ok[np.argmin(f_c[ok])]
+    summary = cycle_summary(cycle, [result])
+    assert summary["moves"][0]["choose"] == "fastest"
+    assert summary["moves"][0]["T"] == T[ok].min()
+    assert summary["cycle_time"] == T[ok].min()

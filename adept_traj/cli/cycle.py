@@ -27,6 +27,7 @@ from adept_traj.cli import status
 from adept_traj.cli._run_folder import as_path, folder_lock
 from adept_traj.cycle import (
     PLAYBACK_FILE,
+    chosen_member,
     cycle_html,
     plan_on_clock,
     read_cycle_file,
@@ -81,7 +82,10 @@ def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
     if not args.no_playback:
         names = [m.name for m in cycle.moves]
         robot, page = cycle.robot.load(), out / PLAYBACK_FILE
-        cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
+        rows = [chosen_member(r, m) for r, m in zip(results, cycle.moves)]
+        cycle_html(
+            results, names, page, robot=robot, scene=cycle.scene, title=cycle.name, members=rows
+        )
     print((out / "cycle.md").read_text(encoding="utf-8"))
     return status.OK if summary["all_certified"] else status.NOT_CERTIFIED
 

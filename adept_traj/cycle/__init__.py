@@ -10,6 +10,7 @@ Dask (``distributed``) is imported only when a cycle runs."""
 
 from __future__ import annotations
 
+from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
     MAX_CLOCKED_MOVES,
     ClockedMove,
@@ -22,6 +23,7 @@ from adept_traj.cycle.clock import (
     scene_period,
 )
 from adept_traj.cycle.cycle_file import (
+    CHOICES,
     MAX_DWELL_CANDIDATES,
     MAX_MOVES,
     Cycle,
@@ -80,6 +82,7 @@ from adept_traj.cycle.summary import (
 __all__ = [
     "ALGORITHM_PAIR",
     "BOXPLOT_FIGURE",
+    "CHOICES",
     "CYCLE_FILE",
     "CYCLE_REPORT",
     "GANTT_FIGURE",
@@ -104,6 +107,7 @@ __all__ = [
     "RestCheck",
     "certify_rest",
     "check_chained",
+    "chosen_member",
     "clock_playback",
     "clock_summary",
     "cycle_html",

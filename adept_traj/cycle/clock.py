@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.collision import CollisionChecker
+from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
 from adept_traj.cycle.runner import (
     MOVES_FOLDER,
@@ -203,7 +204,8 @@ class ClockedMove:
     Attributes
     ----------
     pass_index, index, name: the pass (0-based), the move's place in the sequence, its name.
-    folder: its result folder, relative to the cycle's output folder.
+    folder: its result folder, relative to the cycle's output folder; member: the row of
+        its front the cycle runs (:func:`~adept_traj.cycle.chosen_member`).
     start_time, dwell, T: scene time [s] the move starts, the dwell [s] before it, its
         travel time [s] (the reported solution's).
     move_certified: the reported solution is certified at ``start_time``.
@@ -215,6 +217,7 @@ class ClockedMove:
     index: int
     name: str
     folder: str
+    member: int
     start_time: float
     dwell: float
     T: float
@@ -332,12 +335,12 @@ def plan_on_clock(
                 ]
                 results = run_planning_tasks(candidates, where, resume=True, client=client)
                 rests = [certify_rest(robot, cycle.scene, task.start, t, d, **rest) for d in grid]
-                ok = [r.feasible and c.certified for r, c in zip(results, rests)]
-                ends = [
-                    (d + float(r.best_objectives[0]), j)
-                    for j, (d, r) in enumerate(zip(grid, results))
-                ]
-                j = min((e for e, good in zip(ends, ok) if good), default=(0.0, 0))[1]
+                rows = [chosen_member(r, m) for r in results]
+                times = [float(r.front.objectives[k, 0]) for r, k in zip(results, rows)]
+                good = [bool(r.front.feasible[k]) for r, k in zip(results, rows)]
+                ok = [g and c.certified for g, c in zip(good, rests)]
+                ends = [(d + T, j) for j, (d, T) in enumerate(zip(grid.tolist(), times))]
+                j = min((e for e, g in zip(ends, ok) if g), default=(0.0, 0))[1]
                 r = results[j]
                 row.append(
                     ClockedMove(
@@ -345,15 +348,13 @@ def plan_on_clock(
                         index=m.index,
                         name=m.name,
                         folder=f"{MOVES_FOLDER}/{candidates[j].move.name}",
+                        member=rows[j],
                         start_time=t + float(grid[j]),
                         dwell=float(grid[j]),
-                        T=float(r.best_objectives[0]),
-                        move_certified=bool(r.feasible),
+                        T=times[j],
+                        move_certified=good[j],
                         rest=rests[j],
-                        candidates=tuple(
-                            (float(d), float(c.best_objectives[0]), bool(c.feasible))
-                            for d, c in zip(grid, results)
-                        ),
+                        candidates=tuple(zip(grid.tolist(), times, good)),
                     )
                 )
                 row_results.append(r)

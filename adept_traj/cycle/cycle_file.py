@@ -36,15 +36,26 @@ from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy
 from adept_traj.validation import readonly_copy
 
-__all__ = ["MAX_DWELL_CANDIDATES", "MAX_MOVES", "Cycle", "Location", "MoveSpec", "read_cycle_file"]
+__all__ = [
+    "CHOICES",
+    "MAX_DWELL_CANDIDATES",
+    "MAX_MOVES",
+    "Cycle",
+    "Location",
+    "MoveSpec",
+    "read_cycle_file",
+]
 
 _ERROR = error_factory(CycleError)
 _TOP_KEYS = ("name", "robot", "scene", "repeat", "plan", "location", "move", "dwell")
 _DWELL_KEYS = ("step", "max")
 #: Most dwell candidates of one move (``max / step + 1``): each is a planning run.
 MAX_DWELL_CANDIDATES = 32
-_PLAN_KEYS = ("algorithm", "seed", "pop_size", "n_gen", "weights", "rate_hz")
-_MOVE_KEYS = ("name", "from", "to", "algorithm", "seed", "pop_size", "n_gen", "weights")
+_PLAN_KEYS = ("algorithm", "seed", "pop_size", "n_gen", "weights", "rate_hz", "choose")
+_MOVE_KEYS = ("name", "from", "to", "algorithm", "seed", "pop_size", "n_gen", "weights", "choose")
+#: What a move reports of its front (``choose``): the best trade-off (f_c and F_avg ranks,
+#: today's rule), the fastest certified member, the certified member of least f_c alone.
+CHOICES = ("trade-off", "fastest", "weighted-sum")
 #: Most moves of a cycle file (each is a planning run).
 MAX_MOVES = 1000
 
@@ -80,6 +91,8 @@ class MoveSpec:
     algorithm, seed, pop_size, n_gen, weights: the planning run (``pop_size``/``n_gen``
         ``None``: the algorithm's paper budget); the seed defaults to the cycle's seed +
         ``index``, so it does not depend on where or when the move is planned.
+    choose: which member of the front the cycle runs (:data:`CHOICES`,
+        :func:`~adept_traj.cycle.chosen_member`).
     """
 
     index: int
@@ -91,6 +104,7 @@ class MoveSpec:
     pop_size: int | None
     n_gen: int | None
     weights: tuple[float, ...]
+    choose: str = "trade-off"
 
 
 @dataclass(frozen=True)
@@ -258,6 +272,7 @@ def _moves(node: Node, locations: dict[str, Location], defaults: Node) -> tuple[
                 pop_size=fields["pop_size"],
                 n_gen=fields["n_gen"],
                 weights=fields["weights"],
+                choose=fields["choose"],
             )
         )
     return tuple(moves)
@@ -272,6 +287,7 @@ def _plan_fields(node: Node, base: dict[str, Any] | None) -> dict[str, Any]:
         "pop_size": None,
         "n_gen": None,
         "weights": tuple(PAPER_WEIGHTS),
+        "choose": "trade-off",
     }
     out = {
         "algorithm": node["algorithm"].string(choices=tuple(ALGORITHMS), default=b["algorithm"]),
@@ -279,6 +295,7 @@ def _plan_fields(node: Node, base: dict[str, Any] | None) -> dict[str, Any]:
         "pop_size": node["pop_size"].integer(minimum=2, maximum=100_000, default=b["pop_size"]),
         "n_gen": node["n_gen"].integer(minimum=1, maximum=100_000, default=b["n_gen"]),
         "weights": b["weights"],
+        "choose": node["choose"].string(choices=CHOICES, default=b["choose"]),
     }
     if node["weights"].present:
         w = node["weights"].array((6,), "", minimum=0.0)

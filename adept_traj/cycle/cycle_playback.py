@@ -41,15 +41,21 @@ def cycle_playback(
     robot: Robot | None = None,
     scene: Scene | None = None,
     fps: float = 30.0,
+    members: Sequence[int] | None = None,
 ) -> Any:
     """The :class:`~adept_traj.viz.playback.Playback` of the moves ``results`` (in order,
     named ``names``) played one after the other at real time and ``fps`` [1/s]; ``robot``
-    and ``scene``: those of the runs (default: loaded from each result)."""
+    and ``scene``: those of the runs (default: loaded from each result); ``members``: the
+    row of each front to play (default: the best trade-offs)."""
     from adept_traj.viz.framing import camera, floor
     from adept_traj.viz.playback import Playback, SceneObject, build_animation
 
+    rows = [r.best.index for r in results] if members is None else list(members)
     parts = [
-        build_animation(r, fps=fps, replay=Replay.of(r, robot=robot, scene=scene)) for r in results
+        build_animation(
+            r, fps=fps, replay=Replay.of(r, r.front.x[k], robot=robot, scene=scene), member=k
+        )
+        for r, k in zip(results, rows, strict=True)
     ]
     animated: dict[str, list[np.ndarray]] = {}
     fixed: dict[str, Any] = {}
@@ -117,7 +123,8 @@ def clock_playback(
     certified = clock.certified
     entries = [(m, r) for moves, rs in zip(clock.passes, results) for m, r in zip(moves, rs)]
     for n, (m, r) in enumerate(entries):
-        part = build_animation(r, fps=fps, replay=Replay.of(r, robot=robot, scene=scene))
+        replay = Replay.of(r, r.front.x[m.member], robot=robot, scene=scene)
+        part = build_animation(r, fps=fps, replay=replay, member=m.member)
         animated = {o.path: o.poses for o in part.objects if o.animated}
         if m.dwell > 0:
             segments.append(_rest(scene, m.start_time - m.dwell, m.dwell, part, 0, fps))
@@ -209,6 +216,7 @@ def cycle_html(
     title: str = "adept_traj cycle",
     clock: CycleClock | None = None,
     passes: Sequence[Sequence[PlanningResult]] | None = None,
+    members: Sequence[int] | None = None,
 ) -> Path:
     """Write the self-contained page (no server, no network) playing
     :func:`cycle_playback` in a loop (with ``clock`` and the chosen results of its
@@ -219,6 +227,6 @@ def cycle_html(
     if clock is not None and robot is not None and scene is not None and passes is not None:
         playback = clock_playback(clock, passes, robot=robot, scene=scene)
     else:
-        playback = cycle_playback(results, names, robot=robot, scene=scene)
+        playback = cycle_playback(results, names, robot=robot, scene=scene, members=members)
     text = render_html(playback, title=f"{title}, {playback.duration:.3f} s")
     return write_text_atomic(Path(path), text)

@@ -79,13 +79,14 @@ def _fixed(summary: dict[str, Any], load: Any) -> CycleVerification:
     lines, ok = [], True
     for m in summary["moves"]:
         r = load(m["folder"])
+        x = r.front.x[m.get("member", r.best.index)]
         problem = r.problem()
         try:
-            c = certify(problem, r.best_x, rate_hz=r.certificate.rate_hz)
+            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
         finally:
             problem.close()
         ok &= c.feasible
-        lines.append(_line(m["name"], 0, 0.0, float(r.best_x[0]), c.feasible, c.min_distance))
+        lines.append(_line(m["name"], 0, 0.0, float(x[0]), c.feasible, c.min_distance))
     return CycleVerification(tuple(lines), ok, (), len(lines))
 
 
@@ -105,7 +106,7 @@ def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> Cycl
     for p, moves in enumerate(passes):
         for m in moves:
             r = load(m["folder"])
-            start, T = t + m["dwell"], float(r.best_x[0])
+            start, T = t + m["dwell"], float(r.front.x[m["member"], 0])
             if abs(start - m["start_time"]) > _CLOCK_TOLERANCE:
                 mismatches.append(
                     f"pass {p} {m['name']}: starts at {m['start_time']} s, not "
@@ -136,11 +137,12 @@ def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> Cycl
     lines, ok = [], True
     for p, m, shift in schedule:
         r = load(m["folder"])
+        x = r.front.x[m["member"]]
         start = m["start_time"] + shift
         settings = replace(r.problem_settings, start_time=start, workers=1)
         problem = TrajectoryProblem(robot, scene, r.start, r.goal, settings)
         try:
-            c = certify(problem, r.best_x, rate_hz=r.certificate.rate_hz)
+            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
         finally:
             problem.close()
         rest = certify_rest(
@@ -153,13 +155,13 @@ def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> Cycl
             rate_hz=r.certificate.rate_hz,
         )
         ok &= bool(c.feasible and rest.certified)
-        line = _line(m["name"], p, start, float(r.best_x[0]), c.feasible, c.min_distance)
+        line = _line(m["name"], p, start, float(x[0]), c.feasible, c.min_distance)
         if m["dwell"]:
             line += f"; its dwell of {m['dwell']:.4f} s: {_word(rest.certified)}"
         lines.append(line)
         final = clock["final_dwell"]
         if period is not None and m is passes[0][-1] and repeat > 1 and final > 0:
-            end = start + float(r.best_x[0])
+            end = start + float(x[0])
             kept = certify_rest(
                 robot, scene, r.goal, end, final, settings=settings, rate_hz=r.certificate.rate_hz
             )

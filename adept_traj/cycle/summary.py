@@ -24,8 +24,10 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.analysis import combined_objective
+from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import CycleClock, RestCheck
-from adept_traj.cycle.cycle_file import Cycle
+from adept_traj.cycle.cycle_file import Cycle, MoveSpec
 from adept_traj.cycle.runner import MOVES_FOLDER
 from adept_traj.files import write_text_atomic
 from adept_traj.results import PlanningResult
@@ -71,9 +73,7 @@ def cycle_summary(
                 "folder": folder,
                 "algorithm": r.algorithm,
                 "seed": m.seed,
-                "certified": bool(r.feasible),
-                "T": float(r.best_objectives[0]),
-                "f_c": float(r.best.f_c),
+                **_reported(r, m),
                 "fastest_certified_T": fastest_certified(r),
                 "n_certified": int(r.front.n_certified),
             }
@@ -109,6 +109,26 @@ def cycle_summary(
     return out
 
 
+def _reported(r: PlanningResult, m: MoveSpec) -> dict[str, Any]:
+    """certified, T [s] and f_c of the member the move runs (``choose``; the key
+    ``choose`` and the member's row ``member`` when it is not the best trade-off)."""
+    if m.choose == "trade-off":
+        return {
+            "certified": bool(r.feasible),
+            "T": float(r.best_objectives[0]),
+            "f_c": float(r.best.f_c),
+        }
+    k = chosen_member(r, m)
+    f_c = combined_objective(r.front.objectives, m.weights)[k]
+    return {
+        "choose": m.choose,
+        "member": k,
+        "certified": bool(r.front.feasible[k]),
+        "T": float(r.front.objectives[k, 0]),
+        "f_c": float(f_c),
+    }
+
+
 def _rest(rest: RestCheck | None) -> dict[str, Any] | None:
     if rest is None:
         return None
@@ -137,6 +157,7 @@ def clock_summary(clock: CycleClock) -> dict[str, Any]:
                 {
                     "name": m.name,
                     "folder": m.folder,
+                    "member": m.member,
                     "start_time": m.start_time,
                     "dwell": m.dwell,
                     "T": m.T,
