@@ -207,6 +207,7 @@ def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path) ->
     assert "mismatch: pass 0 place-home: starts at" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_playback_runs_on_one_continuous_clock(planned: Path, cluster) -> None:
     cycle = read_cycle_file(planned.parent / "c.toml")
     summary = json.loads((planned / "cycle.json").read_text())
