@@ -91,6 +91,18 @@ def test_evaluation_at_a_start_time_equals_the_reference(robot, detour) -> None:
     assert not np.allclose(at_zero.min_distance, batched.min_distance)  # the clock matters
 
 
+def test_parallel_workers_use_the_start_time(robot, detour) -> None:
+    """The forked evaluation workers see the same clock as the main process."""
+    x = np.vstack([MOVES["fast_without_pendulum"], MOVES["fastest_nsga2_seed1"]] * 8)
+    serial = at.TrajectoryProblem(robot, detour, detour.start, detour.goal, start_time=2.0)
+    with at.TrajectoryProblem(
+        robot, detour, detour.start, detour.goal, start_time=2.0, workers=2
+    ) as parallel:
+        both = parallel.evaluate_batch(x)
+    np.testing.assert_array_equal(both.min_distance, serial.evaluate_batch(x).min_distance)
+    assert both.min_distance[0].min() < 0  # the rod, at 2.0 + t
+
+
 def test_distance_time_derivative_at_a_start_time(robot, detour) -> None:
     """∂d/∂t of the distance rows (the obstacle's motion at scene time t0 + t) against a
     central difference of the distance in t0 at fixed joints."""

@@ -198,11 +198,12 @@ def cycle_markdown(summary: dict[str, Any]) -> str:
             f"{'yes' if m['certified'] else 'NO'} | {_t(m['T'])} | {m['f_c']:.4g} | "
             f"{_t(m['fastest_certified_T'])} | {m['n_certified']} |"
         )
-    lines += [
-        "",
-        f"Cycle time (best trade-offs): **{_t(summary['cycle_time'])} s**; "
-        f"with the fastest certified members: {_t(summary['cycle_time_fastest'])} s.",
-    ]
+    fastest = (
+        f"with the fastest certified members: {_t(summary['cycle_time_fastest'])} s."
+        if "clock" not in summary
+        else "the fastest members would shift every later start: not certified so."
+    )
+    lines += ["", f"Cycle time (best trade-offs): **{_t(summary['cycle_time'])} s**; {fastest}"]
     if "clock" in summary:
         lines += _clock_markdown(summary)
     if not summary["all_certified"]:
