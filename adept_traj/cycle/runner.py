@@ -306,6 +306,10 @@ def run_cycle(
     (``out/moves/NAME/``, :func:`run_planning_tasks`); return the results in the order of
     the moves.
 
+    Every move is planned from scene time 0, all at once: right for a fixed-obstacle
+    scene. With moving obstacles a move is certified only for its own start time: plan
+    such a cycle with :func:`~adept_traj.cycle.plan_on_clock` (``adept-traj cycle`` does).
+
     Parameters
     ----------
     cycle: from :func:`~adept_traj.cycle.read_cycle_file`.
