@@ -326,3 +326,76 @@ def test_a_move_asks_for_what_its_weights_say(tmp_path: Path) -> None:
     assert summary["moves"][0]["choose"] == "fastest"
     assert summary["moves"][0]["T"] == T[ok].min()
     assert summary["cycle_time"] == T[ok].min()
+
+
+def _brute_force(T: np.ndarray, ok: np.ndarray, P: float, phases: np.ndarray, rest_ok) -> float:
+    """The least pass time over every sequence of start phases, written out again."""
+    import itertools
+
+    best = math.inf
+    for seq in itertools.product(range(len(phases)), repeat=T.shape[0]):
+        end, fine = 0.0, True
+        for k, j in enumerate(seq):
+            if not ok[k, j]:
+                fine = False
+                break
+            start = phases[j]
+            while start < end - 1e-12:  # the first time ≥ end in phase j
+                start += P
+            if not rest_ok(k, end, start - end):
+                fine = False
+                break
+            end = start + T[k, j]
+        if fine:
+            best = min(best, math.ceil(end / P - 1e-9) * P)
+    return best
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_phase_grid_dynamic_programming_equals_brute_force(seed: int) -> None:
+    from adept_traj.cycle import PhaseTable, phase_schedules
+
+    rng = np.random.default_rng(seed)
+    K, N, P = 4, 5, 2.0
+    phases = P * np.arange(N) / N
+    T = rng.uniform(0.5, 2.6, size=(K, N))
+    ok = rng.uniform(size=(K, N)) > 0.3
+    banned = {(k, j) for k in range(K) for j in range(N) if rng.uniform() < 0.15}
+
+    def rest_ok(k, start, duration):  # a dwell ending in a banned phase is not certified
+        return duration <= 1e-12 or (k, round(((start + duration) % P) / P * N) % N) not in banned
+
+    table = PhaseTable(P, phases, T, ok, np.zeros((K, N), dtype=int))
+    found = phase_schedules(table, rest_ok)
+    expected = _brute_force(T, ok, P, phases, rest_ok)
+    if found["optimised"] is None:
+        assert expected == math.inf
+        return
+    j, start = found["optimised"][-1]
+    assert math.ceil((start + T[K - 1, j]) / P - 1e-9) * P == pytest.approx(expected)
+    if found["naive"] is not None:  # back to back: never better than the optimum
+        jn, sn = found["naive"][-1]
+        assert math.ceil((sn + T[K - 1, jn]) / P - 1e-9) * P >= expected - 1e-9
+
+
+def test_phase_grid_cycle_is_certified_at_its_start_times(tmp_path: Path, cluster, capsys) -> None:
+    path = _files(tmp_path, CYCLE.replace("[dwell]\nstep = 0.5\nmax = 1.5\n", ""))
+    out = tmp_path / "out"
+    argv = ["cycle", str(path), "--out", str(out), "--scheduler", cluster.scheduler_address]
+    assert main([*argv, "--quiet", "--no-playback", "--no-plots", "--phase-grid", "4"]) == 0
+    summary = json.loads((out / "cycle.json").read_text())
+    clock = summary["clock"]
+    assert clock["mode"] == "phase grid (optimised)"
+    assert len(clock["phase_grid"]) == 4
+    scene = Scene.from_file(tmp_path / "swing.toml").to_dict()
+    robot = Robot.adept_one_xl()
+    for p in range(summary["repeat"]):
+        for m in clock["passes"][0]:
+            t, q = _dense(out / m["folder"])
+            rows = np.r_[np.arange(0, len(t), 12), len(t) - 1]
+            start = m["start_time"] + p * clock["pass_time"]
+            hand, _ = clearance_by_hand(robot, scene, q[rows], start + t[rows])
+            assert hand.min() >= MARGIN - 1e-6
+    capsys.readouterr()
+    assert main(["verify", str(out)]) == 0
+    assert "every move and dwell certified" in capsys.readouterr().out

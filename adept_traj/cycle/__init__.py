@@ -37,6 +37,12 @@ from adept_traj.cycle.cycle_playback import (
     cycle_html,
     cycle_playback,
 )
+from adept_traj.cycle.phase_grid import (
+    DEFAULT_PHASES,
+    PhaseTable,
+    phase_schedules,
+    plan_phase_grid,
+)
 from adept_traj.cycle.runner import (
     MOVE_FILE,
     MOVES_FOLDER,
@@ -85,6 +91,7 @@ __all__ = [
     "CHOICES",
     "CYCLE_FILE",
     "CYCLE_REPORT",
+    "DEFAULT_PHASES",
     "GANTT_FIGURE",
     "MAX_CLOCKED_MOVES",
     "MAX_DWELL_CANDIDATES",
@@ -104,6 +111,7 @@ __all__ = [
     "Metric",
     "MoveSpec",
     "MoveTask",
+    "PhaseTable",
     "RestCheck",
     "certify_rest",
     "check_chained",
@@ -119,8 +127,10 @@ __all__ = [
     "dwell_grid",
     "fastest_certified",
     "parse_seeds",
+    "phase_schedules",
     "plan_move",
     "plan_on_clock",
+    "plan_phase_grid",
     "read_cycle_file",
     "run_cycle",
     "run_metrics",

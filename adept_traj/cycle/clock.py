@@ -247,7 +247,10 @@ class CycleClock:
     final_dwell, final_rest: the dwell [s] after the first pass that makes the pass time a
         multiple of P and its certificate (periodic scene with ``repeat`` > 1; else 0 and
         ``None``).
-    repeat: passes per cycle; dwells: the dwell grid [s].
+    repeat: passes per cycle; dwells: the dwell grid [s] (the start phases [s] of a phase
+        grid, :mod:`adept_traj.cycle.phase_grid`).
+    mode: ``"dwell grid"`` (:func:`plan_on_clock`) or ``"phase grid (optimised)"`` /
+        ``"phase grid (naive)"`` (:func:`~adept_traj.cycle.plan_phase_grid`).
     """
 
     period: float | None
@@ -256,6 +259,7 @@ class CycleClock:
     final_rest: RestCheck | None
     repeat: int
     dwells: tuple[float, ...]
+    mode: str = "dwell grid"
 
     @property
     def pass_time(self) -> float:

@@ -146,9 +146,10 @@ def clock_summary(clock: CycleClock) -> dict[str, Any]:
     every planned pass's moves (scene start time, dwell, T [s], certificates, candidates)."""
     return {
         "scene_clock": "periodic" if clock.period is not None else "every pass planned",
+        "mode": clock.mode,
         "period": clock.period,
         "passes_planned": len(clock.passes),
-        "dwell_grid": list(clock.dwells),
+        ("phase_grid" if clock.mode.startswith("phase") else "dwell_grid"): list(clock.dwells),
         "pass_time": clock.pass_time,
         "final_dwell": clock.final_dwell,
         "final_rest": _rest(clock.final_rest),
