@@ -84,13 +84,15 @@ SEQUENCE = [
 ]
 
 
+#: Six moves between locations where the robot may wait at rest (at "place", the paper
+#: scene's goal, the pendulum hits the resting robot at some phases: −12.7 mm).
 PICK6 = [
     ("home", "pick"),
-    ("pick", "place"),
-    ("place", "feeder"),
+    ("pick", "feeder"),
     ("feeder", "tray"),
     ("tray", "pick"),
-    ("pick", "home"),
+    ("pick", "tray"),
+    ("tray", "home"),
 ]
 
 DETOUR_LOCATIONS = """\

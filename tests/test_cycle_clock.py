@@ -378,6 +378,7 @@ def test_phase_grid_dynamic_programming_equals_brute_force(seed: int) -> None:
         assert math.ceil((sn + T[K - 1, jn]) / P - 1e-9) * P >= expected - 1e-9
 
 
+@pytest.mark.slow
 def test_phase_grid_cycle_is_certified_at_its_start_times(tmp_path: Path, cluster, capsys) -> None:
     path = _files(tmp_path, CYCLE.replace("[dwell]\nstep = 0.5\nmax = 1.5\n", ""))
     out = tmp_path / "out"
@@ -399,3 +400,38 @@ def test_phase_grid_cycle_is_certified_at_its_start_times(tmp_path: Path, cluste
     capsys.readouterr()
     assert main(["verify", str(out)]) == 0
     assert "every move and dwell certified" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_a_scene_that_is_not_periodic_plans_every_pass(tmp_path: Path, cluster, capsys) -> None:
+    """Two pendulums of incommensurate periods: no common period, so both passes are
+    planned, the second starting where the first ends (plus its dwell)."""
+    two = SWING + (
+        '\n[[pendulum]]\nname = "far"\npivot = [3.0, 3.0, 2.0]\nlength = 0.5\nv0 = 1.0\n'
+        "omega = 2.0\nbob_radius = 0.05\n"
+    )
+    cycle = CYCLE.replace("repeat = 3", "repeat = 2").replace("max = 1.5", "max = 0.5")
+    path = _files(tmp_path, cycle, two)
+    out = tmp_path / "out"
+    argv = ["cycle", str(path), "--out", str(out), "--scheduler", cluster.scheduler_address]
+    main([*argv, "--quiet", "--no-playback", "--no-plots"])
+    summary = json.loads((out / "cycle.json").read_text())
+    clock = summary["clock"]
+    assert clock["scene_clock"] == "every pass planned"
+    assert clock["period"] is None
+    assert len(clock["passes"]) == 2
+    first, second = clock["passes"]
+    assert second[0]["start_time"] == pytest.approx(first[-1]["end_time"] + second[0]["dwell"])
+    assert summary["cycle_time"] == pytest.approx(second[-1]["end_time"])
+    scene = Scene.from_file(tmp_path / "swing.toml").to_dict()
+    robot = Robot.adept_one_xl()
+    for m in first + second:
+        t, q = _dense(out / m["folder"])
+        rows = np.r_[np.arange(0, len(t), 12), len(t) - 1]
+        hand, _ = clearance_by_hand(robot, scene, q[rows], m["start_time"] + t[rows])
+        if m["move_certified"]:
+            assert hand.min() >= MARGIN - 1e-6
+    capsys.readouterr()
+    code = main(["verify", str(out)])
+    assert code == (0 if summary["all_certified"] else 1)
+    assert capsys.readouterr().out.count("start ") == 4

@@ -197,8 +197,15 @@ def plan_phase_grid(
     found = phase_schedules(table, lambda k, s, d: rest(k, s, d).certified)
     path = found[schedule]
     if path is None:
+        counts = ", ".join(
+            f"{t.move.name} {int(c.sum())}/{n}" for t, c in zip(base, table.certified)
+        )
+        unsafe = sorted({base[k].move.start for (k, _, _), v in checked.items() if not v.certified})
         raise CycleError(
-            f"{cycle.source}: no certified {schedule} schedule on a grid of {n} phases"
+            f"{cycle.source}: no certified {schedule} schedule on a grid of {n} phases "
+            f"(certified start phases: {counts}; a move starts on the grid, so the robot "
+            f"dwells before it, and a dwell was not certified at {unsafe or 'no location'}); "
+            "plan the cycle without --phase-grid (its dwells may be 0)"
         )
     row, chosen = [], []
     end = 0.0
