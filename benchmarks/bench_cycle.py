@@ -1,24 +1,35 @@
-"""A 12-move cycle on Dask: one worker against two, and a scheduler + workers over TCP.
+"""Cycles on Dask: one worker against two, a scheduler + workers over TCP, and (issue 25)
+the phase-optimised plan of a cycle with a moving obstacle against the naive one.
 
-Run: ``python benchmarks/bench_cycle.py [--pop 100] [--gens 100] [--out DIR]``
-(the defaults are the paper's NSGA-II budget; takes several minutes).
+Run: ``python benchmarks/bench_cycle.py [--cycle detour|pick6|bench12] [--pop 100]
+[--gens 60] [--phases 8] [--out DIR]`` (takes minutes at the default budgets).
 
-Writes a 12-move cycle file of the paper scene (five locations, poses and joints) and
-times the command as a user types it, whole process included:
+The cycles (every scene here has the pendulum, so every cycle runs on the scene clock and
+is planned on a phase grid of ``--phases`` start phases: one Dask task per move × phase,
+``adept-traj cycle --phase-grid N``, docs/cycles.md):
 
-1. ``adept-traj cycle FILE --out DIR/one --workers 1``;
-2. ``adept-traj cycle FILE --out DIR/two --workers 2`` (target: ≥ 1.8× faster than 1,
-   issue #16; on a machine with two free cores);
+- ``detour``: the shipped detour scene, a → b, b → a (a, b its start and goal),
+  ``repeat = 5``, seed 3 (issue 25's cycle);
+- ``pick6``: a closed 6-move pick-and-place on the paper scene, ``repeat = 10``;
+- ``bench12``: the 12-move cycle of issue 16 on the paper scene.
+
+Each is timed as a user types it, whole process included:
+
+1. ``adept-traj cycle FILE --out DIR/one --workers 1 --phase-grid N``;
+2. the same with ``--workers 2`` (target: ≥ 1.8× faster than 1 on two free cores);
 3. ``dask scheduler`` and two ``dask worker … --nthreads 1`` processes on 127.0.0.1
-   (real TCP), then ``adept-traj cycle FILE --out DIR/tcp --scheduler tcp://127.0.0.1:P``.
+   (real TCP), then ``adept-traj cycle … --scheduler tcp://127.0.0.1:P``.
 
-Then checks that the three runs give identical results (every move's front and best
-trade-off bit for bit) and prints the figures against the target.
+Then checks that the three runs give identical results (every task's front and best
+trade-off bit for bit) and prints the cycle time of the phase-optimised plan (dynamic
+programming over the grid) against the naive back-to-back plan that only adds the dwells
+it needs, both certified at their start times.
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import socket
 import subprocess
 import sys
@@ -27,6 +38,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _timing import load_average  # benchmarks/_timing.py
 
 from adept_traj.cycle import MOVES_FOLDER, read_cycle_file
 from adept_traj.results import PlanningResult
@@ -72,20 +84,63 @@ SEQUENCE = [
 ]
 
 
-def cycle_text(pop: int, gens: int) -> str:
+#: Six moves between locations where the robot may wait at rest (at "place", the paper
+#: scene's goal, the pendulum hits the resting robot at some phases: −12.7 mm).
+PICK6 = [
+    ("home", "pick"),
+    ("pick", "feeder"),
+    ("feeder", "tray"),
+    ("tray", "pick"),
+    ("pick", "tray"),
+    ("tray", "home"),
+]
+
+DETOUR_LOCATIONS = """\
+[[location]]
+name = "a"
+joints = [0.1682, 1.3849, 0.08, -0.7555]
+
+[[location]]
+name = "b"
+joints = [-0.7610, 0.2450, 0.20, 1.0095]
+"""
+
+#: name -> (scene, repeat, seed, locations, sequence)
+CYCLES = {
+    "detour": ("detour", 5, 3, DETOUR_LOCATIONS, [("a", "b"), ("b", "a")]),
+    "pick6": ("paper", 10, 1, LOCATIONS, PICK6),
+    "bench12": ("paper", 1, 1, LOCATIONS, SEQUENCE),
+}
+
+
+def cycle_text(name: str, pop: int, gens: int) -> str:
     """The benchmark's cycle file."""
-    moves = "".join(f'\n[[move]]\nfrom = "{a}"\nto = "{b}"\n' for a, b in SEQUENCE)
-    head = f'name = "bench12"\nscene = "paper"\n\n[plan]\npop_size = {pop}\nn_gen = {gens}\n\n'
-    return head + LOCATIONS + moves
+    scene, repeat, seed, locations, sequence = CYCLES[name]
+    moves = "".join(f'\n[[move]]\nfrom = "{a}"\nto = "{b}"\n' for a, b in sequence)
+    head = (
+        f'name = "{name}"\nscene = "{scene}"\nrepeat = {repeat}\n\n'
+        f"[plan]\npop_size = {pop}\nn_gen = {gens}\nseed = {seed}\n\n"
+    )
+    return head + locations + moves
 
 
-def timed(argv: list[str]) -> float:
-    """Wall time [s] of the command ``argv`` (checked: exit 0 or 1 = not all certified)."""
+def timed(argv: list[str]) -> tuple[float, str]:
+    """Wall time [s] and stderr of the command ``argv`` (checked: exit 0 or 1 = not all
+    certified)."""
     t0 = time.perf_counter()
-    code = subprocess.run(argv, stdout=subprocess.DEVNULL, check=False).returncode
-    if code not in (0, 1):
-        raise SystemExit(f"{' '.join(argv)} exited with {code}")
-    return time.perf_counter() - t0
+    run = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if run.returncode not in (0, 1):
+        raise SystemExit(f"{' '.join(argv)} exited with {run.returncode}: {run.stderr[-500:]}")
+    return time.perf_counter() - t0, run.stderr
+
+
+def pass_times(stderr: str) -> tuple[float, float | None]:
+    """(optimised, naive) pass times [s] from the command's phase-grid line."""
+    found = re.search(r"pass time ([0-9.]+) s, naive back-to-back ([0-9.]+|–) s", stderr)
+    if found is None:
+        raise SystemExit(f"no phase-grid line in: {stderr[-500:]}")
+    naive = found.group(2)
+    return float(found.group(1)), None if naive == "–" else float(naive)
 
 
 def free_port() -> int:
@@ -94,7 +149,7 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def run_on_tcp(file: Path, out: Path) -> float:
+def run_on_tcp(file: Path, out: Path, extra: list[str]) -> tuple[float, str]:
     """The cycle on a ``dask scheduler`` and two ``dask worker`` processes over TCP."""
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"
@@ -114,7 +169,7 @@ def run_on_tcp(file: Path, out: Path) -> float:
             )
         time.sleep(5.0)  # both workers registered
         return timed(["adept-traj", "cycle", str(file), "--out", str(out), "--quiet",
-                      "--no-plots", "--scheduler", address])  # fmt: skip
+                      "--no-plots", "--no-playback", "--scheduler", address, *extra])  # fmt: skip
     finally:  # the workers first: a worker outliving its scheduler logs heartbeat errors
         for p in workers:
             p.terminate()
@@ -124,37 +179,53 @@ def run_on_tcp(file: Path, out: Path) -> float:
         scheduler.wait(timeout=30)
 
 
-def same_results(file: Path, outs: list[Path]) -> bool:
-    """Whether every move's front and best trade-off are identical in all ``outs``."""
-    for move in read_cycle_file(file).moves:
-        loaded = [PlanningResult.load(o / MOVES_FOLDER / move.name) for o in outs]
+def same_results(outs: list[Path]) -> bool:
+    """Whether every task's front and best trade-off are identical in all ``outs``."""
+    names = sorted(p.name for p in (outs[0] / MOVES_FOLDER).iterdir())
+    for name in names:
+        loaded = [PlanningResult.load(o / MOVES_FOLDER / name) for o in outs]
         for r in loaded[1:]:
             if not (
                 np.array_equal(r.front.x, loaded[0].front.x)
                 and np.array_equal(r.best_x, loaded[0].best_x)
             ):
-                print(f"move {move.name}: results differ")
+                print(f"task {name}: results differ")
                 return False
     return True
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--pop", type=int, default=100, help="population (paper NSGA-II: 100)")
-    parser.add_argument("--gens", type=int, default=100, help="generations (paper: 100)")
+    parser.add_argument("--cycle", choices=sorted(CYCLES), default="detour")
+    parser.add_argument("--pop", type=int, default=100, help="population (default 100)")
+    parser.add_argument("--gens", type=int, default=60, help="generations (default 60)")
+    parser.add_argument("--phases", type=int, default=8, help="start phases per period")
     parser.add_argument("--out", type=Path, help="output folder (default: a temporary one)")
     args = parser.parse_args()
     root = args.out or Path(tempfile.mkdtemp(prefix="bench_cycle_"))
     root.mkdir(parents=True, exist_ok=True)
-    file = root / "bench12.toml"
-    file.write_text(cycle_text(args.pop, args.gens))
-    base = ["adept-traj", "cycle", str(file), "--quiet", "--no-plots", "--out"]
-    t1 = timed([*base, str(root / "one"), "--workers", "1"])
-    t2 = timed([*base, str(root / "two"), "--workers", "2"])
-    t_tcp = run_on_tcp(file, root / "tcp")
-    same = same_results(file, [root / "one", root / "two", root / "tcp"])
+    file = root / f"{args.cycle}.toml"
+    file.write_text(cycle_text(args.cycle, args.pop, args.gens))
+    repeat = read_cycle_file(file).repeat
+    grid = ["--phase-grid", str(args.phases)]
+    base = ["adept-traj", "cycle", str(file), "--quiet", "--no-plots", "--no-playback", "--out"]
+    t1, err1 = timed([*base, str(root / "one"), "--workers", "1", *grid])
+    t2, _ = timed([*base, str(root / "two"), "--workers", "2", *grid])
+    t_tcp, _ = run_on_tcp(file, root / "tcp", grid)
+    same = same_results([root / "one", root / "two", root / "tcp"])
+    best, naive = pass_times(err1)
     speedup = t1 / t2
-    print(f"12-move cycle, NSGA-II {args.pop} × {args.gens}, results in {root}")
+    tasks = len(read_cycle_file(file).moves) * args.phases
+    print(f"{args.cycle} cycle, NSGA-II {args.pop} × {args.gens}, {args.phases} phases "
+          f"({tasks} tasks), load {load_average()}, results in {root}")  # fmt: skip
+    print(
+        f"  cycle time, phase-optimised: {repeat * best:8.3f} s ({best:.3f} s per pass × {repeat})"
+    )
+    if naive is None:
+        print("  cycle time, naive back-to-back: no certified schedule")
+    else:
+        print(f"  cycle time, naive back-to-back: {repeat * naive:8.3f} s "
+              f"(gain {100 * (1 - best / naive):.1f} %)")  # fmt: skip
     print(f"  1 local worker : {t1:7.1f} s")
     print(f"  2 local workers: {t2:7.1f} s   speed-up {speedup:.2f}× (target ≥ {TARGET_SPEEDUP}×)"
           f"  {'OK' if speedup >= TARGET_SPEEDUP else 'MISSED'}")  # fmt: skip

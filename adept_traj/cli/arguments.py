@@ -51,10 +51,18 @@ def floats(text: str) -> list[float]:
         ) from None
 
 
-def add_problem_arguments(parser: argparse.ArgumentParser) -> None:
+def add_problem_arguments(parser: argparse.ArgumentParser, *, start_time: bool = False) -> None:
     """Declare the options of a planning problem: scene, start, goal, seed, weights, rate,
-    workers (default ``None``: :func:`~adept_traj.problem.available_cores`) and
-    ``--quiet``."""
+    workers (default ``None``: :func:`~adept_traj.problem.available_cores`), ``--quiet``
+    and, with ``start_time``, ``--start-time T0`` (scene time [s] of the move's start)."""
+    if start_time:
+        parser.add_argument(
+            "--start-time",
+            type=float,
+            metavar="T0",
+            help="scene time [s] at which the move starts (default 0): moving obstacles are "
+            "checked, certified and shown at scene time T0 + t",
+        )
     parser.add_argument(
         "--scene",
         default="paper",
@@ -191,7 +199,12 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     goal = check_task(robot, goal, "goal") if goal is not None else None
     goal = _pose_joints(robot, getattr(args, "goal_pose", None), "goal", goal, start, args)
     workers = available_cores() if args.workers is None else args.workers
-    problem = TrajectoryProblem(robot, scene, start, goal, workers=workers)
+    start_time = getattr(args, "start_time", None)  # plan --start-time; None: 0
+    extra = {}
+    if start_time is not None:
+        as_scalar(start_time, "--start-time", "[s] (a scene time)", minimum=0)
+        extra["start_time"] = start_time
+    problem = TrajectoryProblem(robot, scene, start, goal, workers=workers, **extra)
     try:
         raw = None if args.scene in SHIPPED_SCENES else read_toml(args.scene, SceneError)
         for warning in unit_warnings(problem, raw):

@@ -27,7 +27,10 @@ from adept_traj.cli import status
 from adept_traj.cli._run_folder import as_path, folder_lock
 from adept_traj.cycle import (
     PLAYBACK_FILE,
+    chosen_member,
     cycle_html,
+    plan_on_clock,
+    plan_phase_grid,
     read_cycle_file,
     run_cycle,
     write_cycle_report,
@@ -48,6 +51,13 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--no-plots", action="store_true", help="no cycle_gantt.png")
     p.add_argument("--no-playback", action="store_true", help="no playback.html")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument(
+        "--phase-grid",
+        type=int,
+        metavar="N",
+        help="periodic moving obstacles: plan every move at N start phases at once and "
+        "choose the sequence of least pass time (dynamic programming; docs/cycles.md)",
+    )
     return p
 
 
@@ -63,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
     """The moves of ``cycle`` and their report, with ``out`` held (:func:`run`)."""
+    if cycle.scene.moving:
+        return _run_on_clock(args, cycle, out)
     with tqdm(
         total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
     ) as bar:
@@ -78,6 +90,64 @@ def _run(args: argparse.Namespace, cycle: Any, out: Path) -> int:
     if not args.no_playback:
         names = [m.name for m in cycle.moves]
         robot, page = cycle.robot.load(), out / PLAYBACK_FILE
-        cycle_html(results, names, page, robot=robot, scene=cycle.scene, title=cycle.name)
+        rows = [chosen_member(r, m) for r, m in zip(results, cycle.moves)]
+        cycle_html(
+            results, names, page, robot=robot, scene=cycle.scene, title=cycle.name, members=rows
+        )
+    print((out / "cycle.md").read_text(encoding="utf-8"))
+    return status.OK if summary["all_certified"] else status.NOT_CERTIFIED
+
+
+def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
+    """A scene with moving obstacles: the moves planned in the order they run, each at its
+    start time on the scene clock (:func:`~adept_traj.cycle.plan_on_clock`)."""
+    if args.phase_grid is not None:
+        clock, passes, report = plan_phase_grid(
+            cycle,
+            out,
+            phases=args.phase_grid,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+        )
+        naive = report["naive"]
+        print(
+            f"phase grid of {args.phase_grid}: pass time {report['optimised']:.3f} s, naive "
+            f"back-to-back {'–' if naive is None else f'{naive:.3f}'} s",
+            file=sys.stderr,
+        )
+        return _report_on_clock(args, cycle, out, clock, passes)
+    with tqdm(
+        total=len(cycle.moves), desc="moves", unit="move", disable=args.quiet, file=sys.stderr
+    ) as bar:
+        clock, passes = plan_on_clock(
+            cycle,
+            out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=lambda name: bar.update(1),
+        )
+    return _report_on_clock(args, cycle, out, clock, passes)
+
+
+def _report_on_clock(
+    args: argparse.Namespace, cycle: Any, out: Path, clock: Any, passes: Any
+) -> int:
+    """The report, the playback and the exit status of a cycle on the scene clock."""
+    summary = write_cycle_report(cycle, passes[0], out, figure=not args.no_plots, clock=clock)
+    if not args.no_playback:
+        robot, page = cycle.robot.load(), out / PLAYBACK_FILE
+        names = [m.name for m in cycle.moves]
+        cycle_html(
+            passes[0],
+            names,
+            page,
+            robot=robot,
+            scene=cycle.scene,
+            title=cycle.name,
+            clock=clock,
+            passes=passes,
+        )
     print((out / "cycle.md").read_text(encoding="utf-8"))
     return status.OK if summary["all_certified"] else status.NOT_CERTIFIED

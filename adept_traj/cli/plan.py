@@ -74,7 +74,7 @@ __all__ = ["RUN_FILE", "add_parser", "run"]
 _SAVED = (
     "scene", "start", "goal", "start_pose", "goal_pose", "elbow", "seed", "weights", "rate",
     "algorithm", "pop", "gens", "workers", "no_html", "no_plots", "ros", "allow_infeasible",
-    "no_polish", "polish",
+    "no_polish", "polish", "start_time",
     "robot", "params", "tool_frame", "srdf", "package_dir", "locked_joint",
 )  # fmt: skip
 #: Saved options that may be given anew when resuming (they change nothing in the result).
@@ -88,7 +88,7 @@ _WEIGHTED_MODE_KEY = "time_optimal_weights"
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``plan`` and its options."""
     p = sub.add_parser("plan", help="plan a trajectory and save a verified result")
-    add_problem_arguments(p)
+    add_problem_arguments(p, start_time=True)
     p.add_argument(
         "--algorithm",
         default="nsga2",
@@ -242,6 +242,8 @@ def run(args: argparse.Namespace) -> int:
                 remove_written(folder)  # only with --overwrite: check_folder refused otherwise
                 saved = {k: getattr(opts, k) for k in _SAVED}
                 saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
+                if saved["start_time"] is None:  # not given: run.json as before the option
+                    del saved["start_time"]
                 write_arguments(folder, saved)
             with (
                 finisher_for(problem, figures=not opts.no_plots, html=not opts.no_html) as f,

@@ -109,6 +109,11 @@ def summary(result: PlanningResult, folder: Path) -> str:
         f"distance: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'}; "
         f"torque: {cert.torque_guarantee or f'sampled at {cert.rate_hz:g} Hz'})",
     ]
+    t0 = result.problem_settings.start_time
+    if t0:
+        lines.append(
+            f"  scene clock: the move starts at scene time t0 = {t0:g} s (obstacles at t0 + t)"
+        )
     lines += weighted_sum_text(result)
     lines += [f"  violation: {v}" for v in cert.violations]
     if result.self_pairs is not None:

@@ -17,6 +17,11 @@ One line per limit kind gives the worst ratio over the joints that have the limi
 bound (position: fraction of the range beyond the nearer limit, bound 0; the others:
 ratio to the limit, bound 1); joints without the limit (an infinite one, e.g. no
 acceleration or jerk limit in the robot's files) are listed as ``no limit``.
+
+``DIR`` may also be the output folder of ``adept-traj cycle`` (it holds ``cycle.json``):
+then every move of every pass is certified again at its start time on the scene clock,
+and every dwell (:func:`~adept_traj.cycle.verify_cycle`): exit status 0 all certified,
+1 not, 3 the record's clock arithmetic does not hold.
 """
 
 from __future__ import annotations
@@ -42,7 +47,9 @@ __all__ = ["add_parser", "run"]
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``verify`` and its options."""
     p = sub.add_parser("verify", help="re-run the dense verification of a saved result")
-    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    p.add_argument(
+        "folder", type=Path, help="result folder (result.json) or cycle folder (cycle.json)"
+    )
     p.add_argument("--rate", type=float, default=1000.0, help="verification rate [Hz]")
     p.add_argument(
         "--weights",
@@ -76,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
     """Run ``verify``; return the exit status (0 feasible and no mismatch, 1 not feasible,
     3 a mismatch)."""
     rate = check_rate(args.rate)
+    folder = Path(args.folder)
+    if (folder / "cycle.json").is_file() and not (folder / "result.json").exists():
+        return _verify_cycle(folder)
     result = PlanningResult.load(args.folder)
     scene = None
     if args.scene is not None:
@@ -97,6 +107,9 @@ def run(args: argparse.Namespace) -> int:
         f"{'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f"; min distance {cert.min_distance:.4f} m (margin {cert.margin} m)"
     )
+    t_start = result.problem_settings.start_time
+    if t_start:
+        print(f"  scene clock: certified at scene times t0 + t, t0 = {t_start:g} s")
     for check in cert.checks:
         print(f"  {check.kind:<13} {_limit_line(check, limits)}")
     for violation in cert.violations:
@@ -128,3 +141,19 @@ def run(args: argparse.Namespace) -> int:
     if not found.ok:
         return status.MISMATCH
     return status.OK if cert.feasible else status.NOT_CERTIFIED
+
+
+def _verify_cycle(folder: Path) -> int:
+    """``verify`` of a cycle's output folder (:func:`~adept_traj.cycle.verify_cycle`)."""
+    from adept_traj.cycle.cycle_verify import verify_cycle
+
+    found = verify_cycle(folder)
+    print(f"{folder}: cycle re-certified, {found.n_moves} moves on the scene clock:")
+    for line in found.lines:
+        print(f"  {line}")
+    for mismatch in found.mismatches:
+        print(f"  mismatch: {mismatch}")
+    print(f"  {'every move and dwell certified' if found.certified else 'NOT all certified'}")
+    if found.mismatches:
+        return status.MISMATCH
+    return status.OK if found.certified else status.NOT_CERTIFIED

@@ -103,12 +103,23 @@ class CollisionChecker:
     influence:
         Distance [m] below which distances are computed exactly (default 0.05 m). Must be
         ≥ 0; it should be at least the safety margin used with the distances.
+    start_time:
+        Scene time t0 [s] of the motion's time 0 (default 0): the obstacles are placed at
+        scene time :math:`t_0 + t` for the times ``t`` the methods are given (finite, ≥ 0).
     """
 
-    def __init__(self, robot: Robot, scene: Scene, influence: float = 0.05) -> None:
+    def __init__(
+        self, robot: Robot, scene: Scene, influence: float = 0.05, start_time: float = 0.0
+    ) -> None:
         if not (np.isfinite(influence) and influence >= 0):
             raise InvalidInputError(f"influence must be a finite distance ≥ 0 [m]; got {influence}")
+        if not (np.isfinite(start_time) and start_time >= 0):
+            raise InvalidInputError(
+                f"start_time must be a finite scene time ≥ 0 [s]; got {start_time}"
+            )
         self.robot, self.scene, self.influence = robot, scene, float(influence)
+        #: Scene time [s] of the motion's time 0.
+        self.start_time = float(start_time)
         objects = robot.collision_model.geometryObjects
         self.solid_names = tuple(g.name for g in objects)
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
@@ -212,12 +223,19 @@ class CollisionChecker:
             )
         return self._min_distances(qa, ta, joint_frames)
 
+    def scene_time(self, t: Any) -> np.ndarray:
+        """Scene times :math:`t_0 + t` [s] of the motion's times ``t`` [s] (any shape; ``t``
+        itself when :attr:`start_time` is 0)."""
+        ta = np.asarray(t, dtype=float)
+        return ta if self.start_time == 0.0 else ta + self.start_time
+
     # ------------------------------------------------------------------ private hooks
     def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
-        """Obstacle poses in the robot base frame at the flattened times ``t``: per obstacle
-        one (4, 4) pose if it is fixed, else (N, 4, 4) with N = ``t.size``."""
+        """Obstacle poses in the robot base frame at the flattened motion times ``t`` (scene
+        times :meth:`scene_time`): per obstacle one (4, 4) pose if it is fixed, else
+        (N, 4, 4) with N = ``t.size``."""
         to_base = self._to_base
-        flat_t = t.reshape(-1)
+        flat_t = self.scene_time(t).reshape(-1)
         laws: dict[int, np.ndarray] = {}  # a pendulum's rod and bob share one motion law
         poses = []
         for ob, fixed in zip(self.scene.obstacles, self._fixed_poses):

@@ -223,6 +223,7 @@ def _obstacle_term(
         if not ob.is_moving or len(sel) == 0:
             continue
         world = p2[sel] @ to_world[:3, :3].T + to_world[:3, 3]
-        velocity = ob.motion.point_velocity(t[rows[sel]], world) @ to_base[:3, :3].T
+        times = checker.scene_time(t[rows[sel]])  # the scene's clock, t0 + t
+        velocity = ob.motion.point_velocity(times, world) @ to_base[:3, :3].T
         out[sel] = np.einsum("mi,mi->m", normal[sel], velocity)
     return out

@@ -36,12 +36,26 @@ from adept_traj.schema import Node, error_factory
 from adept_traj.transforms import transform_from_xyz_rpy
 from adept_traj.validation import readonly_copy
 
-__all__ = ["MAX_MOVES", "Cycle", "Location", "MoveSpec", "read_cycle_file"]
+__all__ = [
+    "CHOICES",
+    "MAX_DWELL_CANDIDATES",
+    "MAX_MOVES",
+    "Cycle",
+    "Location",
+    "MoveSpec",
+    "read_cycle_file",
+]
 
 _ERROR = error_factory(CycleError)
-_TOP_KEYS = ("name", "robot", "scene", "repeat", "plan", "location", "move")
-_PLAN_KEYS = ("algorithm", "seed", "pop_size", "n_gen", "weights", "rate_hz")
-_MOVE_KEYS = ("name", "from", "to", "algorithm", "seed", "pop_size", "n_gen", "weights")
+_TOP_KEYS = ("name", "robot", "scene", "repeat", "plan", "location", "move", "dwell")
+_DWELL_KEYS = ("step", "max")
+#: Most dwell candidates of one move (``max / step + 1``): each is a planning run.
+MAX_DWELL_CANDIDATES = 32
+_PLAN_KEYS = ("algorithm", "seed", "pop_size", "n_gen", "weights", "rate_hz", "choose")
+_MOVE_KEYS = ("name", "from", "to", "algorithm", "seed", "pop_size", "n_gen", "weights", "choose")
+#: What a move reports of its front (``choose``): the best trade-off (f_c and F_avg ranks,
+#: today's rule), the fastest certified member, the certified member of least f_c alone.
+CHOICES = ("trade-off", "fastest", "weighted-sum")
 #: Most moves of a cycle file (each is a planning run).
 MAX_MOVES = 1000
 
@@ -77,6 +91,8 @@ class MoveSpec:
     algorithm, seed, pop_size, n_gen, weights: the planning run (``pop_size``/``n_gen``
         ``None``: the algorithm's paper budget); the seed defaults to the cycle's seed +
         ``index``, so it does not depend on where or when the move is planned.
+    choose: which member of the front the cycle runs (:data:`CHOICES`,
+        :func:`~adept_traj.cycle.chosen_member`).
     """
 
     index: int
@@ -88,6 +104,7 @@ class MoveSpec:
     pop_size: int | None
     n_gen: int | None
     weights: tuple[float, ...]
+    choose: str = "trade-off"
 
 
 @dataclass(frozen=True)
@@ -101,6 +118,9 @@ class Cycle:
     locations: by name; moves: the sequence, in order.
     repeat: times the sequence runs per cycle (each move is planned once).
     rate_hz: dense-certificate rate [Hz].
+    dwell_step, max_dwell: the ``[dwell]`` table: the dwells [s] a move of a scene with
+        moving obstacles may wait before it starts are ``0, step, 2·step, …, ≤ max``
+        (``None``: the defaults of :func:`~adept_traj.cycle.dwell_grid`).
     """
 
     name: str
@@ -111,6 +131,8 @@ class Cycle:
     moves: tuple[MoveSpec, ...]
     repeat: int
     rate_hz: float
+    dwell_step: float | None = None
+    max_dwell: float | None = None
 
 
 def read_cycle_file(path: str | os.PathLike[str]) -> Cycle:
@@ -136,6 +158,7 @@ def read_cycle_file(path: str | os.PathLike[str]) -> Cycle:
     defaults = plan_node.check_keys(_PLAN_KEYS)
     locations = _locations(top["location"], robot)
     moves = _moves(top["move"], locations, defaults)
+    step, most = _dwell(top["dwell"], scene) if top["dwell"].present else (None, None)
     return Cycle(
         name=top["name"].string(nonempty=True, default=p.stem or "cycle"),
         source=str(p),
@@ -145,7 +168,24 @@ def read_cycle_file(path: str | os.PathLike[str]) -> Cycle:
         moves=moves,
         repeat=top["repeat"].integer(minimum=1, maximum=10**6, default=1),
         rate_hz=defaults["rate_hz"].number("[Hz]", minimum=100.0, default=1000.0),
+        dwell_step=step,
+        max_dwell=most,
     )
+
+
+def _dwell(node: Node, scene: Scene) -> tuple[float | None, float | None]:
+    """``step`` and ``max`` [s] of the ``[dwell]`` table (``None``: not given)."""
+    dwell = node.check_keys(_DWELL_KEYS)
+    if not scene.moving:
+        raise dwell.error(f"scene {scene.name!r} has no moving obstacle: its moves never dwell")
+    step = dwell["step"].number("[s]", minimum=0.0, strict=True, default=None)
+    most = dwell["max"].number("[s]", minimum=0.0, default=None)
+    if step is not None and most is not None and most / step + 1 > MAX_DWELL_CANDIDATES:
+        raise dwell.error(
+            f"max / step + 1 = {most / step + 1:.0f} dwell candidates per move, more than "
+            f"MAX_DWELL_CANDIDATES = {MAX_DWELL_CANDIDATES}"
+        )
+    return step, most
 
 
 def _scene(node: Node, folder: Path) -> Scene:
@@ -232,6 +272,7 @@ def _moves(node: Node, locations: dict[str, Location], defaults: Node) -> tuple[
                 pop_size=fields["pop_size"],
                 n_gen=fields["n_gen"],
                 weights=fields["weights"],
+                choose=fields["choose"],
             )
         )
     return tuple(moves)
@@ -246,6 +287,7 @@ def _plan_fields(node: Node, base: dict[str, Any] | None) -> dict[str, Any]:
         "pop_size": None,
         "n_gen": None,
         "weights": tuple(PAPER_WEIGHTS),
+        "choose": "trade-off",
     }
     out = {
         "algorithm": node["algorithm"].string(choices=tuple(ALGORITHMS), default=b["algorithm"]),
@@ -253,6 +295,7 @@ def _plan_fields(node: Node, base: dict[str, Any] | None) -> dict[str, Any]:
         "pop_size": node["pop_size"].integer(minimum=2, maximum=100_000, default=b["pop_size"]),
         "n_gen": node["n_gen"].integer(minimum=1, maximum=100_000, default=b["n_gen"]),
         "weights": b["weights"],
+        "choose": node["choose"].string(choices=CHOICES, default=b["choose"]),
     }
     if node["weights"].present:
         w = node["weights"].array((6,), "", minimum=0.0)

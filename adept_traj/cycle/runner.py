@@ -20,7 +20,8 @@ import json
 import os
 import shutil
 import uuid
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -44,6 +45,7 @@ __all__ = [
     "RETRIES",
     "MoveTask",
     "cycle_tasks",
+    "dask_client",
     "plan_move",
     "run_cycle",
     "run_planning_tasks",
@@ -66,6 +68,7 @@ class MoveTask:
     ----------
     move: the move; start, goal: (nq,) joints [rad | m].
     robot: where the worker loads the robot; scene: the scene; rate_hz: certificate rate.
+    start_time: scene time [s] at which the move starts (the problem's ``start_time``).
     """
 
     move: MoveSpec
@@ -74,13 +77,16 @@ class MoveTask:
     robot: RobotSource
     scene: Scene
     rate_hz: float
+    start_time: float = 0.0
 
     def description(self) -> dict[str, Any]:
         """The JSON form written to ``move.json`` (what identifies the task's result)."""
         m = self.move
+        clock = {"start_time": self.start_time} if self.start_time else {}  # 0: as before
         return json.loads(
             json.dumps(
                 {
+                    **clock,
                     "name": m.name,
                     "from": m.start,
                     "to": m.goal,
@@ -123,7 +129,8 @@ def _robot(source: RobotSource) -> Robot:
 def plan_move(task: MoveTask) -> PlanningResult:
     """Plan one move (the body of a Dask task; also callable directly)."""
     m = task.move
-    problem = TrajectoryProblem(_robot(task.robot), task.scene, task.start, task.goal, workers=1)
+    robot, t0 = _robot(task.robot), task.start_time
+    problem = TrajectoryProblem(robot, task.scene, task.start, task.goal, workers=1, start_time=t0)
     try:
         return plan(
             problem,
@@ -170,17 +177,30 @@ def run_tasks(
     workers: int | None = None,
     scheduler: str | None = None,
     on_result: Callable[[int, Any], None] | None = None,
+    client: Any = None,
 ) -> list[Any]:
     """``[function(t) for t in tasks]``, each call a Dask task (``retries`` =
     :data:`RETRIES`), on a new local cluster of ``workers`` single-threaded worker
-    processes (default: one per core) or on the scheduler at address ``scheduler``.
+    processes (default: one per core) or on the scheduler at address ``scheduler``, or on
+    the caller's ``distributed.Client`` ``client`` (:func:`dask_client`; left open).
     ``on_result(i, value)`` is called in this process as each task finishes."""
-    from distributed import Client, LocalCluster, as_completed
+    if client is not None:
+        return _run_on(client, tasks, function, on_result)
+    with dask_client(workers, scheduler, len(tasks)) as own:
+        return _run_on(own, tasks, function, on_result)
+
+
+@contextmanager
+def dask_client(workers: int | None, scheduler: str | None, n_tasks: int) -> Iterator[Any]:
+    """A ``distributed.Client``: of a new local cluster of ``min(workers, n_tasks)``
+    single-threaded worker processes (default: one per core), or of the scheduler at
+    address ``scheduler``; closed (and the cluster stopped) on leaving."""
+    from distributed import Client, LocalCluster
 
     if scheduler is None:
         n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
         cluster = LocalCluster(
-            n_workers=min(n, max(len(tasks), 1)),
+            n_workers=min(n, max(n_tasks, 1)),
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0",  # any free port: 8787 may be taken
@@ -189,24 +209,36 @@ def run_tasks(
     else:
         cluster, client = None, Client(scheduler)
     try:
-        run_id = uuid.uuid4().hex  # keys unique on a shared scheduler
-        futures = [
-            client.submit(function, t, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
-            for i, t in enumerate(tasks)
-        ]
-        index = {f.key: i for i, f in enumerate(futures)}
-        out: list[Any] = [None] * len(tasks)
-        for future in as_completed(futures):
-            i = index[future.key]
-            out[i] = future.result()
-            future.release()
-            if on_result is not None:
-                on_result(i, out[i])
-        return out
+        yield client
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _run_on(
+    client: Any,
+    tasks: Sequence[Any],
+    function: Callable[[Any], Any],
+    on_result: Callable[[int, Any], None] | None,
+) -> list[Any]:
+    """:func:`run_tasks` on ``client``."""
+    from distributed import as_completed
+
+    run_id = uuid.uuid4().hex  # keys unique on a shared scheduler
+    futures = [
+        client.submit(function, t, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
+        for i, t in enumerate(tasks)
+    ]
+    index = {f.key: i for i, f in enumerate(futures)}
+    out: list[Any] = [None] * len(tasks)
+    for future in as_completed(futures):
+        i = index[future.key]
+        out[i] = future.result()
+        future.release()
+        if on_result is not None:
+            on_result(i, out[i])
+    return out
 
 
 def run_planning_tasks(
@@ -217,9 +249,11 @@ def run_planning_tasks(
     scheduler: str | None = None,
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
+    client: Any = None,
 ) -> list[PlanningResult]:
-    """Plan ``tasks`` on Dask (:func:`run_tasks`), each result saved as it arrives into
-    ``folder/NAME/`` (NAME: the task's move name); return the results in order.
+    """Plan ``tasks`` on Dask (:func:`run_tasks`; on ``client`` when given), each result
+    saved as it arrives into ``folder/NAME/`` (NAME: the task's move name); return the
+    results in order.
 
     ``resume``: a task whose folder holds the same task (``move.json``) is loaded, not
     planned; without it a ``folder`` that already holds results is refused
@@ -254,6 +288,7 @@ def run_planning_tasks(
             workers=workers,
             scheduler=scheduler,
             on_result=saved,
+            client=client,
         )
     return results  # type: ignore[return-value]
 
@@ -270,6 +305,10 @@ def run_cycle(
     """Plan every move of ``cycle`` on Dask; save each result as it finishes
     (``out/moves/NAME/``, :func:`run_planning_tasks`); return the results in the order of
     the moves.
+
+    Every move is planned from scene time 0, all at once: right for a fixed-obstacle
+    scene. With moving obstacles a move is certified only for its own start time: plan
+    such a cycle with :func:`~adept_traj.cycle.plan_on_clock` (``adept-traj cycle`` does).
 
     Parameters
     ----------

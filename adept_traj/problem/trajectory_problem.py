@@ -61,7 +61,7 @@ from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Box
-from adept_traj.validation import as_batch, as_integer
+from adept_traj.validation import as_batch, as_integer, as_scalar
 
 __all__ = ["ProblemSettings", "TrajectoryProblem"]
 
@@ -115,6 +115,8 @@ class ProblemSettings:
         SRDF pairs. The problem's settings hold every disabled pair naming two links with
         solids (these and the SRDF's, sorted), so that a saved result rebuilds the same
         check.
+    start_time:
+        Scene time t0 [s] (≥ 0) of the move's start: obstacles are seen at t0 + t.
     """
 
     n_knots: int = 20
@@ -127,6 +129,7 @@ class ProblemSettings:
     search_buffer: float = 0.002
     self_collision: bool | None = None
     disabled_pairs: tuple[tuple[str, str], ...] = ()
+    start_time: float = 0.0
 
     def __post_init__(self) -> None:
         if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
@@ -154,6 +157,8 @@ class ProblemSettings:
                 f"disabled_pairs must be (link1, link2) pairs; got {self.disabled_pairs!r}"
             ) from None
         object.__setattr__(self, "disabled_pairs", pairs)
+        t0 = as_scalar(self.start_time, "start_time", "[s]", minimum=0, error=ConfigurationError)
+        object.__setattr__(self, "start_time", t0)
         for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
             value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
             object.__setattr__(self, name, value)
@@ -238,15 +243,12 @@ class TrajectoryProblem(Problem):
         self.lower_bound = kinematic_lower_bound(
             self.start, self.goal, lim.velocity, lim.acceleration, lim.jerk
         )
-        t_min, t_max = settings.t_bounds or (
-            self.lower_bound.T_min,
-            2.5 * self.lower_bound.T_min,
-        )
+        t_min, t_max = settings.t_bounds or (self.lower_bound.T_min, 2.5 * self.lower_bound.T_min)
         xl, xu = self.trajectory.decision_bounds(lim.lower, lim.upper, t_min, t_max)
         s, w = self.trajectory.quadrature(settings.nodes_per_segment)
         self.s = np.concatenate([[0.0], s, [1.0]])  # both ends too (weight 0)
         self.weights = np.concatenate([[0.0], w, [0.0]])
-        self.checker = CollisionChecker(robot, scene, influence=settings.influence)
+        self.checker = CollisionChecker(robot, scene, settings.influence, settings.start_time)
         super().__init__(
             n_var=self.trajectory.n_var,
             n_obj=len(OBJECTIVES),
@@ -357,7 +359,7 @@ class TrajectoryProblem(Problem):
         st = self.settings
         if st.z3 == "clearance":
             return np.sum(np.maximum(0.0, 1.0 - min_dist / st.influence) ** 2, axis=-1)
-        poses = self.scene.obstacle_poses(smp.t, in_base_frame=True)  # (n_obs, pop, n_s, 4, 4)
+        poses = self.scene.obstacle_poses(self.checker.scene_time(smp.t), in_base_frame=True)
         return self._paper_penalty(tool_pose[..., :3, 3], poses)
 
     def _paper_penalty(self, tool: np.ndarray, poses: np.ndarray) -> np.ndarray:

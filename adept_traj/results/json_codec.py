@@ -73,11 +73,18 @@ def _read_json(path: Path) -> PlanningResult:
 
 # ============================================================================ encoding
 def _problem_settings(settings: ProblemSettings) -> dict[str, Any]:
-    """The settings as stored: a zero ``search_buffer``, ``self_collision`` off and no
-    ``disabled_pairs`` are left out, so that files written before the fields existed are
-    written back unchanged (absent reads back as 0, off and none)."""
+    """The settings as stored: a zero ``search_buffer``, ``self_collision`` off, no
+    ``disabled_pairs`` and a zero ``start_time`` are left out, so that files written before
+    the fields existed are written back unchanged (absent reads back as 0, off, none and
+    0)."""
     out = dataclasses.asdict(settings)
-    for key, default in (("search_buffer", 0.0), ("self_collision", False), ("disabled_pairs", ())):
+    defaults = (
+        ("search_buffer", 0.0),
+        ("self_collision", False),
+        ("disabled_pairs", ()),
+        ("start_time", 0.0),
+    )
+    for key, default in defaults:
         if out[key] == default or out[key] is None:
             del out[key]
     return out

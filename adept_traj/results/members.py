@@ -110,8 +110,9 @@ def member_dense(result: PlanningResult, index: int, replay: Any = None) -> Dens
     positions and derivatives exact from the spline, torques from the robot's inverse
     dynamics (:meth:`~adept_traj.results.Replay.torques`) and, per sample, the smallest
     exact signed distance over every (solid, obstacle) pair
-    (``CollisionChecker(robot, scene).distances(q, t, exact=True)``; ``inf`` when the scene
-    has no obstacle), as :func:`~adept_traj.analysis.certify` computes them.
+    (``CollisionChecker(robot, scene, start_time=t0).distances(q, t, exact=True)``, the
+    obstacles at scene time t0 + t; ``inf`` when the scene has no obstacle), as
+    :func:`~adept_traj.analysis.certify` computes them.
 
     Parameters
     ----------
@@ -144,7 +145,7 @@ def member_dense(result: PlanningResult, index: int, replay: Any = None) -> Dens
             f"at most {MAX_MEMBER_SAMPLES} are resampled"
         )
     smp = motion.sample_uniform(n, orders=(0, 1, 2, 3))
-    checker = CollisionChecker(motion.robot, motion.scene)
+    checker = CollisionChecker(motion.robot, motion.scene, start_time=motion.start_time)
     if checker.n_obstacles and checker.n_solids:
         pairs = checker.distances(smp.q[None], smp.t[None], exact=True).distance[0]
         per_sample = pairs.min(axis=(1, 2))

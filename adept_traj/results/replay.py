@@ -41,12 +41,16 @@ class Replay:
     scene: the :class:`~adept_traj.scene.Scene` (obstacles at their pose at each time).
     trajectory: the :class:`~adept_traj.problem.BSplineTrajectory` (start, goal, knots).
     x: (n_var,) the decision vector ``[T, free control points]`` of the move.
+    start_time: scene time t0 [s] at which the move starts (default 0): the obstacles of
+        the move's time t are at their pose at scene time :math:`t_0 + t`
+        (:meth:`scene_time`).
     """
 
     robot: Robot
     scene: Scene
     trajectory: BSplineTrajectory
     x: np.ndarray
+    start_time: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.robot, Robot):
@@ -65,6 +69,10 @@ class Replay:
         if x.shape != (self.trajectory.n_var,):
             raise InputShapeError(f"x must have shape ({self.trajectory.n_var},); got {x.shape}")
         object.__setattr__(self, "x", readonly_copy(x))
+        t0 = float(self.start_time)
+        if not (np.isfinite(t0) and t0 >= 0.0):
+            raise InvalidInputError(f"start_time must be a finite scene time ≥ 0 [s]; got {t0}")
+        object.__setattr__(self, "start_time", t0)
 
     @classmethod
     def of(
@@ -99,7 +107,8 @@ class Replay:
         trajectory = BSplineTrajectory(
             result.start, result.goal, n_knots=int(result.problem_settings.n_knots)
         )
-        return cls(robot, scene, trajectory, result.best_x if x is None else x)
+        t0 = result.problem_settings.start_time
+        return cls(robot, scene, trajectory, result.best_x if x is None else x, t0)
 
     @classmethod
     def of_best(cls, result: PlanningResult, replay: Any = None) -> Replay:
@@ -128,7 +137,7 @@ class Replay:
 
     def shows(self, result: PlanningResult, x: Any) -> bool:
         """Whether this replay is the move of decision vector ``x`` (n_var,) of ``result``:
-        the same joints, start, goal, knots and decision vector."""
+        the same joints, start, goal, knots, decision vector and start time."""
         tr = self.trajectory
         return (
             tuple(self.robot.joint_names) == tuple(result.robot.joint_names)
@@ -136,7 +145,14 @@ class Replay:
             and deep_equal(tr.start, result.start)
             and deep_equal(tr.goal, result.goal)
             and deep_equal(self.x, np.asarray(x, dtype=float))
+            and self.start_time == result.problem_settings.start_time
         )
+
+    def scene_time(self, times: Any) -> np.ndarray:
+        """Scene times :math:`t_0 + t` [s] of the move's times ``times`` [s] (any shape):
+        where the obstacles are drawn and checked."""
+        t = np.asarray(times, dtype=float)
+        return t if self.start_time == 0.0 else t + self.start_time
 
     @property
     def duration(self) -> float:

@@ -180,7 +180,8 @@ def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
             z4 = min(z4, _manipulability(jac[rows]))
             pin.updateGeometryPlacements(model, data, gm, gdata, q)
             tool_points.append(data.oMf[tool_id].translation.copy())
-            poses = problem.scene.obstacle_poses(np.array([s * T]), in_base_frame=True)[:, 0]
+            scene_t = st.start_time + s * T  # the move starts at scene time t0
+            poses = problem.scene.obstacle_poses(np.array([scene_t]), in_base_frame=True)[:, 0]
             obs_poses.append(poses)
             for o, ob in enumerate(problem.scene.obstacles):
                 tf_o = coal.Transform3s(poses[o, :3, :3], poses[o, :3, 3])

@@ -42,7 +42,8 @@ def closest_points(
     robot: the robot (its collision model gives the solids).
     scene: the obstacles and the robot base pose in the world.
     q: (n, nq) joint positions [rad | m].
-    times: (n,) physical times of the frames [s] (moving obstacles' poses).
+    times: (n,) scene times of the frames [s] (moving obstacles' poses: a move started
+        at scene time t0 passes t0 + t).
 
     Returns
     -------

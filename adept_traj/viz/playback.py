@@ -273,8 +273,8 @@ def build_animation(
         material = mg.MeshLambertMaterial(color=hex_colour(rgba[:3]), opacity=float(rgba[3]))
         objects.append(SceneObject(f"robot/{g.name}", solid_parts(g, material), solid_poses[:, k]))
 
-    # --- obstacles, at the physical time of each frame
-    obstacle_poses = scene.obstacle_poses(times)  # (n_obs, n, 4, 4)
+    # --- obstacles, at the scene time of each frame (t0 + t: the move's start time on)
+    obstacle_poses = scene.obstacle_poses(replay.scene_time(times))  # (n_obs, n, 4, 4)
     for i, ob in enumerate(scene.obstacles):
         color = MOVING_OBSTACLE_COLOR if ob.is_moving else FIXED_OBSTACLE_COLOR
         material = mg.MeshLambertMaterial(color=color, opacity=1.0 if ob.is_moving else 0.85)
@@ -288,7 +288,7 @@ def build_animation(
     # --- closest-point segment
     closest = distance = None
     if show_closest and scene.obstacles:
-        closest, distance = closest_points(robot, scene, q, times)
+        closest, distance = closest_points(robot, scene, q, replay.scene_time(times))
         objects.extend(_closest_objects(closest))
 
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]

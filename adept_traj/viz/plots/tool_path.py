@@ -31,9 +31,9 @@ def _layers(
 ) -> list[tuple[list[np.ndarray], dict[str, Any]]]:
     """Everything but the tool path, as (polylines, line style) layers in the world frame:
     the robot's solids at the first and last of the samples ``q`` (n, nq) [rad | m], the
-    fixed obstacles, the moving ones at t = 0 and T and the centre path of every moving
-    sphere over the times ``t`` (n,) [s]."""
-    base, T = scene.robot_base, float(t[-1])
+    fixed obstacles, the moving ones at the first and last of the scene times ``t`` (n,)
+    [s] and the centre path of every moving sphere over them."""
+    base = scene.robot_base
     solids = robot.collision_model.geometryObjects
     layers: list[tuple[list[np.ndarray], dict[str, Any]]] = []
     for poses, alpha in zip(base @ robot.geometry_poses(q[[0, -1]]), (0.55, 0.25)):
@@ -46,7 +46,7 @@ def _layers(
             (shape_wireframe(ob.shape, ob.pose(0.0)), {"colors": "saddlebrown", "linewidths": 1.3})
         )
     for ob in scene.moving:
-        for ts, alpha in ((0.0, 0.35), (T, 0.9)):
+        for ts, alpha in ((float(t[0]), 0.35), (float(t[-1]), 0.9)):
             style = {"colors": "tab:red", "linewidths": 1.0, "alpha": alpha}
             layers.append((shape_wireframe(ob.shape, ob.pose(ts)), style))
         if isinstance(ob.shape, Sphere):
@@ -98,7 +98,7 @@ def tool_path_3d(
     dense = r.best_trajectory
     t, T = dense.t, float(dense.t[-1])
     tool = (base @ robot.tool_pose(dense.q))[:, :3, 3]
-    layers = _layers(robot, scene, dense.q, t)
+    layers = _layers(robot, scene, dense.q, replay.scene_time(t))  # the scene's clock
 
     fig = new_figure(15.5, 9.5)
     grid = fig.add_gridspec(2, 2, width_ratios=(1.3, 1.0), left=0.0, right=0.92, bottom=0.06,

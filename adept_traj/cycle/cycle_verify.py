@@ -1,0 +1,176 @@
+"""Re-certifying a whole cycle: every move of every pass at its start time on the scene clock.
+
+:func:`verify_cycle` reads ``cycle.json`` and the moves' result folders of an
+``adept-traj cycle`` output folder. A fixed-obstacle cycle: each move's best trade-off is
+certified again (the start time does not matter). A cycle planned on the scene clock
+(``clock`` in ``cycle.json``): the record's arithmetic is checked first (each move starts
+at the previous end plus its dwell, its T and its result's start time are those recorded,
+a periodic pass time is a multiple of the period), then every move of **every** pass of
+the ``repeat`` is certified at its scene start time (a periodic cycle's pass p at the
+first pass's times + p × the pass time), and every dwell (the robot at rest while the
+obstacles move) with :func:`~adept_traj.cycle.certify_rest`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from adept_traj.analysis import certify
+from adept_traj.cycle.clock import certify_rest
+from adept_traj.cycle.summary import CYCLE_FILE
+from adept_traj.errors import CycleError
+from adept_traj.files import parse_json, read_bytes_bounded
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.results import PlanningResult
+from adept_traj.scene import Scene
+
+__all__ = ["CycleVerification", "verify_cycle"]
+
+#: Tolerance [s] of the recorded clock arithmetic (start = previous end + dwell).
+_CLOCK_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class CycleVerification:
+    """What :func:`verify_cycle` found.
+
+    Attributes
+    ----------
+    lines: one line per move of every pass and per dwell checked.
+    certified: every move and dwell is certified.
+    mismatches: where the record's clock arithmetic or a move's result disagrees with it.
+    n_moves: moves certified (passes × moves).
+    """
+
+    lines: tuple[str, ...]
+    certified: bool
+    mismatches: tuple[str, ...]
+    n_moves: int
+
+
+def verify_cycle(folder: str | os.PathLike[str]) -> CycleVerification:
+    """Re-certify the cycle saved in ``folder`` (module doc).
+
+    Raises
+    ------
+    CycleError
+        ``folder`` holds no ``cycle.json`` or it cannot be read.
+    """
+    where = Path(folder)
+    path = where / CYCLE_FILE
+    summary = parse_json(read_bytes_bounded(path, CycleError), str(path), CycleError)
+    results: dict[str, PlanningResult] = {}
+
+    def load(rel: str) -> PlanningResult:
+        if rel not in results:
+            results[rel] = PlanningResult.load(where / rel)
+        return results[rel]
+
+    clock = summary.get("clock")
+    if clock is None:
+        return _fixed(summary, load)
+    return _on_clock(summary, clock, load)
+
+
+def _fixed(summary: dict[str, Any], load: Any) -> CycleVerification:
+    lines, ok = [], True
+    for m in summary["moves"]:
+        r = load(m["folder"])
+        x = r.front.x[m.get("member", r.best.index)]
+        problem = r.problem()
+        try:
+            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
+        finally:
+            problem.close()
+        ok &= c.feasible
+        lines.append(_line(m["name"], 0, 0.0, float(x[0]), c.feasible, c.min_distance))
+    return CycleVerification(tuple(lines), ok, (), len(lines))
+
+
+def _word(ok: bool) -> str:
+    return "certified" if ok else "NOT CERTIFIED"
+
+
+def _line(name: str, p: int, start: float, T: float, ok: bool, low: float) -> str:
+    return f"pass {p} {name}: start {start:.4f} s, T {T:.4f} s: {_word(ok)} (min {low:.4f} m)"
+
+
+def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> CycleVerification:
+    passes, period = clock["passes"], clock["period"]
+    repeat = int(summary["repeat"])
+    mismatches = []
+    t = 0.0
+    for p, moves in enumerate(passes):
+        for m in moves:
+            r = load(m["folder"])
+            start, T = t + m["dwell"], float(r.front.x[m["member"], 0])
+            if abs(start - m["start_time"]) > _CLOCK_TOLERANCE:
+                mismatches.append(
+                    f"pass {p} {m['name']}: starts at {m['start_time']} s, not "
+                    f"at the previous end + dwell = {start} s"
+                )
+            if m["T"] != T:
+                mismatches.append(
+                    f"pass {p} {m['name']}: T {m['T']} s recorded, {T} s in its result"
+                )
+            planned_at = r.problem_settings.start_time  # a phase grid's: congruent mod P
+            gap = m["start_time"] - planned_at
+            if period is not None and clock.get("mode", "").startswith("phase"):
+                gap -= period * round(gap / period)
+            if abs(gap) > _CLOCK_TOLERANCE * max(1.0, abs(m["start_time"])):
+                mismatches.append(
+                    f"pass {p} {m['name']}: its result was planned at start time "
+                    f"{planned_at} s, not {m['start_time']} s"
+                )
+            t = m["start_time"] + T
+    pass_time = t + clock["final_dwell"]
+    if period is not None and repeat > 1:
+        ratio = pass_time / period
+        if abs(ratio - round(ratio)) > 1e-9 * max(ratio, 1.0):
+            mismatches.append(f"pass time {pass_time} s is not a multiple of the period {period} s")
+    schedule = (
+        [(p, m, p * pass_time) for p in range(repeat) for m in passes[0]]
+        if period is not None
+        else [(p, m, 0.0) for p, moves in enumerate(passes) for m in moves]
+    )
+    first = load(passes[0][0]["folder"])
+    robot, scene = first.robot.load(), Scene.from_dict(first.scene, source="result scene")
+    lines, ok = [], True
+    for p, m, shift in schedule:
+        r = load(m["folder"])
+        x = r.front.x[m["member"]]
+        start = m["start_time"] + shift
+        settings = replace(r.problem_settings, start_time=start, workers=1)
+        problem = TrajectoryProblem(robot, scene, r.start, r.goal, settings)
+        try:
+            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
+        finally:
+            problem.close()
+        rest = certify_rest(
+            robot,
+            scene,
+            r.start,
+            start - m["dwell"],
+            m["dwell"],
+            settings=settings,
+            rate_hz=r.certificate.rate_hz,
+        )
+        ok &= bool(c.feasible and rest.certified)
+        line = _line(m["name"], p, start, float(x[0]), c.feasible, c.min_distance)
+        if m["dwell"]:
+            line += f"; its dwell of {m['dwell']:.4f} s: {_word(rest.certified)}"
+        lines.append(line)
+        final = clock["final_dwell"]
+        if period is not None and m is passes[0][-1] and repeat > 1 and final > 0:
+            end = start + float(x[0])
+            kept = certify_rest(
+                robot, scene, r.goal, end, final, settings=settings, rate_hz=r.certificate.rate_hz
+            )
+            ok &= kept.certified
+            lines.append(
+                f"pass {p} final dwell {final:.4f} s from {end:.4f} s: {_word(kept.certified)}"
+            )
+    return CycleVerification(tuple(lines), ok, tuple(mismatches), len(schedule))
