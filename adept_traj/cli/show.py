@@ -1,4 +1,5 @@
-"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1).
+"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1), and
+name the folder's front explorer (``explorer.html``, written first when missing).
 
 ``--member N`` plays member N of the front (the index of ``adept-traj front DIR``) instead
 of the best trade-off; an uncertified member
@@ -76,6 +77,18 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
+def _explorer(folder: Path, result: PlanningResult, replay: Replay | None) -> Path:
+    """The folder's ``explorer.html``, written first when missing (a folder of an earlier
+    version, or ``plan --no-html``)."""
+    from adept_traj.viz.explorer import EXPLORER_FILE, write_explorer
+
+    page = folder / EXPLORER_FILE
+    if not page.is_file():
+        robot, scene = (None, None) if replay is None else (replay.robot, replay.scene)
+        write_explorer(result, page, robot=robot, scene=scene)
+    return page
+
+
 def _play(args: argparse.Namespace) -> NoReturn:
     """Start the server and play until interrupted; the server is closed on the way out."""
     from adept_traj.viz import server
@@ -98,9 +111,11 @@ def _play(args: argparse.Namespace) -> NoReturn:
         open_browser=args.open,
         member=index,
     )
+    page = _explorer(args.folder, result, replay)
     which = "best trade-off" if index == result.best.index else "member"
     label = f"{which} {index}, {'certified' if certified else 'NOT CERTIFIED'}"
     try:  # the URL is printed inside: a Ctrl-C right after it must still stop cleanly
+        print(f"front explorer (offline page, any member): {page.resolve().as_uri()}")
         print(f"playing {args.folder} ({label}) at {vis.url()} (Ctrl-C to stop)", flush=True)
         while True:
             time.sleep(1.0)
