@@ -104,5 +104,10 @@ def cycle_html(
     from adept_traj.viz.meshcat_scene import render_html
 
     playback = cycle_playback(results, names, robot=robot, scene=scene)
-    text = render_html(playback, title=f"{title}, {playback.duration:.3f} s")
+    status = "all certified" if playback.certified else "NOT ALL CERTIFIED"
+    label = (
+        f"cycle of {len(results)} moves, each its best trade-off · "
+        f"T = {playback.duration:.3f} s in all · {status}"
+    )
+    text = render_html(playback, title=f"{title}, {playback.duration:.3f} s", label=label)
     return write_text_atomic(Path(path), text)
