@@ -94,7 +94,8 @@ class SceneFileNotFoundError(SceneError, FileNotFoundError):
 
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):
-    """The local meshcat server could not be started or does not answer."""
+    """The local meshcat server, or the page server ``adept-traj show`` starts beside it
+    (:mod:`adept_traj.viz.page_server`), could not be started or does not answer."""
 
 
 class FigureError(AdeptTrajError, RuntimeError):

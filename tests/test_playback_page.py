@@ -1,7 +1,9 @@
 """The playback page (``playback.html``): the pendulum's pivot, the label naming the member
-shown (its T, certified or not), the legend, and — in a real browser (headless Chromium +
-Selenium, slow tier) — the play/pause button, the scrubber and the time read-out, checked
-against the drawn robot's pose at the read-out's time computed from the replay."""
+shown (its T, certified or not), the legend, ``adept-traj show`` serving it and the
+explorer on 127.0.0.1 (fetched from the printed addresses), and — in a real browser
+(headless Chromium + Selenium, slow tier) — the play/pause button, the scrubber and the
+time read-out, checked against the drawn robot's pose at the read-out's time computed from
+the replay."""
 
 from __future__ import annotations
 
@@ -9,13 +11,16 @@ import html
 import io
 import re
 import shutil
+import socket
 import time
+import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from adept_traj.cli import main
+from adept_traj.cli import show as show_command
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult, Replay, certified_members
 from adept_traj.testing.paper_moves import lift_then_lower, single_result
@@ -114,6 +119,71 @@ def test_the_page_names_the_member_and_has_a_legend(run: PlanningResult, tmp_pat
     scrub = re.search(r'<input id="scrub"[^>]*max="([^"]+)"', text)
     assert scrub is not None
     assert float(scrub[1]) == float(run.best_x[0])
+
+
+def fetch(url: str) -> tuple[int, bytes]:
+    with urllib.request.urlopen(url, timeout=10) as reply:
+        return reply.status, reply.read()
+
+
+def refused(port: int) -> bool:
+    """Nothing listens on 127.0.0.1:port."""
+    try:
+        socket.create_connection(("127.0.0.1", port), timeout=2).close()
+    except ConnectionRefusedError:
+        return True
+    return False
+
+
+class _FakeViewer:
+    """Stands in for the live meshcat viewer (tested in test_viz_meshcat)."""
+
+    closed = False
+
+    def url(self) -> str:
+        return "http://127.0.0.1:7000/static/"
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_show_serves_the_explorer_and_the_member_s_page(
+    result: PlanningResult,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from adept_traj.viz import server
+
+    out = result.save(tmp_path / "run")
+    assert not (out / "explorer.html").exists()  # show writes it
+    result = PlanningResult.load(out)
+    member = result.best.index
+    viewer = _FakeViewer()
+    monkeypatch.setattr(server, "show", lambda result, **kw: viewer)
+    served: dict[str, tuple[int, bytes]] = {}
+    urls: list[str] = []
+
+    def fetch_then_stop(_seconds: float) -> None:  # the command's wait loop: fetch, then Ctrl-C
+        urls.extend(re.findall(r"http://127\.0\.0\.1:\d+/\S+\.html", capsys.readouterr().out))
+        for url in urls:
+            served[url.rsplit("/", 1)[1]] = fetch(url)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(show_command.time, "sleep", fetch_then_stop)
+    assert main(["show", str(out), "--member", str(member)]) == 0
+    assert set(served) == {"explorer.html", "playback.html"}
+    assert served["explorer.html"] == (200, (out / "explorer.html").read_bytes())
+    status, page = served["playback.html"]
+    assert status == 200
+    label = re.search(rb'<div id="member-label"[^>]*>(.*?)</div>', page)
+    assert label is not None
+    T = float(result.front.x[member, 0])
+    expected = f"member {member} of 1 (the best trade-off) · T = {T:.3f} s · certified"
+    assert label[1].decode("utf-8").endswith(expected)
+    assert viewer.closed
+    port = int(re.search(r":(\d+)/", next(iter(urls)))[1])
+    assert refused(port)  # the page server was closed with the command
 
 
 # ============================================================================ real browser
