@@ -70,6 +70,23 @@ def test_the_pendulum_is_drawn_with_its_pivot(
     assert {"/meshcat/pivots/pendulum/part0", "/meshcat/pivots/pendulum/part1"} <= drawn
 
 
+def test_the_explorer_marks_the_pendulum_s_pivot(
+    result: PlanningResult, problem: TrajectoryProblem
+) -> None:
+    import base64
+
+    from adept_traj.viz.explorer import explorer_data
+
+    data = explorer_data(result, robot=problem.robot, scene=problem.scene)
+    ((pivot,),) = [[p for p in data["pivots"] if p["name"] == "pendulum"]]
+    (bob,) = [ob for ob in data["obstacles"] if ob["name"] == "pendulum.bob"]
+    poses = np.frombuffer(base64.b64decode(bob["poses"]), "<f4").reshape(bob["n_poses"], 3, 4)
+    length = problem.scene.obstacle("pendulum.rod").shape.length
+    gap = np.linalg.norm(poses[:, :, 3] - np.array(pivot["point"]), axis=-1)
+    np.testing.assert_allclose(gap, length, atol=1e-5)  # float32 poses
+    assert len(data["pivots"]) == 1
+
+
 def playback_commands(text: str) -> list[dict]:
     import base64
 

@@ -50,7 +50,7 @@ _COMMANDS = {
     "plan": ("plan", "plan a trajectory and save a verified result"),
     "compare": ("compare", "NSGA-II vs MODE: the paper's Tables 3-5"),
     "cycle": ("cycle", "plan every move of a cycle file (TOML) on Dask"),
-    "show": ("show", "play a saved result in the browser (meshcat)"),
+    "show": ("show", "play a saved result in the browser (meshcat) and serve its explorer"),
     "verify": ("verify", "re-run the dense verification of a saved result"),
     "front": ("front", "list the members of a saved front (to pick one)"),
     "export": ("export", "write a front member for a controller (CSV, ROS)"),

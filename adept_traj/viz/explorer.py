@@ -15,7 +15,8 @@ coordinates with brushing, scatter plots and a WebGL 3-D view). It shows:
   ranks of :math:`f_c` and :math:`F_{avg}`; the first certified member in that order, as
   :func:`~adept_traj.plan` reports it);
 - clicking a member plays it in a 3-D view (the robot as the chain of its joint origins
-  and tool, the obstacles at their pose on the scene clock, the tool path), with its joint
+  and tool, the obstacles at their pose on the scene clock, each pendulum's pivot, the
+  tool path), with its joint
   motion against the limits (computed in the page from the member's B-spline) and its
   certificate (guarantee, minimum distance, when and between what, worst ratios);
 - downloads of the chosen member at a fixed step, the files of ``adept-traj export``
@@ -47,7 +48,7 @@ from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult, Replay, certified_members
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import LIMIT_KINDS
-from adept_traj.scene import Box, Capsule, Cylinder, Scene, Sphere
+from adept_traj.scene import Box, Capsule, Cylinder, PendulumMotion, Scene, Sphere
 from adept_traj.validation import check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
 
@@ -157,6 +158,18 @@ def _obstacles(scene: Scene, horizon: float) -> tuple[list[dict[str, Any]], floa
     return out, VIEW_DT
 
 
+def _pivots(scene: Scene) -> list[dict[str, Any]]:
+    """Each pendulum's pivot (its obstacles share one motion law): the name before the last
+    dot of its first obstacle's (``pendulum`` of ``pendulum.rod``) and the (3,) world
+    point [m]."""
+    found: dict[int, dict[str, Any]] = {}
+    for ob in scene.obstacles:
+        if isinstance(ob.motion, PendulumMotion) and id(ob.motion) not in found:
+            name = ob.name.rpartition(".")[0] or ob.name
+            found[id(ob.motion)] = {"name": name, "point": ob.motion.pivot.tolist()}
+    return list(found.values())
+
+
 # ============================================================================ members
 def _member_certificates(result: PlanningResult) -> list[MemberCertificate | None]:
     """Each member's certificate summary; the best trade-off's from its full certificate
@@ -263,6 +276,7 @@ def explorer_data(
             "points": _b64(points, "<f4"),
         },
         "obstacles": obstacles,
+        "pivots": _pivots(scene),
         "scene_dt": scene_dt,
     }
 

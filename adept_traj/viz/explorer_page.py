@@ -267,6 +267,8 @@ function draw3d() {
   D.obstacles.forEach((ob, i) => { const v = obstacleAt(ob, 0);
     traces.push({type: "mesh3d", name: ob.name + (ob.moving ? " (moving)" : ""), showlegend: true, ...v,
       i: ob.faces.map(f => f[0]), j: ob.faces.map(f => f[1]), k: ob.faces.map(f => f[2]), color: ob.color, opacity: ob.moving ? 1 : 0.6, flatshading: true}); });
+  if (D.pivots.length) traces.push({type: "scatter3d", mode: "markers", name: "pendulum pivot", x: D.pivots.map(p => p.point[0]),
+    y: D.pivots.map(p => p.point[1]), z: D.pivots.map(p => p.point[2]), text: D.pivots.map(p => p.name), marker: {size: 6, color: "#212f3c", symbol: "diamond"}});
   Plotly.react("view3d", traces, {margin: {l: 0, r: 0, t: 0, b: 0}, legend: {x: 0, y: 1},
     scene: {aspectmode: "data", camera: {eye: {x: 1.4, y: -1.4, z: 0.9}}}, uirevision: "keep"}, {displayModeBar: false});
   document.getElementById("shown-member").textContent = "shown: " + memberText(k) + (k === D.best ? ", the best trade-off" : "");
