@@ -140,7 +140,8 @@ class OpenMeshWarning(UserWarning):
 
 
 class MeshcatServerError(AdeptTrajError, RuntimeError):
-    """The local meshcat server could not be started or does not answer."""
+    """The local meshcat server, or the page server ``adept-traj show`` starts beside it
+    (:mod:`adept_traj.viz.page_server`), could not be started or does not answer."""
 
 
 class FigureError(AdeptTrajError, RuntimeError):

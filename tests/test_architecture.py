@@ -23,6 +23,7 @@ RANK = {
     "problem": 6,
     "analysis": 7,
     "results": 8,
+    "export": 8.5,  # fixed-step exports of a result's members; used by viz's explorer
     "optimise": 9,
     "viz": 9,
     "testing": 10,

@@ -66,7 +66,7 @@ def _table(out: str) -> tuple[list[str], list[list[str]], list[str]]:
 # ------------------------------------------------------------------------------ front
 def test_front_lists_every_member_of_a_v1_result(capsys: pytest.CaptureFixture[str]) -> None:
     raw = json.loads((OLD / "result.json").read_text(encoding="utf-8"))
-    assert main(["front", str(OLD)]) == 0
+    assert main(["front", str(OLD), "--sort", "index"]) == 0
     out = capsys.readouterr().out
     header, rows, rest = _table(out)
     assert [h.strip() for h in header] == [
@@ -115,7 +115,8 @@ def test_front_scores_are_best_tradeoff_with_the_given_weights(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     weights = [0.5, 0.1, 0.1, 0.1, 0.1, 0.1]
-    assert main(["front", str(OLD), "--weights", ",".join(map(str, weights))]) == 0
+    argv = ["front", str(OLD), "--sort", "index", "--weights", ",".join(map(str, weights))]
+    assert main(argv) == 0
     _, rows, _ = _table(capsys.readouterr().out)
     choice = best_tradeoff(PlanningResult.load(OLD).front.objectives, weights)
     assert [float(r[8]) for r in rows] == pytest.approx(choice.f_c, rel=1e-5, abs=1e-9)
@@ -229,3 +230,31 @@ def test_show_refuses_an_uncertified_member(
     err = capsys.readouterr().err
     assert f"member {other} of the front is not certified" in err
     assert "--allow-infeasible" in err
+
+
+def test_front_lists_the_best_tradeoff_first_by_default(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Default order: the result's best, then certified members by best_tradeoff's order,
+    then the others in that order (the v1 result certified none)."""
+    r = PlanningResult.load(OLD)
+    assert main(["front", str(OLD)]) == 0
+    _, rows, _ = _table(capsys.readouterr().out)
+    order = [int(k) for k in best_tradeoff(r.front.objectives).order]
+    best = r.best.index
+    assert [int(row[1]) for row in rows] == [best, *(k for k in order if k != best)]
+    assert rows[0][0] == "*"
+
+
+def test_front_into_a_closed_pipe_ends_quietly(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    code = "import sys; from adept_traj.cli import main; sys.exit(main(['front', sys.argv[1]]))"
+    proc = subprocess.Popen([sys.executable, "-c", code, str(OLD)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)  # fmt: skip
+    proc.stdout.close()  # no reader left before the listing is written: EPIPE, as after head
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 0, err
+    assert "Broken pipe" not in err
+    assert err == ""

@@ -38,6 +38,7 @@ from adept_traj.results import FRONT_FILE, RESULT_FILE, TRAJECTORY_FILE
 
 __all__ = [
     "CHECKPOINT",
+    "EXPLORER_FILE",
     "FIGURES",
     "HTML_FILE",
     "RUN_FILE",
@@ -59,10 +60,20 @@ RUN_FILE = "run.json"
 CHECKPOINT = "checkpoint"
 #: The static meshcat playback.
 HTML_FILE = "playback.html"
+#: The front explorer, written with ``playback.html`` (:mod:`adept_traj.viz.explorer`).
+EXPLORER_FILE = "explorer.html"
 #: The folder of the figures.
 FIGURES = "figures"
 #: The files ``plan`` writes at the top of its folder.
-TOP_FILES = (RESULT_FILE, FRONT_FILE, TRAJECTORY_FILE, HTML_FILE, RUN_FILE, "collision_matrix.srdf")
+TOP_FILES = (
+    RESULT_FILE,
+    FRONT_FILE,
+    TRAJECTORY_FILE,
+    HTML_FILE,
+    EXPLORER_FILE,
+    RUN_FILE,
+    "collision_matrix.srdf",
+)
 #: The names of the figures ``plan`` writes (``<name>``: the algorithm).
 _FIGURE_NAMES = (
     "pareto_matrix.png",
@@ -123,7 +134,9 @@ def check_folder(folder: Path, *, overwrite: bool, html: bool, figures: bool) ->
         raise InvalidInputError(f"--out {folder}: {existing} is not a folder")
     if not _writable(existing):
         raise InvalidInputError(f"--out {folder}: cannot write in {existing}")
-    outputs = [folder / name for name in TOP_FILES if html or name != HTML_FILE]
+    outputs = [
+        folder / name for name in TOP_FILES if html or name not in (HTML_FILE, EXPLORER_FILE)
+    ]
     taken = [p for p in outputs if p.exists() and not p.is_file()]
     if (folder / CHECKPOINT).exists() and not (folder / CHECKPOINT).is_dir():
         taken.append(folder / CHECKPOINT)

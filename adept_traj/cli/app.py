@@ -13,6 +13,8 @@ Sub-commands, one module each:
   verification of a saved result.
 - ``adept-traj front DIR`` (:mod:`adept_traj.cli.front`) — list the members of a saved
   front (objectives, f_c, F_avg, certified), sorted by any column, to pick one.
+- ``adept-traj export DIR`` (:mod:`adept_traj.cli.export`) — write a front member at a
+  fixed time step for a controller (CSV, ROS ``JointTrajectory`` JSON or YAML).
 - ``adept-traj show DIR`` (:mod:`adept_traj.cli.show`) — play a saved result in the
   browser (meshcat, 127.0.0.1); ``--member N`` plays another member of the front.
 - ``adept-traj robot`` (:mod:`adept_traj.cli.robot`) — the robot-model demo (torques and
@@ -51,9 +53,10 @@ _COMMANDS = {
     "plan": ("plan", "plan a trajectory and save a verified result"),
     "compare": ("compare", "NSGA-II vs MODE: the paper's Tables 3-5"),
     "cycle": ("cycle", "plan every move of a cycle file (TOML) on Dask"),
-    "show": ("show", "play a saved result in the browser (meshcat)"),
+    "show": ("show", "play a saved result in the browser (meshcat) and serve its explorer"),
     "verify": ("verify", "re-run the dense verification of a saved result"),
     "front": ("front", "list the members of a saved front (to pick one)"),
+    "export": ("export", "write a front member for a controller (CSV, ROS)"),
     "robot": ("robot", "robot-model demo: torques and manipulability"),
     "build-urdf": ("build_urdf", "write a URDF from a robot parameter file"),
 }

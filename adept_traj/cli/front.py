@@ -21,14 +21,20 @@ local solver reached in the run; ``-``: not computed).
 ``result.json`` v1) only certified its best trade-off: the other members show ``no`` and
 a note says that their ``feasible`` flag was the optimiser's verdict at its samples.
 
-Rows are sorted by ``--sort COLUMN`` (default ``index``), ascending unless
-``--descending``; ties keep the index order. Reads ``result.json`` only: nothing is
+Rows are sorted by the best trade-off first (default, ``--sort tradeoff``): the result's
+best trade-off, then the certified members in the order of
+:func:`~adept_traj.analysis.best_tradeoff` with ``--weights``, then the uncertified ones in
+that order; or by ``--sort COLUMN``, ascending unless ``--descending``; ties keep the index
+order. A reader that stops early (``adept-traj front DIR | head``) ends the listing
+quietly (exit status 0). Reads ``result.json`` only: nothing is
 recomputed, no robot file is loaded.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +45,10 @@ from adept_traj.cli.arguments import floats
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, certified_members
 
-__all__ = ["COLUMNS", "add_parser", "front_table", "run"]
+__all__ = ["COLUMNS", "TRADEOFF", "add_parser", "front_table", "run"]
+
+#: The sort key of the default listing: the best trade-off first (module docstring).
+TRADEOFF = "tradeoff"
 
 #: The columns of the listing, in order, with their units (``-``: dimensionless; ``""``:
 #: no unit shown, ``index`` and ``certified``, which is ``yes`` or ``no``).
@@ -66,9 +75,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("folder", type=Path, help="result folder (with result.json)")
     p.add_argument(
         "--sort",
-        default="index",
-        choices=list(COLUMNS),
-        help="column to sort by (default: index)",
+        default=TRADEOFF,
+        choices=[TRADEOFF, *COLUMNS],
+        help="column to sort by (default: tradeoff, the best trade-off first)",
     )
     p.add_argument("--descending", action="store_true", help="sort in descending order")
     p.add_argument(
@@ -97,6 +106,11 @@ def _columns(result: PlanningResult, weights: list[float]) -> dict[str, np.ndarr
     cols.update(f_c=choice.f_c, F_avg=choice.F_avg, certified=certified, clearance=clearance)
     exact[result.best.index] = True
     cols["clearance_exact"] = exact
+    rank = np.empty(n)
+    rank[choice.order] = np.arange(n)
+    rank += np.where(certified, 0.0, n)  # certified members first
+    rank[result.best.index] = -1.0
+    cols[TRADEOFF] = rank
     t_lb, t_best = float(result.lower_bound.T_min), result.metrics.t_best
     cols["T/T_lb"] = front.x[:, 0] / t_lb if t_lb > 0 else np.full(n, np.nan)
     cols["T/T_best"] = front.x[:, 0] / t_best if t_best else np.full(n, np.nan)
@@ -118,7 +132,7 @@ def _cell(name: str, value: float | bool, exact: bool = True) -> str:
 def front_table(
     result: PlanningResult,
     *,
-    sort: str = "index",
+    sort: str = TRADEOFF,
     descending: bool = False,
     weights: list[float] | tuple[float, ...] = PAPER_WEIGHTS,
 ) -> str:
@@ -128,7 +142,7 @@ def front_table(
     Parameters
     ----------
     result: the planning result.
-    sort: a key of :data:`COLUMNS`.
+    sort: :data:`TRADEOFF` (the best trade-off first) or a key of :data:`COLUMNS`.
     descending: sort in descending order (ties keep the index order).
     weights: (6,) w1…w6 for ``f_c`` and ``F_avg`` (:func:`~adept_traj.analysis.best_tradeoff`).
 
@@ -136,8 +150,10 @@ def front_table(
     ------
     InvalidInputError: ``sort`` is not a column, or bad ``weights``.
     """
-    if sort not in COLUMNS:
-        raise InvalidInputError(f"sort must be one of {', '.join(COLUMNS)}; got {sort!r}")
+    if sort != TRADEOFF and sort not in COLUMNS:
+        raise InvalidInputError(
+            f"sort must be one of {TRADEOFF}, {', '.join(COLUMNS)}; got {sort!r}"
+        )
     cols = _columns(result, list(weights))
     key = np.asarray(cols[sort], dtype=float)
     key = np.where(np.isnan(key), -np.inf if descending else np.inf, key)  # '-' last
@@ -163,7 +179,11 @@ def front_table(
 
 
 def run(args: argparse.Namespace) -> int:
-    """Print the listing; exit status 0."""
+    """Print the listing; exit status 0 (also when the reader stops early)."""
     result = PlanningResult.load(args.folder)
-    print(front_table(result, sort=args.sort, descending=args.descending, weights=args.weights))
+    text = front_table(result, sort=args.sort, descending=args.descending, weights=args.weights)
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:  # e.g. | head: the reader has what it wanted
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no error at exit
     return status.OK

@@ -370,9 +370,11 @@ def _write_outputs(
     try:
         result.save(folder)
         if not opts.no_html:
-            from adept_traj.viz import meshcat_scene
+            from adept_traj.viz import explorer, meshcat_scene
 
             meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
+            explorer.write_explorer(result, folder / explorer.EXPLORER_FILE,
+                                    robot=replay.robot, scene=replay.scene)  # fmt: skip
         finish_figures(figures, folder / "figures")
     finally:
         if figures is not None:

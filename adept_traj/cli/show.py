@@ -1,4 +1,9 @@
-"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1).
+"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1), and
+serve beside it, on 127.0.0.1 too (:class:`~adept_traj.viz.page_server.PageServer`), the
+folder's front explorer (``explorer.html``, written first when missing) and the playback
+page of the member shown (the page ``plan`` writes as ``playback.html``: label, legend,
+play/pause, scrubber and time read-out), at ``http://127.0.0.1:PORT/explorer.html`` and
+``…/playback.html``.
 
 ``--member N`` plays member N of the front (the index of ``adept-traj front DIR``) instead
 of the best trade-off; an uncertified member
@@ -25,19 +30,28 @@ import threading
 import time
 from pathlib import Path
 from types import FrameType
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from adept_traj.cli import status
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, Replay, certified_members, member_index
 
+if TYPE_CHECKING:  # pragma: no cover - for type checkers only
+    from adept_traj.viz.page_server import PageServer
+
+#: The names of the pages served beside meshcat (those of a result folder's files).
+EXPLORER_PAGE = "explorer.html"
+PLAYBACK_PAGE = "playback.html"
+
 __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``show`` and its options."""
-    p = sub.add_parser("show", help="play a saved result in the browser (meshcat)")
+    p = sub.add_parser(
+        "show", help="play a saved result in the browser (meshcat) and serve its explorer"
+    )
     p.add_argument("folder", type=Path, help="result folder (with result.json)")
     p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
     p.add_argument("--closest", action="store_true", help="draw the closest-point segment")
@@ -76,6 +90,18 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
+def _explorer(folder: Path, result: PlanningResult, replay: Replay | None) -> Path:
+    """The folder's ``explorer.html``, written first when missing (a folder of an earlier
+    version, or ``plan --no-html``)."""
+    from adept_traj.viz.explorer import EXPLORER_FILE, write_explorer
+
+    page = folder / EXPLORER_FILE
+    if not page.is_file():
+        robot, scene = (None, None) if replay is None else (replay.robot, replay.scene)
+        write_explorer(result, page, robot=robot, scene=scene)
+    return page
+
+
 def _play(args: argparse.Namespace) -> NoReturn:
     """Start the server and play until interrupted; the server is closed on the way out."""
     from adept_traj.viz import server
@@ -98,11 +124,31 @@ def _play(args: argparse.Namespace) -> NoReturn:
         open_browser=args.open,
         member=index,
     )
-    which = "best trade-off" if index == result.best.index else "member"
-    label = f"{which} {index}, {'certified' if certified else 'NOT CERTIFIED'}"
-    try:  # the URL is printed inside: a Ctrl-C right after it must still stop cleanly
+    pages = None
+    try:  # the URLs are printed inside: a Ctrl-C right after them must still stop cleanly
+        pages = _serve_pages(args, result, replay, index)
+        which = "best trade-off" if index == result.best.index else "member"
+        label = f"{which} {index}, {'certified' if certified else 'NOT CERTIFIED'}"
+        print(f"front explorer (any member): {pages.url(EXPLORER_PAGE)}")
+        print(f"playback page (time read-out, scrubber): {pages.url(PLAYBACK_PAGE)}")
         print(f"playing {args.folder} ({label}) at {vis.url()} (Ctrl-C to stop)", flush=True)
         while True:
             time.sleep(1.0)
     finally:
+        if pages is not None:
+            pages.close()
         vis.close()
+
+
+def _serve_pages(
+    args: argparse.Namespace, result: PlanningResult, replay: Replay | None, index: int
+) -> PageServer:
+    """Serve the folder's explorer and the member's playback page on 127.0.0.1."""
+    from adept_traj.viz.meshcat_scene import result_page
+    from adept_traj.viz.page_server import PageServer
+
+    explorer = _explorer(args.folder, result, replay).read_bytes()
+    playback = result_page(
+        result, speed=args.speed, show_closest=args.closest, replay=replay, member=index
+    )
+    return PageServer({EXPLORER_PAGE: explorer, PLAYBACK_PAGE: playback})

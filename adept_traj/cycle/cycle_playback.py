@@ -228,5 +228,10 @@ def cycle_html(
         playback = clock_playback(clock, passes, robot=robot, scene=scene)
     else:
         playback = cycle_playback(results, names, robot=robot, scene=scene, members=members)
-    text = render_html(playback, title=f"{title}, {playback.duration:.3f} s")
+    status = "all certified" if playback.certified else "NOT ALL CERTIFIED"
+    label = (
+        f"cycle of {len(results)} moves, each its chosen member · "
+        f"T = {playback.duration:.3f} s in all · {status}"
+    )
+    text = render_html(playback, title=f"{title}, {playback.duration:.3f} s", label=label)
     return write_text_atomic(Path(path), text)

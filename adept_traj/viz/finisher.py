@@ -201,8 +201,12 @@ def _write(
 
 
 def _page(result: PlanningResult, path: Path, replay: Replay) -> Path:
+    """``playback.html`` at ``path`` and the front explorer beside it
+    (:data:`~adept_traj.viz.explorer.EXPLORER_FILE`)."""
+    from adept_traj.viz.explorer import EXPLORER_FILE, write_explorer
     from adept_traj.viz.meshcat_scene import static_html
 
+    write_explorer(result, path.parent / EXPLORER_FILE, robot=replay.robot, scene=replay.scene)
     return static_html(result, path, replay=replay)
 
 
@@ -215,6 +219,9 @@ def _preload(figures: bool, html: bool) -> None:
 
         load_matplotlib()
     if html:
+        import plotly.offline  # noqa: F401  (the explorer's library)
+
+        import adept_traj.viz.explorer
         import adept_traj.viz.meshcat_scene  # noqa: F401
 
 

@@ -21,13 +21,24 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     import meshcat.geometry as mg
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.scene import Box, Capsule, Cylinder, Mesh, PointCloud, Shape, Sphere
+from adept_traj.scene import (
+    Box,
+    Capsule,
+    Cylinder,
+    Mesh,
+    PendulumMotion,
+    PointCloud,
+    Scene,
+    Shape,
+    Sphere,
+)
 
 __all__ = [
     "MAX_DRAWN_POINTS",
     "Y_TO_Z",
     "Part",
     "hex_colour",
+    "pendulum_pivots",
     "shape_parts",
     "solid_parts",
     "translation",
@@ -36,6 +47,8 @@ __all__ = [
 #: Most points of a point-cloud obstacle drawn (an evenly strided subset beyond: the page
 #: stays small); the planner uses every point.
 MAX_DRAWN_POINTS = 100_000
+_PIVOT_RADIUS = 0.025  # pendulum pivot ball [m]
+_AXLE_RADIUS, _AXLE_LENGTH = 0.008, 0.14  # pendulum axle along the swing normal [m]
 
 #: (4, 4) turns a meshcat cylinder, axis along local y, onto coal's z axis (90° about x).
 Y_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
@@ -150,3 +163,26 @@ def solid_parts(gobj: Any, material: mg.Material) -> tuple[Part, ...]:
         f"robot solid {name!r}: cannot draw a {type(geometry).__name__} "
         "(supported: box, sphere, cylinder, capsule, cone, ellipsoid, .stl/.obj/.dae mesh)"
     )
+
+
+def pendulum_pivots(scene: Scene, color: int) -> list[tuple[str, tuple[Part, ...], np.ndarray]]:
+    """The pivot of each pendulum of ``scene`` (its obstacles sharing one
+    :class:`~adept_traj.scene.PendulumMotion`) as (node path, parts, (4, 4) world pose) of a
+    fixed node ``pivots/NAME`` (NAME: their name before the last dot, ``pendulum`` of
+    ``pendulum.rod``): a ball at the pivot and an axle along the swing plane's normal
+    ``e_n``, the axis the pendulum turns about, in ``color`` (0xRRGGBB). The node's frame:
+    origin at the pivot, axes (e_swing, e_n, e_z)."""
+    found: dict[int, tuple[str, PendulumMotion]] = {}
+    for ob in scene.obstacles:
+        if isinstance(ob.motion, PendulumMotion) and id(ob.motion) not in found:
+            found[id(ob.motion)] = (ob.name.rpartition(".")[0] or ob.name, ob.motion)
+    material = mg.MeshLambertMaterial(color=color)
+    ball = Part(mg.Mesh(mg.Sphere(_PIVOT_RADIUS), material), np.eye(4))
+    axle = Part(mg.Mesh(mg.Cylinder(_AXLE_LENGTH, _AXLE_RADIUS), material), np.eye(4))  # along y
+    nodes = []
+    for name, motion in found.values():
+        pose = np.eye(4)
+        pose[:3, 0], pose[:3, 1], pose[:3, 2] = motion.swing_axis, motion.normal_axis, (0, 0, 1)
+        pose[:3, 3] = motion.pivot
+        nodes.append((f"pivots/{name}", (ball, axle), pose))
+    return nodes

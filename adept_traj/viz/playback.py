@@ -11,10 +11,11 @@ or an HTML page; :mod:`~adept_traj.viz.server` serves it live.
 What is drawn, all in the **world** frame of the scene [m]: the robot's link solids in the
 colours of its visual model (poses ``scene.robot_base @`` the base-frame poses), the fixed
 obstacles (red), the moving obstacles (purple: the pendulum's rod and bob) at the physical
-time of each frame, the tool path of the move (a green line with a sphere at the
-start and the goal), the floor z = 0 with a 0.1 m grid and the world axes and, optionally,
-the closest-point segment (yellow) between the robot's collision solids and the nearest
-obstacle at every frame (:mod:`~adept_traj.viz.closest_points`).
+time of each frame, each pendulum's pivot (a fixed dark ball at the pivot with a short
+axle along the swing plane's normal, the axis it turns about), the tool path of the move
+(a green line with a sphere at the start and the goal), the floor z = 0 with a 0.1 m grid
+and the world axes and, optionally, the closest-point segment (yellow) between the robot's
+collision solids and the nearest obstacle at every frame (:mod:`~adept_traj.viz.closest_points`).
 
 Timing: frame ``k`` is shown at playback time ``k / fps`` [s] and shows the physical time
 
@@ -54,6 +55,7 @@ from adept_traj.viz.inputs import as_result
 from adept_traj.viz.meshcat_geometry import (
     Part,
     hex_colour,
+    pendulum_pivots,
     shape_parts,
     solid_parts,
     translation,
@@ -63,6 +65,7 @@ __all__ = [
     "DEFAULT_ROOT",
     "MAX_FRAMES",
     "MAX_PATH_POINTS",
+    "PIVOT_COLOR",
     "Part",
     "Playback",
     "SceneObject",
@@ -82,6 +85,7 @@ TOOL_PATH_COLOR = 0x1E8449
 START_COLOR = 0x1E8449
 GOAL_COLOR = 0x0B5345
 CLOSEST_COLOR = 0xF1C40F
+PIVOT_COLOR = 0x212F3C
 
 _MARKER_RADIUS = 0.012  # tool path start/goal spheres [m]
 _SEGMENT_RADIUS = 0.005  # closest-point segment [m]
@@ -280,6 +284,8 @@ def build_animation(
         material = mg.MeshLambertMaterial(color=color, opacity=1.0 if ob.is_moving else 0.85)
         poses = obstacle_poses[i] if ob.is_moving else obstacle_poses[i, 0]
         objects.append(SceneObject(f"obstacles/{ob.name}", shape_parts(ob.shape, material), poses))
+    pivots = [SceneObject(*node) for node in pendulum_pivots(scene, PIVOT_COLOR)]
+    objects.extend(pivots)
 
     # --- tool path of the dense trajectory
     tool = _tool_path(result, replay, index)
@@ -293,6 +299,7 @@ def build_animation(
 
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
     seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
+    seen += [p.poses[None, :3, 3] for p in pivots]
     seen_points = np.vstack(seen)
     objects.extend(SceneObject(path, parts, pose) for path, parts, pose in floor(seen_points))
     target, position = camera(seen_points)
