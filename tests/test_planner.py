@@ -58,8 +58,9 @@ def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monk
         return certify(problem, x, **kwargs)
 
     monkeypatch.setattr(planner, "certify", counting)
-    # MODE with 12 x 2 finds no feasible member (seed 1)
-    res = at.plan(problem, "mode", seed=1, pop_size=12, n_gen=2)
+    # MODE with 12 x 2 finds no feasible member (seed 1); without the polish (whose global
+    # stage finds one, below) the front is the least infeasible
+    res = at.plan(problem, "mode", seed=1, pop_size=12, n_gen=2, polish=False)
     assert len(res.front) == 10  # never empty: the 10 least infeasible
     assert not res.front.feasible.any()
     assert res.warning == NO_FEASIBLE_WARNING
@@ -67,6 +68,17 @@ def test_least_infeasible_front_with_warning(problem: at.TrajectoryProblem, monk
     # only the trade-off choice is certified: no other member is feasible at the samples
     assert len(certified) == 1
     np.testing.assert_array_equal(certified[0], res.best_x)
+
+
+def test_the_global_stage_finds_a_move_the_search_did_not(problem: at.TrajectoryProblem) -> None:
+    """The same search with the polish: no member of the search is feasible, the global
+    stage's refinement is certified (issue #24), at the kinematic bound to 1 %."""
+    res = at.plan(problem, "mode", seed=1, pop_size=12, n_gen=2)
+    assert res.feasible
+    assert res.warning is None
+    fastest = res.front.x[res.front.feasible, 0].min()
+    assert fastest <= 1.01 * problem.lower_bound.T_min
+    assert certify(problem, res.front.x[np.argmin(res.front.x[:, 0])]).certified
 
 
 @pytest.mark.parametrize(

@@ -126,7 +126,7 @@ def test_plan_verify_and_playback_at_a_start_time(tmp_path: Path, capsys) -> Non
     """``plan --start-time`` records t0; ``verify`` re-certifies at it (no mismatch), a
     tampered t0 is a mismatch; the playback draws the bob at t0 + t."""
     out = tmp_path / "run"
-    argv = ["plan", "--scene", "detour", "--pop", "8", "--gens", "2", "--no-html", "--no-plots"]
+    argv = ["plan", "--scene", "paper", "--pop", "8", "--gens", "2", "--no-html", "--no-plots"]
     assert main([*argv, "--quiet", "--start-time", "1.25", "--out", str(out)]) == 0
     assert "t0 = 1.25 s" in capsys.readouterr().out
     stored = json.loads((out / "result.json").read_text())
@@ -154,7 +154,7 @@ def test_plan_verify_and_playback_at_a_start_time(tmp_path: Path, capsys) -> Non
 
 def test_default_start_time_is_left_out_of_result_json(tmp_path: Path) -> None:
     out = tmp_path / "run"
-    argv = ["plan", "--scene", "detour", "--pop", "8", "--gens", "2", "--no-html", "--no-plots"]
+    argv = ["plan", "--scene", "paper", "--pop", "8", "--gens", "2", "--no-html", "--no-plots"]
     assert main([*argv, "--quiet", "--out", str(out)]) == 0
     stored = json.loads((out / "result.json").read_text())
     assert "start_time" not in stored["problem_settings"]  # files as before the field

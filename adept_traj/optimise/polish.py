@@ -254,7 +254,7 @@ def fastest_of_basins(
     rate_hz: rate [Hz] of the certificates.
     max_basins: most basins refined (≥ 1), and most via-point starts.
     """
-    xs = np.atleast_2d(np.asarray(x, dtype=float))
+    xs = np.asarray(x, dtype=float).reshape(-1, problem.n_var)
     max_basins = as_integer(max_basins, "max_basins", minimum=1, error=ConfigurationError)
     near = functools.partial(near_lower_bound, problem)
     screened: list[Refinement] = []

@@ -15,19 +15,21 @@ The front and its normalisation bounds are taken from the population **before** 
 (frozen), so the choice does not depend on what the polish finds first.
 
 :func:`polish_fastest` takes a run's final population (a
-:class:`~adept_traj.optimise.RunState`), polishes its fastest feasible member (none when
-no member is feasible: the result then stays the least-infeasible front) by
-:func:`~adept_traj.optimise.minimum_time`,
-and adds the polished move to the population when it passes its certificate (the
-certificate decides, not the solver) and is faster than its start. The front is taken from
-the population afterwards, so the polished move replaces the members it dominates. Its wall
-time and its evaluations (each constraint-and-Jacobian evaluation counts as one) are added
-to the run's. No randomness: the same final population gives the same polished move, so a
-run resumed from a checkpoint ends with the same result.
+:class:`~adept_traj.optimise.RunState`) and refines the fastest feasible member of each of
+its fastest basins, and — unless one comes within 1 % of the kinematic lower bound, or
+when no member is feasible at all — the global stage's starts
+(:func:`~adept_traj.optimise.fastest_of_basins`, ``docs/engine.md``). Every refined move
+that passes its certificate (the certificate decides, not the solver) and is new (not its
+certified start) joins the population; the front is taken from the population afterwards,
+so a refined move replaces the members it dominates. Its wall time and its evaluations
+(each constraint-and-Jacobian evaluation counts as one) are added to the run's. No
+randomness: the same final population gives the same refined moves, so a run resumed from
+a checkpoint ends with the same result.
 
 :func:`time_optimal_run` is ``plan(problem, algorithm="time-optimal")``: the moves of
-:func:`~adept_traj.optimise.time_optimal` (multi-start SLSQP from the straight move and
-seeded ramps) as a population, for the same front extraction and certificates.
+:func:`~adept_traj.optimise.time_optimal` (the certified local solver from the straight
+move, seeded ramps and the global stage) as a population, for the same front extraction
+and certificates.
 """
 
 from __future__ import annotations
@@ -112,9 +114,7 @@ def _polish_fastest(
     adds to ``certified`` under each move's ``x.tobytes()``."""
     X = np.asarray(state.X, dtype=float)
     feasible = np.flatnonzero(np.all(np.asarray(state.G) <= 0.0, axis=1))
-    if len(feasible) == 0:
-        return state
-    tic = time.perf_counter()
+    tic = time.perf_counter()  # no feasible member: the global stage alone
     outcomes = fastest_of_basins(problem, X[feasible], rate_hz=rate_hz)
     counted = dataclasses.replace(
         state,
