@@ -77,11 +77,22 @@ def test_the_pendulum_binds_the_fastest_move(problems) -> None:
 
 def test_plan_and_verify_on_the_detour_scene(tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
-    argv = ["plan", "--scene", "detour", "--pop", "8", "--gens", "2", "--no-html", "--no-plots"]
+    argv = [
+        "plan",
+        "--scene",
+        "detour",
+        "--pop",
+        "8",
+        "--gens",
+        "2",
+        "--no-html",
+        "--no-plots",
+        "--no-polish",
+    ]
     code = main([*argv, "--quiet", "--out", str(out)])
     result = at.PlanningResult.load(out)
     assert result.scene["name"] == "detour"
-    assert not result.feasible  # 16 evaluations find no detour (seed 1)
+    assert not result.feasible  # 16 evaluations find no detour (seed 1; no polish)
     assert code == 1  # a run that found nothing certified: not 0 (the folder is written)
     capsys.readouterr()
     assert main(["verify", str(out)]) == 1  # not feasible, and nothing differs

@@ -29,7 +29,7 @@ def results() -> dict[str, PlanningResult]:
     problem = at.TrajectoryProblem(at.Robot.adept_one_xl(), scene, scene.start, scene.goal)
     try:
         return {
-            name: at.plan(problem, name, seed=1, pop_size=12, n_gen=3, rate_hz=250.0)
+            name: at.plan(problem, name, seed=1, pop_size=12, n_gen=3, rate_hz=250.0, polish=False)
             for name in ("nsga2", "mode")
         }
     finally:
