@@ -68,7 +68,7 @@ SPEEDS: tuple[float, ...] = (1.0, 1.0, 1.15, 1.35, 1.6)
 
 #: Moves of each kind (via points, ramps) of one batch of :func:`via_point_starts` (one
 #: evaluation of the batch by the problem).
-_BATCH = 1500
+_BATCH = 600
 
 #: Least-infeasible moves returned after the feasible ones.
 _LEAST_INFEASIBLE = 2
@@ -121,7 +121,7 @@ class ViaPointSampling:
 
 
 def via_point_starts(
-    problem: Any, seed: int, *, n_starts: int = 3, n_batches: int = 2, n_moves: int = _BATCH
+    problem: Any, seed: int, *, n_starts: int = 3, n_batches: int = 1, n_moves: int = _BATCH
 ) -> np.ndarray:
     """(k, n_var): the global stage's starts — the fastest evaluator-feasible move of each
     of at most ``n_starts`` basins, fastest first, then the :data:`_LEAST_INFEASIBLE`
