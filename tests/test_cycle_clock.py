@@ -121,6 +121,7 @@ def _dense(folder: Path) -> tuple[np.ndarray, np.ndarray]:
     return rows[:, header.index("t")], rows[:, q_cols]
 
 
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
 def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path) -> None:
     summary = json.loads((planned / "cycle.json").read_text())
     scene = Scene.from_file(planned.parent / "swing.toml").to_dict()
@@ -161,6 +162,7 @@ def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path)
     assert checked == summary["repeat"] * len(moves)
 
 
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
 def test_the_clock_decides_the_dwells(planned: Path) -> None:
     """The chosen moves are certified for their own start times, not for any: started a
     quarter, half or three quarters of a period later, a move hits the pendulum (by hand;
@@ -192,6 +194,7 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
     assert "dwell [s]" in text
 
 
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
 def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path) -> None:
     capsys.readouterr()
     assert main(["verify", str(planned)]) == 0

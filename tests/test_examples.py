@@ -21,7 +21,12 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
             "mode: 39 evaluations",
             marks=pytest.mark.slow,  # ~3.5 s: the default tier's budget
         ),
-        ("custom_scene.py", ["--gens", "2", "--pop", "12"], "best trade-off T ="),
+        pytest.param(
+            "custom_scene.py",
+            ["--gens", "2", "--pop", "12"],
+            "best trade-off T =",
+            marks=pytest.mark.slow,  # ~7 s: the polish's global stage on a blocked scene
+        ),
         ("other_robot.py", ["--gens", "2", "--pop", "12"], "planned T ="),
         ("ur5_around_a_box.py", ["--gens", "2", "--pop", "12"], "certified feasible"),
         pytest.param(

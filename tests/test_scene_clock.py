@@ -122,6 +122,7 @@ def test_distance_time_derivative_at_a_start_time(robot, detour) -> None:
     assert np.abs(grad.dt[near, rod]).max() > 0.1  # the rod moves there
 
 
+@pytest.mark.slow  # ~9 s: plan with the polish's global stage, verify, playback
 def test_plan_verify_and_playback_at_a_start_time(tmp_path: Path, capsys) -> None:
     """``plan --start-time`` records t0; ``verify`` re-certifies at it (no mismatch), a
     tampered t0 is a mismatch; the playback draws the bob at t0 + t."""

@@ -250,8 +250,18 @@ def test_mismatch_line_format(old, tmp_path, capsys) -> None:
 
 
 # ------------------------------------------------------------------ helpers
+_PLANAR: list[PlanningResult] = []  # made once: a result is frozen, the tests replace parts
+
+
 def _planar_run(tmp_path: Path) -> PlanningResult:
-    """A tiny feasible run of the planar 2-link arm (its parameter file in ``tmp_path``)."""
+    """A tiny feasible run of the planar 2-link arm (its parameter file in ``tmp_path``),
+    made once per session (the same arguments give the same result)."""
+    if not _PLANAR:
+        _PLANAR.append(_planar_plan(tmp_path))
+    return _PLANAR[0]
+
+
+def _planar_plan(tmp_path: Path) -> PlanningResult:
     params = tmp_path / "planar.toml"
     params.write_text('tool_frame = "hand"\ntask_rows = ["vx", "vz"]\n')
     robot = Robot.from_urdf(ROOT / "tests" / "data" / "planar_2link.urdf", params)
