@@ -58,8 +58,12 @@ def test_summary_and_front_print_both_gaps(runs) -> None:
     r = runs["fastest"]
     text = summary(r, Path("out"))
     t_lb = r.lower_bound.T_min
-    assert f"gap {r.best_objectives[0] / t_lb:.2f}x" in text
-    assert f"T_best {r.metrics.t_best:.4f} s by polish, gap {r.gap_best:.3f}x" in text
+    assert f"T = {r.best_objectives[0] / t_lb:.2f} × T_lb" in text
+    assert f"T = {r.gap_best:.3f} × T_best ({r.metrics.t_best:.4f} s by polish)" in text
+    # every objective with its unit (issue #29), z3 dimensionless
+    z = r.best_objectives
+    assert f"z2 = {z[1]:.4g} N²·m²·s, z3 = {z[2]:.4g}, z4 = {z[3]:.4g} m²" in text
+    assert f"z5 = {z[4]:.4g} rad²/s⁵, z6 = {z[5]:.4g} rad²/s³" in text
     assert "T_best not computed" in summary(runs["off"], Path("out"))
     assert "T_best not computed" in summary(PlanningResult.load(OLD), Path("out"))
     lines = front_table(r).splitlines()

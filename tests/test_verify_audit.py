@@ -171,7 +171,7 @@ def test_changed_metric_is_named(old, capsys) -> None:
 
 
 def test_feasible_run_with_changed_hypervolume_and_robot_file(tmp_path: Path) -> None:
-    result = _planar_run(tmp_path)
+    result = _planar_plan(tmp_path)  # its own parameter file, changed below
     metrics = dataclasses.replace(result.metrics, hv=result.metrics.hv * 0.9)
     found = audit(dataclasses.replace(result, metrics=metrics))
     assert [m.field for m in found.mismatches] == ["metrics.HV"]

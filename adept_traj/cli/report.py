@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.analysis import WeightedSum
+from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.results.unchecked import unchecked_of
 from adept_traj.viz.finisher import start_finisher
@@ -19,6 +20,7 @@ __all__ = [
     "MATRIX_FILE",
     "finish_figures",
     "finisher_for",
+    "objectives_text",
     "save_collision_matrix",
     "save_figures",
     "start_figures",
@@ -52,12 +54,22 @@ def save_collision_matrix(problem: Any, folder: Path) -> Path | None:
 
 
 def t_best_text(result: PlanningResult) -> str:
-    """``"T_best 1.077 s by polish, gap 1.06x"`` (the best trade-off's z1 over
+    """``"T = 1.06 × T_best (1.0766 s by polish)"`` (the best trade-off's z1 over
     ``metrics.t_best`` [s]) or ``"T_best not computed"``."""
     m = result.metrics
     if m.t_best is None:
         return "T_best not computed"
-    return f"T_best {m.t_best:.4f} s by {m.t_best_source}, gap {result.gap_best:.3f}x"
+    return f"T = {result.gap_best:.3f} × T_best ({m.t_best:.4f} s by {m.t_best_source})"
+
+
+def objectives_text(z: np.ndarray) -> str:
+    """``"z2 = 3451 N²·m²·s, z3 = 0.0256, …"``: z2…z6 (6,) with their units
+    (:data:`~adept_traj.problem.OBJECTIVES`; none where dimensionless)."""
+    parts = []
+    for value, objective in zip(z[1:], OBJECTIVES[1:]):
+        unit = "" if objective.unit == "-" else f" {objective.unit}"
+        parts.append(f"{objective.name} = {value:.4g}{unit}")
+    return ", ".join(parts)
 
 
 def weighted_sum_text(result: PlanningResult) -> list[str]:
@@ -101,9 +113,8 @@ def summary(result: PlanningResult, folder: Path) -> str:
         f"{result.timing.total_s:.1f} s ({result.timing.evaluation_s:.1f} s evaluating, "
         f"{workers} worker{'s' if workers != 1 else ''}); "
         f"front of {len(front)}{certified}",
-        f"best trade-off: T = {z[0]:.3f} s (lower bound {result.lower_bound.T_min:.3f} s, "
-        f"gap {result.gap:.2f}x; {t_best_text(result)}), z2 = {z[1]:.4g}, z3 = {z[2]:.4g}, "
-        f"z4 = {z[3]:.4g} m², z5 = {z[4]:.4g}, z6 = {z[5]:.4g}",
+        f"best trade-off: T = {z[0]:.3f} s (T = {result.gap:.2f} × T_lb, the kinematic lower "
+        f"bound {result.lower_bound.T_min:.3f} s; {t_best_text(result)}), {objectives_text(z)}",
         f"verified at {cert.rate_hz:g} Hz: {'FEASIBLE' if cert.feasible else 'NOT FEASIBLE'}"
         f" (min distance {cert.min_distance:.4f} m, margin {cert.margin} m; "
         f"distance: {cert.guarantee or f'sampled at {cert.rate_hz:g} Hz'}; "
