@@ -22,6 +22,7 @@ __all__ = [
     "as_integer",
     "as_scalar",
     "as_vector",
+    "check_increasing",
     "check_type",
     "deep_equal",
     "describe_bad_values",
@@ -70,6 +71,18 @@ def as_vector(value: Any, name: str, size: int, unit: str = "") -> np.ndarray:
         units = f" {unit}" if unit else ""
         raise InputShapeError(f"{name} must have shape ({size},){units}; got shape {arr.shape}")
     return arr
+
+
+def check_increasing(t: np.ndarray, name: str = "times") -> None:
+    """:class:`~adept_traj.errors.InvalidInputError` naming the first sample of ``t`` (n,)
+    [s] that does not follow its predecessor strictly."""
+    bad = np.flatnonzero(np.diff(t) <= 0.0)
+    if len(bad):
+        k = int(bad[0])
+        raise InvalidInputError(
+            f"{name} must be strictly increasing [s]; {name}[{k + 1}] = {t[k + 1]!r} "
+            f"follows {name}[{k}] = {t[k]!r}"
+        )
 
 
 def readonly_copy(value: Any) -> np.ndarray:

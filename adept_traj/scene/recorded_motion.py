@@ -32,7 +32,7 @@ from adept_traj.errors import InvalidInputError, MotionFileError
 from adept_traj.files import read_bytes_bounded
 from adept_traj.scene.motion_laws import MotionLaw, as_times, check_ball
 from adept_traj.transforms import rotation_from_rpy
-from adept_traj.validation import as_finite_array, readonly_copy
+from adept_traj.validation import as_finite_array, check_increasing, readonly_copy
 
 __all__ = ["MAX_RECORDED_POSES", "RecordedMotion", "read_pose_csv"]
 
@@ -68,13 +68,7 @@ class RecordedMotion(MotionLaw):
         n = t.size
         if t.ndim != 1 or n < 2:
             raise InvalidInputError(f"times must have shape (n,), n ≥ 2 [s]; got shape {t.shape}")
-        bad = np.flatnonzero(np.diff(t) <= 0.0)
-        if len(bad):
-            k = int(bad[0])
-            raise InvalidInputError(
-                f"times must be strictly increasing [s]; times[{k + 1}] = {t[k + 1]!r} "
-                f"follows times[{k}] = {t[k]!r}"
-            )
+        check_increasing(t)
         xyz, rpy = (as_finite_array(a, name) for a, name in ((self.xyz, "xyz"), (self.rpy, "rpy")))
         for a, name in ((xyz, "xyz"), (rpy, "rpy")):
             if a.shape != (n, 3):

@@ -38,7 +38,7 @@ from adept_traj.scene.motion_laws import MotionLaw, as_times, check_ball
 from adept_traj.scene.scene import Obstacle
 from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere, _ValueObject
 from adept_traj.transforms import as_rigid_transform
-from adept_traj.validation import as_finite_array, readonly_copy
+from adept_traj.validation import as_finite_array, check_increasing, readonly_copy
 
 __all__ = ["JointTrajectory", "RobotSolidMotion", "load_robot", "robot_obstacles"]
 
@@ -69,13 +69,7 @@ class JointTrajectory(_ValueObject):
             raise InvalidInputError(
                 f"times (n,) and q (n, nq) with n ≥ 2; got shapes {t.shape} and {q.shape}"
             )
-        bad = np.flatnonzero(np.diff(t) <= 0.0)
-        if len(bad):
-            k = int(bad[0])
-            raise InvalidInputError(
-                f"times must be strictly increasing [s]; times[{k + 1}] = {t[k + 1]!r} "
-                f"follows times[{k}] = {t[k]!r}"
-            )
+        check_increasing(t)
         object.__setattr__(self, "times", readonly_copy(t))
         object.__setattr__(self, "q", readonly_copy(q))
         object.__setattr__(self, "source", str(self.source))
