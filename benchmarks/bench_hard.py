@@ -89,7 +89,7 @@ def main() -> None:
                 T, wall, status = run(scene, algorithm, seed, folder)
                 ratios.append(T / best)
                 walls.append(wall)
-                flag = "  (faster than the best known)" if best > T else ""
+                flag = "  (faster than the best known)" if best * (1 - 1e-4) > T else ""
                 print(
                     f"{algorithm:<14}{seed:>5}{T:>10.4f}{T / best:>8.3f}{wall:>10.1f}"
                     f"{status:>6}{flag}",
