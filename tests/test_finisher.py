@@ -289,7 +289,9 @@ def test_the_helper_writes_the_same_files_as_the_caller(
 ) -> None:
     """Real figures and page: with a ready helper and without one, byte for byte."""
     scene, robot = at.Scene.paper(), at.Robot.adept_one_xl()
-    problem = argparse.Namespace(robot=robot, scene=scene)
+    problem = argparse.Namespace(
+        robot=robot, scene=scene, self_check=None
+    )  # as a problem without self-collision
     opts = argparse.Namespace(
         no_html=False, no_plots=False, ros=None, allow_infeasible=False, algorithm="nsga2"
     )

@@ -133,7 +133,8 @@ def trust_box_solve(
                 problem, x, extra, buffer, lower, upper, live, iterations, free is False, counts
             )
             binding |= violated & ~live
-            if found is not None or not np.any(violated & ~live) or inside is None:
+            progress = found is not None and (inside is None or found[0] < inside[0])
+            if progress or not np.any(violated & ~live) or inside is None:
                 break  # progress (the next box keeps those rows); from outside: one solve
             live |= violated  # a row left out binds after all: solve the box again with it
         if found is not None and (inside is None or found[0] < inside[0]):

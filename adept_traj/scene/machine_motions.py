@@ -101,7 +101,8 @@ class LinearMotion(MotionLaw):
         return p + 0.5 * self.wrap * self._direction, 0.5 * self.wrap + r  # type: ignore[attr-defined]
 
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
-        """|v| [m/s] (every point moves with the belt, between the jumps)."""
+        """The belt's speed :math:`\\lVert v \\rVert` [m/s] (every point moves with the
+        belt, between the jumps)."""
         check_ball(point, radius)
         return self._speed  # type: ignore[attr-defined]
 

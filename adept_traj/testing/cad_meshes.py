@@ -15,7 +15,7 @@ __all__ = ["box_mesh", "merge_meshes", "table_mesh", "write_stl"]
 
 def box_mesh(size, subdivisions: int = 1, centre=(0.0, 0.0, 0.0)):
     """A closed, outward-oriented box mesh of full side lengths ``size`` (3,) [m] about
-    ``centre`` (3,) [m], each face cut into ``subdivisions``² squares (12·s² triangles).
+    ``centre`` (3,) [m], each face cut into s × s squares, s = ``subdivisions`` (12·s² triangles).
 
     Returns:
         (vertices (n, 3) [m], triangles (m, 3) int), vertices shared between faces.

@@ -48,7 +48,16 @@ from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult, Replay, certified_members
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import LIMIT_KINDS
-from adept_traj.scene import Box, Capsule, Cylinder, PendulumMotion, Scene, Sphere
+from adept_traj.scene import (
+    Box,
+    Capsule,
+    Cylinder,
+    Mesh,
+    PendulumMotion,
+    PointCloud,
+    Scene,
+    Sphere,
+)
 from adept_traj.validation import check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
 
@@ -129,8 +138,16 @@ def _mesh(shape: Any) -> tuple[np.ndarray, np.ndarray]:
             faces.append(f + offset)
             offset += len(v)
         return np.vstack(verts), np.vstack(faces)
+    if isinstance(shape, Mesh):  # its own triangles
+        return np.asarray(shape.vertices, dtype=float), np.asarray(shape.triangles)
+    if isinstance(shape, PointCloud):  # drawn as the box of its points (the page stays small)
+        points = np.asarray(shape.points, dtype=float)
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        v, f = _box(hi - lo)
+        return v + 0.5 * (lo + hi), f
     raise InvalidInputError(
-        f"cannot draw obstacle shape {type(shape).__name__} (box, sphere, cylinder, capsule)"
+        f"cannot draw obstacle shape {type(shape).__name__} "
+        "(box, sphere, cylinder, capsule, mesh, point cloud)"
     )
 
 
