@@ -401,6 +401,7 @@ def _planar_verify(tmp_path: Path, joints: str, capsys: pytest.CaptureFixture[st
     return saved, lines
 
 
+@pytest.mark.slow  # ≥ 3 s: kept out of the default tier (≤ 3 min)
 def test_verify_says_no_limit_for_a_robot_without_acceleration_and_jerk_limits(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -99,6 +99,7 @@ def dip() -> tuple[TrajectoryProblem, np.ndarray]:
     return _dip_between_samples()
 
 
+@pytest.mark.slow  # ≥ 3 s: kept out of the default tier (≤ 3 min)
 def test_dip_is_between_the_1khz_samples(dip):
     problem, x = dip
     margin = problem.settings.margin

@@ -233,6 +233,7 @@ def test_hull_distance_brackets_the_mesh_distance(ur5: Robot) -> None:
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "data"
 
 
+@pytest.mark.slow  # ≥ 3 s: kept out of the default tier (≤ 3 min)
 def test_a_result_verifies_in_a_fresh_process_without_environment(tmp_path: Path) -> None:
     """The meshes come from a package only ``package_dirs`` names (not installed, no
     ROS_PACKAGE_PATH): the result records the folder, and ``verify`` finds it again."""
@@ -279,6 +280,7 @@ def test_the_command_line_plans_the_robot_a_scene_file_names(tmp_path: Path) -> 
     assert main(["verify", str(out)]) in (0, 1)  # 1: a certificate failure, reported
 
 
+@pytest.mark.slow  # ≥ 3 s: kept out of the default tier (≤ 3 min)
 def test_missing_acceleration_and_jerk_limits_warn(ur5: Robot) -> None:
     """(verify's "no limit" for such joints: tests/test_cli.py)"""
     scene = Scene.from_file(EXAMPLES / "ur5_box.toml")
