@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
 import signal
+import time
+from pathlib import Path
 
 import pytest
 
@@ -58,3 +62,51 @@ def child_fault():
         return wrapped
 
     return faulty
+
+
+# ---------------------------------------------------------------- a real browser
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+CHROMEDRIVER = shutil.which("chromedriver")
+NO_BROWSER = (
+    "no headless Chromium and chromium-driver on this machine (.ci/run installs the Debian "
+    "packages chromium and chromium-driver)"
+)
+#: The flags that render WebGL on a CPU-only machine (shared/design/measured-facts.md).
+CHROMIUM_FLAGS = (
+    "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--disable-gpu", "--no-first-run", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync",
+)  # fmt: skip
+
+
+@contextlib.contextmanager
+def chromium_driver(profile: Path, *flags: str):
+    """A Selenium driver of the system's headless Chromium with a new profile folder and
+    ``flags`` beside :data:`CHROMIUM_FLAGS`; the test is skipped, with the reason, where
+    selenium, Chromium or its driver is missing. Quit when the block is left."""
+    webdriver = pytest.importorskip(
+        "selenium.webdriver", reason="selenium not installed (test extra)"
+    )
+    if CHROMIUM is None or CHROMEDRIVER is None:
+        pytest.skip(NO_BROWSER)
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    for flag in (*CHROMIUM_FLAGS, *flags, f"--user-data-dir={profile}"):
+        options.add_argument(flag)
+    options.binary_location = CHROMIUM
+    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+    try:
+        yield driver
+    finally:
+        driver.quit()
+
+
+def wait_for(condition, timeout: float = 60.0, step: float = 0.1) -> None:
+    """Poll ``condition()`` every ``step`` [s] until it is true; AssertionError after
+    ``timeout`` [s]."""
+    end = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > end:
+            raise AssertionError("the page did not get there in time")
+        time.sleep(step)

@@ -11,36 +11,23 @@ from __future__ import annotations
 
 import csv
 import io
-import shutil
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import CHROMEDRIVER, CHROMIUM, NO_BROWSER, chromium_driver, wait_for
 
 from adept_traj.analysis import best_tradeoff
 from adept_traj.cli import main
 from adept_traj.results import PlanningResult
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-DRIVER = shutil.which("chromedriver")
 webdriver = pytest.importorskip("selenium.webdriver", reason="selenium not installed (test extra)")
 
 pytestmark = [
     pytest.mark.slow,
-    pytest.mark.skipif(
-        CHROMIUM is None or DRIVER is None,
-        reason="no headless Chromium and chromium-driver on this machine (.ci/run installs "
-        "the Debian packages chromium and chromium-driver)",
-    ),
+    pytest.mark.skipif(CHROMIUM is None or CHROMEDRIVER is None, reason=NO_BROWSER),
 ]
-
-#: The flags that render WebGL on a CPU-only machine (docs: measured facts).
-FLAGS = [
-    "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-    "--disable-gpu", "--no-first-run", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--window-size=1400,1800",
-]  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -54,24 +41,8 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory: pytest.TempPathFactory):
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    for flag in FLAGS:
-        options.add_argument(flag)
-    options.add_argument(f"--user-data-dir={tmp_path_factory.mktemp('profile')}")
-    options.binary_location = CHROMIUM
-    driver = webdriver.Chrome(service=Service(DRIVER), options=options)
-    yield driver
-    driver.quit()
-
-
-def wait_for(condition, timeout: float = 60.0) -> None:
-    end = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > end:
-            raise AssertionError("the page did not get there in time")
-        time.sleep(0.2)
+    with chromium_driver(tmp_path_factory.mktemp("profile"), "--window-size=1400,1800") as driver:
+        yield driver
 
 
 def png(driver, element_id: str) -> np.ndarray:

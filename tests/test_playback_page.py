@@ -10,7 +10,6 @@ from __future__ import annotations
 import html
 import io
 import re
-import shutil
 import socket
 import time
 import urllib.request
@@ -18,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import chromium_driver, wait_for
 
 from adept_traj.cli import main
 from adept_traj.cli import show as show_command
@@ -204,44 +204,15 @@ def test_show_serves_the_explorer_and_the_member_s_page(
 
 
 # ============================================================================ real browser
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-DRIVER = shutil.which("chromedriver")
-FLAGS = [
-    "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-    "--disable-gpu", "--no-first-run", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--window-size=1000,700",
-    "--host-resolver-rules=MAP * ~NOTFOUND",  # no network: the page must not need it
-]  # fmt: skip
+#: The page must need no network: every host name resolves to nothing.
+NO_NETWORK = "--host-resolver-rules=MAP * ~NOTFOUND"
 
 
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory: pytest.TempPathFactory):
-    webdriver = pytest.importorskip(
-        "selenium.webdriver", reason="selenium not installed (test extra)"
-    )
-    if CHROMIUM is None or DRIVER is None:
-        pytest.skip(
-            "no headless Chromium and chromium-driver on this machine (.ci/run installs the "
-            "Debian packages chromium and chromium-driver)"
-        )
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    for flag in FLAGS:
-        options.add_argument(flag)
-    options.add_argument(f"--user-data-dir={tmp_path_factory.mktemp('profile')}")
-    options.binary_location = CHROMIUM
-    driver = webdriver.Chrome(service=Service(DRIVER), options=options)
-    yield driver
-    driver.quit()
-
-
-def wait_for(condition, timeout: float = 60.0) -> None:
-    end = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > end:
-            raise AssertionError("the page did not get there in time")
-        time.sleep(0.1)
+    profile = tmp_path_factory.mktemp("profile")
+    with chromium_driver(profile, "--window-size=1000,700", NO_NETWORK) as driver:
+        yield driver
 
 
 def shot(driver) -> np.ndarray:
