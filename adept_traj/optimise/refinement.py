@@ -17,12 +17,18 @@ accepts. Rounds:
    :func:`~adept_traj.optimise.kinematic_time`). Certified: done — the feasible set of
    the continuous problem lies inside the sampled one, so a certified optimum of the
    sampled problem is one of the continuous problem.
-3. Otherwise **add samples** where the certificate's dense distance dips below the margin
-   plus :data:`DIP_TOLERANCE` (its local minima, and the instant of the smallest distance)
-   and where the dense torque exceeds :math:`(1 - \text{tolerance})\,UC`, at the normalised
-   times :math:`s = t / T` of the failing move, and solve again from it. A fast move near a
-   thin moving obstacle (the pendulum's rod) passes between the problem's 116 samples
-   closer than at them; the new rows stop exactly that.
+3. Otherwise **add samples** where the certificate's dense distance comes within
+   :data:`DIP_WINDOW` of the margin — a grid of step :data:`DIP_STEP` (normalised time)
+   over each such window, its local minima below the margin plus :data:`DIP_TOLERANCE`,
+   and the instant of the smallest distance — and where the dense torque exceeds
+   :math:`(1 - \text{tolerance})\,UC`, at the normalised times :math:`s = t / T` of the
+   failing move, and solve again from it. A fast move near a thin moving obstacle (the
+   pendulum's rod) passes between the problem's 116 samples closer than at them; the new
+   rows stop exactly that, and a window sampled finer than the problem's grid lets the
+   solver slide past the obstacle instead of stepping back in T (measured on the detour
+   scene from the fixed-obstacle optimum: one sample per dip ends at 1.1145 s, windows of
+   step 0.005 at 1.0985–1.1023 s; ``docs/detour-scene.md``). The start's own certificate
+   seeds these samples before the first solve.
 4. A round that finds nothing new to sample (the failure is elsewhere: a self-distance, a
    pair the rows do not model) raises an extra distance buffer, :data:`BUFFERS` in turn —
    the last resort.
@@ -58,7 +64,9 @@ from adept_traj.validation import as_integer, as_scalar, as_vector
 
 __all__ = [
     "BUFFERS",
+    "DIP_STEP",
     "DIP_TOLERANCE",
+    "DIP_WINDOW",
     "MAX_EXTRA_SAMPLES",
     "NO_MOVE_INSIDE",
     "SCREEN_BOXES",
@@ -72,6 +80,11 @@ __all__ = [
 #: Distance [m] above the margin below which a dip of the certificate's dense distance
 #: becomes a constraint sample.
 DIP_TOLERANCE = 0.002
+
+#: Distance [m] above the margin within which the certificate's dense distance makes a
+#: window of constraint samples, and their step [normalised time] (finer than the
+#: problem's grid of 116 samples, step ≈ 0.0087).
+DIP_WINDOW, DIP_STEP = 0.005, 0.005
 
 #: Extra distance buffers [m] of the solves, raised in turn only when a failing move
 #: shows no new place to sample (the last resort).
@@ -147,6 +160,7 @@ def refine_minimum_time(
     max_rounds: int = 8,
     max_boxes: int = 40,
     start_certificate: MemberCertificate | None = None,
+    extra_samples: Any = None,
 ) -> Refinement:
     """The fastest certified move from ``x0`` (see the module docstring).
 
@@ -165,7 +179,12 @@ def refine_minimum_time(
         Most trust boxes per round (≥ 1).
     start_certificate:
         The start's certificate summary when already known (made at ``rate_hz`` by
-        :func:`~adept_traj.analysis.certify_members`), else it is made here.
+        :func:`~adept_traj.analysis.certify_members`), else it is made here (and seeds
+        the adaptive samples).
+    extra_samples:
+        (k,) adaptive samples [normalised time, in [0, 1]] to start from (e.g. those of an
+        earlier refinement of the same start), added to those the start's certificate
+        seeds.
     """
     x0 = as_vector(x0, "x0", problem.n_var)
     if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
@@ -176,8 +195,14 @@ def refine_minimum_time(
     import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
     from threadpoolctl import threadpool_limits  # lazy, as scipy.optimize
 
+    extra = np.empty(0) if extra_samples is None else np.asarray(extra_samples, dtype=float)
+    if extra.ndim != 1 or np.any(~np.isfinite(extra)) or np.any((extra < 0) | (extra > 1)):
+        raise ConfigurationError(
+            "extra_samples must be a 1-D array of normalised times in [0, 1]; got "
+            f"{np.array2string(np.atleast_1d(extra), threshold=6)}"
+        )
     with threadpool_limits(limits=1, user_api="blas"):
-        return _refine(problem, x0, rate, rounds, boxes, start_certificate)
+        return _refine(problem, x0, rate, rounds, boxes, start_certificate, np.unique(extra))
 
 
 def screen_starts(
@@ -206,11 +231,17 @@ def refine_starts(
     """The full refinements (:func:`refine_minimum_time`) of the :data:`SCREEN_KEEP`
     fastest screened moves (:func:`screen_starts`) that reached a point inside the
     constraints, from where their screening ended: a multi-start that spends its
-    iterations on the most promising starts."""
+    iterations on the most promising starts (each with its screening's adaptive samples)."""
     inside = [o for o in screened if o.message != NO_MOVE_INSIDE]
     inside.sort(key=lambda o: float(o.x[0]))
     return [
-        refine_minimum_time(problem, o.x, rate_hz=rate_hz, start_certificate=o.certificate)
+        refine_minimum_time(
+            problem,
+            o.x,
+            rate_hz=rate_hz,
+            start_certificate=o.certificate,
+            extra_samples=o.extra_samples,
+        )
         for o in inside[:SCREEN_KEEP]
     ]
 
@@ -222,19 +253,21 @@ def _refine(
     max_rounds: int,
     max_boxes: int,
     start_certificate: MemberCertificate | None,
+    extra: np.ndarray,
 ) -> Refinement:
     started = time.perf_counter()
     counts = SolveCounts()
     if start_certificate is None:
         tic = time.perf_counter()
-        start_certificate = certify_member(problem, x0, rate_hz=rate)[0]
+        start_certificate, dense = certify_member(problem, x0, rate_hz=rate)
         counts.evaluation_s += time.perf_counter() - tic
+        seeded = _failing_samples(problem, dense, np.concatenate([problem.s, extra]))
+        extra = np.sort(np.concatenate([extra, seeded]))  # seeded by the start
     best: tuple[np.ndarray, Any, MemberCertificate] | None = None
     if start_certificate.feasible:
         ev = problem.evaluate_batch(x0)
         counts.evaluations += 1
         best = (x0.copy(), ev, start_certificate)
-    extra = np.empty(0)
     buffers = list(BUFFERS)
     buffer = buffers.pop(0)
     x, last = x0.copy(), None
@@ -293,7 +326,8 @@ def _refine(
 
 def _failing_samples(problem: Any, certificate: Any, existing: np.ndarray) -> np.ndarray:
     """Normalised times (k,) where ``certificate`` (of the certifying problem) shows the
-    distance within :data:`DIP_TOLERANCE` of the margin (local minima of the dense
+    distance within :data:`DIP_WINDOW` of the margin (a grid of step :data:`DIP_STEP` over
+    those windows), within :data:`DIP_TOLERANCE` of it (local minima of the dense
     distance, and the instant of the smallest one) or a torque above its limit, farther
     than :data:`_SAMPLE_GAP` from every ``existing`` sample."""
     dense = certificate.dense
@@ -304,6 +338,11 @@ def _failing_samples(problem: Any, certificate: Any, existing: np.ndarray) -> np
     if len(d) > 2:
         inner = (d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < level)
         times.append(dense.t[1:-1][inner])
+    close = dense.t[d < certificate.margin + DIP_WINDOW] / T
+    if len(close):  # a grid of step DIP_STEP over the windows where the distance binds
+        grid = np.arange(0.0, 1.0 + 0.5 * DIP_STEP, DIP_STEP)
+        within = np.abs(grid[:, None] - close[None, :]).min(axis=1) <= DIP_STEP
+        times.append(grid[within] * T)
     if certificate.t_min_distance is not None and certificate.min_distance < level:
         times.append([certificate.t_min_distance])
     limit = problem.robot.limits.bound(LIMITS[4].name)
