@@ -61,10 +61,11 @@ def cloud_bytes(n_points: int) -> int:
 class PointCloud(Shape):
     """Points in the cloud's frame, as an octree of cells of edge ``resolution``.
 
-    Attributes:
-        points: (n, 3) points [m], n ≥ 1.
-        resolution: r, the octree's cell edge [m], positive.
-        source: the file it was read from ("" if built from an array).
+    Attributes
+    ----------
+    points: (n, 3) points [m], n ≥ 1.
+    resolution: r, the octree's cell edge [m], positive.
+    source: the file it was read from ("" if built from an array).
     """
 
     points: np.ndarray
@@ -165,12 +166,15 @@ def _coarse_field(points: np.ndarray, r: float, lo: np.ndarray, hi: np.ndarray) 
 def read_cloud_points(path: str | os.PathLike[str], *, budget: int | None = None) -> np.ndarray:
     """The points (n, 3) [file units] of a cloud file (module docstring).
 
-    Raises:
-        MeshFileError: missing file, unknown suffix, a malformed header or data, no point
-            (the message names the file).
-        ResourceLimitError: the cloud's octree would need more memory than ``budget`` [B]
-            (default :func:`~adept_traj.memory.memory_budget`), from the header's point
-            count, before the data is read.
+    Raises
+    ------
+    MeshFileError
+        missing file, unknown suffix, a malformed header or data, no point
+        (the message names the file).
+    ResourceLimitError
+        the cloud's octree would need more memory than ``budget`` [B]
+        (default :func:`~adept_traj.memory.memory_budget`), from the header's point
+        count, before the data is read.
     """
     p = Path(path)
     suffix = p.suffix.lower()
