@@ -6,8 +6,8 @@ Conventions: a transform is a ``(..., 4, 4)`` array (rotation block, translation
 The conversions are Pinocchio's (``pin.rpy.rpyToMatrix``, ``pin.rpy.matrixToRpy``,
 ``pin.SE3``), one call per pose. They serve file reading and writing (scene files, the
 robot's parameter file), a handful of poses at a time: leading batch axes are accepted and
-looped over (≈ 1 µs a pose, against ≈ 0.07 µs a pose for a closed-form numpy batch of 1000;
-no hot path converts batches of angles).
+looped over (slower per pose than a closed-form numpy batch would be; no hot path converts
+batches of angles).
 """
 
 from __future__ import annotations
