@@ -111,9 +111,8 @@ class BSplineTrajectory:
     ----------
     start: start configuration [rad] or [m] per joint, shape ``(nq,)``.
     goal: goal configuration [rad] or [m] per joint, shape ``(nq,)``.
-    n_knots: number of knots :math:`m \ge 4` (paper: 20); segments ``S = m − 1``,
-        control points per joint ``n_control = m + 2``, free per joint
-        ``n_free = m − 4``.
+    n_knots: number of knots :math:`m \ge 4` (paper: 20); segments ``S = m − 1``, control points
+        per joint ``n_control = m + 2``, free per joint ``n_free = m − 4``.
 
     The object is immutable (``start`` and ``goal`` are stored as read-only copies). See the
     module docstring for the decision-vector layout

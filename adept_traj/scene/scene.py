@@ -118,8 +118,7 @@ def pendulum_obstacles(
 
     Parameters
     ----------
-    name: the pendulum's name; the obstacles are named ``name + ".rod"`` and
-        ``name + ".bob"``.
+    name: the pendulum's name; the obstacles are named ``name + ".rod"`` and ``name + ".bob"``.
     motion: the pendulum's motion law.
     bob_radius: radius of the spherical bob [m].
     rod_radius: radius of the cylindrical rod [m] (default 0.01).
@@ -202,8 +201,7 @@ class Scene(_ValueObject):
     Attributes
     ----------
     obstacles: the obstacles (tuple; names unique).
-    robot_base: (4, 4) rigid pose of the robot base frame in the world [m]; default
-        identity.
+    robot_base: (4, 4) rigid pose of the robot base frame in the world [m]; default identity.
     start: optional (nq,) default start configuration, in the robot's joint order
         [rad for revolute, m for prismatic joints]; given together with ``goal``.
     goal: optional (nq,) default goal configuration, same length as ``start``.
@@ -358,10 +356,9 @@ class Scene(_ValueObject):
         SceneFileNotFoundError
             the file does not exist.
         SceneError
-            the file cannot be read, is not valid TOML (the message gives the
-            line and column), or does not describe a valid scene; the message names the
-            file, the entry (obstacle or pendulum, by name or 1-based position) and the
-            field.
+            the file cannot be read, is not valid TOML (the message gives the line and column),
+            or does not describe a valid scene; the message names the file, the entry (obstacle
+            or pendulum, by name or 1-based position) and the field.
         """
         from adept_traj.scene.scene_file import read_scene_file
 
@@ -379,8 +376,7 @@ class Scene(_ValueObject):
         Raises
         ------
         ResourceLimitError
-            more than :data:`MAX_OBSTACLES` obstacles (checked before
-            any is built).
+            more than :data:`MAX_OBSTACLES` obstacles (checked before any is built).
         SceneError
             ``data`` does not describe a valid scene.
         """
