@@ -107,7 +107,7 @@ class ForkedHelper:
         """Stop a helper that will not be used without waiting for its end: killed now,
         reaped by :meth:`cancel` (e.g. at the end of the ``with`` block). On a busy machine
         the end of a helper still preparing at nice 19 waits for that thread to get a core
-        (0.7 s measured at load 3): the caller does not wait for it."""
+        (long, under load): the caller does not wait for it."""
         self._given_up = True
         if self._process is not None:
             self._process.kill()

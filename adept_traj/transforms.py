@@ -6,8 +6,8 @@ Conventions: a transform is a ``(..., 4, 4)`` array (rotation block, translation
 The conversions are Pinocchio's (``pin.rpy.rpyToMatrix``, ``pin.rpy.matrixToRpy``,
 ``pin.SE3``), one call per pose. They serve file reading and writing (scene files, the
 robot's parameter file), a handful of poses at a time: leading batch axes are accepted and
-looped over (≈ 1 µs a pose, against ≈ 0.07 µs a pose for a closed-form numpy batch of 1000;
-no hot path converts batches of angles).
+looped over (slower per pose than a closed-form numpy batch would be; no hot path converts
+batches of angles).
 """
 
 from __future__ import annotations
@@ -38,11 +38,13 @@ def rotation_from_rpy(rpy: Any) -> np.ndarray:
 
     fixed-axis rotations about world x (roll), then world y (pitch), then world z (yaw).
 
-    Args:
-        rpy: (..., 3) roll, pitch, yaw [rad].
+    Parameters
+    ----------
+    rpy: (..., 3) roll, pitch, yaw [rad].
 
-    Returns:
-        (..., 3, 3) rotation matrices (a new array).
+    Returns
+    -------
+    (..., 3, 3) rotation matrices (a new array).
     """
     a = as_batch(rpy, "rpy", 3, "[rad]")
     rows = [pin.rpy.rpyToMatrix(r) for r in a.reshape(-1, 3)]
@@ -52,13 +54,15 @@ def rotation_from_rpy(rpy: Any) -> np.ndarray:
 def transform_from_xyz_rpy(xyz: Any = (0.0, 0.0, 0.0), rpy: Any = (0.0, 0.0, 0.0)) -> np.ndarray:
     """Homogeneous transforms from a translation and roll-pitch-yaw angles (URDF ``<origin>``).
 
-    Args:
-        xyz: (..., 3) translation [m].
-        rpy: (..., 3) roll, pitch, yaw [rad], ``R = Rz(yaw) · Ry(pitch) · Rx(roll)``.
-            ``xyz`` and ``rpy`` broadcast against each other.
+    Parameters
+    ----------
+    xyz: (..., 3) translation [m].
+    rpy: (..., 3) roll, pitch, yaw [rad], ``R = Rz(yaw) · Ry(pitch) · Rx(roll)``.
+        ``xyz`` and ``rpy`` broadcast against each other.
 
-    Returns:
-        (..., 4, 4) transforms (a new array).
+    Returns
+    -------
+    (..., 4, 4) transforms (a new array).
     """
     p = as_batch(xyz, "xyz", 3, "[m]")
     r = rotation_from_rpy(rpy)
@@ -83,11 +87,13 @@ def xyz_rpy_from_transform(transform: Any) -> tuple[np.ndarray, np.ndarray]:
     At gimbal lock (``|pitch| = π/2``) only roll − yaw (pitch = π/2) or roll + yaw
     (pitch = −π/2) is determined; the angles returned give back the same rotation.
 
-    Args:
-        transform: (..., 4, 4) rigid transforms.
+    Parameters
+    ----------
+    transform: (..., 4, 4) rigid transforms.
 
-    Returns:
-        ``(xyz, rpy)``: (..., 3) translation [m] and (..., 3) roll, pitch, yaw [rad].
+    Returns
+    -------
+    ``(xyz, rpy)``: (..., 3) translation [m] and (..., 3) roll, pitch, yaw [rad].
     """
     t = as_rigid_transform(transform, "transform", batched=True)
     poses = [pin.SE3(m) for m in t.reshape(-1, 4, 4)]

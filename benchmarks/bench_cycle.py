@@ -38,6 +38,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _results import figure, recorded  # benchmarks/_results.py
 from _timing import load_average  # benchmarks/_timing.py
 
 from adept_traj.cycle import MOVES_FOLDER, read_cycle_file
@@ -231,8 +232,17 @@ def main() -> None:
           f"  {'OK' if speedup >= TARGET_SPEEDUP else 'MISSED'}")  # fmt: skip
     print(f"  scheduler + 2 dask workers over TCP: {t_tcp:7.1f} s")
     print(f"  identical results (1, 2 workers, TCP): {'yes' if same else 'NO'}")
+    budget = f"NSGA-II {args.pop} × {args.gens}, {args.phases} phases, {tasks} tasks"
+    figure(f"{args.cycle}_one_worker", f"{args.cycle} cycle on 1 local Dask worker", round(t1, 1),
+           "s", note=budget)  # fmt: skip
+    figure(f"{args.cycle}_speedup", f"{args.cycle} cycle: 2 local workers vs 1", round(speedup, 2),
+           "×", target=f"≥ {TARGET_SPEEDUP}×", met=speedup >= TARGET_SPEEDUP,
+           note=f"{t2:.1f} s on 2 workers")  # fmt: skip
+    figure(f"{args.cycle}_tcp", f"{args.cycle} cycle on a scheduler + 2 dask workers over TCP",
+           round(t_tcp, 1), "s", note=f"identical results: {'yes' if same else 'NO'}")  # fmt: skip
     sys.exit(0 if same else 1)
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "work cycles on Dask: one worker, two, a scheduler over TCP"):
+        main()

@@ -22,6 +22,7 @@ import argparse
 import time
 
 import numpy as np
+from _results import recorded  # benchmarks/_results.py
 
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 
@@ -69,4 +70,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "the detour scene: the search alone, the time-optimal mode, the search with its polish",
+    ):
+        main()

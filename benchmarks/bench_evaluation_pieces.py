@@ -33,6 +33,7 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+from _results import recorded  # benchmarks/_results.py
 from _timing import pair_order  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
@@ -187,4 +188,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "CPU time per sample of each piece of an evaluation block",
+        child_flags=("--whole",),
+    ):
+        main()

@@ -34,6 +34,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _results import recorded  # benchmarks/_results.py
 from _timing import load_average  # benchmarks/_timing.py
 
 _FINISH = """
@@ -127,4 +128,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "the finish of `adept-traj plan` (after the optimiser), two checkouts alternately",
+    ):
+        main()

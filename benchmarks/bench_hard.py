@@ -24,6 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from _results import figure, recorded  # benchmarks/_results.py
 from _timing import load_average
 
 #: The best known move of each scene [s] and where it comes from (docs/detour-scene.md).
@@ -105,8 +106,25 @@ def main() -> None:
                 met = "met" if statistics.median(walls) <= target else "NOT met"
                 line += f" (target ≤ {target} s: {met})"
             print(line)
+            figure(
+                f"{scene}_{algorithm}_ratio", f"{scene}, {algorithm}: worst fastest-certified T "
+                f"over the best known ({best:.4f} s), seeds {args.seeds}", round(max(ratios), 3),
+                "×", target="≤ 1.01×", met=max(ratios) <= 1.01, runs=[round(r, 4) for r in ratios],
+            )  # fmt: skip
+            target = TIME_OPTIMAL_TARGET[scene] if algorithm == "time-optimal" else None
+            figure(
+                f"{scene}_{algorithm}_wall", f"{scene}, {algorithm}: median wall time",
+                round(statistics.median(walls), 1), "s",
+                target=None if target is None else f"≤ {target} s",
+                met=None if target is None else statistics.median(walls) <= target,
+                runs=[round(w, 2) for w in walls],
+            )  # fmt: skip
     print(f"\nload average after: {load_average()}; result folders in {base}")
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "optimal where obstacles bind: fastest certified moves vs the best known (issue #24)",
+    ):
+        main()

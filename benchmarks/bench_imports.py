@@ -32,6 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from _results import recorded  # benchmarks/_results.py
 from _timing import compared_codes, load_average  # benchmarks/_timing.py
 
 HERE = Path(__file__).resolve().parent.parent
@@ -95,4 +96,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "the start of `adept-traj plan`: its import, `--help` and a tiny run"):
+        main()

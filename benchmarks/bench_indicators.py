@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import moocore
 import numpy as np
+from _results import figure, recorded  # benchmarks/_results.py
 
 from adept_traj.testing.indicator_oracles import dominated_mask, wfg_hypervolume
 
@@ -52,7 +53,12 @@ def main() -> None:
         nd_w = median_of(lambda F=F: dominated_mask(F), args.repeat)
         ms = (1e3 * hv_c, 1e3 * hv_w, 1e3 * nd_c, 1e3 * nd_w)
         print(f"{n:>5} {ms[0]:>11.3f} {ms[1]:>11.1f} {ms[2]:>11.3f} {ms[3]:>11.3f}")
+        figure(f"hv_{n}", f"hypervolume of {n} points, {args.m} objectives: moocore",
+               round(ms[0], 3), "ms", note=f"WFG {ms[1]:.1f} ms")  # fmt: skip
+        figure(f"dominance_{n}", f"dominance of {n} points, {args.m} objectives: moocore",
+               round(ms[2], 3), "ms", note=f"numpy {ms[3]:.3f} ms")  # fmt: skip
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "hypervolume and dominance: moocore vs the former numpy WFG"):
+        main()

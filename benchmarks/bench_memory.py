@@ -19,6 +19,8 @@ import sys
 import tempfile
 import time
 
+from _results import recorded  # benchmarks/_results.py
+
 from adept_traj.optimise import population_bytes
 
 
@@ -52,4 +54,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "memory of the evaluation and the certificate"):
+        main()

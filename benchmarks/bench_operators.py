@@ -36,6 +36,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _results import recorded  # benchmarks/_results.py
 from _timing import compared_codes, load_average  # benchmarks/_timing.py
 
 HERE = Path(__file__).resolve().parent.parent
@@ -171,4 +172,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "the optimiser's own time between generations (issue #15)"):
+        main()

@@ -30,6 +30,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from _results import recorded  # benchmarks/_results.py
 from _timing import load_average, pair_order  # benchmarks/_timing.py
 
 
@@ -105,4 +106,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "`adept-traj plan --out DIR` as typed, two checkouts alternately"):
+        main()

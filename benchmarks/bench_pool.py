@@ -31,6 +31,7 @@ import sys
 import time
 
 import numpy as np
+from _results import recorded  # benchmarks/_results.py
 from _timing import pair_order  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
@@ -160,4 +161,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "the parallel evaluation's own cost: a population on several processes vs one",
+        child_flags=("--json",),
+    ):
+        main()

@@ -23,6 +23,7 @@ import argparse
 import tracemalloc
 
 import numpy as np
+from _results import figure, recorded  # benchmarks/_results.py
 from _timing import best_of  # benchmarks/_timing.py
 
 from adept_traj import Robot, Scene
@@ -71,6 +72,13 @@ def main() -> None:
             f"{name:<15}{batched:>13.0f}{reference:>16.1f}{batched / reference:>7.0f}×"
             f"{ev.n_narrow / args.pop:>15.1f}{int(ev.feasible.sum()):>10}"
         )
+        key = name.replace(" ", "_")
+        figure(f"{key}_rate", f"{name}: evaluations/s, one core", round(batched), "/s")
+        figure(
+            f"{key}_ratio", f"{name}: one core vs the per-sample reference",
+            round(batched / reference), "×", target="≥ 20×", met=batched / reference >= 20,
+            note=f"reference {reference:.1f}/s",
+        )  # fmt: skip
     parallel = TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=args.workers)
     parallel.evaluate_batch(populations["random"][:40])  # start the workers
     for name, pop in populations.items():
@@ -80,6 +88,11 @@ def main() -> None:
             f"{name:<15} {args.workers} workers: {both:.0f} ev/s, serial {serial:.0f} ev/s "
             f"({both / serial:.2f}×)"
         )
+        figure(
+            f"{name.replace(' ', '_')}_rate_workers",
+            f"{name}: evaluations/s, {args.workers} workers", round(both), "/s",
+            target="≥ 2 000/s", met=both >= 2000, note=f"serial {serial:.0f}/s in the same run",
+        )  # fmt: skip
     parallel.close()
     pop = populations["near feasible"]
     tracemalloc.start()
@@ -87,7 +100,12 @@ def main() -> None:
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     print(f"peak memory of one batched evaluation of {args.pop}: {peak / 2**20:.0f} MiB")
+    figure("peak_memory", f"peak memory of one batched evaluation of {args.pop}",
+           round(peak / 2**20), "MiB")  # fmt: skip
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__, "evaluations per second of the full problem, batched vs the per-sample reference"
+    ):
+        main()

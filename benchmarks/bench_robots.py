@@ -33,6 +33,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from _results import figure, recorded  # benchmarks/_results.py
 
 from adept_traj import Obstacle, Robot, Scene, TrajectoryProblem, certify, plan
 from adept_traj.robot import installed_data_dirs
@@ -116,7 +117,23 @@ def main() -> None:
             f"{name:<14}{nq:>3}{meshes:>7}{pairs:>5}{rate:>9.0f}{r_eval:>7.2f}"
             f"{cert:>8.3f}{r_cert:>7.2f}{cpu:>7.3f}{cpu / ref_cpu:>7.2f}{shown:>16}{met:>5}"
         )
+        if name != "adept_one_xl":
+            key = name.replace(" +", "_")
+            figure(
+                f"{key}_rate", f"{name}: evaluations/s vs the AdeptOne XL's", round(r_eval, 2),
+                "×", target=None if target is None else f"≥ {target[0]}×",
+                met=None if target is None else r_eval >= target[0], note=f"{rate:.0f}/s",
+            )  # fmt: skip
+            figure(
+                f"{key}_certificate", f"{name}: certificate time vs the AdeptOne XL's",
+                round(r_cert, 2), "×", target=None if target is None else f"≤ {target[1]}×",
+                met=None if target is None else r_cert <= target[1], note=f"{cert:.3f} s",
+            )  # fmt: skip
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(
+        __file__,
+        "real robots (UR5, Jaco2) against the AdeptOne XL: evaluations/s and certificate time",
+    ):
+        main()

@@ -21,6 +21,7 @@ import argparse
 import time
 
 import numpy as np
+from _results import recorded  # benchmarks/_results.py
 from scipy.optimize import Bounds, NonlinearConstraint, minimize
 from threadpoolctl import threadpool_limits
 
@@ -117,4 +118,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with recorded(__file__, "the polish's local solver: SLSQP vs trust-constr"):
+        main()

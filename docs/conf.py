@@ -5,7 +5,7 @@ Build (exactly what ``tests/test_docs.py`` and CI run; warnings are errors)::
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
 The Markdown pages are read by myst-parser; the API reference (``api.md``) is generated
-from the docstrings (numpy and Google sections, RST ``.. math::``) by autodoc + napoleon.
+from the docstrings (numpy sections, RST ``.. math::``) by autodoc + napoleon.
 The build needs no network: there is no intersphinx, and MathJax is only *linked* from its
 CDN (``mathjax_path`` is left at Sphinx's default), so a reader's browser loads it when a
 page with formulas is opened.
@@ -54,9 +54,9 @@ myst_heading_anchors = 3
 
 # -- API reference (autodoc + napoleon) --------------------------------------------------
 
-# The docstrings use numpy sections ("Parameters" + dashes) and, in several modules, Google
-# sections ("Args:", "Returns:", "Attributes:", "Raises:"): both parsers are on.
-napoleon_google_docstring = True
+# The docstrings use numpy sections ("Parameters" + dashes) only (tests/test_style.py fails
+# on a Google-style "Args:" section): napoleon's Google parser is off.
+napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 # "Attributes" sections become :ivar: fields of their class, not separate object
 # descriptions: frozen dataclasses list their fields there, and autodoc documents the

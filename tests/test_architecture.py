@@ -5,6 +5,7 @@ exception class lives in errors.py."""
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -171,10 +172,12 @@ LONG_MODULES = {
 
 def test_modules_are_small():
     """One concept per module: ≲ 400 lines, except the few listed with their reason, and
-    none past 460."""
+    none past 460. A numpy section's underline (a line of dashes) is layout, not content:
+    it is not counted (issue #27 made every docstring numpy)."""
     long = {}
     for path in _modules():
-        n = len(path.read_text(encoding="utf-8").splitlines())
+        lines = path.read_text(encoding="utf-8").splitlines()
+        n = sum(1 for line in lines if not re.fullmatch(r"\s*-{3,}\s*", line))
         rel = str(path.relative_to(PACKAGE))
         if n > 460 or (n > 400 and rel not in LONG_MODULES):
             long[rel] = n

@@ -3,7 +3,7 @@ against independent references: Pinocchio's own kinematics, Jacobians and geomet
 placements, scipy's B-splines, numpy's LU determinant and the pendulum's closed-form bob
 position; and the heap kept between blocks against the page faults the kernel counts.
 (The whole evaluation is compared bit for bit with the previous code by the benchmark of
-docs/performance.md, not here: a stored reference would be fragile.)"""
+benchmarks/results/notebook.md, not here: a stored reference would be fragile.)"""
 
 from __future__ import annotations
 

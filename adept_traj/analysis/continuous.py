@@ -88,15 +88,16 @@ CONTINUOUS = "continuous"
 class DistanceGuarantee:
     """Result of :func:`continuous_distance`.
 
-    Attributes:
-        guarantee: ``"continuous"`` or ``"sampled at N Hz"`` (see the module docstring).
-        lower_bound: smallest interval bound :math:`\\underline d` over [0, T] and all pairs
-            [m] (``inf``: no obstacle); a true lower bound of the distance at every instant.
-        min_distance: smallest exact distance over the uniform and refined samples [m].
-        t_min_distance: its time [s] (``None``: no obstacle).
-        pair: ``(solid, obstacle)`` indices at that sample (``None``: no obstacle).
-        depth: bisection levels used (0: the uniform grid sufficed).
-        n_refined: exact distance evaluations (samples × all pairs) added by the refinement.
+    Attributes
+    ----------
+    guarantee: ``"continuous"`` or ``"sampled at N Hz"`` (see the module docstring).
+    lower_bound: smallest interval bound :math:`\\underline d` over [0, T] and all pairs
+        [m] (``inf``: no obstacle); a true lower bound of the distance at every instant.
+    min_distance: smallest exact distance over the uniform and refined samples [m].
+    t_min_distance: its time [s] (``None``: no obstacle).
+    pair: ``(solid, obstacle)`` indices at that sample (``None``: no obstacle).
+    depth: bisection levels used (0: the uniform grid sufficed).
+    n_refined: exact distance evaluations (samples × all pairs) added by the refinement.
     """
 
     guarantee: str
@@ -196,20 +197,22 @@ def continuous_distance(
 ) -> DistanceGuarantee:
     """Lower-bound the distance between the samples and refine where needed.
 
-    Args:
-        problem: the problem (robot, scene, margin).
-        x: (n_var,) checked decision vector.
-        t: (n,) sample times [s], increasing, ``t[0] = 0``, ``t[-1] = T``.
-        qd: (n, nq) joint speeds at ``t`` [rad/s | m/s].
-        pairs: (n, ns, no) exact distances at ``t`` [m], or lower bounds of them.
-        rate_hz: the uniform grid's rate [Hz], ``(n − 1) / T`` (for the guarantee's name).
-        max_depth: most bisections (≥ 0).
-        exact: distances at the midpoints exact for every pair (``False``: lower bounds
-            above the checker's influence distance, as
-            :meth:`~adept_traj.collision.CollisionChecker.distances`).
+    Parameters
+    ----------
+    problem: the problem (robot, scene, margin).
+    x: (n_var,) checked decision vector.
+    t: (n,) sample times [s], increasing, ``t[0] = 0``, ``t[-1] = T``.
+    qd: (n, nq) joint speeds at ``t`` [rad/s | m/s].
+    pairs: (n, ns, no) exact distances at ``t`` [m], or lower bounds of them.
+    rate_hz: the uniform grid's rate [Hz], ``(n − 1) / T`` (for the guarantee's name).
+    max_depth: most bisections (≥ 0).
+    exact: distances at the midpoints exact for every pair (``False``: lower bounds
+        above the checker's influence distance, as
+        :meth:`~adept_traj.collision.CollisionChecker.distances`).
 
-    Returns:
-        :class:`DistanceGuarantee`.
+    Returns
+    -------
+    :class:`DistanceGuarantee`.
     """
     acc = problem.trajectory.bounds(x).qdd_abs_max
     return _continuous_distance(problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc)

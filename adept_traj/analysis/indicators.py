@@ -23,11 +23,9 @@ Why moocore
 -----------
 moocore (C; pymoo depends on it, so it is always installed) replaced the package's own
 numpy WFG hypervolume and pairwise dominance test, which are now the independent oracles
-of the tests (``tests/indicator_oracles.py``). Measured by ``benchmarks/bench_indicators.py``
-(6 objectives, mutually non-dominated points on the unit sphere, medians on a shared 2-core
-machine): hypervolume 0.6 / 3.7 / 49 / 821 ms for 50 / 100 / 200 / 500 points against
-0.27 / 1.1 / 5.3 / 16 s for WFG (20–450 times faster); dominance 15 / 35 / 75 / 292 µs
-against 0.15 / 0.5 / 4.6 / 12.6 ms.
+of the tests (``tests/indicator_oracles.py``). ``benchmarks/bench_indicators.py`` times
+both (6 objectives, mutually non-dominated points on the unit sphere); its figures are in
+``docs/performance.md``.
 """
 
 from __future__ import annotations
@@ -200,7 +198,7 @@ def hypervolume(
     maximised: sense of each objective; default :data:`MAXIMISED`.
     method: ``"auto"`` or ``"moocore"`` (the same). ``"wfg"``, the package's former numpy
         implementation, is deprecated: it warns and gives moocore's value (the same to
-        within 1e-12 relative; moocore is 20–450 times faster on 6-objective fronts).
+        within 1e-12 relative; moocore is much faster, ``docs/performance.md``).
 
     Returns
     -------

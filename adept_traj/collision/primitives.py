@@ -30,9 +30,9 @@ penetration (d < 0)       0 ≤ e ≤ 3.0 µm         0 ≤ e ≤ 3.4 µm
 
 so a distance is never understated and, at the safety margins that matter (≥ 1 mm),
 within 2 nm. Capsules, spheres and boxes against a box face come out to rounding
-(~1e-15 m). The cost is within the noise of the shared machine: on the paper problem
-(medians of 12 interleaved runs) ``evaluate_batch`` of 100 trajectories 172 → 170 ms,
-:func:`~adept_traj.analysis.certificate.certify` of a 2.1 s move at 1 kHz 0.96 → 0.99 s.
+(~1e-15 m). The cost was measured within the noise of the shared machine, both for
+``evaluate_batch`` and for :func:`~adept_traj.analysis.certificate.certify`
+(``benchmarks/results/notebook.md``).
 """
 
 from __future__ import annotations

@@ -203,8 +203,8 @@ class _PaperNSGA2(_StampedGeneticAlgorithm):
     """pymoo's :class:`~pymoo.algorithms.moo.nsga2.NSGA2` as this module configures it:
     its genetic algorithm, binary tournament type, output, termination and ``opt`` (the
     rank-0 members, or the least infeasible one), without importing
-    ``pymoo.algorithms.moo.nsga2``, whose module imports ``scipy.spatial`` (≈ 0.2 s at the
-    start of every run) for crowding measures this module does not use."""
+    ``pymoo.algorithms.moo.nsga2``, whose module imports ``scipy.spatial`` (a noticeable
+    part of the start of every run) for crowding measures this module does not use."""
 
     def __init__(self, **kwargs: Any) -> None:
         kwargs.setdefault("output", MultiObjectiveOutput())

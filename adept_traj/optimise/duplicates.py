@@ -19,7 +19,7 @@ a binary search gives each row of X the few candidates whose sums are that close
 a random population none but its copies). A candidate pair equal in every variable is
 at distance 0; one differing by more than ε in a variable is farther than ε; only a
 pair in between (a few ulps apart) has its distance computed, by the same scipy
-``cdist`` as pymoo (imported then only: ``scipy.spatial`` takes ≈ 0.2 s to import).
+``cdist`` as pymoo (imported then only: ``scipy.spatial`` is slow to import).
 Candidate pairs are compared in blocks of at most :data:`BLOCK_PAIRS` / n_var pairs
 (≈ 16 MB of differences), whatever N — also when many rows share a sum.
 """

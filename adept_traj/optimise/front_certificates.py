@@ -1,8 +1,7 @@
 """The front members' certificates on the problem's worker processes.
 
 :func:`~adept_traj.analysis.certify_members` certifies one batch of members after the
-other (about 8–9 ms of CPU a member on the paper scene on a loaded machine: 0.9 s for
-NSGA-II's 100 members, 4.3 s for MODE's 500).
+other (``benchmarks/bench_certify.py`` times it; ``docs/performance.md``).
 :func:`certify_front_members` gives each of ``workers`` forked processes every
 ``workers``-th member (the trade-off order interleaved, so that each gets as many of the
 costly and the cheap ones), each process calls

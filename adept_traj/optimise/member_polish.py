@@ -307,7 +307,7 @@ def _rows_in_reach(p0: _Pieces, half: np.ndarray, influence: float) -> tuple[np.
     −_ROW_SLACK, manipulability rows whose lowest value may be the minimum, distance rows
     likewise per obstacle (a clipped row with a zero gradient never binds below the bound
     :math:`m_o \le \delta`). SLSQP's subproblem costs grow with the rows (2 900 on a paper
-    member; measured 42 ms per iteration with all of them); the evaluator's check of every
+    member); the evaluator's check of every
     iterate catches a dropped row that binds after all."""
     reach_g = np.abs(p0.dg) @ half
     on_g = np.flatnonzero(p0.g + reach_g > -_ROW_SLACK)

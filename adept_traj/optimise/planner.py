@@ -306,7 +306,7 @@ def plan(
         settings_dict = {**settings.to_dict(), "polish": polish}
         name = settings.name
         n_searched = len(state.X) if polish != "off" else None
-        # the front's certificates made meanwhile (docs/performance.md)
+        # the front's certificates made meanwhile (benchmarks/results/notebook.md)
         rows = feasible_front(state.F, state.G, _weights(weights))
         rows = rows if polish != "off" and max_certify is None else []
         fork = problem.settings.workers > 1  # one worker: certified in this process

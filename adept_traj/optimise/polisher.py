@@ -1,8 +1,8 @@
 """The polish after the search run by a helper process prepared while the search goes on:
 :func:`start_polisher`, :class:`Polisher`.
 
-The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize`` (≈ 0.3 s of
-CPU), after the search, on the command's critical path. :func:`start_polisher` forks a
+The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize`` (a slow
+import), after the search, on the command's critical path. :func:`start_polisher` forks a
 helper process from the caller once the problem exists (before the evaluator's worker
 processes); a thread of the helper imports ``scipy.optimize`` and ``threadpoolctl`` and
 makes the problem's certifying problem at the lowest priority (nice 19,

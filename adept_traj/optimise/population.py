@@ -9,7 +9,7 @@ two Python calls per member. The optimiser reads the population after every gene
 exactly as ``Population.get`` does (same array, bit for bit).
 
 A member's total constraint violation CV is computed by pymoo lazily, on its first read,
-by ``calc_cv`` — one Python call chain per member (about 8 µs).
+by ``calc_cv`` — one Python call chain per member.
 :func:`cache_violations` computes it for every freshly evaluated member at once, with the
 same operations (hence the same bits) for pymoo's default configuration:
 
@@ -28,7 +28,7 @@ the fronts are filled in rank order).
 into the members itself — pymoo's ``Population.set`` checks every value and calls
 ``Individual.set`` (``hasattr``, then ``setattr``) for every member and key — and setting
 the members' CV as :func:`cache_violations` does, in the same pass: the same values in the
-same members (each its own copy of its row), ≈ 2× less time.
+same members (each its own copy of its row), in less time.
 """
 
 from __future__ import annotations

@@ -6,8 +6,8 @@ infeasible ones by increasing total constraint violation CV. Before ranking, pym
 ``Survival.do`` splits the merged parents and offspring (2N members) into feasible and
 infeasible ones with ``Population.get("F", "CV", "FEAS")``: three properties per member,
 each evaluated twice (``hasattr`` then ``getattr``) and ``FEAS`` compares a fresh array
-each time — ≈ 10 µs per member, about as long as the non-dominated sorting itself for
-MODE's 1 000 members.
+each time — per member, and for MODE's 1 000 members about as long as the non-dominated
+sorting itself.
 
 :class:`RankAndCrowdingSurvival` takes the same decisions from one (2N, 1) array of CV:
 member i is feasible when
@@ -35,7 +35,7 @@ per objective k, with the members sorted by :math:`F_{\cdot k}` (stable) and
 (a term 0 where all values of objective k are equal; :math:`+\infty` at the ends), and
 :math:`+\infty` for every member of a front of at most two. It is here rather than taken
 from pymoo's ``rank_and_crowding.metrics`` because that module imports ``scipy.spatial``
-(≈ 0.2 s at the start of every run) for other crowding measures; another
+(slow, at the start of every run) for other crowding measures; another
 ``crowding_func`` than ``"cd"`` is still pymoo's.
 """
 

@@ -32,14 +32,13 @@ straight move at :math:`T_{lb}`) and the smooth per-sample constraints :math:`g_
 
 Why so: a direct SLSQP on :math:`f_c` from front members left the feasible set and did not
 converge on 5 of 5 members (``docs/engine.md``); the steps only ever keep a move the
-evaluator finds feasible. The box and the budget were measured on the paper scene (five
-weight vectors, 3 starts, ``benchmarks/bench_weighted.py``): the sum of the five best
-:math:`f_w` and the CPU time were 2.942 / 16.8 s (β = 0.1, 100 evaluations a start),
-2.897 / 26.1 s (0.1, 200), **2.882 / 16.7 s (0.3, 100)**, 2.882 / 25.7 s (0.3, 200),
-2.892 / 14.6 s (0.3, 60); β = 0.5 was worse on z2 (0.688 against 0.673), the ε-step's
-3 % much slower (from one start, weights on z2: 404 evaluations for 0.803, against 170
-for 0.803 with β = 0.1). Deterministic: the same problem, seed and weights give the same
-bits (SLSQP with one BLAS thread).
+evaluator finds feasible. The box and the budget were chosen on the paper scene (five
+weight vectors, 3 starts, ``benchmarks/bench_weighted.py``, figures in
+``docs/performance.md``): β = 0.3 with 100 evaluations a start gave the least sum of the
+five best :math:`f_w` (2.882) at the least cost; β = 0.1 reached less (2.942), β = 0.5 was
+worse on z2 (0.688 against 0.673), the ε-step's 3 % needed many more evaluations (from one
+start, weights on z2: 404 for 0.803, against 170 with β = 0.1). Deterministic: the same
+problem, seed and weights give the same bits (SLSQP with one BLAS thread).
 """
 
 from __future__ import annotations

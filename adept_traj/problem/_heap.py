@@ -6,8 +6,8 @@ trim threshold (by default twice the largest array it has mapped and freed, so a
 MB here), and the next block faults those pages in again. Whether that happens depends
 on where the few long-lived objects of the process lie in the heap — on the exact code,
 even on the length of its path — so the same evaluation cost from 0 to about 27 000 page
-faults per population of 500 (20–30 ms of system CPU time on 150–190 ms, measured on
-2026-12-01, issue #15), from one process to the next.
+faults per population of 500 (a noticeable share of system CPU time, issue #15;
+``benchmarks/results/notebook.md``), from one process to the next.
 
 :func:`keep_heap` sets two ``malloc`` parameters for the whole process, once:
 ``M_MMAP_THRESHOLD`` = 32 MiB (glibc's own ceiling of its dynamic threshold) and

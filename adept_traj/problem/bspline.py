@@ -107,21 +107,25 @@ def _check_positive_times(T: np.ndarray, name: str) -> None:
 class BSplineTrajectory:
     r"""Rest-to-rest uniform cubic B-spline trajectories from ``start`` to ``goal``.
 
-    Args:
-        start: start configuration [rad] or [m] per joint, shape ``(nq,)``.
-        goal: goal configuration [rad] or [m] per joint, shape ``(nq,)``.
-        n_knots: number of knots :math:`m \ge 4` (paper: 20); segments ``S = m − 1``,
-            control points per joint ``n_control = m + 2``, free per joint
-            ``n_free = m − 4``.
+    Parameters
+    ----------
+    start: start configuration [rad] or [m] per joint, shape ``(nq,)``.
+    goal: goal configuration [rad] or [m] per joint, shape ``(nq,)``.
+    n_knots: number of knots :math:`m \ge 4` (paper: 20); segments ``S = m − 1``, control points
+        per joint ``n_control = m + 2``, free per joint ``n_free = m − 4``.
 
     The object is immutable (``start`` and ``goal`` are stored as read-only copies). See the
     module docstring for the decision-vector layout
     ``x = [T, free control points joint-major]``, shape ``(n_var,) = (1 + nq·n_free,)``.
 
-    Raises:
-        InvalidInputError: ``start`` or ``goal`` not finite.
-        InputShapeError: ``start`` not 1-D and non-empty, or ``goal`` of another shape.
-        ConfigurationError: ``n_knots`` not an integer ≥ 4.
+    Raises
+    ------
+    InvalidInputError
+        ``start`` or ``goal`` not finite.
+    InputShapeError
+        ``start`` not 1-D and non-empty, or ``goal`` of another shape.
+    ConfigurationError
+        ``n_knots`` not an integer ≥ 4.
     """
 
     start: np.ndarray
@@ -203,30 +207,38 @@ class BSplineTrajectory:
     def decode(self, x: Any) -> tuple[np.ndarray, np.ndarray]:
         """Split decision vectors into travel times and full control-point arrays.
 
-        Args:
-            x: decision vectors, shape ``(..., n_var)``; ``x[..., 0]`` is ``T`` [s] (> 0).
+        Parameters
+        ----------
+        x: decision vectors, shape ``(..., n_var)``; ``x[..., 0]`` is ``T`` [s] (> 0).
 
-        Returns:
-            ``(T, P)``: ``T`` [s] of shape ``(...)`` and control points ``P`` [rad] or [m] of
-            shape ``(..., n_control, nq)`` (``P[..., :3, :] = start``,
-            ``P[..., -3:, :] = goal``). New arrays; ``x`` is not modified.
+        Returns
+        -------
+        ``(T, P)``: ``T`` [s] of shape ``(...)`` and control points ``P`` [rad] or [m] of
+        shape ``(..., n_control, nq)`` (``P[..., :3, :] = start``,
+        ``P[..., -3:, :] = goal``). New arrays; ``x`` is not modified.
 
-        Raises:
-            InputShapeError: wrong last axis. InvalidInputError: NaN/inf or ``T ≤ 0``.
+        Raises
+        ------
+        InputShapeError
+            wrong last axis.
+        InvalidInputError
+            NaN/inf or ``T ≤ 0``.
         """
         return self._decode_clean(self._check_x(x))
 
     def encode(self, T: Any, free: Any) -> np.ndarray:
         """Build decision vectors from travel times and free control points (inverse of decode).
 
-        Args:
-            T: travel times [s] (> 0), shape ``(...)`` (broadcast against ``free``).
-            free: free control points [rad] or [m], shape ``(..., n_free, nq)`` — the same
-                layout as ``P[..., 3:-3, :]`` returned by :meth:`decode`: after
-                ``T, P = traj.decode(x)``, ``traj.encode(T, P[..., 3:-3, :])`` equals ``x``.
+        Parameters
+        ----------
+        T: travel times [s] (> 0), shape ``(...)`` (broadcast against ``free``).
+        free: free control points [rad] or [m], shape ``(..., n_free, nq)`` — the same
+            layout as ``P[..., 3:-3, :]`` returned by :meth:`decode`: after
+            ``T, P = traj.decode(x)``, ``traj.encode(T, P[..., 3:-3, :])`` equals ``x``.
 
-        Returns:
-            Decision vectors, shape ``(..., n_var)``.
+        Returns
+        -------
+        Decision vectors, shape ``(..., n_var)``.
         """
         T_arr = as_finite_array(T, "T")
         _check_positive_times(T_arr, "T")
@@ -263,11 +275,13 @@ class BSplineTrajectory:
         rest-to-rest :math:`\sigma` close to the minimum-jerk profile, so that peak
         accelerations are moderate (a good seed for an optimiser).
 
-        Args:
-            T: travel time(s) [s] (> 0), scalar or shape ``(...)``.
+        Parameters
+        ----------
+        T: travel time(s) [s] (> 0), scalar or shape ``(...)``.
 
-        Returns:
-            Decision vectors, shape ``(..., n_var)``.
+        Returns
+        -------
+        Decision vectors, shape ``(..., n_var)``.
         """
         lam = self._straight_ramp()[_N_FIXED_END:-_N_FIXED_END]
         free = self.start + lam[:, None] * (self.goal - self.start)
@@ -301,12 +315,14 @@ class BSplineTrajectory:
             \frac{d^r q}{ds^r}(s_k) = \sum_c B^{(r)}_{kc} P_c, \qquad
             \frac{d^r q}{dt^r} = T^{-r}\,\frac{d^r q}{ds^r}.
 
-        Args:
-            s: normalised times in [0, 1], shape ``(n_s,)`` (``s = 1`` uses the last segment).
-            order: derivative order ``r`` in 0..3.
+        Parameters
+        ----------
+        s: normalised times in [0, 1], shape ``(n_s,)`` (``s = 1`` uses the last segment).
+        order: derivative order ``r`` in 0..3.
 
-        Returns:
-            ``B`` of shape ``(n_s, n_control)`` (dimensionless, scaled by :math:`S^r`).
+        Returns
+        -------
+        ``B`` of shape ``(n_s, n_control)`` (dimensionless, scaled by :math:`S^r`).
         """
         (order,) = _check_orders([order])
         return _basis(self._check_s(s), order, self.n_segments)
@@ -320,15 +336,17 @@ class BSplineTrajectory:
 
             q^{(r)}(T s_k) = T^{-r} \sum_c B^{(r)}_{kc} P_c .
 
-        Args:
-            x: decision vectors, shape ``(..., n_var)``.
-            s: normalised times in [0, 1], shape ``(n_s,)``.
-            orders: derivative orders to compute (subset of ``(0, 1, 2, 3)``); the others
-                are ``None`` in the result.
+        Parameters
+        ----------
+        x: decision vectors, shape ``(..., n_var)``.
+        s: normalised times in [0, 1], shape ``(n_s,)``.
+        orders: derivative orders to compute (subset of ``(0, 1, 2, 3)``); the others
+            are ``None`` in the result.
 
-        Returns:
-            :class:`TrajectorySamples` with ``t`` [s] ``(..., n_s)`` and
-            ``q, qd, qdd, qddd`` [rad, rad/s, rad/s², rad/s³ or m…] ``(..., n_s, nq)``.
+        Returns
+        -------
+        :class:`TrajectorySamples` with ``t`` [s] ``(..., n_s)`` and
+        ``q, qd, qdd, qddd`` [rad, rad/s, rad/s², rad/s³ or m…] ``(..., n_s, nq)``.
         """
         wanted = _check_orders(orders)
         T, P = self._decode_clean(self._check_x(x))
@@ -347,11 +365,13 @@ class BSplineTrajectory:
             \dot q:&\ u \in \{0, 1, -c_2/(3c_3)\} \cap [0,1] \\
             \ddot q:&\ u \in \{0, 1\}, \qquad \dddot q = 6 c_3 (S/T)^3 .
 
-        Args:
-            x: decision vectors, shape ``(..., n_var)``.
+        Parameters
+        ----------
+        x: decision vectors, shape ``(..., n_var)``.
 
-        Returns:
-            :class:`TrajectoryBounds`, every field of shape ``(..., nq)`` in SI units.
+        Returns
+        -------
+        :class:`TrajectoryBounds`, every field of shape ``(..., nq)`` in SI units.
         """
         return _exact_bounds(*self._decode_clean(self._check_x(x)))
 
@@ -368,12 +388,14 @@ class BSplineTrajectory:
             \int_0^T \dddot q^2 \mathrm{d}t = \Bigl(\frac{S}{T}\Bigr)^5
                 \sum_{\text{seg}} A^2 .
 
-        Args:
-            x: decision vectors, shape ``(..., n_var)``.
+        Parameters
+        ----------
+        x: decision vectors, shape ``(..., n_var)``.
 
-        Returns:
-            :class:`TrajectoryIntegrals` with ``acc_sq`` and ``jerk_sq`` of shape ``(..., nq)``;
-            ``.z6`` and ``.z5`` give the paper's sums over joints, shape ``(...)``.
+        Returns
+        -------
+        :class:`TrajectoryIntegrals` with ``acc_sq`` and ``jerk_sq`` of shape ``(..., nq)``;
+        ``.z6`` and ``.z5`` give the paper's sums over joints, shape ``(...)``.
         """
         return _exact_integrals(*self._decode_clean(self._check_x(x)))
 
@@ -386,12 +408,14 @@ class BSplineTrajectory:
 
         exact when ``f`` is a polynomial of degree ≤ ``2·n_per_segment − 1`` on every segment.
 
-        Args:
-            n_per_segment: Gauss–Legendre nodes per segment (≥ 1).
+        Parameters
+        ----------
+        n_per_segment: Gauss–Legendre nodes per segment (≥ 1).
 
-        Returns:
-            ``(s, w)``: increasing normalised nodes in (0, 1) and weights (sum 1), both of shape
-            ``(n_segments·n_per_segment,)``.
+        Returns
+        -------
+        ``(s, w)``: increasing normalised nodes in (0, 1) and weights (sum 1), both of shape
+        ``(n_segments·n_per_segment,)``.
         """
         n = as_integer(n_per_segment, "n_per_segment", minimum=1)
         return _gauss_legendre(self.n_segments, n)
@@ -408,19 +432,25 @@ class BSplineTrajectory:
         every trajectory in the box then satisfies
         :math:`q_\text{lower} \le q(t) \le q_\text{upper}` for all t.
 
-        Args:
-            q_lower: lower joint limits [rad] or [m], shape ``(nq,)``.
-            q_upper: upper joint limits [rad] or [m], shape ``(nq,)``, ``> q_lower``.
-            T_min: smallest travel time [s], ``> 0`` (e.g. from
-                :func:`~adept_traj.problem.time_bound.kinematic_lower_bound`).
-            T_max: largest travel time [s], ``> T_min``.
+        Parameters
+        ----------
+        q_lower: lower joint limits [rad] or [m], shape ``(nq,)``.
+        q_upper: upper joint limits [rad] or [m], shape ``(nq,)``, ``> q_lower``.
+        T_min: smallest travel time [s], ``> 0`` (e.g. from
+            :func:`~adept_traj.problem.time_bound.kinematic_lower_bound`).
+        T_max: largest travel time [s], ``> T_min``.
 
-        Returns:
-            ``(xl, xu)``, each of shape ``(n_var,)``.
+        Returns
+        -------
+        ``(xl, xu)``, each of shape ``(n_var,)``.
 
-        Raises:
-            InvalidInputError: bad times or limits. JointLimitError (an InvalidInputError):
-            ``start`` or ``goal`` outside the limits (the message names joint, value, range).
+        Raises
+        ------
+        InvalidInputError
+            bad times or limits.
+        JointLimitError
+            (an InvalidInputError) ``start`` or ``goal`` outside the limits (the message
+            names joint, value, range).
         """
         lo = as_vector(q_lower, "q_lower", self.nq, "[rad or m]")
         hi = as_vector(q_upper, "q_upper", self.nq, "[rad or m]")

@@ -233,8 +233,8 @@ def _inverse_dynamics_derivatives(robot: Any, q: np.ndarray, v: np.ndarray, a: n
     :meth:`~adept_traj.robot.Robot.inverse_dynamics`: Pinocchio's analytic RNEA derivatives
     (rotor inertia included in :math:`\\partial u/\\partial a = M(q)`), the viscous friction's
     :math:`F_v` added to :math:`\\partial u / \\partial v`; the Coulomb term's derivative is
-    0 away from rest. One Pinocchio call per sample (no batched variant exists; measured
-    3.3 × faster than batched central differences, 116 samples). Pinocchio's derivatives
+    0 away from rest. One Pinocchio call per sample (no batched variant exists; still
+    faster than batched central differences, 116 samples). Pinocchio's derivatives
     do not support mimic joints (the Panda's fingers): such a model takes
     :func:`_central_dynamics_derivatives`."""
     model = robot.model

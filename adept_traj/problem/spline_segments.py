@@ -42,12 +42,13 @@ _M.flags.writeable = False
 class TrajectorySamples:
     """Joint trajectories sampled at shared normalised times.
 
-    Attributes:
-        t: sample times [s], shape ``(..., n_s)`` (``t = T·s``, one row per individual).
-        q: positions [rad] or [m], shape ``(..., n_s, nq)``.
-        qd: velocities [rad/s] or [m/s], shape ``(..., n_s, nq)``.
-        qdd: accelerations [rad/s²] or [m/s²], shape ``(..., n_s, nq)``.
-        qddd: jerks [rad/s³] or [m/s³], shape ``(..., n_s, nq)``.
+    Attributes
+    ----------
+    t: sample times [s], shape ``(..., n_s)`` (``t = T·s``, one row per individual).
+    q: positions [rad] or [m], shape ``(..., n_s, nq)``.
+    qd: velocities [rad/s] or [m/s], shape ``(..., n_s, nq)``.
+    qdd: accelerations [rad/s²] or [m/s²], shape ``(..., n_s, nq)``.
+    qddd: jerks [rad/s³] or [m/s³], shape ``(..., n_s, nq)``.
 
     A derivative that was not requested (``orders`` of :meth:`BSplineTrajectory.sample`) is
     ``None``.
@@ -64,12 +65,13 @@ class TrajectorySamples:
 class TrajectoryBounds:
     r"""Exact per-joint extrema over :math:`t \in [0, T]`, each of shape ``(..., nq)``.
 
-    Attributes:
-        q_min, q_max: position extrema [rad] or [m].
-        qd_min, qd_max: velocity extrema [rad/s] or [m/s].
-        qdd_min, qdd_max: acceleration extrema [rad/s²] or [m/s²].
-        qddd_min, qddd_max: jerk extrema [rad/s³] or [m/s³] (the jerk is piecewise
-            constant; its value on every segment counts, including the first and last).
+    Attributes
+    ----------
+    q_min, q_max: position extrema [rad] or [m].
+    qd_min, qd_max: velocity extrema [rad/s] or [m/s].
+    qdd_min, qdd_max: acceleration extrema [rad/s²] or [m/s²].
+    qddd_min, qddd_max: jerk extrema [rad/s³] or [m/s³] (the jerk is piecewise
+        constant; its value on every segment counts, including the first and last).
     """
 
     q_min: np.ndarray
@@ -106,11 +108,12 @@ class TrajectoryBounds:
 class TrajectoryIntegrals:
     r"""Exact per-joint integrals of squared acceleration and jerk over :math:`[0, T]`.
 
-    Attributes:
-        acc_sq: :math:`\int_0^T \ddot q_i^2 \, \mathrm{d}t` [rad²/s³] or [m²/s³],
-            shape ``(..., nq)``.
-        jerk_sq: :math:`\int_0^T \dddot q_i^2 \, \mathrm{d}t` [rad²/s⁵] or [m²/s⁵],
-            shape ``(..., nq)``.
+    Attributes
+    ----------
+    acc_sq: :math:`\int_0^T \ddot q_i^2 \, \mathrm{d}t` [rad²/s³] or [m²/s³],
+        shape ``(..., nq)``.
+    jerk_sq: :math:`\int_0^T \dddot q_i^2 \, \mathrm{d}t` [rad²/s⁵] or [m²/s⁵],
+        shape ``(..., nq)``.
     """
 
     acc_sq: np.ndarray

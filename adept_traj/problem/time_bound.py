@@ -26,16 +26,17 @@ __all__ = ["KinematicBound", "kinematic_lower_bound"]
 class KinematicBound:
     r"""Minimum rest-to-rest travel times under velocity, acceleration and jerk limits.
 
-    Attributes:
-        times: per-joint minimum time [s], shape ``(nq,)``.
-        delta: per-joint distance :math:`|q_\text{goal} - q_\text{start}|` [rad] or [m],
-            shape ``(nq,)``.
-        cases: per-joint profile type, one of ``"rest"`` (Δ = 0), ``"instant"`` (all limits
-            infinite), ``"jerk"`` (neither a nor v reached), ``"acc"`` (a reached, v not),
-            ``"vel"`` (v reached, a not), ``"acc+vel"`` (both reached).
-        T_min: :math:`\max_i` ``times[i]`` [s]: no trajectory respecting the limits can be
-            faster.
-        limiting_joint: index of the joint that attains ``T_min`` (0 if all times are 0).
+    Attributes
+    ----------
+    times: per-joint minimum time [s], shape ``(nq,)``.
+    delta: per-joint distance :math:`|q_\text{goal} - q_\text{start}|` [rad] or [m],
+        shape ``(nq,)``.
+    cases: per-joint profile type, one of ``"rest"`` (Δ = 0), ``"instant"`` (all limits
+        infinite), ``"jerk"`` (neither a nor v reached), ``"acc"`` (a reached, v not),
+        ``"vel"`` (v reached, a not), ``"acc+vel"`` (both reached).
+    T_min: :math:`\max_i` ``times[i]`` [s]: no trajectory respecting the limits can be
+        faster.
+    limiting_joint: index of the joint that attains ``T_min`` (0 if all times are 0).
     """
 
     times: np.ndarray
@@ -69,19 +70,22 @@ def kinematic_lower_bound(
     Infinite limits are allowed (``j = inf`` gives the trapezoidal-velocity times;
     all three infinite give 0). ``h = 0`` gives 0.
 
-    Args:
-        start: start configuration [rad] or [m], shape ``(nq,)``.
-        goal: goal configuration [rad] or [m], shape ``(nq,)``.
-        v_max: velocity limits [rad/s] or [m/s], scalar or ``(nq,)``, > 0 (inf allowed).
-        a_max: acceleration limits [rad/s²] or [m/s²], scalar or ``(nq,)``, > 0.
-        j_max: jerk limits [rad/s³] or [m/s³], scalar or ``(nq,)``, > 0.
+    Parameters
+    ----------
+    start: start configuration [rad] or [m], shape ``(nq,)``.
+    goal: goal configuration [rad] or [m], shape ``(nq,)``.
+    v_max: velocity limits [rad/s] or [m/s], scalar or ``(nq,)``, > 0 (inf allowed).
+    a_max: acceleration limits [rad/s²] or [m/s²], scalar or ``(nq,)``, > 0.
+    j_max: jerk limits [rad/s³] or [m/s³], scalar or ``(nq,)``, > 0.
 
-    Returns:
-        :class:`KinematicBound` (per-joint times [s], ``T_min`` [s], ``limiting_joint``).
+    Returns
+    -------
+    :class:`KinematicBound` (per-joint times [s], ``T_min`` [s], ``limiting_joint``).
 
-    Example:
-        >>> kinematic_lower_bound([0.0], [0.929], np.inf, 9.5, 50.0).T_min  # doctest: +ELLIPSIS
-        0.843...
+    Examples
+    --------
+    >>> kinematic_lower_bound([0.0], [0.929], np.inf, 9.5, 50.0).T_min  # doctest: +ELLIPSIS
+    0.843...
     """
     q0 = as_finite_array(start, "start")
     if q0.ndim != 1 or q0.shape[0] == 0:

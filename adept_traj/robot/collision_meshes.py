@@ -98,8 +98,8 @@ class HullReport:
     @cached_property
     def gap(self) -> float:
         """Bound [m] on how much smaller a distance to the hull can be than the distance to
-        the mesh (see the module docstring; computed on first access: about 0.1–5 s per
-        link, too slow to do at every load)."""
+        the mesh (see the module docstring; computed on first access: too slow for a large
+        mesh to do at every load)."""
         mesh, hull = self.shapes
         return hull_gap(np.asarray(hull.points(), dtype=float), triangle_corners(mesh))
 

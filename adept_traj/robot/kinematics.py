@@ -1,6 +1,6 @@
 """Batched forward kinematics and frame Jacobians of a Pinocchio chain, in numpy.
 
-Pinocchio's Python API works one configuration per call (≈ 1.4 µs plus Python overhead);
+Pinocchio's Python API works one configuration per call (plus Python overhead);
 a planner evaluates 10⁴–10⁶ configurations per generation. :class:`BatchKinematics` reads
 the joint placements and axes of a Pinocchio model once and then evaluates whole
 ``(..., nq)`` batches with a few array operations per joint. It supports trees of 1-DoF
@@ -119,7 +119,7 @@ class BatchKinematics:
         :math:`e_z` to the joint axis (the identity for z axes): the product by the
         constant :math:`P_i U_i` is one small GEMM over all samples per row, and the one by
         :math:`R_z(q)` only mixes two columns. Every component is a contiguous (N,) array,
-        so the elementwise work streams (≈ 2× faster than stacked 4 × 4 products).
+        so the elementwise work streams (faster than stacked 4 × 4 products).
         """
         qf = q.reshape(-1, q.shape[-1])
         n = qf.shape[0]

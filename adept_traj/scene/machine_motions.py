@@ -37,10 +37,11 @@ class LinearMotion(MotionLaw):
     one law each, phases ``k L / n``). Every point moves at exactly :math:`|v|` between the
     jumps, which come every :math:`L / |v|` seconds (:attr:`jump_interval`).
 
-    Attributes:
-        velocity: (3,) belt velocity [m/s], non-zero.
-        wrap: L [m], positive, or ``inf`` (no wrap-around; the default).
-        phase: σ [m], in [0, L) with a wrap.
+    Attributes
+    ----------
+    velocity: (3,) belt velocity [m/s], non-zero.
+    wrap: L [m], positive, or ``inf`` (no wrap-around; the default).
+    phase: σ [m], in [0, L) with a wrap.
     """
 
     velocity: np.ndarray
@@ -123,11 +124,12 @@ class RotationMotion(MotionLaw):
     ``point`` along ``axis``: :math:`x \mapsto c + R(\theta)(x - c)`. A point at distance
     :math:`\rho` from the axis moves at exactly :math:`|\omega| \rho`.
 
-    Attributes:
-        axis: (3,) direction of the axis (non-zero; stored normalised).
-        point: (3,) a point c of the axis [m].
-        omega: ω [rad/s], non-zero (positive: counter-clockwise about ``axis``).
-        angle: θ0 [rad] at t = 0.
+    Attributes
+    ----------
+    axis: (3,) direction of the axis (non-zero; stored normalised).
+    point: (3,) a point c of the axis [m].
+    omega: ω [rad/s], non-zero (positive: counter-clockwise about ``axis``).
+    angle: θ0 [rad] at t = 0.
     """
 
     axis: np.ndarray

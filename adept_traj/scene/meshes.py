@@ -71,11 +71,12 @@ def _unit_scale(scale: Any) -> np.ndarray:
 class Mesh(Shape):
     """A triangle mesh obstacle in its own frame (see the module docstring).
 
-    Attributes:
-        vertices: (n, 3) vertex positions in the mesh frame [m] (already scaled).
-        triangles: (m, 3) int vertex indices of each triangle (m ≥ 1).
-        source: the file it was read from ("" if built from arrays); scene files write it.
-        scale: (3,) the scale applied to the file's coordinates [-] (CAD in mm: 0.001).
+    Attributes
+    ----------
+    vertices: (n, 3) vertex positions in the mesh frame [m] (already scaled).
+    triangles: (m, 3) int vertex indices of each triangle (m ≥ 1).
+    source: the file it was read from ("" if built from arrays); scene files write it.
+    scale: (3,) the scale applied to the file's coordinates [-] (CAD in mm: 0.001).
     """
 
     vertices: np.ndarray
@@ -129,14 +130,17 @@ class Mesh(Shape):
     def from_file(cls, path: str | os.PathLike[str], scale: Any = 1.0) -> Mesh:
         """Read a mesh file (:data:`MESH_SUFFIXES`, by coal's assimp loader) and scale it.
 
-        Args:
-            path: the file.
-            scale: a positive number or (3,) per-axis factors applied to the file's
-                coordinates [-] (0.001 for a CAD file in millimetres).
+        Parameters
+        ----------
+        path: the file.
+        scale: a positive number or (3,) per-axis factors applied to the file's
+            coordinates [-] (0.001 for a CAD file in millimetres).
 
-        Raises:
-            MeshFileError: the file does not exist, is too large, cannot be read, or holds
-                no triangle (the message names the file).
+        Raises
+        ------
+        MeshFileError
+            the file does not exist, is too large, cannot be read, or holds
+            no triangle (the message names the file).
         """
         s = _unit_scale(scale)
         vertices, triangles = read_mesh_arrays(path)
@@ -229,9 +233,11 @@ def read_mesh_arrays(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarr
     """Vertices (n, 3) [file units] and triangles (m, 3) of a mesh file, through coal's
     assimp loader (STL, OBJ, DAE, PLY, OFF…).
 
-    Raises:
-        MeshFileError: missing file, a suffix not in :data:`MESH_SUFFIXES`, larger than
-            1 GiB, unreadable by the loader, or no triangle; the message names the file.
+    Raises
+    ------
+    MeshFileError
+        missing file, a suffix not in :data:`MESH_SUFFIXES`, larger than
+        1 GiB, unreadable by the loader, or no triangle; the message names the file.
     """
     p = Path(path)
     if p.suffix.lower() not in MESH_SUFFIXES:

@@ -47,11 +47,13 @@ class MotionLaw(_ValueObject, ABC):
     def pose(self, t: Any) -> np.ndarray:
         """World pose of the moving frame at times ``t``.
 
-        Args:
-            t: times [s], any shape ``(...)`` (a scalar gives one (4, 4) pose).
+        Parameters
+        ----------
+        t: times [s], any shape ``(...)`` (a scalar gives one (4, 4) pose).
 
-        Returns:
-            (..., 4, 4) homogeneous transforms (a new array).
+        Returns
+        -------
+        (..., 4, 4) homogeneous transforms (a new array).
         """
 
     @property
@@ -65,13 +67,15 @@ class MotionLaw(_ValueObject, ABC):
     ) -> tuple[np.ndarray, float]:
         """A fixed ball containing a ball attached to the moving frame, at every time.
 
-        Args:
-            point: (3,) centre of the attached ball in the moving frame [m].
-            radius: radius of the attached ball [m], ≥ 0.
+        Parameters
+        ----------
+        point: (3,) centre of the attached ball in the moving frame [m].
+        radius: radius of the attached ball [m], ≥ 0.
 
-        Returns:
-            ``(centre, r)``: (3,) world centre [m] and radius [m] of a ball that contains the
-            attached ball for every real t (a guarantee, not a sampled estimate).
+        Returns
+        -------
+        ``(centre, r)``: (3,) world centre [m] and radius [m] of a ball that contains the
+        attached ball for every real t (a guarantee, not a sampled estimate).
         """
 
     def point_velocity(self, t: Any, points: Any) -> np.ndarray:
@@ -117,13 +121,15 @@ class MotionLaw(_ValueObject, ABC):
     def max_point_speed(self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0) -> float:
         """Largest speed of any point of a ball attached to the moving frame, at any time.
 
-        Args:
-            point: (3,) centre of the attached ball in the moving frame [m].
-            radius: radius of the attached ball [m], ≥ 0.
+        Parameters
+        ----------
+        point: (3,) centre of the attached ball in the moving frame [m].
+        radius: radius of the attached ball [m], ≥ 0.
 
-        Returns:
-            An upper bound [m/s] of the world speed of every point of the ball, valid for every
-            real t (used by the continuous-time certificate).
+        Returns
+        -------
+        An upper bound [m/s] of the world speed of every point of the ball, valid for every
+        real t (used by the continuous-time certificate).
         """
 
 
@@ -136,8 +142,9 @@ def check_ball(point: Any, radius: Any) -> tuple[np.ndarray, float]:
 class FixedPose(MotionLaw):
     """A frame that does not move.
 
-    Attributes:
-        transform: (4, 4) rigid world pose of the frame (rotation, translation [m]).
+    Attributes
+    ----------
+    transform: (4, 4) rigid world pose of the frame (rotation, translation [m]).
     """
 
     transform: np.ndarray
@@ -212,15 +219,16 @@ class PendulumMotion(MotionLaw):
     the swing plane) and its x axis completing the right-handed frame (``e_swing`` at φ = 0).
     The bob centre is at ``(0, 0, −l)`` and the rod's midpoint at ``(0, 0, −l/2)`` in it.
 
-    Attributes:
-        pivot: (3,) world position of the pivot [m].
-        length: rod length l, pivot to bob centre [m]; positive.
-        v0: bob speed amplitude [m/s]; ≥ 0 and ``v0² / (2 g) ≤ 2 l`` (the bob cannot rise
-            above the pivot's top).
-        omega: angular frequency ω of the speed law [rad/s]; positive.
-        g: gravitational acceleration [m/s²]; positive.
-        swing_axis: (3,) horizontal direction ``e_swing`` of the swing plane (any length, must
-            be non-zero with zero z component); stored normalised.
+    Attributes
+    ----------
+    pivot: (3,) world position of the pivot [m].
+    length: rod length l, pivot to bob centre [m]; positive.
+    v0: bob speed amplitude [m/s]; ≥ 0 and ``v0² / (2 g) ≤ 2 l`` (the bob cannot rise
+        above the pivot's top).
+    omega: angular frequency ω of the speed law [rad/s]; positive.
+    g: gravitational acceleration [m/s²]; positive.
+    swing_axis: (3,) horizontal direction ``e_swing`` of the swing plane (any length, must
+        be non-zero with zero z component); stored normalised.
     """
 
     pivot: np.ndarray
@@ -310,11 +318,13 @@ class PendulumMotion(MotionLaw):
 
         Positive φ moves the bob towards ``+swing_axis``.
 
-        Args:
-            t: times [s], any shape (...).
+        Parameters
+        ----------
+        t: times [s], any shape (...).
 
-        Returns:
-            (...) angles [rad], ``φ = sign(cos ω t) · arccos(1 − h/l) = 2 arcsin(a cos ω t)``.
+        Returns
+        -------
+        (...) angles [rad], ``φ = sign(cos ω t) · arccos(1 − h/l) = 2 arcsin(a cos ω t)``.
         """
         times = as_times(t)
         s = np.clip(self._amplitude_factor * np.cos(self.omega * times), -1.0, 1.0)
@@ -355,12 +365,14 @@ class PendulumMotion(MotionLaw):
     def pose(self, t: Any) -> np.ndarray:
         """World pose of the pendulum frame (origin at the pivot, z along the rod upwards).
 
-        Args:
-            t: times [s], any shape (...).
+        Parameters
+        ----------
+        t: times [s], any shape (...).
 
-        Returns:
-            (..., 4, 4) transforms; columns x = cos φ e_swing + sin φ e_z, y = e_n,
-            z = −sin φ e_swing + cos φ e_z, translation = pivot.
+        Returns
+        -------
+        (..., 4, 4) transforms; columns x = cos φ e_swing + sin φ e_z, y = e_n,
+        z = −sin φ e_swing + cos φ e_z, translation = pivot.
         """
         phi = self.angle(t)
         c, s, out = np.cos(phi), np.sin(phi), np.empty((*phi.shape, 4, 4))

@@ -13,8 +13,8 @@ overlapping an occupied cell is a collision (distance ≤ 0).
 with the distance from its centre to the nearest occupied cell's), so a robot near a cloud
 that surrounds it (a scanned fence) is bounded away from it without a coal call. Where a
 solid comes within the checker's influence distance of the cells, coal's octree distance
-is called: 0.3–12 ms a call on 10⁶ points (``docs/scene-files.md``), 100× a primitive
-pair, so a dense cloud right at the path is slow to plan against.
+is called, far costlier than for a primitive pair (``benchmarks/bench_cells.py``,
+``docs/performance.md``), so a dense cloud right at the path is slow to plan against.
 
 Files: ``.ply`` (ASCII or binary, the vertex element's x, y, z), ``.pcd`` (ASCII or binary,
 fields x, y, z), ``.xyz`` (text, the first three numbers of each line), ``.npy`` ((n, 3)
@@ -61,10 +61,11 @@ def cloud_bytes(n_points: int) -> int:
 class PointCloud(Shape):
     """Points in the cloud's frame, as an octree of cells of edge ``resolution``.
 
-    Attributes:
-        points: (n, 3) points [m], n ≥ 1.
-        resolution: r, the octree's cell edge [m], positive.
-        source: the file it was read from ("" if built from an array).
+    Attributes
+    ----------
+    points: (n, 3) points [m], n ≥ 1.
+    resolution: r, the octree's cell edge [m], positive.
+    source: the file it was read from ("" if built from an array).
     """
 
     points: np.ndarray
@@ -165,12 +166,15 @@ def _coarse_field(points: np.ndarray, r: float, lo: np.ndarray, hi: np.ndarray) 
 def read_cloud_points(path: str | os.PathLike[str], *, budget: int | None = None) -> np.ndarray:
     """The points (n, 3) [file units] of a cloud file (module docstring).
 
-    Raises:
-        MeshFileError: missing file, unknown suffix, a malformed header or data, no point
-            (the message names the file).
-        ResourceLimitError: the cloud's octree would need more memory than ``budget`` [B]
-            (default :func:`~adept_traj.memory.memory_budget`), from the header's point
-            count, before the data is read.
+    Raises
+    ------
+    MeshFileError
+        missing file, unknown suffix, a malformed header or data, no point
+        (the message names the file).
+    ResourceLimitError
+        the cloud's octree would need more memory than ``budget`` [B]
+        (default :func:`~adept_traj.memory.memory_budget`), from the header's point
+        count, before the data is read.
     """
     p = Path(path)
     suffix = p.suffix.lower()

@@ -49,12 +49,13 @@ _COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw")
 class RecordedMotion(MotionLaw):
     """Poses recorded at increasing times, interpolated (module docstring).
 
-    Attributes:
-        times: (n,) strictly increasing times [s], n ≥ 2 (absolute scene time).
-        xyz: (n, 3) positions of the frame's origin [m].
-        rpy: (n, 3) orientations, URDF roll-pitch-yaw [rad].
-        periodic: repeat the record with period ``times[-1] - times[0]``.
-        source: the CSV file it was read from ("" if built from arrays).
+    Attributes
+    ----------
+    times: (n,) strictly increasing times [s], n ≥ 2 (absolute scene time).
+    xyz: (n, 3) positions of the frame's origin [m].
+    rpy: (n, 3) orientations, URDF roll-pitch-yaw [rad].
+    periodic: repeat the record with period ``times[-1] - times[0]``.
+    source: the CSV file it was read from ("" if built from arrays).
     """
 
     times: np.ndarray
@@ -200,10 +201,12 @@ def read_pose_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray,
     the columns ``t, x, y, z, roll, pitch, yaw`` (an optional header line with exactly
     these names; ``#`` comment lines and blank lines skipped).
 
-    Raises:
-        MotionFileError: missing or unreadable file, a row without 7 finite numbers, fewer
-            than 2 rows, more than :data:`MAX_RECORDED_POSES`, or a time not greater than
-            the one before (the message names the file and the line).
+    Raises
+    ------
+    MotionFileError
+        missing or unreadable file, a row without 7 finite numbers, fewer
+        than 2 rows, more than :data:`MAX_RECORDED_POSES`, or a time not greater than
+        the one before (the message names the file and the line).
     """
     p = Path(path)
     raw = read_bytes_bounded(p, MotionFileError, what="recorded-motion CSV")

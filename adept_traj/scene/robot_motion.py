@@ -53,10 +53,11 @@ def load_robot(source: RobotSource) -> Robot:
 class JointTrajectory(_ValueObject):
     """A joint table, interpolated linearly and held outside it.
 
-    Attributes:
-        times: (n,) strictly increasing times [s] (absolute scene time), n ≥ 2.
-        q: (n, nq) joint positions [rad | m].
-        source: the CSV it was read from ("" if built from arrays).
+    Attributes
+    ----------
+    times: (n,) strictly increasing times [s] (absolute scene time), n ≥ 2.
+    q: (n, nq) joint positions [rad | m].
+    source: the CSV it was read from ("" if built from arrays).
     """
 
     times: np.ndarray
@@ -138,12 +139,13 @@ def _shape(geometry: Any, name: str) -> Shape:
 class RobotSolidMotion(MotionLaw):
     """World pose of collision solid ``solid`` of a robot following a joint trajectory.
 
-    Attributes:
-        source: the robot's files (:class:`~adept_traj.robot.RobotSource`).
-        trajectory: its :class:`JointTrajectory` (nq columns, the robot's joint order).
-        solid: index of the solid in the robot's collision model.
-        base: (4, 4) world pose of the robot's base frame [m].
-        group: the name of the robot in the scene (its obstacles' prefix).
+    Attributes
+    ----------
+    source: the robot's files (:class:`~adept_traj.robot.RobotSource`).
+    trajectory: its :class:`JointTrajectory` (nq columns, the robot's joint order).
+    solid: index of the solid in the robot's collision model.
+    base: (4, 4) world pose of the robot's base frame [m].
+    group: the name of the robot in the scene (its obstacles' prefix).
     """
 
     source: RobotSource

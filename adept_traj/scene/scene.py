@@ -59,12 +59,13 @@ class Obstacle(_ValueObject):
 
     The world pose of the shape's frame at time t is ``motion.pose(t) @ offset``.
 
-    Attributes:
-        name: unique (within a scene), non-empty name.
-        shape: the solid, centred on its own frame (see :mod:`adept_traj.scene.shapes`).
-        motion: world pose of the moving frame over time; default: fixed at the origin.
-        offset: (4, 4) rigid pose of the shape's frame in the motion's frame [m]; default
-            identity. Lets several obstacles share one motion law (a pendulum's rod and bob).
+    Attributes
+    ----------
+    name: unique (within a scene), non-empty name.
+    shape: the solid, centred on its own frame (see :mod:`adept_traj.scene.shapes`).
+    motion: world pose of the moving frame over time; default: fixed at the origin.
+    offset: (4, 4) rigid pose of the shape's frame in the motion's frame [m]; default
+        identity. Lets several obstacles share one motion law (a pendulum's rod and bob).
     """
 
     name: str
@@ -88,21 +89,24 @@ class Obstacle(_ValueObject):
     def pose(self, t: Any) -> np.ndarray:
         """World pose of the shape's frame.
 
-        Args:
-            t: times [s], any shape (...); e.g. (n,).
+        Parameters
+        ----------
+        t: times [s], any shape (...); e.g. (n,).
 
-        Returns:
-            (..., 4, 4) homogeneous transforms (a new array).
+        Returns
+        -------
+        (..., 4, 4) homogeneous transforms (a new array).
         """
         return self.motion.pose(t) @ self.offset
 
     def swept_ball(self) -> tuple[np.ndarray, float]:
         """A fixed ball containing the obstacle at every time (for a broad phase).
 
-        Returns:
-            ``(centre, radius)``: (3,) world centre [m] and radius [m]. For a fixed obstacle
-            it is the shape's bounding ball; for a moving one, a ball containing that
-            bounding ball over the whole motion (see :meth:`MotionLaw.swept_ball`).
+        Returns
+        -------
+        ``(centre, radius)``: (3,) world centre [m] and radius [m]. For a fixed obstacle
+        it is the shape's bounding ball; for a moving one, a ball containing that
+        bounding ball over the whole motion (see :meth:`MotionLaw.swept_ball`).
         """
         return self.motion.swept_ball(self.offset[:3, 3], self.shape.bounding_radius)
 
@@ -112,17 +116,18 @@ def pendulum_obstacles(
 ) -> tuple[Obstacle, Obstacle]:
     """The two obstacles of a pendulum, sharing its motion law: its rod and its bob.
 
-    Args:
-        name: the pendulum's name; the obstacles are named ``name + ".rod"`` and
-            ``name + ".bob"``.
-        motion: the pendulum's motion law.
-        bob_radius: radius of the spherical bob [m].
-        rod_radius: radius of the cylindrical rod [m] (default 0.01).
+    Parameters
+    ----------
+    name: the pendulum's name; the obstacles are named ``name + ".rod"`` and ``name + ".bob"``.
+    motion: the pendulum's motion law.
+    bob_radius: radius of the spherical bob [m].
+    rod_radius: radius of the cylindrical rod [m] (default 0.01).
 
-    Returns:
-        ``(rod, bob)``. The rod is a :class:`Cylinder` of length l from the pivot to the bob
-        centre: its centre at the middle of pivot–bob, its z axis along the rod. The bob is a
-        :class:`Sphere` centred at :meth:`PendulumMotion.bob_position`.
+    Returns
+    -------
+    ``(rod, bob)``. The rod is a :class:`Cylinder` of length l from the pivot to the bob
+    centre: its centre at the middle of pivot–bob, its z axis along the rod. The bob is a
+    :class:`Sphere` centred at :meth:`PendulumMotion.bob_position`.
     """
     check_type(motion, PendulumMotion, "motion")
     if not isinstance(name, str) or not name:
@@ -193,16 +198,16 @@ def _as_joint_vector(value: Any, name: str) -> np.ndarray:
 class Scene(_ValueObject):
     """Obstacles, robot base pose and an optional default task, in the world frame.
 
-    Attributes:
-        obstacles: the obstacles (tuple; names unique).
-        robot_base: (4, 4) rigid pose of the robot base frame in the world [m]; default
-            identity.
-        start: optional (nq,) default start configuration, in the robot's joint order
-            [rad for revolute, m for prismatic joints]; given together with ``goal``.
-        goal: optional (nq,) default goal configuration, same length as ``start``.
-        name: the scene's name.
-        allowed_contacts: ``(robot link, obstacle)`` name pairs never checked (a floor under
-            the base): the link's solids and the obstacle count as always clear.
+    Attributes
+    ----------
+    obstacles: the obstacles (tuple; names unique).
+    robot_base: (4, 4) rigid pose of the robot base frame in the world [m]; default identity.
+    start: optional (nq,) default start configuration, in the robot's joint order
+        [rad for revolute, m for prismatic joints]; given together with ``goal``.
+    goal: optional (nq,) default goal configuration, same length as ``start``.
+    name: the scene's name.
+    allowed_contacts: ``(robot link, obstacle)`` name pairs never checked (a floor under
+        the base): the link's solids and the obstacle count as always clear.
 
     Array-like inputs are copied into new read-only arrays.
     """
@@ -288,13 +293,15 @@ class Scene(_ValueObject):
     def obstacle_poses(self, t: Any, *, in_base_frame: bool = False) -> np.ndarray:
         """Poses of every obstacle at times ``t``.
 
-        Args:
-            t: times [s], any shape (...); e.g. (n,).
-            in_base_frame: if True, poses relative to the robot base frame
-                (``inv(robot_base) @ world pose``); else world poses.
+        Parameters
+        ----------
+        t: times [s], any shape (...); e.g. (n,).
+        in_base_frame: if True, poses relative to the robot base frame
+            (``inv(robot_base) @ world pose``); else world poses.
 
-        Returns:
-            (n_obs, ..., 4, 4) homogeneous transforms, obstacles in scene order.
+        Returns
+        -------
+        (n_obs, ..., 4, 4) homogeneous transforms, obstacles in scene order.
         """
         times = as_finite_array(t, "t")
         if not self.obstacles:
@@ -331,8 +338,10 @@ class Scene(_ValueObject):
         ``"detour"`` (the paper's cell with a post on the straight path and the pendulum
         across the arm's way on fast moves: ``docs/detour-scene.md``).
 
-        Raises:
-            SceneError: ``name`` is not one of ``adept_traj.scene.SHIPPED_SCENES``.
+        Raises
+        ------
+        SceneError
+            ``name`` is not one of ``adept_traj.scene.SHIPPED_SCENES``.
         """
         from adept_traj.scene.scene_file import read_shipped_scene
 
@@ -342,12 +351,14 @@ class Scene(_ValueObject):
     def from_file(cls, path: str | os.PathLike[str]) -> Scene:
         """Read a TOML scene file (format: ``docs/scene-files.md``).
 
-        Raises:
-            SceneFileNotFoundError: the file does not exist.
-            SceneError: the file cannot be read, is not valid TOML (the message gives the
-                line and column), or does not describe a valid scene; the message names the
-                file, the entry (obstacle or pendulum, by name or 1-based position) and the
-                field.
+        Raises
+        ------
+        SceneFileNotFoundError
+            the file does not exist.
+        SceneError
+            the file cannot be read, is not valid TOML (the message gives the line and column),
+            or does not describe a valid scene; the message names the file, the entry (obstacle
+            or pendulum, by name or 1-based position) and the field.
         """
         from adept_traj.scene.scene_file import read_scene_file
 
@@ -357,14 +368,17 @@ class Scene(_ValueObject):
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
         """Build a scene from the parsed content of a scene file.
 
-        Args:
-            data: mapping with the scene-file schema (what ``tomllib`` returns).
-            source: name used in error messages (a file name).
+        Parameters
+        ----------
+        data: mapping with the scene-file schema (what ``tomllib`` returns).
+        source: name used in error messages (a file name).
 
-        Raises:
-            ResourceLimitError: more than :data:`MAX_OBSTACLES` obstacles (checked before
-                any is built).
-            SceneError: ``data`` does not describe a valid scene.
+        Raises
+        ------
+        ResourceLimitError
+            more than :data:`MAX_OBSTACLES` obstacles (checked before any is built).
+        SceneError
+            ``data`` does not describe a valid scene.
         """
         from adept_traj.scene.scene_file import scene_from_dict
 
@@ -377,8 +391,10 @@ class Scene(_ValueObject):
         ``Scene.from_dict(scene.to_dict())`` describes the same scene (see
         :func:`adept_traj.scene.scene_file.scene_to_dict`).
 
-        Raises:
-            SceneError: an obstacle cannot be expressed in a scene file.
+        Raises
+        ------
+        SceneError
+            an obstacle cannot be expressed in a scene file.
         """
         from adept_traj.scene.scene_file import scene_to_dict
 

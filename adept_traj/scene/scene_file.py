@@ -78,10 +78,13 @@ _HEADER = (
 def read_scene_file(path: str | os.PathLike[str]) -> Scene:
     """Read a TOML scene file (what :meth:`Scene.from_file` does).
 
-    Raises:
-        SceneFileNotFoundError: the file does not exist.
-        SceneError: the file cannot be read, is not valid TOML (the message gives the line
-            and column), or does not describe a valid scene.
+    Raises
+    ------
+    SceneFileNotFoundError
+        the file does not exist.
+    SceneError
+        the file cannot be read, is not valid TOML (the message gives the line
+        and column), or does not describe a valid scene.
     """
     p = Path(path)
     data = read_toml(p, SceneError, not_found=SceneFileNotFoundError, what="scene file")
@@ -141,10 +144,12 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     obstacle's ``offset`` is folded into its pose), pendulums ``[[pendulum]]`` entries.
     Poses are written as xyz [m] + rpy [rad], so rotations round-trip to rounding (~1e-16).
 
-    Raises:
-        SceneError: an obstacle cannot be expressed in a scene file: a motion law other than
-            FixedPose / PendulumMotion, or a pendulum-moved obstacle that is not one of a
-            rod/bob pair made by :func:`~adept_traj.scene.pendulum_obstacles`.
+    Raises
+    ------
+    SceneError
+        an obstacle cannot be expressed in a scene file: a motion law other than
+        FixedPose / PendulumMotion, or a pendulum-moved obstacle that is not one of a
+        rod/bob pair made by :func:`~adept_traj.scene.pendulum_obstacles`.
     """
     out: dict[str, Any] = {"name": scene.name}
     xyz, rpy = xyz_rpy_from_transform(scene.robot_base)

@@ -68,11 +68,13 @@ def _store_positive_lengths(shape: Shape, *names: str) -> None:
 def coal_transform(transform: np.ndarray) -> coal.Transform3s:
     """Return the coal rigid transform of a homogeneous transform.
 
-    Args:
-        transform: (4, 4) homogeneous transform (rotation block and translation [m]).
+    Parameters
+    ----------
+    transform: (4, 4) homogeneous transform (rotation block and translation [m]).
 
-    Returns:
-        A new :class:`coal.Transform3s` with the same rotation and translation.
+    Returns
+    -------
+    A new :class:`coal.Transform3s` with the same rotation and translation.
     """
     t = as_finite_array(transform, "transform")
     if t.shape != (4, 4):
@@ -102,8 +104,9 @@ class Shape(_ValueObject, ABC):
 class Box(Shape):
     """Rectangular box centred on the origin, edges along the local axes.
 
-    Attributes:
-        size: (3,) full side lengths along local x, y, z [m]; positive, finite.
+    Attributes
+    ----------
+    size: (3,) full side lengths along local x, y, z [m]; positive, finite.
     """
 
     size: np.ndarray
@@ -130,8 +133,9 @@ class Box(Shape):
 class Sphere(Shape):
     """Sphere centred on the origin.
 
-    Attributes:
-        radius: radius [m]; positive, finite.
+    Attributes
+    ----------
+    radius: radius [m]; positive, finite.
     """
 
     radius: float
@@ -154,9 +158,10 @@ class Sphere(Shape):
 class Cylinder(Shape):
     """Solid cylinder centred on the origin, axis along local z (as :class:`coal.Cylinder`).
 
-    Attributes:
-        radius: radius [m]; positive, finite.
-        length: full length along local z [m] (from z = -length/2 to +length/2); positive.
+    Attributes
+    ----------
+    radius: radius [m]; positive, finite.
+    length: full length along local z [m] (from z = -length/2 to +length/2); positive.
     """
 
     radius: float
@@ -180,11 +185,12 @@ class Cylinder(Shape):
 class Capsule(Shape):
     """Capsule (a segment swept by a ball) centred on the origin, axis along local z.
 
-    Attributes:
-        radius: radius of the swept ball [m]; positive, finite.
-        length: length of the axis segment [m], excluding the two hemispherical caps (as
-            :class:`coal.Capsule`); the capsule's total extent along z is
-            ``length + 2 * radius``. Positive.
+    Attributes
+    ----------
+    radius: radius of the swept ball [m]; positive, finite.
+    length: length of the axis segment [m], excluding the two hemispherical caps (as
+        :class:`coal.Capsule`); the capsule's total extent along z is
+        ``length + 2 * radius``. Positive.
     """
 
     radius: float

@@ -17,8 +17,9 @@ def box_mesh(size, subdivisions: int = 1, centre=(0.0, 0.0, 0.0)):
     """A closed, outward-oriented box mesh of full side lengths ``size`` (3,) [m] about
     ``centre`` (3,) [m], each face cut into s × s squares, s = ``subdivisions`` (12·s² triangles).
 
-    Returns:
-        (vertices (n, 3) [m], triangles (m, 3) int), vertices shared between faces.
+    Returns
+    -------
+    (vertices (n, 3) [m], triangles (m, 3) int), vertices shared between faces.
     """
     s = int(subdivisions)
     h = 0.5 * np.asarray(size, dtype=float)

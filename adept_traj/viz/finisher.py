@@ -1,13 +1,13 @@
 """The end of a run written by a helper process prepared while the run goes on:
 :func:`start_finisher`, :class:`Finisher`.
 
-A run's figures and ``playback.html`` need matplotlib and meshcat, whose imports
-(≈ 0.3 s each) used to come after the optimiser. :func:`start_finisher` forks a helper
+A run's figures and ``playback.html`` need matplotlib and meshcat, whose slow imports
+used to come after the optimiser. :func:`start_finisher` forks a helper
 process from the caller once the robot and scene exist (before the optimiser's workers);
 a thread of the helper imports the drawing modules at the lowest priority (nice 19: it
 runs while a core idles and never takes one from the optimiser), and the helper then
 waits. :meth:`Finisher.start` hands it the finished results over a pipe (pickled: about
-0.4 MB and 1 ms for the paper run); the helper builds each
+0.4 MB for the paper run); the helper builds each
 :class:`~adept_traj.results.Replay` from the robot and scene it inherited (nothing is
 reloaded) and writes the figures (:func:`adept_traj.viz.plots.save_all`, its second
 share in its own fork) and the page (:func:`adept_traj.viz.meshcat_scene.static_html`),

@@ -1,6 +1,6 @@
 """Many panels on ONE hidden matplotlib ``Axes``: its cells, their tick values and labels.
 
-A matplotlib ``Axes`` costs about 25 ms to make and draw (its axis objects, ticks and
+A matplotlib ``Axes`` is costly to make and draw (its axis objects, ticks and
 spines), so the figures with many panels (the Pareto matrix: 36, the joint motion: 20)
 draw every panel as a cell of one ``Axes`` with its own scale, each kind of line as one
 collection over all the cells, and only the tick labels that are seen as text.
@@ -50,7 +50,7 @@ def tick_labels(
     factor text (``""`` if none) of a ``ScalarFormatter``.
 
     ``power_of_ten``: a factor written ``×10³`` (Unicode, as ``useMathText`` shows it but
-    without mathtext, whose parser costs about 0.07 s on a figure's first use) instead of
+    without mathtext, whose parser is slow on a figure's first use) instead of
     ``1e3``. ``power_limits``: the exponents (low, high) outside which a factor is used
     (``ScalarFormatter.set_powerlimits``; default matplotlib's, −5 and 6).
 

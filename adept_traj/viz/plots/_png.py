@@ -1,9 +1,9 @@
 """A figure's Agg pixels as a PNG file, encoded with numpy and zlib.
 
 matplotlib's ``savefig`` hands the (h, w, 4) RGBA buffer to Pillow, whose PNG encoder
-chooses a row filter per row by trying all five (about 60 ms for a 1650 × 1650 figure at
-any zlib level). The figures are opaque line art on white: rows unfiltered, RGB when every
-pixel is opaque, compress 2–3× faster into smaller files, with the same pixels.
+chooses a row filter per row by trying all five (slow at any zlib level). The figures are
+opaque line art on white: rows unfiltered, RGB when every pixel is opaque, compress faster
+into smaller files, with the same pixels.
 """
 
 from __future__ import annotations
