@@ -53,6 +53,7 @@ from adept_traj.optimise.mating import (
     ArrayMating,
 )
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
+from adept_traj.optimise.minimum_time import PolishOutcome, minimum_time
 from adept_traj.optimise.mutation import (
     mutate,
 )
@@ -64,11 +65,9 @@ from adept_traj.optimise.polish import (
     MAX_BASINS,
     STRETCHES,
     GlobalStage,
-    PolishOutcome,
     fastest_of_basins,
     global_stage,
     global_starts,
-    minimum_time,
     time_optimal,
 )
 from adept_traj.optimise.polish_step import (

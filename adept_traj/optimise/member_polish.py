@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.polish import PolishOutcome
+from adept_traj.optimise.minimum_time import PolishOutcome
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.problem import MAXIMISED, local_constraints, objective_gradients
 from adept_traj.robot import VELOCITY_AT_REST

@@ -1,22 +1,6 @@
-r"""Gradient-based polishing: the fastest move near a given one (SLSQP).
-
-:func:`minimum_time` solves, from a start vector :math:`x_0`,
-
-.. math::
-    \min_{x = [T, P]} T \quad \text{s.t.} \quad g_k(x) \le 0 \ \ \forall k, \qquad
-    x_l \le x \le x_u,
-
-with the smooth per-sample constraints :math:`g_k` of
-:func:`~adept_traj.problem.local_constraints` (velocity, acceleration, jerk, torque and
-distance per sample; exact Jacobians up to the state derivatives of the dynamics and the
-distances, see :mod:`adept_traj.problem.gradients`) by scipy's SLSQP (sequential quadratic
-programming; ``scipy.optimize`` is imported when first used). IPOPT (cyipopt) has no wheel
-for this platform and is not offered. The solver's answer is then made kinematically exact:
-T is raised to the spline's exact kinematic minimum :math:`T_{kin}(P)`
-(:func:`~adept_traj.optimise.kinematic_time`) if the velocity samples missed a peak, and
-the move is evaluated by the problem itself; the caller certifies it
-(:func:`~adept_traj.analysis.certify`): the certificate, not the solver, decides
-feasibility.
+r"""The time-optimal mode and the polish's fastest basins: multi-start certified local
+solves (:func:`time_optimal`, :func:`fastest_of_basins`) and the global stage
+(:func:`global_stage`).
 
 :func:`time_optimal` runs the certified local solver
 (:func:`~adept_traj.optimise.refine_minimum_time`) from several starts — the straight move
@@ -25,7 +9,7 @@ and the ``n_starts − 1`` kinematically fastest of 8 × (``n_starts`` − 1) ra
 at its kinematic minimum T — and returns every outcome. When none of them ends certified
 within :data:`~adept_traj.optimise.GLOBAL_GAP` of the kinematic lower bound (the straight
 move blocked, as on the detour scene), it adds the refinements of the global stage's
-starts (:func:`~adept_traj.optimise.via_point_starts`; ``docs/engine.md``). Everything is
+starts (:func:`global_stage`; ``docs/engine.md``). Everything is
 deterministic: the same problem and seed give the same vectors.
 """
 
@@ -33,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,18 +32,16 @@ from adept_traj.optimise.refinement import (
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
-from adept_traj.problem import CONSTRAINT_KINDS, TrajectoryProblem, local_constraints
-from adept_traj.validation import as_integer, as_scalar, as_vector
+from adept_traj.problem import CONSTRAINT_KINDS, TrajectoryProblem
+from adept_traj.validation import as_integer
 
 __all__ = [
     "MAX_BASINS",
     "STRETCHES",
     "GlobalStage",
-    "PolishOutcome",
     "fastest_of_basins",
     "global_stage",
     "global_starts",
-    "minimum_time",
     "time_optimal",
 ]
 
@@ -79,87 +60,6 @@ STRETCHES = (1.0, 1.1, 1.25)
 
 #: Index of the distance rows in :data:`~adept_traj.problem.CONSTRAINT_KINDS`.
 _DISTANCE = CONSTRAINT_KINDS.index("distance")
-
-
-@dataclass(frozen=True)
-class PolishOutcome:
-    """One local solve.
-
-    Attributes
-    ----------
-    x:
-        (n_var,) the polished decision vector (T raised to its kinematic minimum if needed).
-    objectives, constraints:
-        (6,) z1…z6 and (n_constr,) constraints of ``x`` by the problem's evaluator.
-    feasible:
-        True when every evaluator constraint of ``x`` is ≤ 0 (not yet a certificate).
-    start:
-        (n_var,) the start vector.
-    n_iterations:
-        SLSQP iterations.
-    n_evaluations:
-        Constraint-and-Jacobian evaluations of the solver plus the final evaluation.
-    seconds:
-        Wall time [s] of the solve.
-    evaluation_s:
-        The part of ``seconds`` spent evaluating constraints, Jacobians and the result [s].
-    message:
-        SLSQP's exit message.
-    """
-
-    x: np.ndarray
-    objectives: np.ndarray
-    constraints: np.ndarray
-    feasible: bool
-    start: np.ndarray
-    n_iterations: int
-    n_evaluations: int
-    seconds: float
-    evaluation_s: float
-    message: str
-
-
-def minimum_time(
-    problem: Any, x0: Any, *, max_iter: int = 100, tol: float = 1e-10, buffer: float = 0.0
-) -> PolishOutcome:
-    """The fastest move near ``x0`` (n_var,) subject to every constraint (see the module
-    docstring).
-
-    Parameters
-    ----------
-    problem:
-        The :class:`~adept_traj.problem.TrajectoryProblem`.
-    x0:
-        (n_var,) start ``[T [s], free control points [rad | m]]``, inside the bounds.
-    max_iter:
-        Most SLSQP iterations (≥ 1).
-    tol:
-        SLSQP's ``ftol`` on the travel time [s] (> 0).
-    buffer:
-        Distance [m] (≥ 0) the solve adds to the problem's margin and search buffer in its
-        distance rows (the final evaluation uses the problem's own): room for the corners
-        a fast move cuts between the samples.
-
-    When SLSQP ends outside the constraints (from a detour its iterates may cross an
-    obstacle and stop there), the fastest point it visited inside every per-sample
-    constraint is returned instead, evaluated (the start when it was inside).
-    """
-    x0 = as_vector(x0, "x0", problem.n_var)
-    max_iter = as_integer(max_iter, "max_iter", minimum=1, error=ConfigurationError)
-    tol = as_scalar(tol, "tol", minimum=0.0, error=ConfigurationError)
-    buffer = as_scalar(buffer, "buffer", "m", minimum=0.0, error=ConfigurationError)
-    if tol <= 0.0:
-        raise ConfigurationError(f"tol must be > 0 [s]; got {tol}")
-    if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
-        raise ConfigurationError("x0 must lie inside the decision bounds (problem.xl, problem.xu)")
-    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
-    from threadpoolctl import threadpool_limits  # lazy, as scipy.optimize
-
-    # One BLAS thread: a multi-threaded BLAS sums in an order that depends on its thread
-    # count, and SLSQP amplifies the last-bit differences (a move polished in a Dask worker,
-    # single-threaded, differed from the same move polished here at 1e-13 s).
-    with threadpool_limits(limits=1, user_api="blas"):
-        return _minimum_time(problem, x0, max_iter, tol, buffer)
 
 
 def time_optimal(
@@ -249,9 +149,7 @@ def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) ->
     :data:`~adept_traj.optimise.GLOBAL_SEED` (a function of the problem alone). Without
     moving obstacles, or when the relaxed problem has no certified move, the floor is 0.
 
-    Measured on the detour scene: the fixed-obstacle optimum refined with the pendulum
-    comes within 0.2 % of it, where NSGA-II's own members end at 1.55 s and the via points
-    mostly at 1.64–1.66 s (``docs/detour-scene.md``)."""
+    Measured figures on the detour scene: ``docs/detour-scene.md``."""
     via = via_point_starts(problem, GLOBAL_SEED, n_starts=n_starts)
     relaxed, floor = np.empty((0, problem.n_var)), 0.0
     scene = problem.scene
@@ -325,8 +223,7 @@ def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
     """(n_starts, n_var): the straight move, then the ``n_starts − 1`` ramps of smallest
     kinematic minimum T among ``_RAMPS_PER_START`` × as many seeded ramps, each at its
     kinematic minimum T (SLSQP from a slow detour rarely converges in a few dozen
-    iterations; measured on the paper scene: every ramp start with T_kin ≤ 1.4 s reached
-    the optimum, none above 1.8 s)."""
+    iterations: ``docs/engine.md``)."""
     traj = problem.trajectory
     straight = traj.straight_line(problem.xl[0])[None]
     n_ramps = _RAMPS_PER_START * (n_starts - 1)
@@ -337,75 +234,3 @@ def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
     x, t_kin = x[order], t_kin[order]
     x[:, 0] = np.clip(t_kin * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
     return x
-
-
-def _minimum_time(
-    problem: Any, x0: np.ndarray, max_iter: int, tol: float, buffer: float
-) -> PolishOutcome:
-    from scipy.optimize import minimize  # lazy: scipy.optimize is heavy
-
-    started = time.perf_counter()
-    cache: dict[bytes, Any] = {}
-
-    def constraints(x: np.ndarray) -> Any:
-        key = x.tobytes()
-        if key not in cache:
-            cache.clear()
-            tic = time.perf_counter()
-            xc = np.clip(x, problem.xl, problem.xu)
-            lc = local_constraints(problem, xc)
-            cache[key] = (lc.values[0] + extra * (lc.kind == _DISTANCE), lc.jacobian[0])
-            counter[0] += 1
-            spent[0] += time.perf_counter() - tic
-            if np.all(lc.values[0] <= 0.0) and (safe[0] is None or xc[0] < safe[0][0]):
-                safe[0] = xc  # the fastest point found within the problem's constraints
-        return cache[key]
-
-    counter, spent, safe = [0], [0.0], [None]
-    extra = buffer / problem.settings.influence  # distance rows are scaled by influence
-    grad = np.zeros(problem.n_var)
-    grad[0] = 1.0
-    res = minimize(
-        lambda x: x[0],
-        x0,
-        jac=lambda x: grad,
-        method="SLSQP",
-        bounds=list(zip(problem.xl, problem.xu)),
-        constraints=[
-            {
-                "type": "ineq",  # scipy: fun(x) ≥ 0
-                "fun": lambda x: -constraints(x)[0],
-                "jac": lambda x: -constraints(x)[1],
-            }
-        ],
-        options={"maxiter": max_iter, "ftol": tol},
-    )
-    x, ev = _evaluated(problem, res.x)
-    spent[0] += ev.seconds
-    if np.any(ev.constraints > 0.0) and safe[0] is not None:
-        # SLSQP ended outside (from a detour its iterates cross an obstacle and stop there):
-        # the fastest point it visited inside every per-sample constraint instead.
-        x, ev = _evaluated(problem, safe[0])
-        counter[0] += 1
-        spent[0] += ev.seconds
-    return PolishOutcome(
-        x=x,
-        objectives=ev.objectives,
-        constraints=ev.constraints,
-        feasible=bool(np.all(ev.constraints <= 0.0)),
-        start=x0.copy(),
-        n_iterations=int(res.nit),
-        n_evaluations=counter[0] + 1,
-        seconds=time.perf_counter() - started,
-        evaluation_s=spent[0],
-        message=str(res.message),
-    )
-
-
-def _evaluated(problem: Any, x: np.ndarray) -> tuple[np.ndarray, Any]:
-    """``x`` (n_var,) clipped to the bounds with T raised to its kinematic minimum, and its
-    evaluation by the problem."""
-    x = np.clip(x, problem.xl, problem.xu)
-    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
-    x[0] = min(max(x[0], t_kin), problem.xu[0])
-    return x, problem.evaluate_batch(x)

@@ -46,7 +46,8 @@ from adept_traj.analysis.member_certificate import MemberCertificate, certify_me
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.loop import RunState
 from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
-from adept_traj.optimise.polish import PolishOutcome, fastest_of_basins, time_optimal
+from adept_traj.optimise.minimum_time import PolishOutcome
+from adept_traj.optimise.polish import fastest_of_basins, time_optimal
 from adept_traj.optimise.refinement import (
     SCREEN_BOXES,
 )

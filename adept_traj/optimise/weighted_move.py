@@ -52,7 +52,7 @@ import numpy as np
 from adept_traj.analysis.weighted_sum import WeightedSum, weighted_sum
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.member_polish import _start, _threads_limited
-from adept_traj.optimise.polish import PolishOutcome
+from adept_traj.optimise.minimum_time import PolishOutcome
 from adept_traj.optimise.polish_step import _with_members, time_optimal_run
 from adept_traj.problem import from_pymoo
 from adept_traj.validation import as_integer, check_type
