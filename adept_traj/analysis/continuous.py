@@ -71,7 +71,9 @@ __all__ = [
     "DEFAULT_MAX_DEPTH",
     "DistanceGuarantee",
     "continuous_distance",
+    "continuous_distance_with_acceleration",
     "continuous_self_distance",
+    "continuous_self_distance_with_acceleration",
     "obstacle_jump_intervals",
     "obstacle_speeds",
     "solid_lever_arms",
@@ -212,10 +214,12 @@ def continuous_distance(
         :class:`DistanceGuarantee`.
     """
     acc = problem.trajectory.bounds(x).qdd_abs_max
-    return _continuous_distance(problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc)
+    return continuous_distance_with_acceleration(
+        problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc
+    )
 
 
-def _continuous_distance(
+def continuous_distance_with_acceleration(
     problem: TrajectoryProblem,
     x: np.ndarray,
     t: np.ndarray,
@@ -226,10 +230,25 @@ def _continuous_distance(
     exact: bool,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    """:func:`continuous_distance` with the spline's exact largest |q̈| ``acc`` (nq,)
-    [rad/s² | m/s²] (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``.qdd_abs_max``
-    of ``x``) already computed by the caller, :func:`~adept_traj.analysis.certify`. Private:
-    a smaller ``acc`` would void the guarantee."""
+    r""":func:`continuous_distance` with the spline's largest |q̈| already computed by the
+    caller (:func:`~adept_traj.analysis.certify`, which has the spline's bounds of ``x``).
+
+    Parameters
+    ----------
+    problem, x, t, qd, pairs, rate_hz, max_depth, exact:
+        As :func:`continuous_distance`: the problem, the move (n_var,), the sample times
+        (n,) [s], the joint speeds (n, nq) [rad/s | m/s] and the distances (n, n_solids,
+        n_obstacles) [m] there, the grid rate [Hz], the most bisections, exact distances.
+    acc:
+        (nq,) [rad/s² | m/s²] the spline's exact largest :math:`|\ddot q_i|` over the move:
+        :meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``(x).qdd_abs_max``. A smaller
+        value voids the guarantee; pass only that value.
+
+    Returns
+    -------
+    DistanceGuarantee
+        As :func:`continuous_distance`.
+    """
     checker = problem.checker
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
@@ -260,10 +279,12 @@ def continuous_self_distance(
     obstacle speed). The midpoints' distances are exact below the margin, lower bounds
     above it. The returned ``pair`` is ``(pair index, 0)``."""
     acc = problem.trajectory.bounds(x).qdd_abs_max
-    return _continuous_self_distance(problem, x, t, qd, pairs, rate_hz, max_depth, acc)
+    return continuous_self_distance_with_acceleration(
+        problem, x, t, qd, pairs, rate_hz, max_depth, acc
+    )
 
 
-def _continuous_self_distance(
+def continuous_self_distance_with_acceleration(
     problem: TrajectoryProblem,
     x: np.ndarray,
     t: np.ndarray,
@@ -273,8 +294,22 @@ def _continuous_self_distance(
     max_depth: int,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    """:func:`continuous_self_distance` with the exact ``acc`` (nq,) of the caller (as
-    :func:`_continuous_distance`; private for the same reason)."""
+    """:func:`continuous_self_distance` with the spline's largest |q̈| already computed by the
+    caller (as :func:`continuous_distance_with_acceleration`).
+
+    Parameters
+    ----------
+    problem, x, t, qd, pairs, rate_hz, max_depth:
+        As :func:`continuous_self_distance`; ``pairs`` (n, n_pairs) [m].
+    acc:
+        (nq,) [rad/s² | m/s²] :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
+        ``(x).qdd_abs_max``: a smaller value voids the guarantee.
+
+    Returns
+    -------
+    DistanceGuarantee
+        As :func:`continuous_self_distance`.
+    """
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")

@@ -41,12 +41,12 @@ import numpy as np
 from adept_traj.analysis.certificate import (
     DEFAULT_RATE_HZ,
     Certificate,
-    _certify,
+    certify_states,
     check_certificate_memory,
 )
 from adept_traj.analysis.continuous import DEFAULT_MAX_DEPTH
-from adept_traj.analysis.dense_trajectory import _dense_states, batch_samples, dense_samples
-from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, _limits
+from adept_traj.analysis.dense_trajectory import batch_samples, dense_samples, dense_states
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, position_spans
 from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
@@ -204,13 +204,15 @@ def certify_members(
             f"x[{bad[0]}, 0] (travel time T [s]) must be > 0; got {xs[bad[0], 0]!r}"
         )
     fast, influence = certifying_problem(problem)
-    _limits(fast.robot.limits)
+    position_spans(fast.robot.limits)
     for k in rows:  # every member's memory before any is sampled
         check_certificate_memory(fast, rate, float(xs[k, 0]))
     for group in _batches(xs, rows, rate, batch_samples(fast)):
-        states = _dense_states(fast, xs[group], rate, False)
+        states = dense_states(fast, xs[group], rate, False)
         for k, dense in zip(group, states):
-            certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+            certificate = certify_states(
+                fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense
+            )
             out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
 
@@ -249,10 +251,10 @@ def certify_member(
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
     fast, influence = certifying_problem(problem)
-    _limits(fast.robot.limits)
+    position_spans(fast.robot.limits)
     check_certificate_memory(fast, rate, float(xa[0]))
-    dense = _dense_states(fast, xa[None], rate, False)[0]
-    certificate = _certify(fast, xa, rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+    dense = dense_states(fast, xa[None], rate, False)[0]
+    certificate = certify_states(fast, xa, rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
     return MemberCertificate.of(certificate, influence), certificate
 
 

@@ -53,7 +53,7 @@ from pymoo.core.problem import Problem
 from adept_traj.collision import CollisionChecker, self_collision_check
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory
-from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
+from adept_traj.problem.evaluation import Evaluation, concatenate_evaluations, timed_evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator
 from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
 from adept_traj.problem.time_bound import kinematic_lower_bound
@@ -279,7 +279,7 @@ class TrajectoryProblem(Problem):
         xa = as_batch(x, "x", self.n_var)
         start = time.perf_counter()
         ev = self._evaluate_batch(np.atleast_2d(xa))
-        return _finish(ev, start, single=xa.ndim == 1)
+        return timed_evaluation(ev, start, single=xa.ndim == 1)
 
     # ------------------------------------------------------------------ pymoo hook
     def _evaluate(self, x: np.ndarray, out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
@@ -322,7 +322,7 @@ class TrajectoryProblem(Problem):
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
         step = max(1, _BLOCK_SAMPLES // len(self.s))  # equal blocks of at most ≈ 1.5 step
         blocks = [self._evaluate_block(b) for b in np.array_split(x, max(1, round(len(x) / step)))]
-        return blocks[0] if len(blocks) == 1 else _concatenate(blocks)
+        return blocks[0] if len(blocks) == 1 else concatenate_evaluations(blocks)
 
     def _evaluate_block(self, x: np.ndarray) -> Evaluation:
         traj, robot, st = self.trajectory, self.robot, self.settings
