@@ -290,6 +290,8 @@ LONG_MODULES = {
     "samples, exact extrema and integrals), half of it docstrings and math",
     "results/json_codec.py": "the one encoder and decoder of result.json (its certificates in "
     "certificate_codec, JSON values in json_values)",
+    "robot/robot.py": "Robot: construction, its frozen copy (replace) and the batched dynamics, "
+    "kinematics and manipulability, half of it docstrings",
 }
 
 

@@ -31,7 +31,6 @@ compares it field by field.
 from __future__ import annotations
 
 import math
-import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -274,27 +273,17 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
     return batches
 
 
-#: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
-#: itself, not held here, so that the key can die), its influence [m] and what it was made
-#: from (:func:`problem_parts`), made once: it takes ≈ 0.1 s (the broad phase's distance
-#: tables), as much as seven certificates, and the polish certifies its moves one call at a
-#: time.
-_CERTIFYING: weakref.WeakKeyDictionary[
-    Any, tuple[TrajectoryProblem | None, float, tuple[Any, ...]]
-] = weakref.WeakKeyDictionary()
-
-
 def problem_parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """The objects an object derived from ``problem`` is made from — its settings, robot,
-    scene, start and goal — to be compared by identity (:func:`same_parts`): a certifying
-    problem, or a helper process forked with a copy of ``problem``, is stale once one of
-    them was replaced (e.g. ``problem.settings`` with another margin)."""
+    """The objects ``problem`` is made from — its settings, robot, scene, start and goal —
+    to be compared by identity (:func:`same_parts`). The problem is frozen, so they never
+    change for one problem; kept for the polisher's check that it was started for the
+    problem it is given."""
     return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
 
 
 def same_parts(parts: tuple[Any, ...], problem: TrajectoryProblem) -> bool:
-    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts now, object
-    for object."""
+    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts, object for
+    object."""
     now = problem_parts(problem)
     return len(parts) == len(now) and all(a is b for a, b in zip(parts, now))
 
@@ -305,29 +294,24 @@ def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, f
     (never raised; a pair whose broad-phase bound exceeds it needs no coal call; 100
     paper-front certificates: 0.85 s instead of 1.6 s with the default 0.05 m).
 
-    Made once per ``problem`` and kept while ``problem`` lives and its settings, robot,
-    scene, start and goal are the same objects (the same object is returned again; made
-    anew when one of them was replaced, e.g. ``problem.settings`` with another margin; it
-    evaluates in one process and, like ``problem`` itself, is not for use from several
-    threads at once). A caller about to fork certifying processes calls it first, so that
-    they share it.
+    Made once per ``problem`` and kept on it (:meth:`~adept_traj.problem.TrajectoryProblem.derived`:
+    the problem is frozen, so the same object is returned again; it evaluates in one
+    process and, like ``problem`` itself, is not for use from several threads at once). A
+    caller about to fork certifying processes calls it first, so that they share it.
     """
     check_type(problem, TrajectoryProblem, "problem")
-    made = _CERTIFYING.get(problem)
-    if made is None or not same_parts(made[2], problem):
-        fast, influence = _certifying_problem(problem)
-        parts = problem_parts(problem)
-        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence, parts)
-    fast, influence, _ = made
+    key = "analysis.member_certificate.certifying"
+    fast, influence = problem.derived(key, _certifying_problem)
     return (problem if fast is None else fast), influence
 
 
-def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
-    """:func:`certifying_problem`, made."""
+def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem | None, float]:
+    """:func:`certifying_problem`, made (``None``: ``problem`` itself, which does not hold
+    itself)."""
     st = problem.settings
     influence = min(st.influence, st.margin + FRONT_INFLUENCE_ABOVE_MARGIN)
     if influence == st.influence:
-        return problem, influence
+        return None, influence
     fast = TrajectoryProblem(
         problem.robot,
         problem.scene,
