@@ -221,8 +221,9 @@ def continuous_distance_with_acceleration(
     exact: bool,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    r""":func:`continuous_distance` with the spline's largest |q̈| already computed by the
-    caller (:func:`~adept_traj.analysis.certify`, which has the spline's bounds of ``x``).
+    r""":func:`continuous_distance` with the spline's largest :math:`|\ddot q_i|` already
+    computed by the caller (:func:`~adept_traj.analysis.certify`, which has the spline's
+    bounds of ``x``).
 
     Parameters
     ----------
@@ -285,8 +286,8 @@ def continuous_self_distance_with_acceleration(
     max_depth: int,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    """:func:`continuous_self_distance` with the spline's largest |q̈| already computed by the
-    caller (as :func:`continuous_distance_with_acceleration`).
+    r""":func:`continuous_self_distance` with the spline's largest :math:`|\ddot q_i|`
+    already computed by the caller (as :func:`continuous_distance_with_acceleration`).
 
     Parameters
     ----------

@@ -159,8 +159,8 @@ def self_distance_with_acceleration(
     max_depth: int,
     acc: np.ndarray,
 ) -> SelfDistance:
-    """:func:`self_distance` with the spline's largest |q̈| already computed by the caller
-    (:func:`~adept_traj.analysis.certify`).
+    r""":func:`self_distance` with the spline's largest :math:`|\ddot q_i|` already computed
+    by the caller (:func:`~adept_traj.analysis.certify`).
 
     Parameters
     ----------

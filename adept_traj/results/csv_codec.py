@@ -173,7 +173,7 @@ def csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = (
     Returns
     -------
     str
-        Header and rows, ``\n`` line ends.
+        Header and rows, newline line ends.
     """
     lines = [",".join(header)]
     for row in rows.tolist():
