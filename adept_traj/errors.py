@@ -7,6 +7,7 @@ can catch them all with one clause. Input errors also derive from :class:`ValueE
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
@@ -17,6 +18,7 @@ __all__ = [
     "ConfigurationError",
     "CycleError",
     "FigureError",
+    "FrozenObjectError",
     "InputShapeError",
     "InvalidInputError",
     "JointLimitError",
@@ -187,6 +189,13 @@ class UnreachableLocationError(InvalidInputError):
 class CycleError(ConfigurationError):
     """A cycle file (``docs/cycles.md``) is missing or malformed, or a cycle run folder
     does not match its cycle. The message names the file, the field and the valid range."""
+
+
+class FrozenObjectError(AdeptTrajError, dataclasses.FrozenInstanceError):
+    """An attribute of a frozen object (a :class:`~adept_traj.problem.TrajectoryProblem`,
+    a :class:`~adept_traj.robot.Robot`) was set or deleted after construction. Its
+    ``replace(...)`` method makes a changed copy. A :class:`dataclasses.FrozenInstanceError`
+    (an :class:`AttributeError`), as the frozen dataclasses of the package raise."""
 
 
 def error_from_process(

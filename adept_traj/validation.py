@@ -14,9 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.errors import FrozenObjectError, InputShapeError, InvalidInputError
 
 __all__ = [
+    "FrozenAttributes",
     "as_batch",
     "as_finite_array",
     "as_integer",
@@ -179,3 +180,36 @@ def deep_equal(a: Any, b: Any) -> bool:
             and all(deep_equal(x, y) for x, y in zip(a, b))
         )
     return bool(a == b)
+
+
+class FrozenAttributes:
+    """Public attributes fixed at construction, for the package's frozen classes that are
+    not dataclasses (:class:`~adept_traj.problem.TrajectoryProblem`,
+    :class:`~adept_traj.robot.Robot`): once :meth:`_freeze` has run, setting or deleting an
+    attribute whose name does not start with ``_`` raises
+    :class:`~adept_traj.errors.FrozenObjectError`; the class's ``replace(...)`` makes a
+    changed copy. Private attributes stay the object's own working state (a worker pool, a
+    cache of derived data), never an input.
+    """
+
+    def _freeze(self) -> None:
+        """Fix the public attributes (the end of ``__init__``)."""
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if not name.startswith("_") and self.__dict__.get("_frozen", False):
+            raise _frozen_error(self, name, "assign to")
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        if not name.startswith("_") and self.__dict__.get("_frozen", False):
+            raise _frozen_error(self, name, "delete")
+        object.__delattr__(self, name)
+
+
+def _frozen_error(obj: object, name: str, what: str) -> FrozenObjectError:
+    kind = type(obj).__name__
+    return FrozenObjectError(
+        f"cannot {what} {kind}.{name}: a {kind} is fixed at construction; make a changed "
+        f"copy with .replace({name}=...)"
+    )

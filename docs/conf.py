@@ -224,7 +224,7 @@ def _split_multi_name_ivars(app, what, name, obj, options, lines: list[str]) -> 
 
 
 def _public_bases(app, name, obj, options, bases: list) -> None:
-    """Show a private base class (``_ValueObject``) as its own bases."""
+    """Show a private base class as its own bases."""
     public: list = []
     for base in bases:
         if getattr(base, "__name__", "").startswith("_"):

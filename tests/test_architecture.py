@@ -1,5 +1,5 @@
 """The package's layout rules, read from the source: data flows one way between the
-subpackages (docs/architecture.md), private names stay inside their subpackage, and every
+subpackages (docs/architecture.md), private names stay inside their module, and every
 exception class lives in errors.py."""
 
 from __future__ import annotations
@@ -103,6 +103,124 @@ def test_private_names_stay_in_their_subpackage(path: Path):
             assert not private_module, f"{where} imports the private module {module}"
 
 
+#: Modules whose private imports belong to another branch of issue #27 (the one process
+#: mechanism, branch of the processes helper: it rewrites processes.py, optimise/polisher.py,
+#: early_certificates.py, front_certificates.py, the evaluator's workers,
+#: viz/plots/all_figures.py and viz/finisher.py). The lead removes this list after merging it.
+PRIVATE_IMPORTS_ELSEWHERE = {
+    "optimise/polisher.py": "_polish_run from optimise/polish_step.py",
+    "optimise/early_certificates.py": "_checked from optimise/front_certificates.py",
+    "viz/finisher.py": "_draw, _figure_jobs, _error from viz/plots/all_figures.py",
+}
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def private_names_used(path: Path, package: Path) -> list[str]:
+    """Every private name (``_x``, not a dunder) that the module at ``path`` takes from
+    another module of ``package``: ``from M import _x`` (also relative), and ``m._x`` on a
+    name ``m`` bound to a module of the package (``import a.b as m``, ``from a import b``).
+    A private *module* of the importer's own subpackage may be imported (``from . import
+    _heap``): it is that subpackage's."""
+    root = package.parent
+    here = list(path.relative_to(root).with_suffix("").parts)
+    me = ".".join(here).removesuffix(".__init__")
+
+    def is_module(dotted: str) -> bool:
+        base = root.joinpath(*dotted.split("."))
+        return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
+
+    def subpackage(dotted: str) -> str:
+        parts = dotted.split(".")
+        return parts[1] if len(parts) > 2 else ""  # "" for the top-level modules
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    modules: dict[str, str] = {}  # local name → module it is bound to
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = here[: len(here) - node.level]
+                module = ".".join([*base, *(node.module.split(".") if node.module else [])])
+            else:
+                module = node.module or ""
+            if module.split(".")[0] != package.name:
+                continue
+            for alias in node.names:
+                target = f"{module}.{alias.name}"
+                if is_module(target):
+                    modules[alias.asname or alias.name] = target
+                    own = subpackage(target) == subpackage(me) and subpackage(me)
+                    if _is_private(alias.name) and not own:
+                        found.append(f"{node.lineno}: from {module} import {alias.name}")
+                elif _is_private(alias.name) and module != me:
+                    found.append(f"{node.lineno}: from {module} import {alias.name}")
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == package.name and alias.asname:
+                    modules[alias.asname] = alias.name
+    for node in ast.walk(tree):
+        if (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id in modules
+            and _is_private(node.attr)
+            and modules[node.value.id] != me
+        ):
+            found.append(f"{node.lineno}: {node.value.id}.{node.attr} ({modules[node.value.id]})")
+    return found
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_no_private_name_is_taken_from_another_module(path: Path):
+    """What another module needs is public in its subpackage (documented), or the two are
+    one module."""
+    rel = str(path.relative_to(PACKAGE))
+    found = private_names_used(path, PACKAGE)
+    if rel in PRIVATE_IMPORTS_ELSEWHERE:
+        return
+    assert not found, f"{rel} takes private names of other modules: {found}"
+
+
+def test_the_private_name_check_finds_each_form(tmp_path: Path):
+    """The check above on a made-up package: each form of a private name taken across
+    modules is found, and what is allowed is not."""
+    pkg = tmp_path / "adept_traj"
+    (pkg / "sub").mkdir(parents=True)
+    for name in ("__init__.py", "sub/__init__.py", "sub/_hidden.py", "sub/other.py", "top.py"):
+        (pkg / name).write_text("", encoding="utf-8")
+    (pkg / "sub" / "mine.py").write_text(
+        "from adept_traj.sub.other import _a, public\n"  # found
+        "from .other import _b\n"  # found
+        "import adept_traj.sub.other as other_module\n"
+        "from adept_traj.sub import other\n"
+        "from . import _hidden\n"  # allowed: a private module of its own subpackage
+        "from adept_traj.sub.other import __version__\n"  # allowed: a dunder
+        "x = other_module._c + other._d + other.e + _hidden.f\n"  # _c, _d found
+        "def _own():\n    return _own\n",  # allowed: its own private name
+        encoding="utf-8",
+    )
+    (pkg / "top.py").write_text("from adept_traj.sub import _hidden\n", encoding="utf-8")
+    found = private_names_used(pkg / "sub" / "mine.py", pkg)
+    assert [f.split(": ", 1)[1] for f in found] == [
+        "from adept_traj.sub.other import _a",
+        "from adept_traj.sub.other import _b",
+        "other_module._c (adept_traj.sub.other)",
+        "other._d (adept_traj.sub.other)",
+    ]
+    # a private module of another subpackage (here: of sub, from the top level) is found
+    assert private_names_used(pkg / "top.py", pkg) == ["1: from adept_traj.sub import _hidden"]
+
+
+def test_the_private_imports_left_to_other_branches_are_still_there():
+    """The allow-list above lists only modules that still need it (remove an entry once
+    its branch is merged)."""
+    stale = [r for r in PRIVATE_IMPORTS_ELSEWHERE if not private_names_used(PACKAGE / r, PACKAGE)]
+    assert not stale, stale
+
+
 def test_every_exception_class_is_in_errors_py():
     elsewhere = []
     for path in _modules():
@@ -167,6 +285,14 @@ LONG_MODULES = {
     "motion and robot entries are in machine_entries)",
     "scene/motion_laws.py": "the MotionLaw contract (pose, speed bound, jumps) and the paper's "
     "pendulum, half of it docstrings",
+    "analysis/certificate.py": "certify, its Certificate record and the certificate of dense "
+    "states already computed (member certificates share it), half of it docstrings",
+    "problem/spline_segments.py": "the per-segment arithmetic behind BSplineTrajectory (basis, "
+    "samples, exact extrema and integrals), half of it docstrings and math",
+    "results/json_codec.py": "the one encoder and decoder of result.json (its certificates in "
+    "certificate_codec, JSON values in json_values)",
+    "robot/robot.py": "Robot: construction, its frozen copy (replace) and the batched dynamics, "
+    "kinematics and manipulability, half of it docstrings",
 }
 
 

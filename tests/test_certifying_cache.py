@@ -1,11 +1,14 @@
 """The cached certifying problem follows the problem's settings (review finding: a margin
-changed after the first certificate was ignored by ``certify_members``), and the
-continuous bounds take no caller-given acceleration bound."""
+changed after the first certificate was ignored by ``certify_members``; the problem is now
+frozen, a margin changes in a copy), and the continuous bounds take no caller-given
+acceleration bound."""
 
 from __future__ import annotations
 
 import dataclasses
 import inspect
+
+import pytest
 
 from adept_traj.analysis import (
     certify,
@@ -15,6 +18,7 @@ from adept_traj.analysis import (
     continuous_self_distance,
     self_distance,
 )
+from adept_traj.errors import FrozenObjectError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
@@ -26,18 +30,24 @@ def _problem() -> TrajectoryProblem:
     return TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal, workers=1)
 
 
-def test_a_replaced_margin_is_seen_by_certify_members():
+def test_a_copy_with_another_margin_is_certified_with_it():
+    """The problem is frozen (issue #27): a margin changes in a copy, which certifies with
+    it; the original and its cached certifying problem are unchanged."""
     problem = _problem()
     x = lift_then_lower(problem)
     first = certify_members(problem, x[None])[0]
     clearance = certify(problem, x).min_distance
     assert first.feasible == (clearance >= problem.settings.margin)
-    # A margin above the move's clearance: both certificates must now say "no".
-    stricter = dataclasses.replace(problem.settings, margin=float(clearance) + 0.005)
-    problem.settings = stricter
-    assert not certify(problem, x).feasible
-    assert not certify_members(problem, x[None])[0].feasible
-    assert certifying_problem(problem)[0].settings.margin == stricter.margin
+    # A margin above the move's clearance: both certificates of the copy must say "no".
+    stricter = problem.replace(margin=float(clearance) + 0.005)
+    assert stricter.settings == dataclasses.replace(problem.settings, margin=clearance + 0.005)
+    assert not certify(stricter, x).feasible
+    assert not certify_members(stricter, x[None])[0].feasible
+    assert certifying_problem(stricter)[0].settings.margin == stricter.settings.margin
+    again = certify_members(problem, x[None])[0]
+    assert (again.feasible, again.min_distance) == (first.feasible, first.min_distance)
+    with pytest.raises(FrozenObjectError):
+        problem.settings = stricter.settings
 
 
 def test_the_certifying_problem_is_made_once_while_nothing_changes():

@@ -216,7 +216,7 @@ def test_torque_peak_between_samples_rejected_with_refinement():
     assert fine_max[0] - sampled_max[0] > 1e-2  # [N·m]: the peak is missed by the samples
     torque = robot.limits.torque.copy()
     torque[0] = 0.5 * (sampled_max[0] + fine_max[0])
-    robot.limits = dataclasses.replace(robot.limits, torque=torque)
+    robot = robot.replace(limits=dataclasses.replace(robot.limits, torque=torque))
     problem = TrajectoryProblem(robot, scene, START, GOAL)
 
     sampled = certify(problem, x, continuous=False)

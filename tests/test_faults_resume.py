@@ -37,8 +37,7 @@ import adept_traj.cli._run_folder as run_folder
 import adept_traj.cli.plan as plan_command
 import adept_traj.optimise.planner as planner
 import adept_traj.problem.trajectory_problem as trajectory_problem
-import adept_traj.results.csv_codec as csv_codec
-import adept_traj.results.json_codec as json_codec
+import adept_traj.results.record as record
 import adept_traj.viz.meshcat_scene as meshcat_scene
 import adept_traj.viz.plots.all_figures as all_figures
 from adept_traj.cli import main
@@ -47,8 +46,8 @@ how, where, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 owner, name = {
     "evaluate": (trajectory_problem.TrajectoryProblem, "_evaluate"),
     "certify": (planner, "certify"),
-    "result_json": (json_codec, "_write_json"),
-    "front_csv": (csv_codec, "_write_front_csv"),
+    "result_json": (record, "write_json"),  # the codecs' writers, as the record calls them
+    "front_csv": (record, "write_front_csv"),
     "html": (meshcat_scene, "static_html"),
     "figures": (all_figures, "joint_motion"),
     "commit": (plan_command, "commit"),  # every file written, the run not marked complete

@@ -103,7 +103,7 @@ if {which!r} == "polish":
     polish.minimum_time(problem, x0)
 else:
     member_polish._solve = record
-    member_polish._threads_limited(problem, x0)
+    member_polish.epsilon_solve(problem, x0)
 print(seen)
 """
 

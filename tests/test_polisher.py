@@ -20,7 +20,7 @@ import adept_traj.optimise.polisher as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 from adept_traj.analysis import PAPER_WEIGHTS, certify_members
 from adept_traj.cli.app import main
-from adept_traj.errors import ConfigurationError, InvalidInputError
+from adept_traj.errors import ConfigurationError, FrozenObjectError, InvalidInputError
 from adept_traj.optimise import (
     feasible_front,
     make_algorithm,
@@ -160,14 +160,17 @@ def test_a_used_polisher_leaves_the_next_polish_to_the_caller(problem, searched,
 
 def test_a_polisher_of_a_problem_changed_since_is_refused(searched) -> None:
     """Its helper would polish and certify the problem as it was when it was forked (e.g.
-    the old margin): refused before the search."""
+    the old margin). The problem is frozen (issue #27): a change is a copy, another problem,
+    refused before the search."""
     scene = Scene.paper()
-    changed = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
-    with start_polisher(changed) as polisher:
-        changed.settings = dataclasses.replace(changed.settings, margin=0.02)
-        with pytest.raises(ConfigurationError, match="replaced after the polisher was started"):
+    original = TrajectoryProblem(Robot.adept_one_xl(), scene, scene.start, scene.goal)
+    with start_polisher(original) as polisher:
+        with pytest.raises(FrozenObjectError):
+            original.settings = dataclasses.replace(original.settings, margin=0.02)
+        changed = original.replace(margin=0.02)
+        with pytest.raises(ConfigurationError, match="started for another problem"):
             _polish(changed, searched, polisher)
-        with pytest.raises(ConfigurationError, match="replaced after the polisher"):
+        with pytest.raises(ConfigurationError, match="started for another problem"):
             plan(changed, "nsga2", pop_size=10**9, polisher=polisher)  # no search starts
 
 

@@ -219,7 +219,7 @@ def test_infinite_values_become_null(problem: TrajectoryProblem, tmp_path: Path)
     """No obstacle (distance +inf) and unknown acceleration limits (inf): null in JSON."""
     robot = Robot.adept_one_xl()
     lim = robot.limits
-    robot.limits = dataclasses.replace(lim, acceleration=np.full(4, np.inf))
+    robot = robot.replace(limits=dataclasses.replace(lim, acceleration=np.full(4, np.inf)))
     empty = Scene(robot_base=problem.scene.robot_base, name="empty")
     p = TrajectoryProblem(robot, empty, problem.start, problem.goal)
     r = make_result(p, lift_then_lower(p)[None], history=None, metrics=Metrics())

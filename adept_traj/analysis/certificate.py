@@ -57,20 +57,28 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.continuous import CONTINUOUS, DEFAULT_MAX_DEPTH, _continuous_distance
+from adept_traj.analysis.continuous import (
+    CONTINUOUS,
+    DEFAULT_MAX_DEPTH,
+    continuous_distance_with_acceleration,
+)
 from adept_traj.analysis.dense_trajectory import (
     DenseStates,
     DenseTrajectory,
-    _dense_states,
     dense_samples,
+    dense_states,
 )
 from adept_traj.analysis.limit_check import (
     DEFAULT_TOLERANCE,
     LimitCheck,
-    _limit_checks,
-    _limits,
+    limit_checks,
+    position_spans,
 )
-from adept_traj.analysis.self_distance import SelfDistance, _normalise_distance, _self_distance
+from adept_traj.analysis.self_distance import (
+    SelfDistance,
+    normalise_distance_fields,
+    self_distance_with_acceleration,
+)
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -90,6 +98,7 @@ __all__ = [
     "Certificate",
     "certificate_bytes",
     "certify",
+    "certify_states",
     "check_certificate_memory",
 ]
 
@@ -160,7 +169,7 @@ class Certificate:
                 raise InvalidInputError(
                     f"{kind} has {check.dense.size} joints, the dense trajectory {self.dense.nq}"
                 )
-        _normalise_distance(
+        normalise_distance_fields(
             self, "min_distance", "t_min_distance", "closest_pair", "distance_bound"
         )
         object.__setattr__(self, "violations", tuple(str(v) for v in self.violations))
@@ -309,13 +318,13 @@ def certify(
     check_type(continuous, bool, "continuous")
     depth = as_integer(max_depth, "max_depth", minimum=0)
     check_type(exact, bool, "exact")
-    _limits(problem.robot.limits)
+    position_spans(problem.robot.limits)
     check_certificate_memory(problem, rate, T)
-    states = _dense_states(problem, xa[None], rate, exact)[0]
-    return _certify(problem, xa, rate, tol, continuous, depth, exact, states)
+    states = dense_states(problem, xa[None], rate, exact)[0]
+    return certify_states(problem, xa, rate, tol, continuous, depth, exact, states)
 
 
-def _certify(
+def certify_states(
     problem: TrajectoryProblem,
     xa: np.ndarray,
     rate: float,
@@ -325,7 +334,26 @@ def _certify(
     exact: bool,
     states: DenseStates,
 ) -> Certificate:
-    """:func:`certify` of the checked ``xa`` (n_var,) from its dense ``states``."""
+    """:func:`certify` of a checked move from its dense states already computed (one
+    :func:`~adept_traj.analysis.dense_trajectory.dense_states` call for many moves).
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    xa:
+        (n_var,) the checked move ``[T [s], control points [rad | m]]``.
+    rate, tol, continuous, depth, exact:
+        As :func:`certify` (``rate_hz`` [Hz], ``tolerance``, ``continuous``,
+        ``max_depth``, ``exact``), checked by the caller.
+    states:
+        The :data:`~adept_traj.analysis.dense_trajectory.DenseStates` of ``xa`` at ``rate``.
+
+    Returns
+    -------
+    Certificate
+        As :func:`certify`.
+    """
     T = float(xa[0])
     smp, tau, pairs = states
     n = len(smp.t)
@@ -338,7 +366,9 @@ def _certify(
         per_sample = pairs.min(axis=(1, 2))
         grid_hz = (n - 1) / T
         if continuous:
-            found = _continuous_distance(problem, xa, t, qd, pairs, grid_hz, depth, exact, acc)
+            found = continuous_distance_with_acceleration(
+                problem, xa, t, qd, pairs, grid_hz, depth, exact, acc
+            )
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
@@ -354,7 +384,7 @@ def _certify(
         min_d, t_min_d, pair = math.inf, None, None
         guarantee, bound = CONTINUOUS, math.inf
 
-    checks, torque_guarantee, violations = _limit_checks(
+    checks, torque_guarantee, violations = limit_checks(
         problem, xa, smp, tau, bounds, tol, continuous
     )
     margin = float(problem.settings.margin)
@@ -363,7 +393,9 @@ def _certify(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and _self_distance(problem, xa, t, q, qd, continuous, depth, acc)
+    own = problem.self_check and self_distance_with_acceleration(
+        problem, xa, t, q, qd, continuous, depth, acc
+    )
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

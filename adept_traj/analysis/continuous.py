@@ -55,10 +55,8 @@ violation found between the uniform samples.
 from __future__ import annotations
 
 import math
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -71,7 +69,9 @@ __all__ = [
     "DEFAULT_MAX_DEPTH",
     "DistanceGuarantee",
     "continuous_distance",
+    "continuous_distance_with_acceleration",
     "continuous_self_distance",
+    "continuous_self_distance_with_acceleration",
     "obstacle_jump_intervals",
     "obstacle_speeds",
     "solid_lever_arms",
@@ -134,24 +134,17 @@ def obstacle_jump_intervals(problem: TrajectoryProblem) -> np.ndarray:
     return np.array([ob.motion.jump_interval for ob in obstacles]).reshape(len(obstacles))
 
 
-#: (lever arms (n_solids, nq), obstacle speeds (n_obstacles,)) of each problem, read-only:
-#: they depend on the robot and the scene alone, and a front certifies hundreds of moves of
-#: one problem (computing them took ≈ 1 ms per certificate).
-_RATES: weakref.WeakKeyDictionary[TrajectoryProblem, tuple[np.ndarray, np.ndarray, Any, Any]] = (
-    weakref.WeakKeyDictionary()
-)
-
-
 def _rates(problem: TrajectoryProblem) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`solid_lever_arms` and :func:`obstacle_speeds` of ``problem``, computed once
-    per problem and robot and scene (read-only arrays; computed anew when
-    ``problem.robot`` or ``problem.scene`` was replaced)."""
-    rates = _RATES.get(problem)
-    if rates is None or rates[2] is not problem.robot or rates[3] is not problem.scene:
-        arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
-        arms.flags.writeable = speeds.flags.writeable = False
-        rates = _RATES[problem] = (arms, speeds, problem.robot, problem.scene)
-    return rates[0], rates[1]
+    """:func:`solid_lever_arms` and :func:`obstacle_speeds` of ``problem``, read-only, made
+    once and kept on the (frozen) problem: they depend on its robot and scene alone, and a
+    front certifies hundreds of moves of one problem (≈ 1 ms per certificate otherwise)."""
+    return problem.derived("analysis.continuous.rates", _made_rates)
+
+
+def _made_rates(problem: TrajectoryProblem) -> tuple[np.ndarray, np.ndarray]:
+    arms, speeds = solid_lever_arms(problem), obstacle_speeds(problem)
+    arms.flags.writeable = speeds.flags.writeable = False
+    return arms, speeds
 
 
 def _interval_bounds(
@@ -215,10 +208,12 @@ def continuous_distance(
     :class:`DistanceGuarantee`.
     """
     acc = problem.trajectory.bounds(x).qdd_abs_max
-    return _continuous_distance(problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc)
+    return continuous_distance_with_acceleration(
+        problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc
+    )
 
 
-def _continuous_distance(
+def continuous_distance_with_acceleration(
     problem: TrajectoryProblem,
     x: np.ndarray,
     t: np.ndarray,
@@ -229,10 +224,26 @@ def _continuous_distance(
     exact: bool,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    """:func:`continuous_distance` with the spline's exact largest |q̈| ``acc`` (nq,)
-    [rad/s² | m/s²] (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``.qdd_abs_max``
-    of ``x``) already computed by the caller, :func:`~adept_traj.analysis.certify`. Private:
-    a smaller ``acc`` would void the guarantee."""
+    r""":func:`continuous_distance` with the spline's largest :math:`|\ddot q_i|` already
+    computed by the caller (:func:`~adept_traj.analysis.certify`, which has the spline's
+    bounds of ``x``).
+
+    Parameters
+    ----------
+    problem, x, t, qd, pairs, rate_hz, max_depth, exact:
+        As :func:`continuous_distance`: the problem, the move (n_var,), the sample times
+        (n,) [s], the joint speeds (n, nq) [rad/s | m/s] and the distances (n, n_solids,
+        n_obstacles) [m] there, the grid rate [Hz], the most bisections, exact distances.
+    acc:
+        (nq,) [rad/s² | m/s²] the spline's exact largest :math:`|\ddot q_i|` over the move:
+        :meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``(x).qdd_abs_max``. A smaller
+        value voids the guarantee; pass only that value.
+
+    Returns
+    -------
+    DistanceGuarantee
+        As :func:`continuous_distance`.
+    """
     checker = problem.checker
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
@@ -263,10 +274,12 @@ def continuous_self_distance(
     obstacle speed). The midpoints' distances are exact below the margin, lower bounds
     above it. The returned ``pair`` is ``(pair index, 0)``."""
     acc = problem.trajectory.bounds(x).qdd_abs_max
-    return _continuous_self_distance(problem, x, t, qd, pairs, rate_hz, max_depth, acc)
+    return continuous_self_distance_with_acceleration(
+        problem, x, t, qd, pairs, rate_hz, max_depth, acc
+    )
 
 
-def _continuous_self_distance(
+def continuous_self_distance_with_acceleration(
     problem: TrajectoryProblem,
     x: np.ndarray,
     t: np.ndarray,
@@ -276,8 +289,22 @@ def _continuous_self_distance(
     max_depth: int,
     acc: np.ndarray,
 ) -> DistanceGuarantee:
-    """:func:`continuous_self_distance` with the exact ``acc`` (nq,) of the caller (as
-    :func:`_continuous_distance`; private for the same reason)."""
+    r""":func:`continuous_self_distance` with the spline's largest :math:`|\ddot q_i|`
+    already computed by the caller (as :func:`continuous_distance_with_acceleration`).
+
+    Parameters
+    ----------
+    problem, x, t, qd, pairs, rate_hz, max_depth:
+        As :func:`continuous_self_distance`; ``pairs`` (n, n_pairs) [m].
+    acc:
+        (nq,) [rad/s² | m/s²] :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
+        ``(x).qdd_abs_max``: a smaller value voids the guarantee.
+
+    Returns
+    -------
+    DistanceGuarantee
+        As :func:`continuous_self_distance`.
+    """
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from adept_traj.analysis.indicators import _as_objectives, _as_sense, _fraction_towards
+from adept_traj.analysis.objective_arrays import as_objectives, as_sense, fraction_towards
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem.objectives import MAXIMISED
 from adept_traj.validation import as_finite_array, as_vector, readonly_copy
@@ -95,11 +95,11 @@ def normalise(
     collision-free solution) scores 1 for every solution: nobody is worse than anybody
     else in that objective.
     """
-    arr = _as_objectives(F, "F")
+    arr = as_objectives(F, "F")
     m = arr.shape[1]
-    sense = _as_sense(maximised, m)
+    sense = as_sense(maximised, m)
     lo, hi = _bounds(arr, z_min, z_max)
-    return _fraction_towards(arr, lo, hi, sense, flat=1.0)
+    return fraction_towards(arr, lo, hi, sense, flat=1.0)
 
 
 def average_fitness(
@@ -288,7 +288,7 @@ def best_tradeoff(
     -------
     :class:`BestTradeoff`.
     """
-    arr = _as_objectives(F, "F")
+    arr = as_objectives(F, "F")
     lo, hi = _bounds(arr, z_min, z_max)
     w = objective_weights(weights, arr.shape[1])
     f_c = combined_objective(arr, w, lo, hi, maximised)

@@ -32,6 +32,7 @@ __all__ = [
     "DenseTrajectory",
     "batch_samples",
     "dense_samples",
+    "dense_states",
 ]
 
 #: Most dense samples of the several moves formed in one batch by
@@ -134,13 +135,32 @@ def dense_samples(T: float, rate_hz: float) -> int:
     return max(2, math.ceil(T * rate_hz - 1e-9) + 1)
 
 
-def _dense_states(
+def dense_states(
     problem: TrajectoryProblem, xs: Sequence[np.ndarray], rate_hz: float, exact: bool
 ) -> list[DenseStates]:
-    """The :data:`DenseStates` of each checked move ``x`` (n_var,) of ``xs`` on its grid of
-    :func:`dense_samples` at ``rate_hz`` [Hz], the moves' samples in one inverse dynamics
-    call and one :meth:`~adept_traj.collision.CollisionChecker.distances` call (``exact``
-    as there)."""
+    """The :data:`DenseStates` of each move on its dense grid, all moves' samples in one
+    inverse-dynamics call and one :meth:`~adept_traj.collision.CollisionChecker.distances`
+    call.
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    xs:
+        Checked moves, each (n_var,) ``[T [s], control points [rad | m]]``.
+    rate_hz:
+        Grid rate [Hz]: move k has :func:`dense_samples` ``(T_k, rate_hz)`` samples.
+    exact:
+        As :meth:`~adept_traj.collision.CollisionChecker.distances`: exact distances also
+        beyond the influence distance.
+
+    Returns
+    -------
+    list of DenseStates
+        Per move: its samples (``t`` (n,) [s], ``q`` … ``qddd`` (n, nq)), its torques (n, nq)
+        [N·m | N] and its distances (n, n_solids, n_obstacles) [m] (``None`` without solids or
+        obstacles).
+    """
     samples = [
         problem.trajectory.sample(x, np.linspace(0.0, 1.0, dense_samples(float(x[0]), rate_hz)))
         for x in xs

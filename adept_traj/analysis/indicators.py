@@ -39,6 +39,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from pymoo.indicators.igd import IGD
 
+from adept_traj.analysis.objective_arrays import (
+    as_objectives,
+    as_sense,
+    fraction_towards,
+    minimisation_form,
+)
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem.objectives import MAXIMISED  # the objective table's sense
 from adept_traj.validation import as_finite_array, as_vector
@@ -57,52 +63,6 @@ __all__ = [
 #: Default reference point of :func:`normalised_hypervolume`, in the unit space where 0 is
 #: the best bound and 1 the worst bound of every objective.
 DEFAULT_HV_REFERENCE = 1.1
-
-
-# --------------------------------------------------------------------------------------
-# Shared input checks (also used by decision and paper_measures)
-# --------------------------------------------------------------------------------------
-def _as_objectives(value: ArrayLike, name: str = "F", min_rows: int = 1) -> np.ndarray:
-    """Return ``value`` as a new finite float64 array of shape ``(n, m)``, n ≥ ``min_rows``."""
-    arr = as_finite_array(value, name)
-    if arr.ndim != 2 or arr.shape[1] < 1:
-        raise InputShapeError(
-            f"{name} must have shape (n, m) (one row per solution); got shape {arr.shape}"
-        )
-    if arr.shape[0] < min_rows:
-        raise InputShapeError(f"{name} must have at least {min_rows} row(s); got shape {arr.shape}")
-    return arr
-
-
-def _as_sense(maximised: bool | Sequence[bool] | np.ndarray, m: int) -> np.ndarray:
-    """Return the objective sense as a bool array of shape ``(m,)``.
-
-    ``maximised`` is a single bool (applies to every column) or one bool per column.
-    """
-    if isinstance(maximised, (bool, np.bool_)):
-        return np.full(m, bool(maximised))
-    try:
-        arr = np.asarray(maximised)
-    except (TypeError, ValueError) as exc:  # pragma: no cover - exotic inputs
-        raise InvalidInputError(f"maximised must be a bool or bools; got {maximised!r}") from exc
-    if arr.dtype != np.bool_:
-        if arr.dtype.kind in "iu" and np.isin(arr, (0, 1)).all():
-            arr = arr.astype(bool)
-        else:
-            raise InvalidInputError(
-                f"maximised must be a bool or a sequence of bools; got {maximised!r}"
-            )
-    if arr.shape != (m,):
-        raise InputShapeError(
-            f"maximised must be a bool or have one entry per objective ({m},); "
-            f"got shape {arr.shape} (the default MAXIMISED is for the six objectives z1..z6)"
-        )
-    return arr.copy()
-
-
-def _minimisation_form(F: np.ndarray, sense: np.ndarray) -> np.ndarray:
-    """Return a copy of ``F`` with the maximised columns negated."""
-    return np.where(sense, -F, F)
 
 
 # --------------------------------------------------------------------------------------
@@ -134,8 +94,8 @@ def non_dominated(
     -------
     (n,) bool array. Feasibility is not considered: filter infeasible rows first.
     """
-    arr = _as_objectives(F, "F")
-    P = _minimisation_form(arr, _as_sense(maximised, arr.shape[1]))
+    arr = as_objectives(F, "F")
+    P = minimisation_form(arr, as_sense(maximised, arr.shape[1]))
     return moocore.is_nondominated(P, keep_weakly=bool(keep_duplicates))
 
 
@@ -159,8 +119,8 @@ def igd(F: ArrayLike, reference_front: ArrayLike) -> float:
     :func:`to_unit_minimisation`) when the objectives have different units. The objective
     sense does not matter (Euclidean distance).
     """
-    A = _as_objectives(F, "F")
-    R = _as_objectives(reference_front, "reference_front")
+    A = as_objectives(F, "F")
+    R = as_objectives(reference_front, "reference_front")
     if R.shape[1] != A.shape[1]:
         raise InputShapeError(
             f"reference_front must have {A.shape[1]} columns like F; got shape {R.shape}"
@@ -204,10 +164,10 @@ def hypervolume(
     -------
     HV ≥ 0, in the product of the objectives' units.
     """
-    arr = _as_objectives(F, "F")
+    arr = as_objectives(F, "F")
     m = arr.shape[1]
     ref = as_vector(reference_point, "reference_point", m)
-    sense = _as_sense(maximised, m)
+    sense = as_sense(maximised, m)
     if method not in ("auto", "moocore", "wfg"):
         raise InvalidInputError(f"method must be 'auto' or 'moocore'; got {method!r}")
     if method == "wfg":
@@ -217,7 +177,7 @@ def hypervolume(
             DeprecationWarning,
             stacklevel=2,
         )
-    P = _minimisation_form(arr, sense)
+    P = minimisation_form(arr, sense)
     r = np.where(sense, -ref, ref)
     P = P[(r > P).all(axis=1)]
     if len(P) == 0:
@@ -241,7 +201,7 @@ def objective_bounds(*fronts: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """
     if not fronts:
         raise InvalidInputError("objective_bounds needs at least one front")
-    arrays = [_as_objectives(f, f"fronts[{i}]") for i, f in enumerate(fronts)]
+    arrays = [as_objectives(f, f"fronts[{i}]") for i, f in enumerate(fronts)]
     m = arrays[0].shape[1]
     for i, a in enumerate(arrays):
         if a.shape[1] != m:
@@ -278,7 +238,7 @@ def to_unit_minimisation(
     -------
     (n, m) new array.
     """
-    arr = _as_objectives(F, "F")
+    arr = as_objectives(F, "F")
     m = arr.shape[1]
     lo = as_vector(lower, "lower", m)
     hi = as_vector(upper, "upper", m)
@@ -287,20 +247,7 @@ def to_unit_minimisation(
         raise InvalidInputError(
             f"lower must not exceed upper; objective {j}: lower={lo[j]!r} > upper={hi[j]!r}"
         )
-    return _fraction_towards(arr, lo, hi, ~_as_sense(maximised, m), flat=0.0)
-
-
-def _fraction_towards(
-    arr: np.ndarray, lo: np.ndarray, hi: np.ndarray, up: np.ndarray, flat: float
-) -> np.ndarray:
-    """Where each value of ``arr`` (n, m) lies between ``lo`` and ``hi`` (m,): the fraction
-    of the way from ``lo`` up (columns where ``up``), else from ``hi`` down; ``flat`` in a
-    column where lo == hi. Shared by :func:`to_unit_minimisation` and
-    :func:`~adept_traj.analysis.decision.normalise`."""
-    span = hi - lo
-    safe = np.where(span > 0, span, 1.0)
-    frac = np.where(up, (arr - lo) / safe, (hi - arr) / safe)
-    return np.where(span > 0, frac, flat)
+    return fraction_towards(arr, lo, hi, ~as_sense(maximised, m), flat=0.0)
 
 
 def normalised_hypervolume(

@@ -39,6 +39,8 @@ __all__ = [
     "TORQUE_REFINE_FRACTION",
     "TORQUE_REFINE_TOLERANCE",
     "LimitCheck",
+    "limit_checks",
+    "position_spans",
 ]
 
 #: Default tolerance on the limit values (dimensionless ratios).
@@ -124,8 +126,25 @@ class LimitCheck:
     __hash__ = None  # type: ignore[assignment]
 
 
-def _limits(lim: Any) -> np.ndarray:
-    """Check the robot's limits; return the position ranges (nq,)."""
+def position_spans(lim: Any) -> np.ndarray:
+    """The position ranges of checked joint limits.
+
+    Parameters
+    ----------
+    lim:
+        The robot's :class:`~adept_traj.robot.JointLimits`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (nq,) ``upper - lower`` [rad | m].
+
+    Raises
+    ------
+    ConfigurationError
+        A position limit is not finite or not lower < upper, or another limit is not > 0
+        (``inf`` allowed).
+    """
     span = np.asarray(lim.upper - lim.lower, dtype=float)
     if not (np.all(np.isfinite(lim.lower)) and np.all(np.isfinite(lim.upper)) and np.all(span > 0)):
         raise ConfigurationError(
@@ -229,7 +248,7 @@ def _refined_torque_check(
     return check, label
 
 
-def _limit_checks(
+def limit_checks(
     problem: Any,
     x: np.ndarray,
     smp: Any,
@@ -238,14 +257,34 @@ def _limit_checks(
     tol: float,
     continuous: bool,
 ) -> tuple[dict[str, LimitCheck], str, list[str]]:
-    """The five :class:`LimitCheck` of the certificate of ``x`` (n_var,) by kind, the
-    torque's guarantee label and the messages of the violated limits, from the dense spline
-    samples ``smp`` (``t`` (n,)
-    [s], ``q, qd, qdd, qddd`` (n, nq)), the torques ``tau`` (n, nq) [N·m | N] and the
-    spline's exact extrema ``bounds`` (:meth:`~adept_traj.problem.BSplineTrajectory.bounds`);
-    ``continuous``: the torque refined near its limit (:func:`_refined_torque_check`)."""
+    """The five limit checks of the certificate of one move.
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    x:
+        (n_var,) the move.
+    smp:
+        Its dense spline samples: ``t`` (n,) [s], ``q, qd, qdd, qddd`` (n, nq).
+    tau:
+        (n, nq) [N·m | N] the torques at the samples.
+    bounds:
+        The spline's exact extrema of ``x``
+        (:meth:`~adept_traj.problem.BSplineTrajectory.bounds`).
+    tol:
+        Tolerance of every ratio.
+    continuous:
+        Refine the torque near its limit (:func:`_refined_torque_check`).
+
+    Returns
+    -------
+    tuple
+        The :class:`LimitCheck` by kind (position … torque), the torque's guarantee label
+        and the messages of the violated limits.
+    """
     lim = problem.robot.limits
-    span = _limits(lim)
+    span = position_spans(lim)
     t, q, n = smp.t, smp.q, len(smp.t)
     excess = np.maximum(q - lim.upper, lim.lower - q) / span  # (n, nq)
     exact_excess = np.maximum(bounds.q_max - lim.upper, lim.lower - bounds.q_min) / span

@@ -31,7 +31,6 @@ compares it field by field.
 from __future__ import annotations
 
 import math
-import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -41,12 +40,12 @@ import numpy as np
 from adept_traj.analysis.certificate import (
     DEFAULT_RATE_HZ,
     Certificate,
-    _certify,
+    certify_states,
     check_certificate_memory,
 )
 from adept_traj.analysis.continuous import DEFAULT_MAX_DEPTH
-from adept_traj.analysis.dense_trajectory import _dense_states, batch_samples, dense_samples
-from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, _limits
+from adept_traj.analysis.dense_trajectory import batch_samples, dense_samples, dense_states
+from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, position_spans
 from adept_traj.analysis.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
@@ -204,13 +203,15 @@ def certify_members(
             f"x[{bad[0]}, 0] (travel time T [s]) must be > 0; got {xs[bad[0], 0]!r}"
         )
     fast, influence = certifying_problem(problem)
-    _limits(fast.robot.limits)
+    position_spans(fast.robot.limits)
     for k in rows:  # every member's memory before any is sampled
         check_certificate_memory(fast, rate, float(xs[k, 0]))
     for group in _batches(xs, rows, rate, batch_samples(fast)):
-        states = _dense_states(fast, xs[group], rate, False)
+        states = dense_states(fast, xs[group], rate, False)
         for k, dense in zip(group, states):
-            certificate = _certify(fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+            certificate = certify_states(
+                fast, xs[k], rate, tol, True, DEFAULT_MAX_DEPTH, False, dense
+            )
             out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
 
@@ -249,10 +250,10 @@ def certify_member(
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
     fast, influence = certifying_problem(problem)
-    _limits(fast.robot.limits)
+    position_spans(fast.robot.limits)
     check_certificate_memory(fast, rate, float(xa[0]))
-    dense = _dense_states(fast, xa[None], rate, False)[0]
-    certificate = _certify(fast, xa, rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
+    dense = dense_states(fast, xa[None], rate, False)[0]
+    certificate = certify_states(fast, xa, rate, tol, True, DEFAULT_MAX_DEPTH, False, dense)
     return MemberCertificate.of(certificate, influence), certificate
 
 
@@ -272,27 +273,17 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
     return batches
 
 
-#: The certifying problem of each problem (:func:`certifying_problem`; ``None``: the problem
-#: itself, not held here, so that the key can die), its influence [m] and what it was made
-#: from (:func:`problem_parts`), made once: it takes ≈ 0.1 s (the broad phase's distance
-#: tables), as much as seven certificates, and the polish certifies its moves one call at a
-#: time.
-_CERTIFYING: weakref.WeakKeyDictionary[
-    Any, tuple[TrajectoryProblem | None, float, tuple[Any, ...]]
-] = weakref.WeakKeyDictionary()
-
-
 def problem_parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """The objects an object derived from ``problem`` is made from — its settings, robot,
-    scene, start and goal — to be compared by identity (:func:`same_parts`): a certifying
-    problem, or a helper process forked with a copy of ``problem``, is stale once one of
-    them was replaced (e.g. ``problem.settings`` with another margin)."""
+    """The objects ``problem`` is made from — its settings, robot, scene, start and goal —
+    to be compared by identity (:func:`same_parts`). The problem is frozen, so they never
+    change for one problem; kept for the polisher's check that it was started for the
+    problem it is given."""
     return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
 
 
 def same_parts(parts: tuple[Any, ...], problem: TrajectoryProblem) -> bool:
-    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts now, object
-    for object."""
+    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts, object for
+    object."""
     now = problem_parts(problem)
     return len(parts) == len(now) and all(a is b for a, b in zip(parts, now))
 
@@ -303,29 +294,24 @@ def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, f
     (never raised; a pair whose broad-phase bound exceeds it needs no coal call, which
     makes a front's certificates much cheaper than with the default 0.05 m).
 
-    Made once per ``problem`` and kept while ``problem`` lives and its settings, robot,
-    scene, start and goal are the same objects (the same object is returned again; made
-    anew when one of them was replaced, e.g. ``problem.settings`` with another margin; it
-    evaluates in one process and, like ``problem`` itself, is not for use from several
-    threads at once). A caller about to fork certifying processes calls it first, so that
-    they share it.
+    Made once per ``problem`` and kept on it (:meth:`~adept_traj.problem.TrajectoryProblem.derived`:
+    the problem is frozen, so the same object is returned again; it evaluates in one
+    process and, like ``problem`` itself, is not for use from several threads at once). A
+    caller about to fork certifying processes calls it first, so that they share it.
     """
     check_type(problem, TrajectoryProblem, "problem")
-    made = _CERTIFYING.get(problem)
-    if made is None or not same_parts(made[2], problem):
-        fast, influence = _certifying_problem(problem)
-        parts = problem_parts(problem)
-        made = _CERTIFYING[problem] = (None if fast is problem else fast, influence, parts)
-    fast, influence, _ = made
+    key = "analysis.member_certificate.certifying"
+    fast, influence = problem.derived(key, _certifying_problem)
     return (problem if fast is None else fast), influence
 
 
-def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
-    """:func:`certifying_problem`, made."""
+def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem | None, float]:
+    """:func:`certifying_problem`, made (``None``: ``problem`` itself, which does not hold
+    itself)."""
     st = problem.settings
     influence = min(st.influence, st.margin + FRONT_INFLUENCE_ABOVE_MARGIN)
     if influence == st.influence:
-        return problem, influence
+        return None, influence
     fast = TrajectoryProblem(
         problem.robot,
         problem.scene,

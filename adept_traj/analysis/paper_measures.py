@@ -24,12 +24,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from adept_traj.analysis.indicators import (
-    _as_objectives,
-    _as_sense,
-    _minimisation_form,
-    non_dominated,
-)
+from adept_traj.analysis.indicators import non_dominated
+from adept_traj.analysis.objective_arrays import as_objectives, as_sense, minimisation_form
 from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
 from adept_traj.problem.objectives import MAXIMISED
 from adept_traj.validation import as_integer, as_scalar
@@ -163,13 +159,13 @@ def spread(
     InputShapeError: bad shapes, fewer than 2 points, ``method="deb"`` with m ≠ 2.
     InvalidInputError: non-finite values, unknown ``method``.
     """
-    arr = _as_objectives(F, "F", min_rows=2)
+    arr = as_objectives(F, "F", min_rows=2)
     m = arr.shape[1]
-    sense = _as_sense(maximised, m)
+    sense = as_sense(maximised, m)
     if reference is None:
         ref = arr
     else:
-        ref = _as_objectives(reference, "reference")
+        ref = as_objectives(reference, "reference")
         if ref.shape[1] != m:
             raise InputShapeError(f"reference must have {m} columns like F; got shape {ref.shape}")
     if method not in ("auto", "deb", "generalized"):
@@ -179,8 +175,8 @@ def spread(
     if method == "deb" and m != 2:
         raise InputShapeError(f"Deb's spread needs exactly 2 objectives; F has {m}")
 
-    S = _minimisation_form(arr, sense)
-    R = _minimisation_form(ref, sense)
+    S = minimisation_form(arr, sense)
+    R = minimisation_form(ref, sense)
     if normalise:
         lo, hi = R.min(axis=0), R.max(axis=0)
         span = np.where(hi > lo, hi - lo, 1.0)

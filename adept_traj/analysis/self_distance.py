@@ -29,11 +29,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from adept_traj.analysis.continuous import CONTINUOUS, _continuous_self_distance
+from adept_traj.analysis.continuous import CONTINUOUS, continuous_self_distance_with_acceleration
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 
-__all__ = ["MIN_SEARCH", "SelfDistance", "self_distance"]
+__all__ = [
+    "MIN_SEARCH",
+    "SelfDistance",
+    "normalise_distance_fields",
+    "self_distance",
+    "self_distance_with_acceleration",
+]
 
 #: Most exact distances computed to make the smallest self-distance of a certificate exact.
 MIN_SEARCH = 64
@@ -65,7 +71,7 @@ class SelfDistance:
     distance_bound: float | None
 
     def __post_init__(self) -> None:
-        _normalise_distance(self, "min_distance", "t_min_distance", "pair", "distance_bound")
+        normalise_distance_fields(self, "min_distance", "t_min_distance", "pair", "distance_bound")
 
     def ok(self, margin: float) -> bool:
         """The smallest self-distance is at least ``margin`` [m]."""
@@ -82,11 +88,23 @@ class SelfDistance:
         )
 
 
-def _normalise_distance(record: object, value: str, when: str, pair: str, bound: str) -> None:
-    """Check and convert, in place, the distance fields of a frozen dataclass ``record``
-    (a :class:`SelfDistance` or a :class:`~adept_traj.analysis.Certificate`): the
-    distance ``value`` [m] a number or +inf, its time ``when`` [s] and ``pair`` of two
-    names (or ``None``), the lower bound ``bound`` [m] a number (or ``None``)."""
+def normalise_distance_fields(record: object, value: str, when: str, pair: str, bound: str) -> None:
+    """Check and convert, in place, the distance fields of a frozen record (a
+    :class:`SelfDistance` or a :class:`~adept_traj.analysis.Certificate`).
+
+    Parameters
+    ----------
+    record:
+        The frozen dataclass, changed in place by its ``__post_init__``.
+    value, when, pair, bound:
+        Field names: the distance [m] (a number or +inf), its time [s] (or ``None``), the
+        pair of two names (or ``None``) and the lower bound [m] (a number or ``None``).
+
+    Raises
+    ------
+    InvalidInputError
+        NaN or -inf distance, a pair that is not two names, a NaN bound.
+    """
     d = float(getattr(record, value))
     if math.isnan(d) or d == -math.inf:
         raise InvalidInputError(f"{value} must be a number or +inf; got {d!r}")
@@ -128,10 +146,10 @@ def self_distance(
     as a bound, ``exact=False``), whatever ``certify``'s ``exact``.
     """
     acc = problem.trajectory.bounds(x).qdd_abs_max
-    return _self_distance(problem, x, t, q, qd, continuous, max_depth, acc)
+    return self_distance_with_acceleration(problem, x, t, q, qd, continuous, max_depth, acc)
 
 
-def _self_distance(
+def self_distance_with_acceleration(
     problem: TrajectoryProblem,
     x: np.ndarray,
     t: np.ndarray,
@@ -141,9 +159,22 @@ def _self_distance(
     max_depth: int,
     acc: np.ndarray,
 ) -> SelfDistance:
-    """:func:`self_distance` with the spline's exact largest |q̈| ``acc`` (nq,)
-    [rad/s² | m/s²] computed by the caller, :func:`~adept_traj.analysis.certify` (private:
-    a smaller ``acc`` would void the continuous bound)."""
+    r""":func:`self_distance` with the spline's largest :math:`|\ddot q_i|` already computed
+    by the caller (:func:`~adept_traj.analysis.certify`).
+
+    Parameters
+    ----------
+    problem, x, t, q, qd, continuous, max_depth:
+        As :func:`self_distance`: ``t`` (n,) [s], ``q`` and ``qd`` (n, nq).
+    acc:
+        (nq,) [rad/s² | m/s²] :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
+        ``(x).qdd_abs_max``: a smaller value voids the continuous bound.
+
+    Returns
+    -------
+    SelfDistance
+        As :func:`self_distance`.
+    """
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
@@ -165,7 +196,9 @@ def _self_distance(
     best, t_best, exact = float(d[k, p]), float(t[k]), bool(known[k, p])
     guarantee, bound = f"sampled at {grid_hz:g} Hz", None
     if continuous:
-        between = _continuous_self_distance(problem, x, t, qd, d, grid_hz, max_depth, acc)
+        between = continuous_self_distance_with_acceleration(
+            problem, x, t, qd, d, grid_hz, max_depth, acc
+        )
         guarantee, bound = between.guarantee, between.lower_bound
         if between.min_distance < best:  # (exact: below the margin) between the samples
             best, t_best, p = between.min_distance, between.t_min_distance, between.pair[0]

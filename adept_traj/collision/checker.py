@@ -145,6 +145,7 @@ class CollisionChecker:
         self._fixed_poses = [
             None if ob.is_moving else to_base @ ob.pose(0.0) for ob in scene.obstacles
         ]
+        self._law_of = shared_motion_laws(scene)
         self._views: dict[tuple[int, ...], CollisionChecker] = {}  # by obstacles kept
 
     @property
@@ -236,13 +237,12 @@ class CollisionChecker:
         (N, 4, 4) with N = ``t.size``."""
         to_base = self._to_base
         flat_t = self.scene_time(t).reshape(-1)
-        laws: dict[int, np.ndarray] = {}  # a pendulum's rod and bob share one motion law
+        laws: dict[int, np.ndarray] = {}  # by the first obstacle of each motion law
         poses = []
-        for ob, fixed in zip(self.scene.obstacles, self._fixed_poses):
+        for ob, fixed, key in zip(self.scene.obstacles, self._fixed_poses, self._law_of):
             if fixed is not None:
                 poses.append(fixed)
                 continue
-            key = id(ob.motion)
             if key not in laws:  # contiguous once, not in each product below
                 laws[key] = np.ascontiguousarray(
                     _left(to_base, ob.motion.pose(flat_t).reshape(-1, 4, 4))
@@ -354,3 +354,28 @@ def _left(a: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """``a @ poses`` for a constant (4, 4) ``a`` and poses (N, 4, 4), as one GEMM (numpy's
     stacked product of small matrices is several times slower)."""
     return (poses.transpose(0, 2, 1).reshape(-1, 4) @ a.T).reshape(-1, 4, 4).transpose(0, 2, 1)
+
+
+def shared_motion_laws(scene: Scene) -> tuple[int, ...]:
+    """Per obstacle of ``scene``, the index of the first obstacle with an equal motion law
+    (a pendulum's rod and bob share one): the poses of each law are computed once per call.
+
+    Parameters
+    ----------
+    scene:
+        The (frozen) scene.
+
+    Returns
+    -------
+    tuple of int
+        (n_obstacles,): its own index for a fixed obstacle and for the first obstacle of
+        each law.
+    """
+    first: dict[Any, int] = {}
+    out = []
+    for i, ob in enumerate(scene.obstacles):
+        try:
+            out.append(first.setdefault(ob.motion, i) if ob.is_moving else i)
+        except TypeError:  # a law that cannot be hashed: its own
+            out.append(i)
+    return tuple(out)

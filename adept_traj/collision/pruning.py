@@ -142,6 +142,7 @@ def restrict_checker(checker: CollisionChecker, obstacles: np.ndarray) -> Collis
     )
     view.allowed = checker.allowed[:, keep]
     view._fixed_poses = [checker._fixed_poses[o] for o in keep]
+    view._law_of = tuple(checker._law_of[o] for o in keep)  # still one key per motion law
     view._views = {}
     return view
 

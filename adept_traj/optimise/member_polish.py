@@ -55,7 +55,12 @@ from adept_traj.problem import MAXIMISED, local_constraints, objective_gradients
 from adept_traj.robot import VELOCITY_AT_REST
 from adept_traj.validation import as_integer, as_vector
 
-__all__ = ["MAX_EVALUATIONS", "epsilon_step"]
+__all__ = [
+    "MAX_EVALUATIONS",
+    "checked_start",
+    "epsilon_solve",
+    "epsilon_step",
+]
 
 #: σ_i of the sign convention: −1 where maximised (z4).
 _SIGN = np.where(MAXIMISED, -1.0, 1.0)
@@ -118,7 +123,7 @@ def epsilon_step(
         ``n_evaluations`` counts constraint-and-Jacobian evaluations and batches of
         evaluated moves.
     """
-    x0 = _start(problem, x0)
+    x0 = checked_start(problem, x0)
     j = as_integer(objective, "objective", minimum=0, maximum=5, error=ConfigurationError)
     span = as_vector(scale, "scale", 6)
     if span[j] <= 0.0:
@@ -128,10 +133,29 @@ def epsilon_step(
     keep = np.ones(6, dtype=bool)
     keep[j] = False
     max_iter = as_integer(max_iter, "max_iter", minimum=1, error=ConfigurationError)
-    return _threads_limited(problem, x0, cost, keep, span, max_iter)
+    return epsilon_solve(problem, x0, cost, keep, span, max_iter)
 
 
-def _start(problem: Any, x0: Any) -> np.ndarray:
+def checked_start(problem: Any, x0: Any) -> np.ndarray:
+    """The start of a member polish, checked.
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    x0:
+        (n_var,) the start ``[T [s], control points [rad | m]]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_var,) float64.
+
+    Raises
+    ------
+    ConfigurationError
+        ``x0`` outside the decision bounds, or the problem's ``z3`` is not ``"clearance"``.
+    """
     x0 = as_vector(x0, "x0", problem.n_var)
     if np.any(x0 < problem.xl) or np.any(x0 > problem.xu):
         raise ConfigurationError("x0 must lie inside the decision bounds (problem.xl, problem.xu)")
@@ -142,7 +166,27 @@ def _start(problem: Any, x0: Any) -> np.ndarray:
     return x0
 
 
-def _threads_limited(problem: Any, x0: np.ndarray, *args: Any, **options: Any) -> PolishOutcome:
+def epsilon_solve(problem: Any, x0: np.ndarray, *args: Any, **options: Any) -> PolishOutcome:
+    """The ε-constraint SLSQP solve of :func:`epsilon_step`, BLAS limited to one thread.
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    x0:
+        (n_var,) the checked start (:func:`checked_start`).
+    *args:
+        ``cost`` (6,) weights of the objectives (z / scale), ``no_worse`` (6,) bool (the
+        objectives kept no worse), ``span`` (6,) the objectives' scales, ``max_iter``.
+    **options:
+        ``box`` (the trust box, a fraction of each variable's range) and
+        ``max_evaluations``.
+
+    Returns
+    -------
+    PolishOutcome
+        As :func:`epsilon_step`.
+    """
     import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
     from threadpoolctl import threadpool_limits  # lazy, as in minimum_time
 

@@ -343,3 +343,7 @@ def _with_members(state: RunState, outcomes: list[PolishOutcome]) -> RunState:
         G=np.concatenate([state.G, G]),
         CV=np.concatenate([np.ravel(state.CV), np.maximum(G, 0.0).sum(axis=1)]),
     )
+
+
+#: :func:`_with_members`'s public name (used by :mod:`~adept_traj.optimise.weighted_move`).
+with_members = _with_members

@@ -51,9 +51,9 @@ import numpy as np
 
 from adept_traj.analysis.weighted_sum import WeightedSum, weighted_sum
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.member_polish import _start, _threads_limited
+from adept_traj.optimise.member_polish import checked_start, epsilon_solve
 from adept_traj.optimise.minimum_time import PolishOutcome
-from adept_traj.optimise.polish_step import _with_members, time_optimal_run
+from adept_traj.optimise.polish_step import time_optimal_run, with_members
 from adept_traj.problem import from_pymoo
 from adept_traj.validation import as_integer, check_type
 
@@ -114,7 +114,7 @@ def weighted_descent(
         (the steps' and the start's evaluation) and ``seconds`` [s] of all of them;
         ``message`` says why the descent stopped.
     """
-    x = _start(problem, x0)
+    x = checked_start(problem, x0)
     check_type(weighted, WeightedSum, "weighted")
     budget = as_integer(
         max_evaluations,
@@ -130,7 +130,7 @@ def weighted_descent(
     n_iterations, n_evaluations, evaluation_s, spent = 0, 1, ev.seconds, 0
     message = "budget spent"
     while spent + STEP_EVALUATIONS <= budget:
-        step = _threads_limited(
+        step = epsilon_solve(
             problem,
             x,
             cost,
@@ -215,7 +215,7 @@ def weighted_run(
     ]
     counted = _counted(state, outcomes, time.perf_counter() - started)
     settings = {**settings, "max_evaluations": budget, "weighted_sum": weighted.to_dict()}
-    return (_with_members(counted, improved) if improved else counted), settings
+    return (with_members(counted, improved) if improved else counted), settings
 
 
 def _counted(state: Any, outcomes: list[PolishOutcome], seconds: float) -> Any:

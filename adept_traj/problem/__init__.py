@@ -31,6 +31,7 @@ from adept_traj.problem.objectives import (
     paper_penalty,
     to_pymoo,
 )
+from adept_traj.problem.problem_settings import ProblemSettings
 from adept_traj.problem.spline_segments import (
     TrajectoryBounds,
     TrajectoryIntegrals,
@@ -38,7 +39,7 @@ from adept_traj.problem.spline_segments import (
     derivative_abs_max,
 )
 from adept_traj.problem.time_bound import KinematicBound, kinematic_lower_bound
-from adept_traj.problem.trajectory_problem import ProblemSettings, TrajectoryProblem
+from adept_traj.problem.trajectory_problem import TrajectoryProblem
 
 __all__ = [
     "CONSTRAINT_KINDS",

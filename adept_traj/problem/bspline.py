@@ -57,11 +57,11 @@ from adept_traj.problem.spline_segments import (
     TrajectoryBounds,
     TrajectoryIntegrals,
     TrajectorySamples,
-    _basis,
-    _exact_bounds,
-    _exact_integrals,
-    _gauss_legendre,
-    _sample,
+    exact_bounds,
+    exact_integrals,
+    gauss_legendre,
+    segment_basis,
+    segment_samples,
 )
 from adept_traj.validation import (
     as_batch,
@@ -325,7 +325,7 @@ class BSplineTrajectory:
         ``B`` of shape ``(n_s, n_control)`` (dimensionless, scaled by :math:`S^r`).
         """
         (order,) = _check_orders([order])
-        return _basis(self._check_s(s), order, self.n_segments)
+        return segment_basis(self._check_s(s), order, self.n_segments)
 
     def sample(self, x: Any, s: Any, orders: Sequence[int] = _ALL_ORDERS) -> TrajectorySamples:
         r"""Evaluate positions and derivatives at normalised times shared by the population.
@@ -350,7 +350,7 @@ class BSplineTrajectory:
         """
         wanted = _check_orders(orders)
         T, P = self._decode_clean(self._check_x(x))
-        return _sample(T, P, self._check_s(s), wanted)
+        return segment_samples(T, P, self._check_s(s), wanted)
 
     # ---- exact per-segment analysis ----------------------------------------------------
 
@@ -373,7 +373,7 @@ class BSplineTrajectory:
         -------
         :class:`TrajectoryBounds`, every field of shape ``(..., nq)`` in SI units.
         """
-        return _exact_bounds(*self._decode_clean(self._check_x(x)))
+        return exact_bounds(*self._decode_clean(self._check_x(x)))
 
     def integrals(self, x: Any) -> TrajectoryIntegrals:
         r"""Exact per-joint integrals of squared acceleration and squared jerk over [0, T].
@@ -397,7 +397,7 @@ class BSplineTrajectory:
         :class:`TrajectoryIntegrals` with ``acc_sq`` and ``jerk_sq`` of shape ``(..., nq)``;
         ``.z6`` and ``.z5`` give the paper's sums over joints, shape ``(...)``.
         """
-        return _exact_integrals(*self._decode_clean(self._check_x(x)))
+        return exact_integrals(*self._decode_clean(self._check_x(x)))
 
     def quadrature(self, n_per_segment: int) -> tuple[np.ndarray, np.ndarray]:
         r"""Composite Gauss–Legendre rule on the spline segments, in normalised time.
@@ -418,7 +418,7 @@ class BSplineTrajectory:
         ``(n_segments·n_per_segment,)``.
         """
         n = as_integer(n_per_segment, "n_per_segment", minimum=1)
-        return _gauss_legendre(self.n_segments, n)
+        return gauss_legendre(self.n_segments, n)
 
     # ---- box bounds for optimisers -----------------------------------------------------
 

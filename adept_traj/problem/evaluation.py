@@ -12,7 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Evaluation"]
+__all__ = [
+    "Evaluation",
+    "concatenate_evaluations",
+    "timed_evaluation",
+]
 
 
 @dataclass(frozen=True)
@@ -43,8 +47,19 @@ class Evaluation:
         return np.all(self.constraints <= 0.0, axis=-1)
 
 
-def _concatenate(parts: list[Evaluation]) -> Evaluation:
-    """One evaluation of the stacked populations of ``parts``."""
+def concatenate_evaluations(parts: list[Evaluation]) -> Evaluation:
+    """One evaluation of stacked populations.
+
+    Parameters
+    ----------
+    parts:
+        Evaluations of consecutive blocks of one population.
+
+    Returns
+    -------
+    Evaluation
+        Their rows in order; ``n_narrow`` summed.
+    """
     return Evaluation(
         objectives=np.concatenate([e.objectives for e in parts]),
         constraints=np.concatenate([e.constraints for e in parts]),
@@ -53,9 +68,23 @@ def _concatenate(parts: list[Evaluation]) -> Evaluation:
     )
 
 
-def _finish(ev: Evaluation, start: float, single: bool) -> Evaluation:
-    """``ev`` with its wall time since ``start`` [s] (``time.perf_counter``); the first row
-    only, without the population axis, when the caller gave a single vector."""
+def timed_evaluation(ev: Evaluation, start: float, single: bool) -> Evaluation:
+    """An evaluation with its wall time.
+
+    Parameters
+    ----------
+    ev:
+        The evaluation of a population (pop, ...).
+    start:
+        ``time.perf_counter()`` [s] when it started.
+    single:
+        The caller gave one vector: keep the first row, without the population axis.
+
+    Returns
+    -------
+    Evaluation
+        ``ev`` with ``seconds`` set.
+    """
     seconds = time.perf_counter() - start
     if single:
         return Evaluation(

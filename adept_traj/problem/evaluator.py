@@ -51,7 +51,7 @@ from adept_traj.errors import (
     error_from_process,
 )
 from adept_traj.problem._heap import keep_heap
-from adept_traj.problem.evaluation import Evaluation, _concatenate
+from adept_traj.problem.evaluation import Evaluation, concatenate_evaluations
 from adept_traj.processes import error_report
 from adept_traj.validation import as_batch, as_integer
 
@@ -236,7 +236,7 @@ class ParallelEvaluator:
         except BaseException:  # a failed chunk, a dead worker, Ctrl-C: stop the workers
             pool.stop(wait=True)
             raise
-        return _concatenate([*parts, mine])
+        return concatenate_evaluations([*parts, mine])
 
     def close(self) -> None:
         """Stop the worker processes and wait for them to exit (idempotent)."""

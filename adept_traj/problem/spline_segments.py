@@ -21,7 +21,17 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["TrajectoryBounds", "TrajectoryIntegrals", "TrajectorySamples", "derivative_abs_max"]
+__all__ = [
+    "TrajectoryBounds",
+    "TrajectoryIntegrals",
+    "TrajectorySamples",
+    "derivative_abs_max",
+    "exact_bounds",
+    "exact_integrals",
+    "gauss_legendre",
+    "segment_basis",
+    "segment_samples",
+]
 
 #: Uniform cubic B-spline basis matrix (rows: coefficients of u³, u², u, 1).
 _M = (
@@ -145,9 +155,23 @@ def _monomial_derivative_rows(u: np.ndarray, order: int) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
-def _basis(s: np.ndarray, order: int, n_segments: int) -> np.ndarray:
-    """Basis (derivative ``order`` in normalised time) at normalised times ``s`` (n_s,) in
-    [0, 1]: shape ``(n_s, n_segments + 3)`` (the math: :meth:`BSplineTrajectory.basis_matrix`)."""
+def segment_basis(s: np.ndarray, order: int, n_segments: int) -> np.ndarray:
+    """The B-spline basis (the math: :meth:`BSplineTrajectory.basis_matrix`).
+
+    Parameters
+    ----------
+    s:
+        (n_s,) normalised times in [0, 1].
+    order:
+        Derivative order (0…3) in normalised time.
+    n_segments:
+        Spline segments S.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_s, S + 3).
+    """
     S = n_segments
     seg = np.minimum(np.floor(s * S).astype(np.intp), S - 1)
     u = s * S - seg
@@ -164,32 +188,62 @@ _SHARED_GRID = 4096
 
 @functools.lru_cache(maxsize=16)
 def _shared_basis(s_bytes: bytes, order: int, n_segments: int) -> np.ndarray:
-    """:func:`_basis` at the times ``np.frombuffer(s_bytes)``, made once per grid (a
+    """:func:`segment_basis` at the times ``np.frombuffer(s_bytes)``, made once per grid (a
     problem samples every population at the same times) and read-only."""
-    basis = _basis(np.frombuffer(s_bytes), order, n_segments)
+    basis = segment_basis(np.frombuffer(s_bytes), order, n_segments)
     basis.flags.writeable = False
     return basis
 
 
-def _sample(
+def segment_samples(
     T: np.ndarray, P: np.ndarray, s: np.ndarray, orders: tuple[int, ...]
 ) -> TrajectorySamples:
-    """Samples at normalised times ``s`` (n_s,) of travel times ``T`` (...) [s] and control
-    points ``P`` (..., S + 3, nq), derivatives ``orders`` (the math:
-    :meth:`BSplineTrajectory.sample`)."""
+    """Samples of splines (the math: :meth:`BSplineTrajectory.sample`).
+
+    Parameters
+    ----------
+    T:
+        (...) travel times [s].
+    P:
+        (..., S + 3, nq) control points [rad | m].
+    s:
+        (n_s,) normalised times in [0, 1].
+    orders:
+        Derivative orders (0…3) wanted.
+
+    Returns
+    -------
+    TrajectorySamples
+        ``t`` (..., n_s) [s] and the wanted derivatives (..., n_s, nq).
+    """
     out: list[np.ndarray | None] = [None, None, None, None]
     for r in orders:
         P_r = P if r == 0 else P * (T[..., None, None] ** (-r))  # small: scale before
         S = P.shape[-2] - 3
-        basis = _shared_basis(s.tobytes(), r, S) if len(s) <= _SHARED_GRID else _basis(s, r, S)
+        basis = (
+            _shared_basis(s.tobytes(), r, S) if len(s) <= _SHARED_GRID else segment_basis(s, r, S)
+        )
         out[r] = basis @ P_r
     t = T[..., None] * s
     return TrajectorySamples(t=t, q=out[0], qd=out[1], qdd=out[2], qddd=out[3])
 
 
-def _gauss_legendre(n_segments: int, n_per_segment: int) -> tuple[np.ndarray, np.ndarray]:
-    """Composite Gauss–Legendre nodes and weights, each (n_segments·n_per_segment,), in
-    normalised time (the math: :meth:`BSplineTrajectory.quadrature`)."""
+def gauss_legendre(n_segments: int, n_per_segment: int) -> tuple[np.ndarray, np.ndarray]:
+    """Composite Gauss–Legendre nodes and weights in normalised time (the math:
+    :meth:`BSplineTrajectory.quadrature`).
+
+    Parameters
+    ----------
+    n_segments:
+        Spline segments S.
+    n_per_segment:
+        Nodes per segment.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Nodes and weights, each (S·n_per_segment,).
+    """
     S = n_segments
     xg, wg = np.polynomial.legendre.leggauss(n_per_segment)
     s = (np.arange(S)[:, None] + 0.5 * (xg + 1.0)) / S
@@ -254,9 +308,22 @@ def _segment_coefficients(P: np.ndarray) -> np.ndarray:
     return np.einsum("ab,...sbj->...saj", _M, windows)
 
 
-def _exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
-    """Extrema over [0, T] of travel times ``T`` (...) [s] and control points ``P``
-    (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.bounds`)."""
+def exact_bounds(T: np.ndarray, P: np.ndarray) -> TrajectoryBounds:
+    r"""Exact extrema over [0, T] of splines (the math: :meth:`BSplineTrajectory.bounds`).
+
+    Parameters
+    ----------
+    T:
+        (...) travel times [s].
+    P:
+        (..., S + 3, nq) control points [rad | m].
+
+    Returns
+    -------
+    TrajectoryBounds
+        Per spline and joint (..., nq): ``q_min``, ``q_max`` [rad | m] and the largest
+        :math:`|\dot q|, |\ddot q|, |\dddot q|`.
+    """
     c = _segment_coefficients(P)
     c3, c2, c1, c0 = c[..., 0, :], c[..., 1, :], c[..., 2, :], c[..., 3, :]  # (..., S, nq)
     a3, b2 = 3.0 * c3, 2.0 * c2
@@ -351,9 +418,22 @@ def _derivative_abs_max(T: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.nd
     return qd.max(axis=-2), qdd.max(axis=-2), np.abs(j3 * rate**3).max(axis=-2)
 
 
-def _exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
-    """Integrals over [0, T] of squared acceleration and jerk of travel times ``T`` (...) [s]
-    and control points ``P`` (..., S + 3, nq) (the math: :meth:`BSplineTrajectory.integrals`)."""
+def exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
+    """Exact integrals over [0, T] of the squared acceleration and jerk of splines (the math:
+    :meth:`BSplineTrajectory.integrals`).
+
+    Parameters
+    ----------
+    T:
+        (...) travel times [s].
+    P:
+        (..., S + 3, nq) control points [rad | m].
+
+    Returns
+    -------
+    TrajectoryIntegrals
+        ``z5`` and ``z6`` (...).
+    """
     c = _segment_coefficients(P)
     A = 6.0 * c[..., 0, :]
     B = 2.0 * c[..., 1, :]

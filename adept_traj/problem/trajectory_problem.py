@@ -42,10 +42,10 @@ baseline for benchmarks. With ``workers > 1`` populations are evaluated by a
 from __future__ import annotations
 
 import copy
-import multiprocessing
 import time
-from dataclasses import dataclass, replace
-from typing import Any
+from collections.abc import Callable
+from dataclasses import fields, replace
+from typing import Any, TypeVar
 
 import numpy as np
 from pymoo.core.problem import Problem
@@ -53,127 +53,24 @@ from pymoo.core.problem import Problem
 from adept_traj.collision import CollisionChecker, self_collision_check
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory
-from adept_traj.problem.evaluation import Evaluation, _concatenate, _finish
+from adept_traj.problem.evaluation import Evaluation, concatenate_evaluations, timed_evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator
 from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
+from adept_traj.problem.problem_settings import ProblemSettings
 from adept_traj.problem.time_bound import kinematic_lower_bound
 from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Box
-from adept_traj.validation import as_batch, as_integer, as_scalar
+from adept_traj.validation import (
+    FrozenAttributes,
+    as_batch,
+    readonly_copy,
+)
 
-__all__ = ["ProblemSettings", "TrajectoryProblem"]
+_Derived = TypeVar("_Derived")
 
-
-@dataclass(frozen=True)
-class ProblemSettings:
-    """Settings of a :class:`TrajectoryProblem` (SI units).
-
-    Attributes
-    ----------
-    n_knots:
-        B-spline knots m (paper: 20).
-    nodes_per_segment:
-        Gauss–Legendre nodes per spline segment where torques, manipulability and distances
-        are sampled (default 6: 114 samples, plus both ends).
-    margin:
-        Safety distance [m] that the certificate checks at every instant.
-    search_buffer:
-        Distance [m] added to the margin in the optimiser's distance constraint only: the
-        search asks :math:`\\min_o d_o \\ge` margin + search_buffer at its samples, so that
-        the distance, which can drop between two samples, still clears the margin there
-        (see docs/problem.md for the measurement behind the default). The certificate keeps
-        the true margin. Need margin + search_buffer ≤ influence.
-    influence:
-        Distance δ [m] below which distances are exact and the clearance penalty z3 acts.
-    t_bounds:
-        (T_min, T_max) [s] of the travel time; ``None``: from the kinematic lower bound
-        :math:`T_{lb}`, ``(T_lb, 2.5 T_lb)``.
-    z3:
-        ``"clearance"`` (default, exact distances), ``"paper-sphere"`` or
-        ``"paper-ellipsoid"`` (eqs. 13–16 on the tool point).
-    workers:
-        Processes evaluating a population in parallel (default 1: in this process).
-        With ``workers > 1`` a population of at least 16 is split into ``workers``
-        chunks (one row each if fewer), evaluated by this process and ``workers - 1``
-        forked processes (Linux) of a :class:`~adept_traj.problem.evaluator.ParallelEvaluator`
-        that the problem owns; results are identical to the serial evaluation. The
-        workers are forked when first needed and hold a snapshot of the problem (later
-        edits of ``robot.model`` are not seen by them); :meth:`TrajectoryProblem.close`
-        stops them.
-    self_collision:
-        Check the robot's own links against each other (the pairs of
-        :class:`~adept_traj.collision.SelfCollision`) in the distance constraint and the
-        certificate, with the same margin. ``None`` (default): on for every robot with a
-        pair to check; without an SRDF, parameter-file pairs or ``disabled_pairs``, the
-        pairs in contact at every pose of its sampled collision matrix are left out
-        (:func:`~adept_traj.collision.self_collision_check`). The problem's
-        :attr:`~TrajectoryProblem.settings` hold the resolved ``True``/``False``.
-    disabled_pairs:
-        ``(link1, link2)`` pairs left out of the self-collision check besides the robot's
-        SRDF pairs. The problem's settings hold every disabled pair naming two links with
-        solids (these and the SRDF's, sorted), so that a saved result rebuilds the same
-        check.
-    start_time:
-        Scene time t0 [s] (≥ 0) of the move's start: obstacles are seen at t0 + t.
-    """
-
-    n_knots: int = 20
-    nodes_per_segment: int = 6
-    margin: float = 0.01
-    influence: float = 0.05
-    t_bounds: tuple[float, float] | None = None
-    z3: str = "clearance"
-    workers: int = 1
-    search_buffer: float = 0.002
-    self_collision: bool | None = None
-    disabled_pairs: tuple[tuple[str, str], ...] = ()
-    start_time: float = 0.0
-
-    def __post_init__(self) -> None:
-        if self.z3 not in ("clearance", "paper-sphere", "paper-ellipsoid"):
-            raise ConfigurationError(
-                f"z3 must be 'clearance', 'paper-sphere' or 'paper-ellipsoid'; got {self.z3!r}"
-            )
-        if not (0 <= self.margin <= self.influence and self.influence > 0):
-            raise ConfigurationError(
-                f"need 0 ≤ margin ≤ influence and influence > 0 [m]; got margin={self.margin}, "
-                f"influence={self.influence}"
-            )
-        if not (0 <= self.search_buffer <= self.influence - self.margin):
-            raise ConfigurationError(
-                f"need 0 ≤ search_buffer ≤ influence − margin = "
-                f"{self.influence - self.margin:.4g} [m]; got search_buffer={self.search_buffer}"
-            )
-        if self.self_collision is not None and not isinstance(self.self_collision, bool):
-            raise ConfigurationError(
-                f"self_collision must be True, False or None; got {self.self_collision!r}"
-            )
-        try:
-            pairs = tuple((str(a), str(b)) for a, b in self.disabled_pairs)
-        except (TypeError, ValueError):
-            raise ConfigurationError(
-                f"disabled_pairs must be (link1, link2) pairs; got {self.disabled_pairs!r}"
-            ) from None
-        object.__setattr__(self, "disabled_pairs", pairs)
-        t0 = as_scalar(self.start_time, "start_time", "[s]", minimum=0, error=ConfigurationError)
-        object.__setattr__(self, "start_time", t0)
-        for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
-            value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
-            object.__setattr__(self, name, value)
-        if self.workers > 1 and "fork" not in multiprocessing.get_all_start_methods():
-            raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
-        if self.t_bounds is not None:
-            try:
-                lo, hi = (float(v) for v in self.t_bounds)
-            except (TypeError, ValueError):
-                raise ConfigurationError(
-                    f"t_bounds must be (T_min, T_max) in seconds; got {self.t_bounds!r}"
-                ) from None
-            if not (np.isfinite(hi) and 0.0 < lo < hi):
-                raise ConfigurationError(f"t_bounds must satisfy 0 < T_min < T_max; got {lo, hi}")
-            object.__setattr__(self, "t_bounds", (lo, hi))
+__all__ = ["TrajectoryProblem"]
 
 
 #: Smallest chunk worth sending to a worker: populations smaller than ``2 × _MIN_CHUNK`` are
@@ -188,8 +85,11 @@ _MIN_CHUNK = 8
 #: samples and more are ≈ 2× slower per sample here: their arrays leave the 2 MB L2 cache).
 _BLOCK_SAMPLES = 4096
 
+#: The parts a problem is made from, as :meth:`TrajectoryProblem.replace` takes them.
+_PARTS = ("robot", "scene", "start", "goal", "settings")
 
-class TrajectoryProblem(Problem):
+
+class TrajectoryProblem(FrozenAttributes, Problem):
     """The multi-objective trajectory problem (see the module docstring).
 
     Parameters
@@ -200,6 +100,14 @@ class TrajectoryProblem(Problem):
         Rest configurations (nq,) [rad | m], inside the joint limits.
     settings:
         :class:`ProblemSettings`; keyword arguments override its fields.
+
+    The problem is frozen: its settings, robot, scene, start and goal, and everything
+    derived from them (the trajectory, the checker, the bounds ``xl``/``xu``, the samples
+    ``s``), are fixed at construction (setting one raises
+    :class:`~adept_traj.errors.FrozenObjectError`; :meth:`replace` makes a changed copy),
+    and its arrays are read-only copies (the caller's ``start`` and ``goal`` are neither
+    kept nor changed). Data derived from the problem alone is made once and kept on it
+    (:meth:`derived`).
     """
 
     def __init__(
@@ -233,8 +141,8 @@ class TrajectoryProblem(Problem):
                 f"robot '{robot.name}' has no task_rows for the manipulability objective z4: "
                 "give them in its parameter file or Robot.from_urdf(..., task_rows=[...])"
             )
-        self.start = lim.check_position(start, "start")
-        self.goal = lim.check_position(goal, "goal")
+        self.start = readonly_copy(lim.check_position(start, "start"))
+        self.goal = readonly_copy(lim.check_position(goal, "goal"))
         if np.array_equal(self.start, self.goal):
             raise ConfigurationError("start and goal are the same configuration: nothing to plan")
         if self.start.shape != (robot.nq,) or self.goal.shape != (robot.nq,):
@@ -246,8 +154,8 @@ class TrajectoryProblem(Problem):
         t_min, t_max = settings.t_bounds or (self.lower_bound.T_min, 2.5 * self.lower_bound.T_min)
         xl, xu = self.trajectory.decision_bounds(lim.lower, lim.upper, t_min, t_max)
         s, w = self.trajectory.quadrature(settings.nodes_per_segment)
-        self.s = np.concatenate([[0.0], s, [1.0]])  # both ends too (weight 0)
-        self.weights = np.concatenate([[0.0], w, [0.0]])
+        self.s = readonly_copy(np.concatenate([[0.0], s, [1.0]]))  # both ends too (weight 0)
+        self.weights = readonly_copy(np.concatenate([[0.0], w, [0.0]]))
         self.checker = CollisionChecker(robot, scene, settings.influence, settings.start_time)
         super().__init__(
             n_var=self.trajectory.n_var,
@@ -259,7 +167,66 @@ class TrajectoryProblem(Problem):
             # copies (the workers' snapshot) and pickles leave the worker pool out
             exclude_from_serialization=["_evaluator"],
         )
+        self.xl.setflags(write=False)  # pymoo's float copies of xl, xu
+        self.xu.setflags(write=False)
         self._evaluator: ParallelEvaluator | None = None
+        self._derived: dict[str, Any] = {}
+        self._freeze()
+
+    def replace(self, **changes: Any) -> TrajectoryProblem:
+        """A new problem with some of this one's parts changed (``dataclasses.replace``
+        for the frozen problem).
+
+        Parameters
+        ----------
+        **changes:
+            ``robot``, ``scene``, ``start``, ``goal`` (nq,) [rad | m], ``settings`` (a
+            :class:`ProblemSettings`; default: this problem's, as it resolved them:
+            ``self_collision`` and ``disabled_pairs`` included, so give new settings
+            with a new robot), and any field of :class:`ProblemSettings` (e.g.
+            ``margin=0.02``), which overrides the settings.
+
+        Returns
+        -------
+        TrajectoryProblem
+            Built anew from the changed parts (nothing derived is shared; no worker
+            pool).
+
+        Raises
+        ------
+        ConfigurationError
+            An unknown name, or a bad setting.
+        """
+        parts = {k: changes.pop(k, getattr(self, k)) for k in _PARTS}
+        unknown = sorted(set(changes) - {f.name for f in fields(ProblemSettings)})
+        if unknown:
+            raise ConfigurationError(
+                f"replace() takes {', '.join(_PARTS)} or ProblemSettings fields; got {unknown}"
+            )
+        return TrajectoryProblem(**parts, **changes)
+
+    def derived(self, key: str, make: Callable[[TrajectoryProblem], _Derived]) -> _Derived:
+        """Data derived from this problem alone, made once by ``make(self)`` and kept on
+        the problem (it is frozen: nothing it is made from can change).
+
+        Parameters
+        ----------
+        key:
+            Names the data (by convention the module making it, e.g.
+            ``"analysis.continuous.rates"``).
+        make:
+            Makes it from the problem; called on the first request for ``key`` only.
+
+        Returns
+        -------
+        object
+            What ``make`` returned for ``key``, the same object on every call.
+        """
+        try:
+            return self._derived[key]
+        except KeyError:
+            value = self._derived[key] = make(self)
+            return value
 
     # ------------------------------------------------------------------ public
     @property
@@ -279,7 +246,7 @@ class TrajectoryProblem(Problem):
         xa = as_batch(x, "x", self.n_var)
         start = time.perf_counter()
         ev = self._evaluate_batch(np.atleast_2d(xa))
-        return _finish(ev, start, single=xa.ndim == 1)
+        return timed_evaluation(ev, start, single=xa.ndim == 1)
 
     # ------------------------------------------------------------------ pymoo hook
     def _evaluate(self, x: np.ndarray, out: dict[str, Any], *args: Any, **kwargs: Any) -> None:
@@ -322,7 +289,7 @@ class TrajectoryProblem(Problem):
     def _evaluate_serial(self, x: np.ndarray) -> Evaluation:
         step = max(1, _BLOCK_SAMPLES // len(self.s))  # equal blocks of at most ≈ 1.5 step
         blocks = [self._evaluate_block(b) for b in np.array_split(x, max(1, round(len(x) / step)))]
-        return blocks[0] if len(blocks) == 1 else _concatenate(blocks)
+        return blocks[0] if len(blocks) == 1 else concatenate_evaluations(blocks)
 
     def _evaluate_block(self, x: np.ndarray) -> Evaluation:
         traj, robot, st = self.trajectory, self.robot, self.settings

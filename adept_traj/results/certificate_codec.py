@@ -10,24 +10,43 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
 from adept_traj.analysis import SelfDistance
 from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
 from adept_traj.analysis.member_certificate import MemberCertificate
-from adept_traj.errors import InvalidInputError
+from adept_traj.results.json_values import json_float, json_floats
 from adept_traj.results.parts import Front
 from adept_traj.robot.limits import LIMIT_KINDS, LIMITS
 from adept_traj.schema import Node
 
-__all__: list[str] = []
+__all__ = [
+    "DENSE_FIELDS",
+    "decode_certificate",
+    "decode_dense",
+    "decode_member_certificate",
+    "encode_certificate",
+    "encode_member_certificate",
+]
 
 #: The series of the dense trajectory stored as ``best_trajectory``.
-_DENSE_FIELDS = ("t", *(kind.quantity for kind in LIMITS), "min_distance")
+DENSE_FIELDS = ("t", *(kind.quantity for kind in LIMITS), "min_distance")
 
 
-def _member_certificate(front: Front, i: int) -> dict[str, Any]:
-    """``{"certificate": ...}`` of member ``i`` (version 2), or nothing (version 1)."""
+def encode_member_certificate(front: Front, i: int) -> dict[str, Any]:
+    """The certificate entry of a front member in ``result.json``.
+
+    Parameters
+    ----------
+    front:
+        The result's :class:`~adept_traj.results.Front`.
+    i:
+        The member's index.
+
+    Returns
+    -------
+    dict
+        ``{"certificate": ...}`` (version 2: the member's certificate or ``None``), or
+        ``{}`` when the front has no certificates (version 1).
+    """
     if front.certificates is None:
         return {}
     m = front.certificates[i]
@@ -40,14 +59,14 @@ def _member_certificate(front: Front, i: int) -> dict[str, Any]:
         "worst": dict(zip(LIMIT_KINDS, m.worst, strict=True)),
         "worst_joint": dict(zip(LIMIT_KINDS, m.worst_joint, strict=True)),
         "t_worst": dict(zip(LIMIT_KINDS, m.t_worst, strict=True)),
-        "min_distance": _float(m.min_distance),
+        "min_distance": json_float(m.min_distance),
         "min_distance_exact": m.min_distance_exact,
         "t_min_distance": m.t_min_distance,
         "closest_pair": None if m.closest_pair is None else list(m.closest_pair),
         "violations": list(m.violations),
     }
     if m.distance_bound is not None:
-        out["distance_bound"] = _float(m.distance_bound)  # null: +inf (no obstacle)
+        out["distance_bound"] = json_float(m.distance_bound)  # null: +inf (no obstacle)
     if m.self_distance is not None:  # optional key (self-collision on)
         out["self_distance"] = _encode_self_distance(m.self_distance)
     return {"certificate": out}
@@ -55,14 +74,14 @@ def _member_certificate(front: Front, i: int) -> dict[str, Any]:
 
 def _encode_self_distance(d: SelfDistance) -> dict[str, Any]:
     out: dict[str, Any] = {
-        "min_distance": _float(d.min_distance),  # null: +inf (no checked pair)
+        "min_distance": json_float(d.min_distance),  # null: +inf (no checked pair)
         "exact": d.exact,
         "t_min_distance": d.t_min_distance,
         "pair": None if d.pair is None else list(d.pair),
         "guarantee": d.guarantee,
     }
     if d.distance_bound is not None:
-        out["distance_bound"] = _float(d.distance_bound)
+        out["distance_bound"] = json_float(d.distance_bound)
     return out
 
 
@@ -82,22 +101,35 @@ def _decode_self_distance(node: Node) -> SelfDistance | None:
     )
 
 
-def _encode_certificate(c: Certificate) -> dict[str, Any]:
+def encode_certificate(c: Certificate) -> dict[str, Any]:
+    """The ``certificate`` object of ``result.json``.
+
+    Parameters
+    ----------
+    c:
+        The best move's :class:`~adept_traj.analysis.Certificate`.
+
+    Returns
+    -------
+    dict
+        Its fields as JSON values, the dense samples left out (they are stored as
+        ``best_trajectory``, :func:`decode_dense`).
+    """
     out: dict[str, Any] = {
         "feasible": c.feasible,
         "rate_hz": c.rate_hz,
         "n_samples": c.n_samples,
         "margin": c.margin,
-        "min_distance": _float(c.min_distance),
+        "min_distance": json_float(c.min_distance),
         "t_min_distance": c.t_min_distance,
         "closest_pair": None if c.closest_pair is None else list(c.closest_pair),
         "violations": list(c.violations),
-        "x": _floats(c.x),
+        "x": json_floats(c.x),
     }
     if c.guarantee is not None:  # optional keys (absent in files of older versions)
         out["guarantee"] = c.guarantee
     if c.distance_bound is not None:
-        out["distance_bound"] = _float(c.distance_bound)  # null: +inf (no obstacle)
+        out["distance_bound"] = json_float(c.distance_bound)  # null: +inf (no obstacle)
     if c.torque_guarantee is not None:
         out["torque_guarantee"] = c.torque_guarantee
     if c.self_distance is not None:
@@ -105,33 +137,34 @@ def _encode_certificate(c: Certificate) -> dict[str, Any]:
     for check in c.checks:
         out[check.kind] = {
             "limit": check.symbol,
-            "worst": _floats(check.worst),
+            "worst": json_floats(check.worst),
             "within": [bool(b) for b in check.within],
-            "dense": _floats(check.dense),
-            "exact": None if check.exact is None else _floats(check.exact),
-            "t_worst": _floats(check.t_worst),
+            "dense": json_floats(check.dense),
+            "exact": None if check.exact is None else json_floats(check.exact),
+            "t_worst": json_floats(check.t_worst),
             "tolerance": check.tolerance,
         }
     return out
 
 
-def _float(value: float) -> float | None:
-    """A finite float as is; ±inf as ``None``; NaN refused."""
-    v = float(value)
-    if math.isnan(v):
-        raise InvalidInputError("NaN cannot be saved")
-    return v if math.isfinite(v) else None
+def decode_member_certificate(node: Node) -> MemberCertificate | None:
+    """A front member's certificate read from ``result.json`` (version 2).
 
+    Parameters
+    ----------
+    node:
+        The member's ``certificate`` node.
 
-def _floats(arr: Any) -> Any:
-    """Nested lists of floats (±inf → ``None``) from an array; NaN refused."""
-    a = np.asarray(arr, dtype=float)
-    if np.isnan(a).any():
-        raise InvalidInputError("NaN cannot be saved")
-    return np.where(np.isinf(a), None, a).tolist() if np.isinf(a).any() else a.tolist()
+    Returns
+    -------
+    MemberCertificate or None
+        ``None`` for a member that was not certified (``null``).
 
-
-def _decode_member_certificate(node: Node) -> MemberCertificate | None:
+    Raises
+    ------
+    ResultFormatError
+        The node is missing or a field is malformed.
+    """
     if not node.present:
         raise node.error("is required in a result of version 2 (an object, or null)")
     if node.value is None:
@@ -162,14 +195,51 @@ def _decode_member_certificate(node: Node) -> MemberCertificate | None:
     )
 
 
-def _decode_dense(node: Node, nq: int) -> DenseTrajectory:
+def decode_dense(node: Node, nq: int) -> DenseTrajectory:
+    """The dense samples of the best move read from ``result.json``.
+
+    Parameters
+    ----------
+    node:
+        The ``best_trajectory`` node (fields :data:`DENSE_FIELDS`).
+    nq:
+        Joint count.
+
+    Returns
+    -------
+    DenseTrajectory
+        ``t`` (n,) [s], ``q`` … ``tau`` (n, nq), ``min_distance`` (n,) [m] (``null`` as +inf).
+
+    Raises
+    ------
+    ResultFormatError
+        A field missing or of the wrong shape.
+    """
     t = node["t"].array((None,))
-    arrays = {name: node[name].array((t.size, nq)) for name in _DENSE_FIELDS[1:-1]}
+    arrays = {name: node[name].array((t.size, nq)) for name in DENSE_FIELDS[1:-1]}
     distance = node["min_distance"].array((t.size,), null=math.inf)
     return node.build(DenseTrajectory, t=t, **arrays, min_distance=distance)
 
 
-def _decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
+def decode_certificate(node: Node, dense: DenseTrajectory) -> Certificate:
+    """The best move's certificate read from ``result.json``.
+
+    Parameters
+    ----------
+    node:
+        The ``certificate`` node.
+    dense:
+        Its dense samples (:func:`decode_dense`).
+
+    Returns
+    -------
+    Certificate
+
+    Raises
+    ------
+    ResultFormatError
+        A field missing or malformed.
+    """
     nq, checks = dense.nq, {}
     for kind in LIMIT_KINDS:
         cd = node[kind]

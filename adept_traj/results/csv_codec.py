@@ -23,17 +23,27 @@ import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from adept_traj.errors import ResultFormatError
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES
-from adept_traj.results.reader import _read_text
-from adept_traj.results.record import PlanningResult
+from adept_traj.results.reader import read_text
 from adept_traj.robot.limits import LIMITS
 
-__all__: list[str] = []
+if TYPE_CHECKING:  # the record imports this module
+    from adept_traj.results.record import PlanningResult
+
+__all__ = [
+    "check_front_csv",
+    "check_trajectory_csv",
+    "csv_text",
+    "trajectory_header",
+    "write_front_csv",
+    "write_trajectory_csv",
+]
 
 #: Derivative prefixes of the joint columns of ``best_trajectory.csv``, in order.
 _JOINT_PREFIXES = tuple(kind.quantity for kind in LIMITS)
@@ -50,17 +60,57 @@ def _front_table(r: PlanningResult) -> np.ndarray:
     return np.column_stack([fr.objectives, fr.feasible.astype(float), fr.x])
 
 
-def _write_front_csv(r: PlanningResult, path: Path) -> Path:
-    text = _csv_text(_front_header(r.front.x.shape[1]), _front_table(r), [len(OBJECTIVE_NAMES)])
+def write_front_csv(r: PlanningResult, path: Path) -> Path:
+    """Write ``front.csv`` of a result (atomically).
+
+    Parameters
+    ----------
+    r:
+        The :class:`~adept_traj.results.PlanningResult`.
+    path:
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    text = csv_text(_front_header(r.front.x.shape[1]), _front_table(r), [len(OBJECTIVE_NAMES)])
     return write_text_atomic(path, text)
 
 
-def _check_front_csv(r: PlanningResult, path: Path) -> None:
+def check_front_csv(r: PlanningResult, path: Path) -> None:
+    """Check that ``front.csv`` agrees with a result read from ``result.json``.
+
+    Parameters
+    ----------
+    r:
+        The :class:`~adept_traj.results.PlanningResult`.
+    path:
+        The file.
+
+    Raises
+    ------
+    ResultFormatError
+        Another header, row count or value (naming the row and column).
+    """
     _check_csv(path, _front_header(r.front.x.shape[1]), _front_table(r))
 
 
 # ============================================================================ best_trajectory.csv
-def _trajectory_header(names: Sequence[str]) -> list[str]:
+def trajectory_header(names: Sequence[str]) -> list[str]:
+    """The header of ``best_trajectory.csv``.
+
+    Parameters
+    ----------
+    names:
+        The joint names.
+
+    Returns
+    -------
+    list of str
+        ``t``, ``q_<joint>`` … ``tau_<joint>``, ``min_distance``.
+    """
     return ["t", *(f"{p}_{n}" for p in _JOINT_PREFIXES for n in names), "min_distance"]
 
 
@@ -70,19 +120,61 @@ def _trajectory_table(r: PlanningResult) -> np.ndarray:
     return np.column_stack([d.t, d.q, d.qd, d.qdd, d.qddd, d.tau, d.min_distance])
 
 
-def _write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
-    text = _csv_text(_trajectory_header(r.robot.joint_names), _trajectory_table(r))
+def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
+    """Write ``best_trajectory.csv`` of a result (atomically).
+
+    Parameters
+    ----------
+    r:
+        The :class:`~adept_traj.results.PlanningResult`.
+    path:
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    text = csv_text(trajectory_header(r.robot.joint_names), _trajectory_table(r))
     return write_text_atomic(path, text)
 
 
-def _check_trajectory_csv(r: PlanningResult, path: Path) -> None:
-    _check_csv(path, _trajectory_header(r.robot.joint_names), _trajectory_table(r))
+def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
+    """Check that ``best_trajectory.csv`` agrees with a result read from ``result.json``.
+
+    Parameters
+    ----------
+    r:
+        The :class:`~adept_traj.results.PlanningResult`.
+    path:
+        The file.
+
+    Raises
+    ------
+    ResultFormatError
+        Another header, row count or value (naming the row and column).
+    """
+    _check_csv(path, trajectory_header(r.robot.joint_names), _trajectory_table(r))
 
 
 # ============================================================================ both
-def _csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = ()) -> str:
-    """The CSV text: ``header``, then ``rows`` as shortest round-trip floats (the
-    ``int_columns`` as integers); ``\\n`` line ends."""
+def csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = ()) -> str:
+    """CSV text of a table, floats in their shortest round-trip form.
+
+    Parameters
+    ----------
+    header:
+        Column names.
+    rows:
+        (n, len(header)) values.
+    int_columns:
+        Columns written as integers.
+
+    Returns
+    -------
+    str
+        Header and rows, newline line ends.
+    """
     lines = [",".join(header)]
     for row in rows.tolist():
         cells = [repr(float(v)) for v in row]
@@ -95,7 +187,7 @@ def _csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = 
 def _check_csv(path: Path, header: list[str], expected: np.ndarray) -> None:
     """Check that the CSV file at ``path`` has ``header`` and the values of ``expected``
     (n, m), exactly; raise :class:`ResultFormatError` naming the first bad row and column."""
-    rows = list(csv.reader(io.StringIO(_read_text(path))))
+    rows = list(csv.reader(io.StringIO(read_text(path))))
     if not rows or rows[0] != header:
         got = rows[0] if rows else "nothing"
         raise ResultFormatError(path, "header", f"expected {','.join(header)}; got {got}")

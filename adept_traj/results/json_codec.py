@@ -20,7 +20,7 @@ import dataclasses
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,15 +28,14 @@ from adept_traj.collision import SelfPairs
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
 from adept_traj.results.certificate_codec import (
-    _DENSE_FIELDS,
-    _decode_certificate,
-    _decode_dense,
-    _decode_member_certificate,
-    _encode_certificate,
-    _float,
-    _floats,
-    _member_certificate,
+    DENSE_FIELDS,
+    decode_certificate,
+    decode_dense,
+    decode_member_certificate,
+    encode_certificate,
+    encode_member_certificate,
 )
+from adept_traj.results.json_values import json_float, json_floats, jsonable
 from adept_traj.results.parts import (
     METRIC_NAMES,
     T_BEST_SOURCES,
@@ -47,28 +46,69 @@ from adept_traj.results.parts import (
     RobotInfo,
     Timing,
 )
-from adept_traj.results.reader import _open_json
-from adept_traj.results.record import FORMAT, READ_VERSIONS, VERSION, PlanningResult, _jsonable
+from adept_traj.results.reader import open_json
 from adept_traj.results.unchecked import unchecked
 from adept_traj.robot.limits import LIMITS, JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.schema import Node
 from adept_traj.validation import deep_equal
 
-__all__: list[str] = []
+if TYPE_CHECKING:  # the record imports this module: its class is given to read_json
+    from adept_traj.results.record import PlanningResult
+
+__all__ = ["FORMAT", "READ_VERSIONS", "VERSION", "read_json", "write_json"]
+
+#: Value of the ``"format"`` key of ``result.json``.
+FORMAT = "adept_traj.result"
+#: Newest schema version: written when the front carries its members' certificates
+#: (version 1, without them, is still read, and written back for a result read from it).
+VERSION = 2
+#: Schema versions read.
+READ_VERSIONS = (1, 2)
 
 #: JSON key of each metric of :class:`Metrics`.
 _JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
 
 
-def _write_json(r: PlanningResult, path: Path) -> Path:
-    """Write ``result.json`` for ``r`` at ``path`` (atomically)."""
+def write_json(r: PlanningResult, path: Path) -> Path:
+    """Write ``result.json`` of a result (atomically).
+
+    Parameters
+    ----------
+    r:
+        The :class:`~adept_traj.results.PlanningResult`.
+    path:
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     return write_text_atomic(path, _dumps(_encode(r)) + "\n")
 
 
-def _read_json(path: Path) -> PlanningResult:
-    """The result stored in the ``result.json`` at ``path``."""
-    return _decode(_open_json(path))
+def read_json(path: Path, result_type: type[PlanningResult]) -> PlanningResult:
+    """The result stored in a ``result.json``.
+
+    Parameters
+    ----------
+    path:
+        The file.
+    result_type:
+        The class to build, :class:`~adept_traj.results.PlanningResult` (given by its
+        ``load``: the record imports this module, not the other way round).
+
+    Returns
+    -------
+    PlanningResult
+
+    Raises
+    ------
+    ResultFormatError
+        As :meth:`~adept_traj.results.PlanningResult.load`.
+    """
+    return _decode(open_json(path), result_type)
 
 
 # ============================================================================ encoding
@@ -94,7 +134,7 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
     lim, lb, c = r.limits, r.lower_bound, r.certificate
     metrics: dict[str, Any] = {key: getattr(r.metrics, name) for name, key in _JSON_METRICS.items()}
     ref = r.metrics.hv_reference_point
-    metrics["HV_reference_point"] = None if ref is None else _floats(ref)
+    metrics["HV_reference_point"] = None if ref is None else json_floats(ref)
     if r.metrics.t_best is not None:  # absent: not computed (and in results before it)
         metrics["T_best"], metrics["T_best_source"] = r.metrics.t_best, r.metrics.t_best_source
     history = None if r.history is None else [dataclasses.asdict(rec) for rec in r.history]
@@ -103,49 +143,49 @@ def _encode(r: PlanningResult) -> dict[str, Any]:
         "version": _version(r),
         "warning": r.warning,
         "robot": r.robot.as_json(),
-        "start": _floats(r.start),
-        "goal": _floats(r.goal),
+        "start": json_floats(r.start),
+        "goal": json_floats(r.goal),
         "seed": r.seed,
         "algorithm": {"name": r.algorithm, "settings": r.algorithm_settings},
-        "problem_settings": _jsonable(_problem_settings(r.problem_settings)),
+        "problem_settings": jsonable(_problem_settings(r.problem_settings)),
         "scene": r.scene,
         "limits": {
             "joint_names": list(lim.names),
             "units": list(lim.units),
-            "q_lower": _floats(lim.lower),
-            "q_upper": _floats(lim.upper),
+            "q_lower": json_floats(lim.lower),
+            "q_upper": json_floats(lim.upper),
             # the other bounds under their quantity's name: qd, qdd, qddd, tau
-            **{kind.quantity: _floats(lim.bound(kind.name)) for kind in LIMITS[1:]},
+            **{kind.quantity: json_floats(lim.bound(kind.name)) for kind in LIMITS[1:]},
         },
         "lower_bound": {
-            "T_min": _float(lb.T_min),
-            "per_joint": _floats(lb.times),
+            "T_min": json_float(lb.T_min),
+            "per_joint": json_floats(lb.times),
             "limiting_joint": int(lb.limiting_joint),
-            "delta": _floats(lb.delta),
+            "delta": json_floats(lb.delta),
             "cases": list(lb.cases),
         },
         "gap": r.gap,
         "best": {
             "index": r.best.index,
-            "objectives": _floats(r.best_objectives),
+            "objectives": json_floats(r.best_objectives),
             "f_c": r.best.f_c,
             "F_avg": r.best.f_avg,
         },
-        "certificate": _encode_certificate(c),
+        "certificate": encode_certificate(c),
         "metrics": metrics,
         "timing": dataclasses.asdict(r.timing),
         "versions": dict(r.versions),
         "front": [
             {
-                "objectives": _floats(r.front.objectives[i]),
-                "x": _floats(r.front.x[i]),
-                "constraints": _floats(r.front.constraints[i]),
+                "objectives": json_floats(r.front.objectives[i]),
+                "x": json_floats(r.front.x[i]),
+                "constraints": json_floats(r.front.constraints[i]),
                 "feasible": bool(r.front.feasible[i]),
             }
-            | _member_certificate(r.front, i)
+            | encode_member_certificate(r.front, i)
             for i in range(len(r.front))
         ],
-        "best_trajectory": {name: _floats(getattr(c.dense, name)) for name in _DENSE_FIELDS},
+        "best_trajectory": {name: json_floats(getattr(c.dense, name)) for name in DENSE_FIELDS},
         "history": history,
     }
     if r.front.n_certified is not None:  # optional key (absent in files of older versions)
@@ -187,7 +227,7 @@ def _scalar(value: Any) -> str:
 
 
 # ============================================================================ decoding
-def _decode(top: Node) -> PlanningResult:
+def _decode(top: Node, result_type: type[PlanningResult]) -> PlanningResult:
     top.table()
     top["format"].string(choices=(FORMAT,))
     version = top["version"].integer()
@@ -253,7 +293,7 @@ def _decode(top: Node) -> PlanningResult:
     )
     if best.index >= len(front):
         raise bd["index"].error(f"{best.index} is not a row of the front ({len(front)} rows)")
-    certificate = _decode_certificate(top["certificate"], _decode_dense(top["best_trajectory"], nq))
+    certificate = decode_certificate(top["certificate"], decode_dense(top["best_trajectory"], nq))
     if not deep_equal(certificate.x, front.x[best.index]):
         raise top["certificate"]["x"].error(
             f"differs from front[{best.index}].x (the best solution)"
@@ -275,7 +315,7 @@ def _decode(top: Node) -> PlanningResult:
     )
     alg = top["algorithm"]
     result = top.build(
-        PlanningResult,
+        result_type,
         start=top["start"].array((nq,)),
         goal=top["goal"].array((nq,)),
         robot=robot,
@@ -368,7 +408,7 @@ def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:
         feas.append(item["feasible"].boolean())
         n_var, n_con = xs[-1].size, cons[-1].size
         if version >= 2:
-            certificates.append(_decode_member_certificate(item["certificate"]))
+            certificates.append(decode_member_certificate(item["certificate"]))
     return node.build(
         Front,
         x=np.array(xs),

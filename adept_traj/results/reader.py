@@ -1,8 +1,8 @@
 """Reading the files of a result folder, with errors that name the file.
 
-- ``_read_text(path)``: the UTF-8 text of a file (missing, unreadable or not UTF-8:
+- ``read_text(path)``: the UTF-8 text of a file (missing, unreadable or not UTF-8:
   :class:`~adept_traj.errors.ResultFormatError`).
-- ``_open_json(path)``: the top :class:`~adept_traj.schema.Node` of a JSON file, whose
+- ``open_json(path)``: the top :class:`~adept_traj.schema.Node` of a JSON file, whose
   accessors raise :class:`~adept_traj.errors.ResultFormatError` naming the file and the
   dotted field path (``front[3].x``).
 
@@ -17,18 +17,47 @@ from adept_traj.errors import ResultFormatError
 from adept_traj.files import read_bytes_bounded
 from adept_traj.schema import Node
 
-__all__: list[str] = []
+__all__ = [
+    "open_json",
+    "read_text",
+]
 
 
-def _open_json(path: Path) -> Node:
-    """The top node of the JSON file at ``path`` (NaN and Infinity refused)."""
-    return Node.from_json(_read_text(path), path, ResultFormatError)
+def open_json(path: Path) -> Node:
+    """The top node of a JSON file of a result folder (NaN and Infinity refused).
+
+    Parameters
+    ----------
+    path:
+        The file.
+
+    Returns
+    -------
+    Node
+        Its accessors raise :class:`~adept_traj.errors.ResultFormatError` naming the file
+        and the field.
+    """
+    return Node.from_json(read_text(path), path, ResultFormatError)
 
 
-def _read_text(path: Path) -> str:
+def read_text(path: Path) -> str:
     """The UTF-8 text of a file of the result folder, at most
-    :data:`~adept_traj.files.MAX_FILE_BYTES` (ResultFormatError if missing, unreadable,
-    too large or not UTF-8)."""
+    :data:`~adept_traj.files.MAX_FILE_BYTES`.
+
+    Parameters
+    ----------
+    path:
+        The file.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ResultFormatError
+        Missing, unreadable, too large or not UTF-8.
+    """
 
     def refuse(message: str) -> ResultFormatError:
         return ResultFormatError(path, None, message.removeprefix(f"{path}: "))

@@ -19,7 +19,6 @@ agreement with ``result.json``); the parts of a result (:class:`~adept_traj.resu
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -37,6 +36,20 @@ from adept_traj.problem import (
     ProblemSettings,
     TrajectoryProblem,
 )
+from adept_traj.results.csv_codec import (
+    check_front_csv,
+    check_trajectory_csv,
+    write_front_csv,
+    write_trajectory_csv,
+)
+from adept_traj.results.json_codec import (
+    FORMAT,
+    READ_VERSIONS,
+    VERSION,
+    read_json,
+    write_json,
+)
+from adept_traj.results.json_values import jsonable
 from adept_traj.results.parts import (
     BestSolution,
     Front,
@@ -69,13 +82,6 @@ __all__ = [
     "PlanningResult",
 ]
 
-#: Value of the ``"format"`` key of ``result.json``.
-FORMAT = "adept_traj.result"
-#: Newest schema version: written when the front carries its members' certificates
-#: (version 1, without them, is still read, and written back for a result read from it).
-VERSION = 2
-#: Schema versions read.
-READ_VERSIONS = (1, 2)
 #: File names inside a result folder.
 RESULT_FILE = "result.json"
 FRONT_FILE = "front.csv"
@@ -173,12 +179,12 @@ class PlanningResult:
         scene = self.scene.to_dict() if isinstance(self.scene, Scene) else self.scene
         if not isinstance(scene, Mapping):
             raise InvalidInputError(f"scene must be a Scene or a mapping; got {type(scene)}")
-        object.__setattr__(self, "scene", _jsonable(scene))
+        object.__setattr__(self, "scene", jsonable(scene))
         if not isinstance(self.algorithm, str) or not self.algorithm:
             raise InvalidInputError(f"algorithm must be a non-empty name; got {self.algorithm!r}")
         if not isinstance(self.algorithm_settings, Mapping):
             raise InvalidInputError("algorithm_settings must be a mapping")
-        object.__setattr__(self, "algorithm_settings", _jsonable(self.algorithm_settings))
+        object.__setattr__(self, "algorithm_settings", jsonable(self.algorithm_settings))
         if self.seed is not None:
             object.__setattr__(self, "seed", as_integer(self.seed, "seed"))
         n_knots = int(self.problem_settings.n_knots)
@@ -335,15 +341,11 @@ class PlanningResult:
     def save(self, folder: str | os.PathLike[str]) -> Path:
         """Write ``result.json``, ``front.csv`` and ``best_trajectory.csv`` into ``folder``
         (created if needed; existing files are replaced). Returns the folder's path."""
-        # The codecs import this module (they build PlanningResult objects): import them here.
-        from adept_traj.results.csv_codec import _write_front_csv, _write_trajectory_csv
-        from adept_traj.results.json_codec import _write_json
-
         path = Path(folder)
         path.mkdir(parents=True, exist_ok=True)
-        _write_json(self, path / RESULT_FILE)
-        _write_front_csv(self, path / FRONT_FILE)
-        _write_trajectory_csv(self, path / TRAJECTORY_FILE)
+        write_json(self, path / RESULT_FILE)
+        write_front_csv(self, path / FRONT_FILE)
+        write_trajectory_csv(self, path / TRAJECTORY_FILE)
         return path
 
     @classmethod
@@ -357,29 +359,8 @@ class PlanningResult:
             format or version, lacks a field or holds a bad value, or a CSV file disagrees
             with it. The message names the file and the field.
         """
-        from adept_traj.results.csv_codec import _check_front_csv, _check_trajectory_csv
-        from adept_traj.results.json_codec import _read_json
-
         path = Path(folder)
-        result = _read_json(path / RESULT_FILE)
-        _check_front_csv(result, path / FRONT_FILE)
-        _check_trajectory_csv(result, path / TRAJECTORY_FILE)
+        result = read_json(path / RESULT_FILE, cls)
+        check_front_csv(result, path / FRONT_FILE)
+        check_trajectory_csv(result, path / TRAJECTORY_FILE)
         return result
-
-
-def _jsonable(value: Any) -> Any:
-    """A JSON-compatible deep copy: mappings → dict (str keys), sequences and arrays →
-    list, numpy scalars → Python, non-finite floats → None, other objects → str."""
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return _jsonable(value.item())
-    if value is None or isinstance(value, (bool, int, str)):
-        return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    return str(value)

@@ -37,7 +37,7 @@ import numpy as np
 from adept_traj.analysis.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
-from adept_traj.results.csv_codec import _csv_text, _trajectory_header
+from adept_traj.results.csv_codec import csv_text, trajectory_header
 from adept_traj.results.members import (
     certified_members,
     member_dense,
@@ -124,7 +124,7 @@ def to_csv(
     _refuse_uncertified(r, index, allow_infeasible)
     d = member_dense(r, index, replay)
     rows = np.column_stack([d.t, d.q, d.qd, d.qdd, d.qddd, d.tau, d.min_distance])
-    return write_text_atomic(out, _csv_text(_trajectory_header(r.robot.joint_names), rows))
+    return write_text_atomic(out, csv_text(trajectory_header(r.robot.joint_names), rows))
 
 
 def _refuse_uncertified(r: PlanningResult, index: int, allow_infeasible: bool) -> None:

@@ -14,13 +14,20 @@ AdeptOne XL they are exactly the DH variables (θ1, θ2, d3, θ4) of the paper's
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from adept_traj.errors import InputShapeError, InvalidInputError, RobotModelError
+from adept_traj.errors import (
+    ConfigurationError,
+    InputShapeError,
+    InvalidInputError,
+    RobotModelError,
+)
 from adept_traj.robot.collision_meshes import HullReport, convex_hull_solids
 from adept_traj.robot.forward_kinematics import ForwardKinematics, place_solids, solid_frames
 from adept_traj.robot.kinematics import BatchKinematics, compose, frames_to_poses
@@ -34,7 +41,7 @@ from adept_traj.robot.urdf_loading import (
     read_srdf_disabled_pairs,
     shipped_file,
 )
-from adept_traj.validation import as_batch
+from adept_traj.validation import FrozenAttributes, as_batch, check_type
 
 __all__ = ["VELOCITY_AT_REST", "ForwardKinematics", "Robot", "coulomb_sign"]
 
@@ -46,10 +53,12 @@ VELOCITY_AT_REST = 1e-9
 _PARALLEL_MIN_BATCH = 16
 
 
-class Robot:
+class Robot(FrozenAttributes):
     """A serial robot: Pinocchio model, collision model, limits and batched evaluations.
 
-    Build one with :meth:`adept_one_xl` or :meth:`from_urdf`.
+    Build one with :meth:`adept_one_xl` or :meth:`from_urdf`. Its attributes are fixed at
+    construction (:class:`~adept_traj.errors.FrozenObjectError`; :meth:`replace` makes a
+    copy with other limits or name).
 
     Attributes
     ----------
@@ -129,6 +138,41 @@ class Robot:
         self.kinematics = BatchKinematics(model)
         self._tool_id = model.getFrameId(tool_frame)
         self._data = model.createData()
+        self._freeze()
+
+    def replace(self, **changes: Any) -> Robot:
+        """A copy with other ``limits`` or ``name`` (``dataclasses.replace`` for the frozen
+        robot; the Pinocchio models are shared, not copied).
+
+        Parameters
+        ----------
+        **changes:
+            ``limits`` (:class:`~adept_traj.robot.JointLimits` of the same joints) and/or
+            ``name``.
+
+        Returns
+        -------
+        Robot
+
+        Raises
+        ------
+        ConfigurationError
+            Another name than these, or limits of other joints (another model: build
+            another Robot).
+        """
+        unknown = sorted(set(changes) - {"limits", "name"})
+        if unknown:
+            raise ConfigurationError(f"Robot.replace() takes limits or name; got {unknown}")
+        limits = changes.get("limits", self.limits)
+        check_type(limits, JointLimits, "limits")
+        if limits.names != self.limits.names:
+            raise ConfigurationError(
+                f"limits must be of the joints {list(self.limits.names)}; got {list(limits.names)}"
+            )
+        new = copy.copy(self)
+        name = str(changes.get("name", self.name))
+        vars(new).update(limits=limits, name=name, _data=self.model.createData())
+        return new
 
     # ------------------------------------------------------------------ construction
     @classmethod

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError
-from adept_traj.scene.shapes import _ValueObject
+from adept_traj.scene.shapes import ValueObject
 from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
 from adept_traj.validation import as_finite_array, as_scalar, as_vector, readonly_copy
 
@@ -40,7 +40,7 @@ def as_times(t: Any) -> np.ndarray:
     return as_finite_array(t, "t")
 
 
-class MotionLaw(_ValueObject, ABC):
+class MotionLaw(ValueObject, ABC):
     """World pose of a moving frame as a function of time. Subclasses are frozen dataclasses."""
 
     @abstractmethod

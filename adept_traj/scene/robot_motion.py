@@ -36,7 +36,7 @@ from adept_traj.robot import Robot, RobotSource
 from adept_traj.robot.robot import solid_frames
 from adept_traj.scene.motion_laws import MotionLaw, as_times, check_ball
 from adept_traj.scene.scene import Obstacle
-from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere, _ValueObject
+from adept_traj.scene.shapes import Box, Capsule, Cylinder, Shape, Sphere, ValueObject
 from adept_traj.transforms import as_rigid_transform
 from adept_traj.validation import as_finite_array, check_increasing, readonly_copy
 
@@ -50,7 +50,7 @@ def load_robot(source: RobotSource) -> Robot:
 
 
 @dataclass(frozen=True, eq=False)
-class JointTrajectory(_ValueObject):
+class JointTrajectory(ValueObject):
     """A joint table, interpolated linearly and held outside it.
 
     Attributes

@@ -21,12 +21,14 @@ from adept_traj.errors import InputShapeError, InvalidInputError, ResourceLimitE
 from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.motion_laws import FixedPose, MotionLaw, PendulumMotion
 from adept_traj.scene.point_clouds import PointCloud
-from adept_traj.scene.shapes import Cylinder, Shape, Sphere, _ValueObject
+from adept_traj.scene.shapes import Cylinder, Shape, Sphere, ValueObject
 from adept_traj.transforms import as_rigid_transform, transform_from_xyz_rpy
 from adept_traj.validation import as_finite_array, check_type, readonly_copy
 
 __all__ = [
+    "BOB_SUFFIX",
     "MAX_OBSTACLES",
+    "ROD_SUFFIX",
     "Obstacle",
     "Scene",
     "check_obstacle_count",
@@ -40,9 +42,10 @@ __all__ = [
 #: obstacles and 5 solids); far beyond this a scene file takes minutes to load.
 MAX_OBSTACLES = 10_000
 
-#: Suffixes of the two obstacles a pendulum yields.
-_ROD_SUFFIX = ".rod"
-_BOB_SUFFIX = ".bob"
+#: Name suffix of a pendulum's rod obstacle (``"<pendulum>.rod"``).
+ROD_SUFFIX = ".rod"
+#: Name suffix of a pendulum's bob obstacle (``"<pendulum>.bob"``).
+BOB_SUFFIX = ".bob"
 
 
 def _identity() -> np.ndarray:
@@ -54,7 +57,7 @@ def _fixed_identity() -> FixedPose:
 
 
 @dataclass(frozen=True, eq=False)
-class Obstacle(_ValueObject):
+class Obstacle(ValueObject):
     """A solid obstacle: a shape placed by a motion law.
 
     The world pose of the shape's frame at time t is ``motion.pose(t) @ offset``.
@@ -134,13 +137,13 @@ def pendulum_obstacles(
         raise InvalidInputError(f"name must be a non-empty string; got {name!r}")
     length = motion.length
     rod = Obstacle(
-        name + _ROD_SUFFIX,
+        name + ROD_SUFFIX,
         Cylinder(rod_radius, length),
         motion,
         transform_from_xyz_rpy((0.0, 0.0, -0.5 * length)),
     )
     bob = Obstacle(
-        name + _BOB_SUFFIX,
+        name + BOB_SUFFIX,
         Sphere(bob_radius),
         motion,
         transform_from_xyz_rpy((0.0, 0.0, -length)),
@@ -173,17 +176,6 @@ def check_obstacle_count(n: int, source: str = "scene") -> int:
     return n
 
 
-def _count_entries(data: Mapping[str, Any]) -> int:
-    """Obstacles a scene-file mapping describes: ``[[obstacle]]`` entries plus two per
-    ``[[pendulum]]`` (non-list values count 0: the reader reports them)."""
-    count = 0
-    for key, per_entry in (("obstacle", 1), ("pendulum", 2)):
-        entries = data.get(key) if isinstance(data, Mapping) else None
-        if isinstance(entries, list):
-            count += per_entry * len(entries)
-    return count
-
-
 def _as_joint_vector(value: Any, name: str) -> np.ndarray:
     arr = as_finite_array(value, name)
     if arr.ndim != 1 or arr.size == 0:
@@ -195,7 +187,7 @@ def _as_joint_vector(value: Any, name: str) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class Scene(_ValueObject):
+class Scene(ValueObject):
     """Obstacles, robot base pose and an optional default task, in the world frame.
 
     Attributes
@@ -382,8 +374,7 @@ class Scene(_ValueObject):
         """
         from adept_traj.scene.scene_file import scene_from_dict
 
-        check_obstacle_count(_count_entries(data), source)
-        return scene_from_dict(data, source)
+        return scene_from_dict(data, source)  # it checks the count first
 
     def to_dict(self) -> dict[str, Any]:
         """The scene as a scene-file mapping (plain str, float and list values).

@@ -35,11 +35,10 @@ from adept_traj.scene.machine_entries import (
 from adept_traj.scene.motion_laws import FixedPose, PendulumMotion
 from adept_traj.scene.robot_motion import RobotSolidMotion
 from adept_traj.scene.scene import (
-    _BOB_SUFFIX,
-    _ROD_SUFFIX,
+    BOB_SUFFIX,
+    ROD_SUFFIX,
     Obstacle,
     Scene,
-    _count_entries,
     check_obstacle_count,
     pendulum_obstacles,
 )
@@ -123,6 +122,17 @@ def read_shipped_scene(name: str) -> Scene:
 def read_paper_scene() -> Scene:
     """The paper's scene, read from the shipped ``adept_traj/data/scenes/paper.toml``."""
     return read_shipped_scene("paper")
+
+
+def _count_entries(data: Mapping[str, Any]) -> int:
+    """Obstacles a scene-file mapping describes: ``[[obstacle]]`` entries plus two per
+    ``[[pendulum]]`` (non-list values count 0: the reader reports them)."""
+    count = 0
+    for key, per_entry in (("obstacle", 1), ("pendulum", 2)):
+        entries = data.get(key) if isinstance(data, Mapping) else None
+        if isinstance(entries, list):
+            count += per_entry * len(entries)
+    return count
 
 
 def scene_from_dict(
@@ -253,13 +263,13 @@ def _pendulum_dict(
         "made by pendulum_obstacles(); it cannot be written to a scene file"
     )
     base = None
-    for suffix in (_ROD_SUFFIX, _BOB_SUFFIX):
+    for suffix in (ROD_SUFFIX, BOB_SUFFIX):
         if ob.name.endswith(suffix) and len(ob.name) > len(suffix):
             base = ob.name[: -len(suffix)]
     if base is None:
         raise SceneError(problem)
-    rod = by_name.get(base + _ROD_SUFFIX)
-    bob = by_name.get(base + _BOB_SUFFIX)
+    rod = by_name.get(base + ROD_SUFFIX)
+    bob = by_name.get(base + BOB_SUFFIX)
     if (
         rod is None
         or bob is None

@@ -30,10 +30,18 @@ from adept_traj.validation import (
     readonly_copy,
 )
 
-__all__ = ["Box", "Capsule", "Cylinder", "Shape", "Sphere", "coal_transform"]
+__all__ = [
+    "Box",
+    "Capsule",
+    "Cylinder",
+    "Shape",
+    "Sphere",
+    "ValueObject",
+    "coal_transform",
+]
 
 
-class _ValueObject:
+class ValueObject:
     """Equality and hashing by field values, numpy arrays compared element-wise.
 
     A dataclass's generated ``__eq__`` fails on array fields (``bool(array == array)`` is
@@ -82,7 +90,7 @@ def coal_transform(transform: np.ndarray) -> coal.Transform3s:
     return coal.Transform3s(np.ascontiguousarray(t[:3, :3]), np.ascontiguousarray(t[:3, 3]))
 
 
-class Shape(_ValueObject, ABC):
+class Shape(ValueObject, ABC):
     """A solid centred on the origin of its local frame.
 
     Subclasses are frozen dataclasses; ``kind`` is the name used in scene files.
