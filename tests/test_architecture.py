@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "adept_traj"
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
     "errors": 0, "data": 0, "urdf": 0,
-    "validation": 1, "files": 1, "memory": 1, "processes": 1,
+    "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
     "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,
@@ -166,6 +166,8 @@ LONG_MODULES = {
     "motion and robot entries are in machine_entries)",
     "scene/motion_laws.py": "the MotionLaw contract (pose, speed bound, jumps) and the paper's "
     "pendulum, half of it docstrings",
+    "process_pool.py": "the one process mechanism: the caller's side (Worker) and the "
+    "worker's (its start, Channel, parent death, error transport), half of it docstrings",
 }
 
 
