@@ -7,6 +7,7 @@ its own workers too (checked in /proc)."""
 
 from __future__ import annotations
 
+import fcntl
 import gc
 import os
 import signal
@@ -235,3 +236,51 @@ def test_a_script_that_never_closes_its_workers_still_exits() -> None:
     )
     assert done.returncode == 0, done.stderr
     assert _ended(int(done.stdout.split()[-1]))
+
+
+def _children_of(pid: int) -> list[int]:
+    """The processes whose parent is ``pid``, read from /proc."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (FileNotFoundError, ProcessLookupError):
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+@pytest.mark.slow
+def test_a_killed_plan_command_leaves_no_process_behind(tmp_path: Path) -> None:
+    """``adept-traj plan`` killed outright mid-search (its evaluation worker, finisher and
+    polisher running): none of its processes is left, so the run folder's lock (a
+    ``flock`` every fork inherits) is free at once for ``--resume`` (a polisher left
+    preparing held it before)."""
+    out = tmp_path / "run"
+    argv = [sys.executable, "-m", "adept_traj.cli", "plan", "--quiet", "--out", str(out)]
+    command = subprocess.Popen([*argv, "--pop", "16", "--gens", "400", "--workers", "2"])
+    try:
+        deadline = time.monotonic() + 120.0
+        while not (out / "checkpoint").exists():
+            assert time.monotonic() < deadline
+            assert command.poll() is None
+            time.sleep(0.05)
+        helpers = _children_of(command.pid)
+        assert len(helpers) >= 3  # the evaluation worker, the finisher, the polisher
+    finally:
+        command.kill()
+        command.wait()
+    assert all(_ended(pid) for pid in helpers)
+    fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY)
+    start = time.monotonic()
+    try:
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:  # released as the killed processes' files close
+                assert time.monotonic() - start < 2.0
+                time.sleep(0.01)
+    finally:
+        os.close(fd)
