@@ -240,7 +240,7 @@ class Worker:
         try:
             self._connection.send_bytes(pickle.dumps(args, protocol=_PROTOCOL))
         except OSError as exc:  # EPIPE: the worker's end is gone
-            raise WorkerDiedError(f"a worker process (pid {self.pid}) has ended") from exc
+            raise WorkerDiedError(f"a worker process (pid {self.pid}) ended abruptly") from exc
 
     def poll(self, timeout: float = 0.0) -> bool:
         """Whether a message of the worker (or the end of its pipe: it ended) waits,

@@ -57,26 +57,6 @@ def available_cores() -> int:
     return max(1, n)
 
 
-class _Workers:
-    """The worker processes of one evaluator (:class:`~adept_traj.process_pool.Worker`,
-    each serving its chunks with the evaluation function it inherited)."""
-
-    def __init__(self) -> None:
-        self.processes: list[Worker] = []
-        self.pid = os.getpid()  # the process that forked them (and may stop them)
-
-    def start(self, evaluate: Callable[[np.ndarray], Evaluation], count: int) -> None:
-        """Fork ``count`` workers running ``evaluate``."""
-        for _ in range(count):
-            self.processes.append(Worker(_serve, evaluate, note=_NOTE))
-
-    def stop(self) -> None:
-        """Stop the workers (idle or evaluating) and reap them."""
-        processes, self.processes = self.processes, []
-        for process in processes:
-            process.close()
-
-
 #: The note before a worker's traceback on its error.
 _NOTE = "raised in an evaluation worker process"
 
@@ -119,7 +99,8 @@ class ParallelEvaluator:
         if not can_fork():
             raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
         self._evaluate = evaluate
-        self._workers = _Workers()
+        self._processes: list[Worker] = []  # forked at the first population
+        self._pid = os.getpid()  # the process that forks them (and may use them)
         self._open = True
 
     @property
@@ -145,8 +126,7 @@ class ParallelEvaluator:
             raise InputShapeError(
                 f"x must have shape (pop, {self.n_var}) with pop ≥ 1; got {xa.shape}"
             )
-        pool = self._workers
-        if os.getpid() != pool.pid:
+        if os.getpid() != self._pid:
             # A forked copy of the process that owns the workers (e.g. a process that
             # certifies front members): their pipes are not its own; it evaluates the
             # population itself (the same rows bit for bit).
@@ -154,22 +134,29 @@ class ParallelEvaluator:
         # The main process takes the last chunk; workers beyond the chunks stay idle.
         chunks = np.array_split(xa, min(self.workers, len(xa)))
         try:
-            if not pool.processes:
-                pool.start(self._evaluate, self.workers - 1)
-            used = pool.processes[: len(chunks) - 1]
+            if not self._processes:
+                for _ in range(self.workers - 1):
+                    self._processes.append(Worker(_serve, self._evaluate, note=_NOTE))
+            used = self._processes[: len(chunks) - 1]
             for process, chunk in zip(used, chunks):
                 process.send(np.ascontiguousarray(chunk))
             mine = self._evaluate(chunks[-1])
             parts = [process.recv() for process in used]
         except BaseException:  # a failed chunk, a dead worker, Ctrl-C: stop the workers
-            pool.stop()
+            self._stop()
             raise
         return _concatenate([*parts, mine])
 
     def close(self) -> None:
         """Stop the worker processes and wait for them to exit (idempotent)."""
         self._open = False
-        self._workers.stop()
+        self._stop()
+
+    def _stop(self) -> None:
+        """Stop the workers (idle or evaluating) and reap them."""
+        processes, self._processes = self._processes, []
+        for process in processes:
+            process.close()
 
     def __enter__(self) -> ParallelEvaluator:
         return self
