@@ -3,7 +3,7 @@
 A :class:`Worker` is one process forked from the caller (Linux ``fork``) that runs
 ``target(channel, *args)`` and talks to the caller over one pipe: the one mechanism of the
 package for parallel work. The evaluation workers (:class:`~adept_traj.problem.ParallelEvaluator`),
-the finish (:class:`~adept_traj.viz.Finisher`), the figures
+the finish (:class:`~adept_traj.viz.finisher.Finisher`), the figures
 (:func:`~adept_traj.viz.plots.save_all`, :func:`~adept_traj.viz.plots.start_save_all`),
 the polish (:class:`~adept_traj.optimise.Polisher`) and the front's certificates
 (:class:`~adept_traj.optimise.EarlyCertificates`,
