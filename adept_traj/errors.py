@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 __all__ = [
@@ -34,6 +35,8 @@ __all__ = [
     "SceneError",
     "SceneFileNotFoundError",
     "UnreachableLocationError",
+    "WorkerDiedError",
+    "WorkerError",
     "error_from_process",
 ]
 
@@ -146,9 +149,19 @@ class MeshcatServerError(AdeptTrajError, RuntimeError):
     (:mod:`adept_traj.viz.page_server`), could not be started or does not answer."""
 
 
-class FigureError(AdeptTrajError, RuntimeError):
-    """Drawing the figures failed in a forked process with an error that could not be
-    handed back as itself; the message holds that process' traceback."""
+class WorkerError(AdeptTrajError, RuntimeError):
+    """A worker process (:mod:`adept_traj.process_pool`) failed with an error that could
+    not be handed back as itself (it does not unpickle); the message holds the worker's
+    traceback."""
+
+
+#: The figures' name of :class:`WorkerError` (drawing the figures in a worker process).
+FigureError = WorkerError
+
+
+class WorkerDiedError(WorkerError, BrokenProcessPool):
+    """A worker process (:mod:`adept_traj.process_pool`) ended without a word (killed, or
+    out of memory); also a :class:`concurrent.futures.process.BrokenProcessPool`."""
 
 
 class ResourceLimitError(InvalidInputError):

@@ -16,7 +16,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "adept_traj"
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
     "errors": 0, "data": 0, "urdf": 0,
-    "validation": 1, "files": 1, "memory": 1, "processes": 1,
+    "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
     "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,
@@ -103,17 +103,6 @@ def test_private_names_stay_in_their_subpackage(path: Path):
             assert not private_module, f"{where} imports the private module {module}"
 
 
-#: Modules whose private imports belong to another branch of issue #27 (the one process
-#: mechanism, branch of the processes helper: it rewrites processes.py, optimise/polisher.py,
-#: early_certificates.py, front_certificates.py, the evaluator's workers,
-#: viz/plots/all_figures.py and viz/finisher.py). The lead removes this list after merging it.
-PRIVATE_IMPORTS_ELSEWHERE = {
-    "optimise/polisher.py": "_polish_run from optimise/polish_step.py",
-    "optimise/early_certificates.py": "_checked from optimise/front_certificates.py",
-    "viz/finisher.py": "_draw, _figure_jobs, _error from viz/plots/all_figures.py",
-}
-
-
 def _is_private(name: str) -> bool:
     return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
 
@@ -179,8 +168,6 @@ def test_no_private_name_is_taken_from_another_module(path: Path):
     one module."""
     rel = str(path.relative_to(PACKAGE))
     found = private_names_used(path, PACKAGE)
-    if rel in PRIVATE_IMPORTS_ELSEWHERE:
-        return
     assert not found, f"{rel} takes private names of other modules: {found}"
 
 
@@ -212,13 +199,6 @@ def test_the_private_name_check_finds_each_form(tmp_path: Path):
     ]
     # a private module of another subpackage (here: of sub, from the top level) is found
     assert private_names_used(pkg / "top.py", pkg) == ["1: from adept_traj.sub import _hidden"]
-
-
-def test_the_private_imports_left_to_other_branches_are_still_there():
-    """The allow-list above lists only modules that still need it (remove an entry once
-    its branch is merged)."""
-    stale = [r for r in PRIVATE_IMPORTS_ELSEWHERE if not private_names_used(PACKAGE / r, PACKAGE)]
-    assert not stale, stale
 
 
 def test_every_exception_class_is_in_errors_py():
@@ -293,6 +273,8 @@ LONG_MODULES = {
     "certificate_codec, JSON values in json_values)",
     "robot/robot.py": "Robot: construction, its frozen copy (replace) and the batched dynamics, "
     "kinematics and manipulability, half of it docstrings",
+    "process_pool.py": "the one process mechanism: the caller's side (Worker) and the "
+    "worker's (its start, Channel, parent death, error transport), half of it docstrings",
 }
 
 

@@ -28,6 +28,7 @@ import adept_traj.cli.report as report
 from adept_traj.cli import status
 from adept_traj.cli.app import main
 from adept_traj.errors import InvalidInputError
+from adept_traj.process_pool import children
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.viz import finisher, meshcat_scene
 from adept_traj.viz.plots import all_figures
@@ -122,7 +123,7 @@ def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_
     assert (tmp_path / "run" / "playback.html").read_bytes() == page.read_bytes()
     assert not (tmp_path / "run" / "run.json").exists()  # marked complete
     assert _gone(helper, within=0.0)  # reaped
-    assert multiprocessing.active_children() == []
+    assert children() == []
 
 
 def test_an_error_of_the_helper_is_raised_and_the_run_not_completed(
@@ -186,7 +187,7 @@ def test_ctrl_c_or_an_error_during_the_run_stops_the_helper(
         with pytest.raises(RuntimeError, match="stop"):
             _plan(monkeypatch, stored, tmp_path / "run", plan=interrupted)
     assert _gone(int(marker.read_text().split()[0]), within=0.0)
-    assert multiprocessing.active_children() == []
+    assert children() == []
 
 
 def test_no_helper_with_no_plots_and_no_html(
@@ -250,8 +251,8 @@ def test_a_helper_dies_with_its_killed_caller(ready: bool, tmp_path: Path) -> No
 
 
 def test_a_script_that_never_cancels_its_helper_still_exits(tmp_path: Path) -> None:
-    """multiprocessing joins its children at exit; a helper still waiting for its order
-    is stopped first, so the interpreter exits (it hung before)."""
+    """A helper still waiting for its order is stopped at the interpreter's exit, so the
+    interpreter exits."""
     script = (
         "import adept_traj as at\n"
         "from adept_traj.viz.finisher import start_finisher\n"

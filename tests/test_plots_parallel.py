@@ -1,8 +1,9 @@
 """save_all draws its figures on several processes: the same files, in the same order, as
-one process; a figure whose process fails is drawn again by the caller (its error raised
-there). start_save_all draws them in a forked process while the caller goes on: the same
-files; its error is raised by wait(); cancel stops it. The drawing functions are replaced
-by cheap fakes (forked processes inherit them)."""
+one process; an error of a figure in a worker process is raised in the caller with the
+worker's traceback, a killed worker's figures are drawn again by the caller.
+start_save_all draws them in a forked process while the caller goes on: the same files;
+its error is raised by wait(); cancel stops it. The drawing functions are replaced by
+cheap fakes (forked processes inherit them)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ from pathlib import Path
 import pytest
 
 import adept_traj as at
-from adept_traj.errors import FigureError, InvalidInputError
+from adept_traj.errors import InvalidInputError, WorkerError
+from adept_traj.process_pool import children
 from adept_traj.results import PlanningResult
 from adept_traj.viz import plots
 from adept_traj.viz.plots import all_figures
@@ -65,19 +67,40 @@ def test_two_processes_write_the_files_of_one(
     assert writers["tool_path_nsga2.png"] != writers["joint_motion_nsga2.png"]
 
 
-def test_a_figure_whose_process_fails_is_drawn_again_here(
+def test_an_error_of_a_figure_in_a_worker_is_raised_here(
     result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     _patch(monkeypatch, joint_motion=_fake("joint_motion", fails_in_child=True))
+    with pytest.raises(ValueError, match="joint_motion failed in process") as caught:
+        plots.save_all(result, tmp_path, processes=2)
+    assert f"in process {os.getpid()}" not in str(caught.value)  # the worker's error
+    (note,) = caught.value.__notes__
+    assert "forked process" in note
+    assert "in draw" in note  # the worker's traceback
+    assert children() == []  # every worker reaped
+
+
+def test_a_killed_worker_has_its_figures_drawn_here(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parent = os.getpid()
+
+    def draw(_results, path, **_kwargs):
+        if os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return _fake("joint_motion")(_results, path)
+
+    _patch(monkeypatch, joint_motion=draw)
     paths = plots.save_all(result, tmp_path, processes=2)
-    assert _writers(paths)["joint_motion_nsga2.png"] == os.getpid()
+    assert _writers(paths)["joint_motion_nsga2.png"] == parent
+    assert children() == []
 
 
 def test_an_error_of_a_figure_is_raised_here(
     result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     _patch(monkeypatch, joint_motion=_fake("joint_motion", fails=True))
-    with pytest.raises(ValueError, match=f"joint_motion failed in process {os.getpid()}"):
+    with pytest.raises(ValueError, match="joint_motion failed in process"):
         plots.save_all(result, tmp_path, processes=2)
 
 
@@ -147,7 +170,7 @@ def test_an_error_that_does_not_unpickle_is_raised_as_its_text(
 
     _patch(monkeypatch, best_tradeoffs=draw)
     with pytest.raises(
-        FigureError, match=r"(?s)in a forked process.*_Unpicklable: unpicklable 1 2"
+        WorkerError, match=r"(?s)in a forked process.*_Unpicklable: unpicklable 1 2"
     ):
         plots.start_save_all(result, tmp_path, processes=1).wait()
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import gc
-import multiprocessing
 import os
 import signal
 import time
@@ -24,6 +23,7 @@ from adept_traj.errors import (
     RobotModelError,
 )
 from adept_traj.problem import Evaluation, ParallelEvaluator, TrajectoryProblem
+from adept_traj.process_pool import children
 from adept_traj.testing.paper_moves import lift_then_lower
 from adept_traj.testing.reference import evaluate_reference
 
@@ -211,7 +211,7 @@ def test_parallel_workers_equal_serial(robot: Robot, scene: Scene, problem) -> N
 
 
 def _new_children(before: set) -> list:
-    return [p for p in multiprocessing.active_children() if p not in before]
+    return [pid for pid in children() if pid not in before]
 
 
 def _running(pid: int) -> bool:
@@ -224,9 +224,9 @@ def _running(pid: int) -> bool:
     return stat.rsplit(")", 1)[1].split()[0] not in ("Z", "X")
 
 
-def _stopped(children: list, timeout: float = 30.0) -> bool:
+def _stopped(pids: list, timeout: float = 30.0) -> bool:
     deadline = time.monotonic() + timeout
-    while any(_running(p.pid) for p in children):
+    while any(_running(pid) for pid in pids):
         if time.monotonic() > deadline:
             return False
         time.sleep(0.02)
@@ -240,7 +240,7 @@ def test_problem_owns_and_stops_its_workers(robot: Robot, scene: Scene, problem)
     rng = np.random.default_rng(31)
     x = problem.xl + (problem.xu - problem.xl) * rng.uniform(size=(20, problem.n_var))
     serial = problem.evaluate_batch(x)
-    before = set(multiprocessing.active_children())
+    before = set(children())
     with TrajectoryProblem(robot, scene, scene.start, scene.goal, workers=2) as parallel:
         parallel.evaluate_batch(x)
         first = _new_children(before)
@@ -334,9 +334,8 @@ def test_a_worker_killed_between_populations_is_a_broken_pool() -> None:
 
 
 def test_workers_stop_although_another_fork_holds_their_pipes() -> None:
-    """A process forked from the owner while the workers live holds copies of the
-    owner's pipe ends, so closing them sends no end-of-file: ``close`` tells the workers
-    to stop and returns."""
+    """A process forked from the owner while the workers live (here by ``os.fork``, not as
+    a worker) does not keep the workers: ``close`` stops them and returns at once."""
     x = np.arange(8.0)[:, None] * np.ones((1, 2))
     evaluator = ParallelEvaluator(_pid_rows, workers=2, n_var=2)
     evaluator.evaluate(x)
@@ -389,7 +388,7 @@ def _failing(main_pid: int):
 
 
 def _worker_pids() -> set:
-    return {p.pid for p in multiprocessing.active_children()}
+    return set(children())
 
 
 @pytest.mark.parametrize(

@@ -137,7 +137,7 @@ def obstacle_jump_intervals(problem: TrajectoryProblem) -> np.ndarray:
 def _rates(problem: TrajectoryProblem) -> tuple[np.ndarray, np.ndarray]:
     """:func:`solid_lever_arms` and :func:`obstacle_speeds` of ``problem``, read-only, made
     once and kept on the (frozen) problem: they depend on its robot and scene alone, and a
-    front certifies hundreds of moves of one problem (≈ 1 ms per certificate otherwise)."""
+    front certifies hundreds of moves of one problem."""
     return problem.derived("analysis.continuous.rates", _made_rates)
 
 

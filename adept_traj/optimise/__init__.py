@@ -80,6 +80,7 @@ from adept_traj.optimise.polish_step import (
     polish_members,
     polish_mode,
     polish_run,
+    polish_run_with_certificates,
     time_optimal_run,
 )
 from adept_traj.optimise.polisher import (
@@ -207,6 +208,7 @@ __all__ = [
     "polish_members",
     "polish_mode",
     "polish_run",
+    "polish_run_with_certificates",
     "polish_with_certificates",
     "population_bytes",
     "population_values",

@@ -5,32 +5,34 @@ After the search :func:`~adept_traj.plan` polishes a few members in the main pro
 core; the other idles), then certifies the front. The polish only adds moves to the
 population, so every member of the front after the polish that the polish did not make
 was already a member before it: its certificate can be made while the polish runs.
-:func:`start_early_certificates` forks one process that certifies the members of the
-front before the polish, in shares of :data:`EARLY_SHARE` members taken one after the other
-from a shared counter (:func:`~adept_traj.analysis.certify_members` on each share, in the
-trade-off order). :meth:`EarlyCertificates.finish`, called once the polish is done, takes
-the shares that are left from the same counter and certifies them in the caller (the
-members still wanted only) while the process goes on with its own, then collects the
-process' summaries. Every certificate depends on its member alone, so the summaries are
-those :func:`~adept_traj.analysis.certify_members` makes in the caller, field for field.
+:func:`start_early_certificates` forks one worker process
+(:class:`~adept_traj.process_pool.Worker`) that certifies the members of the front before
+the polish, in shares of :data:`EARLY_SHARE` members, the first share first
+(:func:`~adept_traj.analysis.certify_members` on each share, in the trade-off order).
+:meth:`EarlyCertificates.finish`, called once the polish is done, certifies shares in
+the caller (the members still wanted only) from the last share down while the worker goes
+on from the first up: before each share the caller claims it over the pipe, and the
+worker, which reads the claims before each of its shares, stops where the caller's begin
+(where both reach the same share at once, both certify it: the same summary). Then the
+caller collects the worker's summaries. Every certificate depends on its member alone, so
+the summaries are those :func:`~adept_traj.analysis.certify_members` makes in the caller,
+field for field.
 With one worker (``fork=False``) no process starts: the caller certifies every share in
 :meth:`EarlyCertificates.finish` (while the helper of
 :mod:`adept_traj.optimise.polisher` polishes, when there is one).
 
-The process never outlives the caller: it ignores Ctrl-C (the caller stops it),
-:meth:`EarlyCertificates.cancel` (or leaving the ``with`` block) terminates and reaps it,
-and it ends by itself between two shares when its parent is gone. A process that fails
-or dies leaves its shares to the caller, which certifies them again: an error it met
-is then raised in the caller by the caller's own attempt (with the process' traceback as
-a note), the same exception as without the process.
+The worker never outlives the caller (:mod:`adept_traj.process_pool`): it ignores Ctrl-C
+(the caller stops it), :meth:`EarlyCertificates.cancel` (or leaving the ``with`` block)
+kills and reaps it, and it ends with the caller. A worker that fails or dies leaves its
+shares to the caller, which certifies them again: an error it met is then raised in the
+caller by the caller's own attempt (with the worker's error as a note), the same exception
+as without the worker — or kept for later when the caller does not know yet whether the
+member stays on the front (``failed``).
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
-import signal
-import traceback
+import contextlib
 from collections.abc import Collection, Sequence
 from typing import Any
 
@@ -39,18 +41,16 @@ import numpy as np
 from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
 from adept_traj.analysis.member_certificate import MemberCertificate, certify_members
-from adept_traj.optimise.front_certificates import _checked
+from adept_traj.errors import WorkerDiedError
+from adept_traj.optimise.front_certificates import checked_members
 from adept_traj.problem import TrajectoryProblem, from_pymoo
-from adept_traj.processes import ForkedHelper
+from adept_traj.process_pool import Channel, Worker, can_fork
 
 __all__ = ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"]
 
-#: Members certified together, by the process or by the caller (≈ 60 ms of CPU on the
-#: paper scene: the caller waits at most about that long for a share under way).
+#: Members certified together, by the worker or by the caller (the caller waits at most
+#: one share's time for a share under way).
 EARLY_SHARE = 8
-#: Longest wait for the shares' counter [s]; longer, its holder died holding it.
-LOCK_TIMEOUT = 5.0
-_DONE = "done"
 
 
 def start_early_certificates(
@@ -80,7 +80,7 @@ def start_early_certificates(
         ``fork=False``, without ``fork`` on the platform or with no member no process
         starts and ``finish`` certifies in the caller.
     """
-    xs, rows, rate = _checked(problem, x, members, rate_hz)
+    xs, rows, rate = checked_members(problem, x, members, rate_hz)
     return EarlyCertificates(problem, np.array(xs), rows, rate, fork=bool(fork))
 
 
@@ -103,10 +103,14 @@ def feasible_front(F: Any, G: Any, weights: Any) -> np.ndarray:
     return rows[best_tradeoff(objectives[rows], weights).order]
 
 
-class EarlyCertificates(ForkedHelper):
+class EarlyCertificates:
     """The certificates started by :func:`start_early_certificates`; a context manager
-    that stops its process when the block is left
-    (:class:`~adept_traj.processes.ForkedHelper`: ``cancel``, ``pid``).
+    that stops its worker when the block is left.
+
+    Attributes
+    ----------
+    pid : int or None
+        The worker's process id (``None`` without one, or once it is reaped).
     """
 
     def __init__(
@@ -120,15 +124,30 @@ class EarlyCertificates(ForkedHelper):
     ) -> None:
         self._problem, self._x, self._rate = problem, x, rate_hz
         self._shares = [rows[i : i + EARLY_SHARE] for i in range(0, len(rows), EARLY_SHARE)]
-        fork = fork and bool(self._shares) and "fork" in multiprocessing.get_all_start_methods()
-        self._next: Any = multiprocessing.get_context("fork").Value("i", 0) if fork else _Counter()
-        super().__init__(_work if fork else None, (self,))
+        self._worker: Worker | None = None
+        if fork and self._shares and can_fork():
+            self._worker = Worker(_work, self, note="raised in the early certificates' worker")
+
+    @property
+    def pid(self) -> int | None:
+        return None if self._worker is None else self._worker.pid
+
+    def cancel(self) -> None:
+        """Stop the worker (a no-op once it is reaped): killed, then reaped."""
+        if self._worker is not None:
+            self._worker.close()
+
+    def __enter__(self) -> EarlyCertificates:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.cancel()
 
     def finish(
         self, wanted: Collection[bytes] | None = None, *, failed: list[int] | None = None
     ) -> dict[bytes, MemberCertificate]:
-        """Certify the shares no process has taken (only the members whose
-        ``x[k].tobytes()`` is in ``wanted``; ``None``: all), collect the process' summaries
+        """Certify the shares the worker has not taken (only the members whose
+        ``x[k].tobytes()`` is in ``wanted``; ``None``: all), collect the worker's summaries
         and reap it (once: a second call certifies every share again, in the caller).
 
         With a list ``failed``, a share whose certificates raise in the caller is not
@@ -145,32 +164,38 @@ class EarlyCertificates(ForkedHelper):
         ------
         Exception
             What :func:`~adept_traj.analysis.certify_members` raised in the caller for a
-            share (the process' traceback as a note when it failed on it first).
+            share (the worker's error as a note when it failed on it first).
         """
+        worker, self._worker = self._worker, None
+        progress = _Progress(worker)
         mine: dict[int, MemberCertificate] = {}
         taken: set[int] = set()
-        received: dict[int, list[MemberCertificate]] = {}
-        note = ""
         try:
-            while (i := _take(self._next, len(self._shares))) is not None:
+            # the caller's shares: from the last down, until the worker's (the worker's
+            # first up; without a worker, the caller's from the first)
+            order = range(len(self._shares))
+            for i in reversed(order) if worker is not None else order:
+                progress.read(block=False)
+                if i <= progress.started:
+                    break
+                progress.claim(i)
                 taken.add(i)
-                note = self._drain(received, block=False) or note
                 mine.update(self._certify(self._shares[i], wanted, failed))
-            note = self._drain(received, block=True) or note
-            self._reap()
+            progress.read(block=True)
             for i, share in enumerate(self._shares):
-                if i in received:
-                    mine.update(zip(share, received[i]))
-                elif i not in taken:  # the process' share it did not send (failed or died)
+                if i in progress.received:
+                    mine.update(zip(share, progress.received[i]))
+                elif i not in taken:  # the worker's share it did not send (failed or died)
                     mine.update(self._certify(share, wanted, failed))
         except Exception as exc:
-            self.cancel()
-            if note:
-                exc.add_note(f"the early certificates' process failed first:\n{note}")
+            progress.close()
+            if progress.note:
+                exc.add_note(f"the early certificates' worker failed first:\n{progress.note}")
             raise
-        except BaseException:  # Ctrl-C included: stop the process at once
-            self.cancel()
+        except BaseException:  # Ctrl-C included: stop the worker at once
+            progress.close()
             raise
+        progress.close()
         return {self._x[k].tobytes(): summary for k, summary in mine.items()}
 
     def certify_again(
@@ -196,76 +221,59 @@ class EarlyCertificates(ForkedHelper):
             return {}
         return {k: out[k] for k in rows}
 
-    def _drain(self, received: dict[int, list[MemberCertificate]], *, block: bool) -> str:
-        """Receive the process' messages (all of them until it ends if ``block``, else
-        those waiting); return its traceback if it failed."""
-        if self._conn is None:
-            return ""
-        while block or self._conn.poll():
+
+class _Progress:
+    """The caller's view of the worker: the shares it has started and sent, its error."""
+
+    def __init__(self, worker: Worker | None) -> None:
+        self.worker = worker
+        self.started = -1  # the last share the worker has started
+        self.received: dict[int, list[MemberCertificate]] = {}
+        self.note = ""  # the worker's error, when it failed
+
+    def claim(self, i: int) -> None:
+        """Tell the worker that the caller certifies share ``i`` (and every later one)."""
+        if self.worker is not None:
+            # an ended worker's messages are still read; its shares not sent: the caller's
+            with contextlib.suppress(WorkerDiedError):
+                self.worker.send(i)
+
+    def read(self, *, block: bool) -> None:
+        """Read the worker's messages: those waiting, or (``block``) all until it ends."""
+        while self.worker is not None and (block or self.worker.poll()):
             try:
-                message = self._conn.recv()
-            except (EOFError, OSError):  # ended without a word (killed)
-                return ""
-            if message == _DONE:
-                return ""
-            i, summaries, text = message
-            if text:
-                return text
-            received[i] = summaries
-        return ""
-
-
-class _Counter:
-    """The shares' counter of a run without a process (the ``value`` of a shared int)."""
-
-    def __init__(self) -> None:
-        self.value = 0
-
-    def get_lock(self) -> Any:
-        return self
-
-    def acquire(self, timeout: float | None = None) -> bool:
-        return True
-
-    def release(self) -> None:
-        return None
-
-
-def _take(counter: Any, n: int) -> int | None:
-    """The next share nobody has taken (``None``: none is left, or the lock stayed taken
-    for :data:`LOCK_TIMEOUT` seconds: its holder was killed holding it)."""
-    lock = counter.get_lock()
-    if not lock.acquire(timeout=LOCK_TIMEOUT):
-        return None
-    try:
-        i = counter.value
-        if i >= n:
-            return None
-        counter.value = i + 1
-    finally:
-        lock.release()
-    return i
-
-
-def _work(conn: Any, callers_end: Any, parent: int, job: EarlyCertificates) -> None:
-    """The process: take shares until none is left or the parent is gone, send
-    ``(share, summaries, "")`` for each, ``(share, None, traceback)`` on an error, then
-    ``"done"``; end at once (``os._exit``: none of the parent's exit handlers runs)."""
-    code = 0
-    try:
-        callers_end.close()
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops it
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        while os.getppid() == parent and (i := _take(job._next, len(job._shares))) is not None:
-            try:
-                summaries = job._certify(job._shares[i], None)
-            except Exception:  # the caller certifies this share again and raises
-                conn.send((i, None, traceback.format_exc()))
-                code = 1
+                message = self.worker.recv()
+            except WorkerDiedError:  # killed: its shares not sent are the caller's
+                self.close()
                 return
-            conn.send((i, [summaries[k] for k in job._shares[i]], ""))
-        conn.send(_DONE)
-    except BaseException:  # a broken pipe (the caller is gone)
-        code = code or 1
-    finally:
-        os._exit(code)
+            except Exception as exc:  # failed on a share: that share is the caller's
+                self.note = "".join([str(exc), *getattr(exc, "__notes__", [])])
+                self.close()
+                return
+            if message[0] == "start":
+                self.started = message[1]
+            elif message[0] == "done":
+                self.received[message[1]] = message[2]
+            else:  # "end": no more shares
+                self.close()
+
+    def close(self) -> None:
+        if self.worker is not None:
+            self.worker.close()
+            self.worker = None
+
+
+def _work(channel: Channel, job: EarlyCertificates) -> None:
+    """The worker: certify the shares from the first up until one the caller has claimed
+    (its claims read before each share), sending ``("start", i)`` before and ``("done", i,
+    summaries)`` after each share, then ``("end",)``; an error is carried to the caller."""
+    limit = len(job._shares)
+    for i in range(len(job._shares)):
+        while channel.poll():  # the caller's claims, from the last share down
+            limit = min(limit, channel.recv()[0])
+        if i >= limit:
+            break
+        channel.send(("start", i))
+        summaries = job._certify(job._shares[i], None)
+        channel.send(("done", i, [summaries[k] for k in job._shares[i]]))
+    channel.send(("end",))

@@ -1,20 +1,19 @@
 """The front members' certificates on the problem's worker processes.
 
 :func:`~adept_traj.analysis.certify_members` certifies one batch of members after the
-other (``benchmarks/bench_certify.py`` times it; ``docs/performance.md``).
-:func:`certify_front_members` gives each of ``workers`` forked processes every
+other (its cost per member: docs/performance.md).
+:func:`certify_front_members` gives each of ``workers`` processes (this one and
+``workers - 1`` worker processes, :class:`~adept_traj.process_pool.Worker`) every
 ``workers``-th member (the trade-off order interleaved, so that each gets as many of the
 costly and the cheap ones), each process calls
 :func:`~adept_traj.analysis.certify_members` once on its share, and the summaries come
 back in the members' rows. Every certificate depends on its member alone, so the result is
-the serial one, field for field (tested). Fork hands the problem and the decision vectors
-to the processes (nothing is pickled but the lists of rows and the summaries).
+the serial one, field for field (tested). The fork hands the problem and the decision
+vectors to the workers (nothing is pickled but the summaries).
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import signal
 from collections.abc import Sequence
 from typing import Any
 
@@ -25,15 +24,12 @@ from adept_traj.analysis.member_certificate import (
     certify_members,
     certifying_problem,
 )
-from adept_traj.errors import ConfigurationError, InputShapeError
+from adept_traj.errors import InputShapeError
 from adept_traj.problem import TrajectoryProblem
+from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
 
-__all__ = ["certify_front_members"]
-
-#: (problem, x, rate_hz) of the certifying process, set once by the pool's initializer;
-#: ``None`` in every other process.
-_JOB: tuple[TrajectoryProblem, np.ndarray, float] | None = None
+__all__ = ["certify_front_members", "checked_members"]
 
 
 def certify_front_members(
@@ -61,24 +57,24 @@ def certify_front_members(
         (n,) a :class:`~adept_traj.analysis.MemberCertificate` per certified row, ``None``
         for the others — the same as :func:`~adept_traj.analysis.certify_members`.
     """
-    xs, rows, rate = _checked(problem, x, members, rate_hz)
+    xs, rows, rate = checked_members(problem, x, members, rate_hz)
     n_proc = problem.settings.workers if workers is None else workers
     n_proc = min(as_integer(n_proc, "workers", minimum=1), len(rows))
-    if n_proc <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+    if n_proc <= 1 or not can_fork():
         return certify_members(problem, xs, rows, rate_hz=rate)
-    certifying_problem(problem)  # made once here: the forked processes inherit it
+    certifying_problem(problem)  # made once here: the workers inherit it
     shares = [rows[i::n_proc] for i in range(n_proc)]
-    pool = multiprocessing.get_context("fork").Pool(
-        n_proc, initializer=_start, initargs=(problem, xs, rate)
-    )
+    forked: list[Worker] = []
     try:
-        parts = pool.map(_certify_share, shares, chunksize=1)
-        pool.close()
-    except BaseException:  # Ctrl-C included: stop the processes at once
-        pool.terminate()
-        raise
-    finally:
-        pool.join()
+        for share in shares[:-1]:
+            note = "raised while certifying front members in a worker process"
+            forked.append(Worker(_certify_share, problem, xs, share, rate, note=note))
+        last = certify_members(problem, xs, shares[-1], rate_hz=rate)  # this process' share
+        parts = [worker.recv() for worker in forked]
+        parts.append([last[k] for k in shares[-1]])
+    finally:  # Ctrl-C or an error included: the workers are stopped at once
+        for worker in forked:
+            worker.close()
     out: list[MemberCertificate | None] = [None] * len(xs)
     for share, part in zip(shares, parts):
         for k, certificate in zip(share, part):
@@ -86,10 +82,24 @@ def certify_front_members(
     return tuple(out)
 
 
-def _checked(
+def checked_members(
     problem: Any, x: Any, members: Sequence[int], rate_hz: Any
 ) -> tuple[np.ndarray, list[int], float]:
-    """The members' checked input: (n, n_var) ``x``, the rows, the rate [Hz] (> 0)."""
+    """The input of a front's certificates, checked: ``problem`` a
+    :class:`~adept_traj.problem.TrajectoryProblem`, ``x`` (n, n_var) decision vectors,
+    ``members`` rows of ``x``, ``rate_hz`` [Hz] > 0.
+
+    Returns
+    -------
+    tuple
+        (``x`` as a float array (n, n_var), the rows as integers, the rate [Hz]).
+
+    Raises
+    ------
+    InvalidInputError
+        A value out of its range (:class:`~adept_traj.errors.InputShapeError`: ``x`` of
+        another shape).
+    """
     check_type(problem, TrajectoryProblem, "problem")
     xs = as_batch(x, "x", problem.n_var)
     if xs.ndim != 2:
@@ -99,17 +109,9 @@ def _checked(
     return xs, rows, rate
 
 
-def _start(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float) -> None:
-    """Pool initializer, once per forked process: keep the job; Ctrl-C is the parent's."""
-    global _JOB
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _JOB = (problem, x, rate_hz)
-
-
-def _certify_share(rows: list[int]) -> list[MemberCertificate]:
-    """Run in a certifying process: the summaries of ``rows``, in that order."""
-    if _JOB is None:  # only a pool started by certify_front_members calls this
-        raise ConfigurationError("_certify_share runs in a certify_front_members process only")
-    problem, x, rate_hz = _JOB
+def _certify_share(
+    channel: Channel, problem: TrajectoryProblem, x: np.ndarray, rows: list[int], rate_hz: float
+) -> None:
+    """A worker: send the summaries of ``rows``, in that order."""
     out = certify_members(problem, x, rows, rate_hz=rate_hz)
-    return [out[k] for k in rows]
+    channel.send([out[k] for k in rows])

@@ -64,6 +64,7 @@ __all__ = [
     "polish_members",
     "polish_mode",
     "polish_run",
+    "polish_run_with_certificates",
     "time_optimal_run",
 ]
 
@@ -148,10 +149,10 @@ def polish_mode(polish: Any) -> str:
 def polish_run(problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any) -> RunState:
     """``state`` after the polish ``mode`` (:data:`POLISH_MODES`, see the module docstring)
     with the f_c ``weights`` (6,) of the run."""
-    return _polish_run(problem, state, rate_hz, mode, weights)[0]
+    return polish_run_with_certificates(problem, state, rate_hz, mode, weights)[0]
 
 
-def _polish_run(
+def polish_run_with_certificates(
     problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any
 ) -> tuple[RunState, dict[bytes, MemberCertificate]]:
     """:func:`polish_run`, and the summaries of the certificates it made, by the polished

@@ -1,37 +1,33 @@
 """The polish after the search run by a helper process prepared while the search goes on:
 :func:`start_polisher`, :class:`Polisher`.
 
-The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize`` (a slow
-import), after the search, on the command's critical path. :func:`start_polisher` forks a
-helper process from the caller once the problem exists (before the evaluator's worker
-processes); a thread of the helper imports ``scipy.optimize`` and ``threadpoolctl`` and
-makes the problem's certifying problem at the lowest priority (nice 19,
-:func:`~adept_traj.processes.prepare_quietly`: it runs while a core idles and never takes
-one from the search), and the helper then waits.
+The polish inside :func:`~adept_traj.plan` first imports ``scipy.optimize``, after the
+search, on the command's critical path. :func:`start_polisher` forks a helper process (a
+:class:`~adept_traj.process_pool.Worker`) from the caller once the problem exists; a
+thread of the helper imports ``scipy.optimize`` and ``threadpoolctl`` and makes the
+problem's certifying problem at the lowest priority (nice 19: it runs while a core idles
+and never takes one from the search), and the helper then waits.
 :meth:`Polisher.start` hands it the search's final population (its arrays and counts,
 pickled: about 0.1 MB for the paper run); the helper polishes it as
-:func:`~adept_traj.optimise.polish_run` does, on the problem it inherited, while the
-caller certifies the front (:mod:`adept_traj.optimise.early_certificates`), and
+:func:`~adept_traj.optimise.polish_run_with_certificates` does, on the problem it
+inherited, while the caller certifies the front (:mod:`adept_traj.optimise.early_certificates`), and
 :meth:`Polisher.result` collects the polished population and the polish's certificates.
 The same code on the same numbers: the population is the one the caller would make, bit
 for bit (only the measured times differ).
 
-The helper never outlives the caller: it ignores Ctrl-C (the caller stops it),
-:meth:`Polisher.cancel` (or leaving the ``with`` block) terminates and reaps it, and it
-ends when the caller's end of the pipe closes. A helper that has not finished its imports
-when the search ends (a machine too busy to lend it a core) is not used:
-:meth:`Polisher.start` stops it and returns ``False``, and the caller polishes itself. A
-helper that fails or dies has its polish done again by the caller (:meth:`Polisher.result`
-returns ``None``): an error it met is then raised in the caller by the caller's own
-attempt, with the helper's traceback as a note (:meth:`Polisher.note`).
+The helper never outlives the caller (:mod:`adept_traj.process_pool`): it ignores Ctrl-C
+(the caller stops it), :meth:`Polisher.cancel` (or leaving the ``with`` block) kills and
+reaps it, and it ends with the caller. A helper that has not finished its imports when the
+search ends (a machine too busy to lend it a core) is not used: :meth:`Polisher.start`
+stops it and returns ``False``, and the caller polishes itself. An error of the helper is
+raised in the caller by :meth:`Polisher.result` (the same exception, with the helper's
+traceback as a note); a helper that dies without a word has its polish done again by the
+caller (:meth:`Polisher.result` returns ``None``).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import os
-import signal
-import traceback
 from functools import partial
 from typing import Any
 
@@ -41,12 +37,12 @@ from adept_traj.analysis import (
     problem_parts,
     same_parts,
 )
-from adept_traj.errors import ConfigurationError
+from adept_traj.errors import ConfigurationError, WorkerDiedError
 from adept_traj.optimise.early_certificates import EarlyCertificates, feasible_front
 from adept_traj.optimise.loop import RunState
-from adept_traj.optimise.polish_step import _polish_run, polish_mode
+from adept_traj.optimise.polish_step import polish_mode, polish_run_with_certificates
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.processes import READY, ForkedHelper, prepare_quietly
+from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_scalar, check_type
 
 __all__ = [
@@ -56,16 +52,12 @@ __all__ = [
     "start_polisher",
 ]
 
-#: How often the waiting helper checks that its parent lives [s].
-_PARENT_CHECK = 0.5
-
 
 def start_polisher(problem: TrajectoryProblem) -> Polisher:
     """Fork the helper that will polish ``problem``'s search result (see the module).
 
-    Call it once the problem exists and before its evaluator's worker processes start
-    (forked after them, the helper would hold copies of their pipes); pass it to
-    :func:`~adept_traj.plan` as ``polisher``.
+    Call it once the problem exists; pass it to :func:`~adept_traj.plan` as
+    ``polisher``. Without ``fork`` (not Linux) no helper starts: the caller polishes.
 
     Raises
     ------
@@ -149,13 +141,8 @@ def polish_with_certificates(
         failed: list[int] = []
         ahead = early.finish(failed=failed)
         done = polisher.result()
-        if done is None:  # the helper failed or died: polished here
-            try:
-                done = _polish_run(problem, state, rate_hz, mode, weights)
-            except Exception as exc:
-                if polisher.note():
-                    exc.add_note(f"the polisher's process failed first:\n{polisher.note()}")
-                raise
+        if done is None:  # the helper died without a word: polished here
+            done = polish_run_with_certificates(problem, state, rate_hz, mode, weights)
         if failed:
             polished = done[0]
             keys = {
@@ -163,33 +150,63 @@ def polish_with_certificates(
             }
             ahead.update(early.certify_again(failed, keys))
         return done[0], {**ahead, **done[1]}
-    polished, certified = _polish_run(problem, state, rate_hz, mode, weights)
+    polished, certified = polish_run_with_certificates(problem, state, rate_hz, mode, weights)
     keys = {polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)}
     return polished, {**early.finish(keys), **certified}
 
 
-class Polisher(ForkedHelper):
+class Polisher:
     """The helper process forked by :func:`start_polisher`; a context manager that stops
-    it when the block is left (:class:`~adept_traj.processes.ForkedHelper`: ``ready``,
-    ``cancel``, ``pid``).
+    it when the block is left.
 
     Attributes
     ----------
-    problem: the problem it polishes for (the caller's object).
-    made_from: ``problem``'s settings, robot, scene, start and goal when it was forked.
+    problem : TrajectoryProblem
+        The problem it polishes for (the caller's object).
+    made_from : tuple
+        ``problem``'s settings, robot, scene, start and goal when it was forked.
+    pid : int or None
+        The helper's process id (``None`` without one, or once it is reaped).
     """
 
     def __init__(self, problem: TrajectoryProblem) -> None:
         self.problem = problem
         self.made_from = problem_parts(problem)
         self._order: dict[str, Any] | None = None
-        self._note = ""
-        super().__init__(_helper, (problem,))
+        self._worker: Worker | None = None
+        if can_fork():
+            self._worker = Worker(
+                _helper,
+                problem,
+                prepare=partial(_prepare, problem),
+                note="raised while polishing in the polisher's worker process",
+            )
+
+    @property
+    def pid(self) -> int | None:
+        return None if self._worker is None else self._worker.pid
+
+    def ready(self, timeout: float = 0.0) -> bool:
+        """Whether the helper is prepared (waiting up to ``timeout`` [s]); ``False`` once
+        it is stopped or used (a helper serves one search)."""
+        return self._worker is not None and self._worker.ready(timeout)
+
+    def cancel(self) -> None:
+        """Stop the helper (a no-op once it is reaped): killed, then reaped."""
+        if self._worker is not None:
+            self._worker.close()
+
+    def __enter__(self) -> Polisher:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.cancel()
 
     def start(self, state: RunState, rate_hz: float, mode: str, weights: Any) -> bool:
         """Hand the search's final ``state`` to the helper, if it is ready, and return at
-        once; the arguments are those of :func:`~adept_traj.optimise.polish_run` (``rate_hz``
-        [Hz] of the certificates, the polish ``mode``, the six ``weights`` of f_c).
+        once; the arguments are those of
+        :func:`~adept_traj.optimise.polish_run_with_certificates` (``rate_hz`` [Hz] of the
+        certificates, the polish ``mode``, the six ``weights`` of f_c).
 
         Returns
         -------
@@ -201,13 +218,14 @@ class Polisher(ForkedHelper):
         mode = polish_mode(mode)
         if self._order is not None:
             raise ConfigurationError("the polisher polishes one population; it has one already")
-        if not self.ready():
-            self._give_up()
+        if self._worker is None or not self.ready():
+            if self._worker is not None:
+                self._worker.kill()  # reaped by cancel: a helper at nice 19 may end slowly
             return False
         arrays = dataclasses.replace(state, history=[], fronts=[])  # what the polish reads
         try:
-            self._conn.send((arrays, rate, mode, weights))
-        except OSError:  # died meanwhile: the caller polishes
+            self._worker.send(arrays, rate, mode, weights)
+        except WorkerDiedError:  # died meanwhile: the caller polishes
             self.cancel()
             return False
         self._order = {"history": state.history, "fronts": state.fronts}
@@ -221,25 +239,23 @@ class Polisher(ForkedHelper):
         tuple or None
             (the polished state, the polish's certificates by the polished move's
             ``x.tobytes()``), as the polish in the caller makes them; ``None`` if the
-            helper failed (its traceback is then :meth:`note`) or died: the caller
-            polishes itself.
-        """
-        if self._order is None:
-            raise ConfigurationError("Polisher.result needs a successful Polisher.start first")
-        message = self._answer()
-        order, self._order = self._order, None
-        if message is None:  # the helper ended without a word (killed)
-            return None
-        text, polished = message
-        if text:
-            self._note = text
-            return None
-        state, certified = polished
-        return dataclasses.replace(state, **order), certified
+            helper died without a word: the caller polishes itself.
 
-    def note(self) -> str:
-        """The traceback of the helper's failure (``""``: it did not fail)."""
-        return self._note
+        Raises
+        ------
+        Exception
+            The helper's error, with its traceback as a note.
+        """
+        if self._order is None or self._worker is None:
+            raise ConfigurationError("Polisher.result needs a successful Polisher.start first")
+        order, self._order = self._order, None
+        try:
+            state, certified = self._worker.recv()
+        except WorkerDiedError:  # the helper ended without a word (killed)
+            return None
+        finally:
+            self._worker.close()
+        return dataclasses.replace(state, **order), certified
 
 
 def _prepare(problem: TrajectoryProblem) -> None:
@@ -250,37 +266,7 @@ def _prepare(problem: TrajectoryProblem) -> None:
     certifying_problem(problem)
 
 
-def _helper(conn: Any, callers_end: Any, parent: int, problem: TrajectoryProblem) -> None:
-    """The helper process: prepare (a thread at nice 19), say ``"ready"``, wait for the
-    order, polish, send ``(traceback or "", (state, certificates) or None)`` and end at
-    once (``os._exit``: none of the parent's exit handlers runs here). ``callers_end``
-    (the caller's end of the pipe, inherited by the fork) is closed first; the wait for
-    the order ends when the pipe closes or the ``parent`` process is gone (processes
-    forked later by the caller may hold copies of its end)."""
-    code = 0
-    try:
-        callers_end.close()
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
-        if prepare_quietly(partial(_prepare, problem)):  # failed: not ready, the caller polishes
-            code = 1
-            return
-        conn.send(READY)
-        while not conn.poll(_PARENT_CHECK):
-            if os.getppid() != parent:
-                return
-        try:
-            state, rate_hz, mode, weights = conn.recv()
-        except EOFError:  # the caller stopped without work for the helper
-            return
-        try:
-            message = ("", _polish_run(problem, state, rate_hz, mode, weights))
-        except Exception:  # the caller polishes again and raises it, with this as a note
-            code = 1
-            message = (traceback.format_exc(), None)
-        conn.send(message)
-        conn.close()
-    except BaseException:  # SIGTERM's default ends the process; a broken pipe lands here
-        code = code or 1
-    finally:
-        os._exit(code)
+def _helper(channel: Channel, problem: TrajectoryProblem) -> None:
+    """The helper process, once prepared: wait for the order, polish, send the result."""
+    state, rate_hz, mode, weights = channel.recv()
+    channel.send(polish_run_with_certificates(problem, state, rate_hz, mode, weights))

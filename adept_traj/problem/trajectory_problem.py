@@ -282,7 +282,7 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         if self._evaluator is None:
             snapshot = copy.copy(self)  # pymoo's __getstate__ leaves out "_evaluator"
             self._evaluator = ParallelEvaluator(
-                snapshot._evaluate_serial, self.settings.workers, self.n_var, owner=self
+                snapshot._evaluate_serial, self.settings.workers, self.n_var
             )
         return self._evaluator
 

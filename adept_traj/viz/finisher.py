@@ -1,12 +1,12 @@
 """The end of a run written by a helper process prepared while the run goes on:
 :func:`start_finisher`, :class:`Finisher`.
 
-A run's figures and ``playback.html`` need matplotlib and meshcat, whose slow imports
-used to come after the optimiser. :func:`start_finisher` forks a helper
-process from the caller once the robot and scene exist (before the optimiser's workers);
-a thread of the helper imports the drawing modules at the lowest priority (nice 19: it
-runs while a core idles and never takes one from the optimiser), and the helper then
-waits. :meth:`Finisher.start` hands it the finished results over a pipe (pickled: about
+A run's figures and ``playback.html`` need matplotlib and meshcat, whose imports
+used to come after the optimiser. :func:`start_finisher` forks a helper process (a
+:class:`~adept_traj.process_pool.Worker`) from the caller once the robot and scene
+exist; a thread of the helper imports the drawing modules at the lowest priority (nice
+19: it runs while a core idles and never takes one from the optimiser), and the helper
+then waits. :meth:`Finisher.start` hands it the finished results over a pipe (pickled: about
 0.4 MB for the paper run); the helper builds each
 :class:`~adept_traj.results.Replay` from the robot and scene it inherited (nothing is
 reloaded) and writes the figures (:func:`adept_traj.viz.plots.save_all`, its second
@@ -14,12 +14,12 @@ share in its own fork) and the page (:func:`adept_traj.viz.meshcat_scene.static_
 at the caller's priority, while the caller saves the result. The files are those the
 caller would write itself, byte for byte.
 
-The helper never outlives the caller: it ignores Ctrl-C (the caller stops it),
-:meth:`Finisher.cancel` (or leaving the ``with`` block) terminates and reaps it, and on
-Linux it receives SIGTERM when the caller dies (``PR_SET_PDEATHSIG``), even by SIGKILL.
-An error of the helper is raised by :meth:`Finisher.wait` in the caller (the same
-exception, with the helper's traceback as a note); a helper that dies without a word has
-its work done again by the caller. A helper that has not finished its imports when the
+The helper never outlives the caller (:mod:`adept_traj.process_pool`): it ignores Ctrl-C
+(the caller stops it), :meth:`Finisher.cancel` (or leaving the ``with`` block) kills and
+reaps it, and it ends with the caller however the caller ends. An error of the helper is
+raised by :meth:`Finisher.wait` in the caller (the same exception, with the helper's
+traceback as a note); a helper that dies without a word has its work done again by the
+caller. A helper that has not finished its imports when the
 run ends (a machine too busy to lend it a core) is not used: :meth:`Finisher.start`
 stops it and returns ``False``, and the caller writes the files itself.
 """
@@ -27,22 +27,13 @@ stops it and returns ``False``, and the caller writes the files itself.
 from __future__ import annotations
 
 import os
-import signal
 from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-from adept_traj.errors import InvalidInputError
-from adept_traj.processes import (
-    LOWEST_PRIORITY,
-    READY,
-    ForkedHelper,
-    end_with_parent,
-    error_report,
-    prepare_quietly,
-    stop_on_sigterm,
-)
+from adept_traj.errors import InvalidInputError, WorkerDiedError
+from adept_traj.process_pool import LOWEST_PRIORITY, Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
@@ -63,10 +54,9 @@ _HTML_WEIGHT = 0.3
 def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> Finisher:
     """Fork the helper that will write a run's figures and/or ``playback.html``.
 
-    Call it once the run's robot and scene exist and before the optimiser's worker
-    processes start (forked after them, the helper would hold copies of their pipes, and
-    nothing but the evaluator's stop word would end them); the helper imports what the
-    outputs need at nice :data:`IMPORT_NICENESS` and waits for :meth:`Finisher.start`.
+    Call it once the run's robot and scene exist; the helper imports what the outputs
+    need at nice :data:`IMPORT_NICENESS` and waits for :meth:`Finisher.start`. Without
+    ``fork`` (not Linux) no helper starts: :meth:`Finisher.start` returns ``False``.
 
     Parameters
     ----------
@@ -86,17 +76,48 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     return Finisher(robot, scene, figures=bool(figures), html=bool(html))
 
 
-class Finisher(ForkedHelper):
+class Finisher:
     """The helper process forked by :func:`start_finisher`; a context manager that stops
-    it when the block is left (:class:`~adept_traj.processes.ForkedHelper`: ``ready``,
-    ``cancel``, ``pid``).
+    it when the block is left.
+
+    Attributes
+    ----------
+    pid : int or None
+        The helper's process id (``None`` without one, or once it is reaped).
     """
 
     def __init__(self, robot: Robot, scene: Scene, *, figures: bool, html: bool) -> None:
         self._robot, self._scene = robot, scene
         self._figures, self._html = figures, html
         self._order: tuple | None = None
-        super().__init__(_helper, (robot, scene, figures, html))
+        self._worker: Worker | None = None
+        if can_fork():
+            self._worker = Worker(
+                _helper,
+                robot,
+                scene,
+                prepare=partial(_preload, figures, html),
+                note="raised while writing the figures and page in a worker process",
+            )
+
+    @property
+    def pid(self) -> int | None:
+        return None if self._worker is None else self._worker.pid
+
+    def ready(self, timeout: float = 0.0) -> bool:
+        """Whether the helper has done its imports (waiting up to ``timeout`` [s])."""
+        return self._worker is not None and self._worker.ready(timeout)
+
+    def cancel(self) -> None:
+        """Stop the helper (a no-op once it is reaped): killed, then reaped."""
+        if self._worker is not None:
+            self._worker.close()
+
+    def __enter__(self) -> Finisher:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.cancel()
 
     def start(
         self,
@@ -123,12 +144,13 @@ class Finisher(ForkedHelper):
         order = _order(results, figures, html)
         if (order[1] is not None and not self._figures) or (order[2] and not self._html):
             raise InvalidInputError("the helper was started without the output asked for")
-        if not self.ready(READY_TIMEOUT):
-            self._give_up()
+        if self._worker is None or not self.ready(READY_TIMEOUT):
+            if self._worker is not None:
+                self._worker.kill()  # reaped by cancel: a helper at nice 19 may end slowly
             return False
         try:
-            self._conn.send(order)
-        except OSError:  # died meanwhile: the caller writes the files
+            self._worker.send(*order)
+        except WorkerDiedError:  # died meanwhile: the caller writes the files
             self.cancel()
             return False
         self._order = order
@@ -144,17 +166,15 @@ class Finisher(ForkedHelper):
             The error that stopped the helper (or the caller's own attempt, if the helper
             died without a word), with the helper's traceback as a note.
         """
-        if self._order is None:
+        if self._order is None or self._worker is None:
             raise InvalidInputError("Finisher.wait needs a successful Finisher.start first")
-        message = self._answer()
         order, self._order = self._order, None
-        if message is None:  # the helper ended without a word (killed): done again here
+        try:
+            paths = self._worker.recv()
+        except WorkerDiedError:  # the helper ended without a word (killed): done again here
             return _write(*order, self._robot, self._scene)
-        text, pickled, paths = message
-        if text:
-            from adept_traj.viz.plots.all_figures import _error
-
-            raise _error(text, pickled)
+        finally:
+            self._worker.close()
         return paths
 
 
@@ -187,16 +207,16 @@ def _write(
     """Write the figures into ``figures`` and the page of the only result into ``html``
     on the cores available (the page as one more job of the figures' processes); return
     the figures' paths."""
-    from adept_traj.viz.plots.all_figures import _draw, _figure_jobs
+    from adept_traj.viz.plots.all_figures import draw_jobs, figure_jobs
 
     replays = {key: Replay.of(r, robot=robot, scene=scene) for key, r in results.items()}
     jobs, paths, processes = [], [], 1
     if figures is not None:
-        jobs, paths, processes = _figure_jobs(results, figures, replays, None)
+        jobs, paths, processes = figure_jobs(results, figures, replays, None)
     if html is not None:
         (key, result), = results.items()  # fmt: skip
         jobs.append((_HTML_WEIGHT, partial(_page, result, html, replays[key])))
-    _draw(jobs, processes)
+    draw_jobs(jobs, processes)
     return paths
 
 
@@ -225,45 +245,8 @@ def _preload(figures: bool, html: bool) -> None:
         import adept_traj.viz.meshcat_scene  # noqa: F401
 
 
-def _die_with(parent: int) -> None:
-    """Ask Linux for SIGTERM when the parent dies (``PR_SET_PDEATHSIG``); end now if it
-    is gone already."""
-    end_with_parent()
-    if os.getppid() != parent:
-        os._exit(0)
-
-
-def _helper(
-    conn: Any, callers_end: Any, parent: int, robot: Robot, scene: Scene, figures: bool, html: bool
-) -> None:
-    """The helper process: import (a thread at nice 19), say ``"ready"``, wait for the
-    order, write, send ``(traceback or "", pickled error or None, figure paths)`` and end
-    at once (``os._exit``: none of the parent's exit handlers runs here). ``callers_end``
-    (the caller's end of the pipe, inherited by the fork) is closed first: the caller's
-    death then ends the wait for the order."""
-    code = 0
-    try:
-        callers_end.close()
-        signal.signal(signal.SIGTERM, stop_on_sigterm)
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the helper
-        _die_with(parent)
-        if prepare_quietly(partial(_preload, figures, html)):  # failed: not ready
-            code = 1
-            return
-        conn.send(READY)
-        try:
-            results, figures_dir, html_path = conn.recv()
-        except EOFError:  # the caller stopped without work for the helper
-            return
-        text, pickled, paths = "", None, []
-        try:
-            paths = _write(results, figures_dir, html_path, robot, scene)
-        except Exception as exc:  # every error is sent to the caller, which raises it
-            code = 1
-            text, pickled = error_report(exc)
-        conn.send((text, pickled, paths))
-        conn.close()
-    except BaseException:  # SIGTERM (cancel, the caller's death) or a broken pipe
-        code = code or 1
-    finally:
-        os._exit(code)
+def _helper(channel: Channel, robot: Robot, scene: Scene) -> None:
+    """The helper process, once its imports are done: wait for the order (results,
+    figures folder, page path), write, send the figures' paths."""
+    results, figures_dir, html_path = channel.recv()
+    channel.send(_write(results, figures_dir, html_path, robot, scene))

@@ -2,31 +2,29 @@
 process while the caller goes on: :func:`start_save_all`.
 
 The figures are drawn at once on the cores available (:func:`adept_traj.problem.available_cores`):
-the calling process draws one share, forked processes the others (Linux ``fork``: they
-inherit the results and matplotlib, nothing is pickled). A figure whose process fails (or
-is killed) is drawn again by the caller, so that its error, if any, is raised there.
+the calling process draws one share, worker processes the others
+(:class:`~adept_traj.process_pool.Worker`: they inherit the results and matplotlib,
+nothing is pickled). An error of a worker is raised in the caller (the same exception,
+with the worker's traceback as a note); a worker that dies without a word (killed) has its
+figures drawn again by the caller.
 
 ``adept-traj plan`` starts its figures with :func:`start_save_all` as soon as the run's
 result exists and writes ``result.json`` and ``playback.html`` meanwhile: the same files.
-An error in the forked process is raised by :meth:`BackgroundFigures.wait` in the caller
-(the same exception, with the forked process' traceback as a note), never swallowed; a
-process that dies without a word (killed) has its figures drawn again by the caller.
+An error in the worker is raised by :meth:`BackgroundFigures.wait` in the caller, never
+swallowed; a worker that dies without a word has its figures drawn again by the caller.
 """
 
 from __future__ import annotations
 
-import multiprocessing
 import os
-import pickle
-import signal
 from collections.abc import Callable, Mapping
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-from adept_traj.errors import FigureError, InvalidInputError
+from adept_traj.errors import InvalidInputError, WorkerDiedError
 from adept_traj.problem import available_cores
-from adept_traj.processes import end_with_parent, error_report, stop_on_sigterm
+from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.validation import as_integer, check_type
 from adept_traj.viz.inputs import replay_for
@@ -37,7 +35,10 @@ from adept_traj.viz.plots.motion import joint_motion
 from adept_traj.viz.plots.tool_path import tool_path_3d
 from adept_traj.viz.plots.tradeoffs import best_tradeoffs
 
-__all__ = ["BackgroundFigures", "save_all", "start_save_all"]
+__all__ = ["BackgroundFigures", "Job", "draw_jobs", "figure_jobs", "save_all", "start_save_all"]
+
+#: The note before a worker's traceback on its error.
+_NOTE = "raised while drawing the figures in a forked process"
 
 
 def save_all(
@@ -70,18 +71,18 @@ def save_all(
     -------
     The paths written, in that order.
     """
-    jobs, paths, n_proc = _figure_jobs(results, folder, replays, processes)
-    _draw(jobs, n_proc)
+    jobs, paths, n_proc = figure_jobs(results, folder, replays, processes)
+    draw_jobs(jobs, n_proc)
     return paths
 
 
 #: A figure to draw: (cost weight, drawing with its path bound).
-_Job = tuple[float, Callable[[], Path]]
+Job = tuple[float, Callable[[], Path]]
 
 
-def _figure_jobs(
+def figure_jobs(
     results: Any, folder: Any, replays: Any, processes: Any
-) -> tuple[list[_Job], list[Path], int]:
+) -> tuple[list[Job], list[Path], int]:
     """The arguments of :func:`save_all`, checked (nothing is drawn; ``folder`` is
     created): the figures to draw, their paths in order and the number of processes."""
     res = as_results(results)
@@ -113,11 +114,18 @@ def _figure_jobs(
     return jobs, [path for _, path, _ in figures], n_proc
 
 
-def _draw(jobs: list[_Job], processes: int) -> None:
+def draw_jobs(jobs: list[Job], processes: int) -> None:
     """Run the figure ``jobs`` (cost weight, drawing) on up to ``processes`` processes (this
-    one included), the heaviest first, each to the least loaded process."""
+    one and worker processes), the heaviest first, each to the least loaded process.
+
+    Raises
+    ------
+    Exception
+        A drawing's error (a worker's with its traceback as a note); a worker that died
+        without a word has its share drawn again here.
+    """
     processes = min(processes, len(jobs))
-    if processes == 1 or "fork" not in multiprocessing.get_all_start_methods():
+    if processes == 1 or not can_fork():
         for _, draw in jobs:
             draw()
         return
@@ -128,38 +136,28 @@ def _draw(jobs: list[_Job], processes: int) -> None:
         k = loads.index(min(loads))
         shares[k].append(i)
         loads[k] += jobs[i][0]
-    context = multiprocessing.get_context("fork")
-    children = [
-        context.Process(target=_draw_share, args=([jobs[i][1] for i in share],), daemon=True)
-        for share in shares[1:]
-    ]
+    workers: list[Worker] = []
     try:
-        for child in children:
-            child.start()
+        for share in shares[1:]:
+            workers.append(Worker(_draw_share, [jobs[i][1] for i in share], note=_NOTE))
         for i in shares[0]:
             jobs[i][1]()
-        for child, share in zip(children, shares[1:]):
-            child.join()
-            if child.exitcode != 0:  # drawn again here: its error, if any, is raised here
+        for worker, share in zip(workers, shares[1:]):
+            try:
+                worker.recv()
+            except WorkerDiedError:  # killed: drawn again here
                 for i in share:
                     jobs[i][1]()
     finally:
-        for child in children:
-            if child.is_alive():
-                child.terminate()
-                child.join()
+        for worker in workers:
+            worker.close()
 
 
-def _draw_share(draws: list[Callable[[], Path]]) -> None:
-    """Run in a forked process: draw these figures; any error ends it with status 1 (the
-    caller draws its figures again and reports the error). It ends with its parent (a
-    parent stopped outright cannot terminate it)."""
-    end_with_parent()
-    try:
-        for draw in draws:
-            draw()
-    except BaseException:  # reported by the caller's second attempt
-        os._exit(1)
+def _draw_share(channel: Channel, draws: list[Callable[[], Path]]) -> None:
+    """A worker: draw these figures, then say so."""
+    for draw in draws:
+        draw()
+    channel.send(None)
 
 
 def _replays(replays: Any, results: Mapping[str, PlanningResult]) -> dict[str, Replay]:
@@ -194,12 +192,12 @@ def start_save_all(
     The drawing under way: call :meth:`~BackgroundFigures.wait` for the paths (and any
     error), or use it as a context manager, which stops it if the block is left early.
     """
-    jobs, paths, n_proc = _figure_jobs(results, folder, replays, processes)
+    jobs, paths, n_proc = figure_jobs(results, folder, replays, processes)
     return BackgroundFigures(jobs, paths, n_proc)
 
 
 class BackgroundFigures:
-    """The figures being drawn in a forked process (made by :func:`start_save_all`).
+    """The figures being drawn in a worker process (made by :func:`start_save_all`).
 
     Attributes
     ----------
@@ -207,17 +205,12 @@ class BackgroundFigures:
         returns them.
     """
 
-    def __init__(self, jobs: list[_Job], paths: list[Path], processes: int) -> None:
+    def __init__(self, jobs: list[Job], paths: list[Path], processes: int) -> None:
         self.paths = list(paths)
         self._jobs, self._processes = jobs, processes
-        self._process: Any = None
-        self._receiver: Any = None
-        if "fork" in multiprocessing.get_all_start_methods():
-            context = multiprocessing.get_context("fork")
-            self._receiver, sender = context.Pipe(duplex=False)
-            self._process = context.Process(target=_child, args=(jobs, processes, sender))
-            self._process.start()  # (flushes sys.stdout and sys.stderr before the fork)
-            sender.close()
+        self._worker: Worker | None = None
+        if can_fork():
+            self._worker = Worker(_draw_all, jobs, processes, note=_NOTE)
 
     def wait(self) -> list[Path]:
         """Wait until every figure is written; return their paths.
@@ -225,37 +218,27 @@ class BackgroundFigures:
         Raises
         ------
         Exception
-            The error that stopped the forked process (or the caller's own attempt, if
-            that process was killed), with the forked process' traceback as a note.
+            The error that stopped the worker (or the caller's own attempt, if the worker
+            was killed), with the worker's traceback as a note.
         """
-        if self._process is None:
-            _draw(self._jobs, self._processes)
+        if self._worker is None:
+            draw_jobs(self._jobs, self._processes)
             return list(self.paths)
+        worker, self._worker = self._worker, None
         try:
-            text, pickled = self._receiver.recv()
-        except EOFError:  # the process ended without a word (killed)
-            text, pickled = None, None
-        except BaseException:  # e.g. Ctrl-C while waiting
-            self.cancel()
-            raise
-        self._process.join()
-        self._receiver.close()
-        self._process = None
-        if text is None:
-            _draw(self._jobs, 1)  # drawn again here: its error, if any, is raised here
-        elif text:
-            raise _error(text, pickled)
+            worker.recv()
+        except WorkerDiedError:  # the worker ended without a word (killed): drawn here
+            draw_jobs(self._jobs, 1)
+        finally:
+            worker.close()
         return list(self.paths)
 
     def cancel(self) -> None:
-        """Stop the drawing (a no-op once :meth:`wait` has returned): the forked process is
-        terminated and waited for; files it has finished stay (each is written atomically)."""
-        if self._process is None:
-            return
-        self._process.terminate()
-        self._process.join()
-        self._receiver.close()
-        self._process = None
+        """Stop the drawing (a no-op once :meth:`wait` has returned): the worker is killed
+        and reaped; files it has finished stay (each is written atomically)."""
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
 
     def __enter__(self) -> BackgroundFigures:
         return self
@@ -264,32 +247,7 @@ class BackgroundFigures:
         self.cancel()
 
 
-def _error(text: str, pickled: bytes | None) -> BaseException:
-    """The forked process' error (unpickled) with its traceback ``text`` as a note; a
-    :class:`~adept_traj.errors.FigureError` holding ``text`` if it does not unpickle."""
-    try:
-        error = pickle.loads(pickled) if pickled is not None else None
-    except Exception:  # e.g. an exception class whose __init__ needs other arguments
-        error = None
-    if not isinstance(error, BaseException):
-        return FigureError(f"drawing the figures failed in a forked process:\n{text}")
-    error.add_note(f"raised while drawing the figures in a forked process:\n{text}")
-    return error
-
-
-def _child(jobs: list[_Job], processes: int, sender: Any) -> None:
-    """In the forked process: draw, send ``("", None)`` or (the error's traceback, the
-    pickled error or ``None``), and end at once (``os._exit``: none of the parent's exit
-    handlers runs here)."""
-    signal.signal(signal.SIGTERM, stop_on_sigterm)  # cancel
-    code, text, pickled = 0, "", None
-    try:
-        _draw(jobs, processes)
-    except BaseException as exc:  # every error is sent to the caller, which raises it
-        code = 1
-        text, pickled = error_report(exc)
-    try:
-        sender.send((text, pickled))
-        sender.close()
-    finally:
-        os._exit(code)
+def _draw_all(channel: Channel, jobs: list[Job], processes: int) -> None:
+    """The worker of :class:`BackgroundFigures`: draw, then say so."""
+    draw_jobs(jobs, processes)
+    channel.send(None)
