@@ -47,12 +47,12 @@ def cloud_bound(
     point bound ``b`` (:meth:`~adept_traj.collision.cloud_distance.CloudCells.point_bound`,
     1-Lipschitz below the distance to the leaves) at samples of the solid's box:
 
-    a. the box cut into cells of at most :data:`CLOUD_COARSE_STEP` a side: every point of
-       the box is within ``s`` (half a cell diagonal) of a cell centre ``g``, so
+    a. the box cut into cells of at most :data:`CLOUD_COARSE_STEP` a side: every point
+       of the box is within ``s`` (half a cell diagonal) of a cell centre ``g``, so
        :math:`d \\ge \\min_g b(g) - s`;
     b. where (a) is positive the box is clear of every leaf, so its distance is that of
        its surface: the same with the faces cut into squares of at most
-       :data:`CLOUD_SAMPLE_STEP` a side (the rows still within ``influence`` only).
+       :data:`CLOUD_SAMPLE_STEP` a side (the rows still within ``influence``).
 
     The solid is inside its box, so these bound its distance too."""
     samples = broad.cloud_samples[k]
@@ -65,10 +65,10 @@ def cloud_bound(
     pos = np.einsum("...ji,...j->...i", po[..., :3, :3], ps[:, :3, 3] - po[..., :3, 3])
     (coarse, s_coarse), (surface, s_surface) = samples
     lower = sampled_bound(cells, coarse, s_coarse, rot, pos)
-    fine = np.flatnonzero((lower > 0.0) & (lower <= broad.influence))
-    if fine.size:
-        lower[fine] = np.maximum(
-            lower[fine], sampled_bound(cells, surface, s_surface, rot[fine], pos[fine])
+    rows = np.flatnonzero((lower > 0.0) & (lower <= broad.influence))
+    if rows.size:  # the box is clear of every leaf there: its faces bound it
+        lower[rows] = np.maximum(
+            lower[rows], sampled_bound(cells, surface, s_surface, rot[rows], pos[rows])
         )
     bound = bound.copy()
     bound[still] = np.maximum(bound[still], lower)
@@ -88,11 +88,12 @@ def sampled_bound(
     return out - slack
 
 
-def cloud_samples(geometry: coal.CollisionGeometry) -> tuple[Any, Any] | None:
+def cloud_samples(geometry: coal.CollisionGeometry) -> tuple[Any, ...] | None:
     """Samples of a primitive solid's box for level 5, solid frame: the centres (m, 3)
-    [m] of cells of at most :data:`CLOUD_COARSE_STEP` a side tiling the box and their half
-    diagonal [m]; the centres of squares of at most :data:`CLOUD_SAMPLE_STEP` a side tiling
-    its faces and their half diagonal; None for another geometry."""
+    [m] of cells of at most :data:`CLOUD_COARSE_STEP` a side tiling the box and their
+    half diagonal [m]; the centres of squares of at most
+    :data:`CLOUD_SAMPLE_STEP` a side tiling its faces and their half diagonal; None for
+    another geometry."""
     half = solid_half_sides(geometry)
     if half is None:
         return None
@@ -102,18 +103,22 @@ def cloud_samples(geometry: coal.CollisionGeometry) -> tuple[Any, Any] | None:
         side = 2.0 * half / n
         return [-half[a] + side[a] * (np.arange(n[a]) + 0.5) for a in axes], side[list(axes)]
 
-    grid, side = cells(CLOUD_COARSE_STEP, (0, 1, 2))
-    coarse = np.stack(np.meshgrid(*grid, indexing="ij"), axis=-1).reshape(-1, 3)
-    faces, slack = [], 0.0
-    for axis in range(3):
-        others = tuple(a for a in range(3) if a != axis)
-        grid, side_f = cells(CLOUD_SAMPLE_STEP, others)
-        u, v = np.meshgrid(*grid, indexing="ij")
-        for sign in (-1.0, 1.0):
-            face = np.zeros((u.size, 3))
-            face[:, others[0]], face[:, others[1]] = u.ravel(), v.ravel()
-            face[:, axis] = sign * half[axis]
-            faces.append(face)
-        slack = max(slack, 0.5 * float(np.linalg.norm(side_f)))
-    coarse_slack = 0.5 * float(np.linalg.norm(side)) + 1e-9
-    return (coarse, coarse_slack), (np.concatenate(faces), slack + 1e-9)
+    out = []
+    for step in (CLOUD_COARSE_STEP,):
+        grid, side = cells(step, (0, 1, 2))
+        centres = np.stack(np.meshgrid(*grid, indexing="ij"), axis=-1).reshape(-1, 3)
+        out.append((centres, 0.5 * float(np.linalg.norm(side)) + 1e-9))
+    for step in (CLOUD_SAMPLE_STEP,):
+        faces, slack = [], 0.0
+        for axis in range(3):
+            others = tuple(a for a in range(3) if a != axis)
+            grid, side_f = cells(step, others)
+            u, v = np.meshgrid(*grid, indexing="ij")
+            for sign in (-1.0, 1.0):
+                face = np.zeros((u.size, 3))
+                face[:, others[0]], face[:, others[1]] = u.ravel(), v.ravel()
+                face[:, axis] = sign * half[axis]
+                faces.append(face)
+            slack = max(slack, 0.5 * float(np.linalg.norm(side_f)))
+        out.append((np.concatenate(faces), slack + 1e-9))
+    return tuple(out)

@@ -124,13 +124,20 @@ class CloudCells:
         dilated by one cube); outside the grid, that of its nearest grid point less the
         distance to it, or the distance to the leaves' box, the larger."""
         origin, h, field = self.field
-        top = origin + h * np.array(field.shape)
-        q = np.clip(p, origin, top - 1e-9 * h)  # the nearest point of the grid
-        out = np.linalg.norm(p - q, axis=-1)  # (a 1-Lipschitz distance: less that)
-        idx = np.floor((q - origin) / h).astype(np.int64)
-        value = field[idx[..., 0], idx[..., 1], idx[..., 2]] - 1e-6 - out  # float32 rounding
-        box = np.linalg.norm(np.maximum(np.abs(p - self._mid) - self._spread, 0.0), axis=-1)
-        return np.maximum(value, box - 1e-9)  # (rounding)
+        dims = field.shape
+        cell = (p - origin) * (1.0 / h)  # grid coordinates (cubes of edge 1)
+        grid = np.clip(cell, 0.0, np.array(dims) - 1e-9)  # the nearest point of the grid
+        idx = grid.astype(np.int64)  # (≥ 0: the truncation is the floor)
+        flat = (idx[..., 0] * dims[1] + idx[..., 1]) * dims[2] + idx[..., 2]
+        value = field.ravel()[flat].astype(float) - 1e-6  # float32 rounding
+        off = cell - grid
+        out = np.einsum("...i,...i->...", off, off)
+        away = out > 0.0  # outside the grid (rare): less the distance to it, or the box's
+        if away.any():
+            q = p[away]
+            box = np.linalg.norm(np.maximum(np.abs(q - self._mid) - self._spread, 0.0), axis=-1)
+            value[away] = np.maximum(value[away] - h * np.sqrt(out[away]), box - 1e-9)
+        return value
 
     @cached_property
     def field(self) -> tuple[np.ndarray, float, np.ndarray]:
