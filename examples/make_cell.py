@@ -2,9 +2,10 @@
 ``docs/example-cell.md``): a table fixture (STL in millimetres, concave and closed), a
 guard block (OBJ in metres), the conveyor's belt frame (STL in millimetres) and the jig on
 the turntable (STL in millimetres), and the joint table of the second robot (``robot_a.csv``:
-a second AdeptOne XL across the belt swinging its arm away from the parts' end of the belt).
+a second AdeptOne XL across the belt swinging its arm away from near the planned goal).
 The scene file ``cell.toml`` beside them places them and sets the machines' motions. Run
-from the repository root: ``python examples/make_cell.py`` (the files are shipped; this script is how they were made).
+from the repository root: ``python examples/make_cell.py`` (the files are shipped; this
+script is how they were made).
 """
 
 from __future__ import annotations
