@@ -2,8 +2,8 @@ r"""Distances of a primitive robot solid to a point cloud's octree, found best-f
 
 coal's octree distance visits every leaf whose box is nearer the solid's axis-aligned
 bounding box than the best distance found so far, in a fixed child order; a long link
-beside a dense scan (a fence) meets thousands of leaves in that box, and one call took
-0.3–12 ms on 10⁶ points. :class:`CloudDistance` computes **the same quantity** — the
+beside a dense scan (a fence) meets thousands of leaves in that box (``docs/scene-files.md``
+has the figures). :class:`CloudDistance` computes **the same quantity** — the
 smallest of coal's distances between the solid and the octree's occupied leaves
 (``OcTree.toBoxes``: axis-aligned cubes in the cloud frame) — with few coal calls, by a
 best-first search over *buckets* of leaves (a grid of :data:`BUCKETBUCKET_EDGE` leaves a side)
@@ -142,7 +142,7 @@ class CloudCells:
     @cached_property
     def field(self) -> tuple[np.ndarray, float, np.ndarray]:
         """``(origin (3,), h, D (nx, ny, nz) float32)`` of :meth:`point_bound` (made on
-        first use: a few seconds for 10⁶ points)."""
+        first use)."""
         from scipy.ndimage import binary_dilation, distance_transform_edt
 
         leaf = 2.0 * float(self.half.min())
