@@ -1,6 +1,7 @@
 """Plan the example work cell (``docs/example-cell.md``): the paper's robot and task among
-CAD meshes (a table fixture, a guard, a conveyor's belt), three parts riding the belt and a
-jig on a turntable; certify the best move in continuous time and re-verify the saved result.
+CAD meshes (a table fixture, a guard, a conveyor's belt), three parts riding the belt, a
+jig on a turntable and a second robot swinging its arm away (its 7 solids moving
+obstacles ``robotA.*``); certify the best move in continuous time and re-verify the saved result.
 
 Run: ``python examples/plan_cell.py [--pop 40] [--gens 30] [--out out/cell]``.
 """

@@ -38,6 +38,7 @@ Levels, each on the rows the previous one left within ``influence``:
    over all directions, so it is at most the overlap on any one axis,
    :math:`d \\ge \\max_u \\text{gap}_u` (this bounds deep candidates tightly, and the
    branch and bound computes few of them).
+5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds`.
 
 Everything is numpy on whole arrays; the Python loops run over solids and obstacles
 (7 × 4 for the AdeptOne XL scene), never over samples. That is why it is kept rather than
@@ -55,6 +56,7 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
+from adept_traj.collision.cloud_bounds import cloud_bound, cloud_samples
 from adept_traj.collision.distance_table import DistanceTable, table_bounds
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.point_distance import (
@@ -130,6 +132,8 @@ class BroadPhase:
         #: Parent joint of each solid (n_solids,) and its placement there (n_solids, 4, 4).
         self.parents, self.local = solid_frames(robot.collision_model)
         covers = [covering_spheres(g.geometry) for g in objects]
+        #: Samples of each primitive solid's box for the point-cloud level (None: other).
+        self.cloud_samples = [cloud_samples(g.geometry) for g in objects]
         self._cover_centres = [c for c, _ in covers]  # per solid: (k, 3), solid frame
         self._cover_radii = [r for _, r in covers]
         balls = [enclosing_ball(g.geometry) for g in objects]
@@ -217,16 +221,12 @@ class BroadPhase:
         """Exact signed distance [m] of one solid–obstacle pair (closed form or coal)."""
         if self.closed_form[k, o]:
             return float(self.closed_form_distance(solid_pose[None], obstacle_pose, k, o)[0])
-        request, result = distance_request(), coal.DistanceResult()
-        functor = distance_functor(geometry, self.obstacle_geometry[o], self.obstacle_shape[o])
-        return float(
-            functor(
-                coal.Transform3s(solid_pose[:3, :3], solid_pose[:3, 3]),
-                coal.Transform3s(obstacle_pose[:3, :3], obstacle_pose[:3, 3]),
-                request,
-                result,
-            )
+        functor = distance_functor(
+            geometry, self.obstacle_geometry[o], self.obstacle_shape[o], self.influence
         )
+        tf_s = coal.Transform3s(solid_pose[:3, :3], solid_pose[:3, 3])
+        tf_o = coal.Transform3s(obstacle_pose[:3, :3], obstacle_pose[:3, 3])
+        return float(functor(tf_s, tf_o, distance_request(), coal.DistanceResult()))
 
     def solid_poses(self, frames: np.ndarray, rows: np.ndarray, k: int | np.ndarray) -> np.ndarray:
         """Poses (R, 4, 4) at the samples ``rows`` (R,) of the joint frames ``frames``
@@ -426,6 +426,8 @@ class BroadPhase:
             bound = np.where(cover > 0.0, np.maximum(cover, bound), bound)
         kind_s, kind_o = self.solid_kind[k], self.obstacle_kind[o]
         still = np.flatnonzero(bound <= self.influence)
+        if still.size and kind_o is None:  # a point cloud: level 5 (a mesh: as it is)
+            return cloud_bound(self, bound, still, frames, idx, po, k, o)
         if still.size == 0 or kind_s is None or kind_o is None:
             return bound
         ps = self.solid_poses(frames, idx[still], k)

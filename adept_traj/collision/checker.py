@@ -133,7 +133,10 @@ class CollisionChecker:
         self._robot_geoms = [g.geometry for g in objects]
         shapes = self._broad.obstacle_shape  # a closed mesh's functor tests the inside too
         self._functors = [
-            [distance_functor(g, o, sh) for o, sh in zip(self._broad.obstacle_geometry, shapes)]
+            [
+                distance_functor(g, o, sh, self.influence)
+                for o, sh in zip(self._broad.obstacle_geometry, shapes)
+            ]
             for g in self._robot_geoms
         ]
         self._request = distance_request()

@@ -26,7 +26,9 @@ from typing import Any
 import coal
 import numpy as np
 
+from adept_traj.collision.cloud_distance import CloudDistance, solid_distance_bound
 from adept_traj.scene.meshes import Mesh
+from adept_traj.scene.point_clouds import PointCloud
 
 __all__ = ["MeshDistance", "distance_functor"]
 
@@ -63,10 +65,16 @@ class MeshDistance:
         return -d
 
 
-def distance_functor(solid: coal.CollisionGeometry, obstacle_geometry: Any, shape: object) -> Any:
+def distance_functor(
+    solid: coal.CollisionGeometry, obstacle_geometry: Any, shape: object, cap: float = np.inf
+) -> Any:
     """The distance functor of a robot solid and an obstacle's coal geometry: a
-    :class:`MeshDistance` for a closed :class:`Mesh` obstacle, else coal's own
-    ``ComputeDistance``."""
+    :class:`MeshDistance` for a closed :class:`Mesh` obstacle, a
+    :class:`~adept_traj.collision.cloud_distance.CloudDistance` for a primitive solid and
+    a :class:`PointCloud` (distances above ``cap`` [m] returned as a lower bound above
+    it), else coal's own ``ComputeDistance``."""
     if isinstance(shape, Mesh) and shape.closed:
         return MeshDistance(solid, obstacle_geometry, shape)
+    if isinstance(shape, PointCloud) and solid_distance_bound(solid, np.zeros((1, 3))):
+        return CloudDistance(solid, obstacle_geometry, shape, cap)
     return coal.ComputeDistance(solid, obstacle_geometry)

@@ -79,11 +79,6 @@ class LinearMotion(MotionLaw):
         return out
 
     @property
-    def is_fixed(self) -> bool:
-        """False."""
-        return False
-
-    @property
     def jump_interval(self) -> float:
         """:math:`L / |v|` [s] with a wrap, else ``inf``."""
         return self.wrap / self._speed  # type: ignore[attr-defined]
@@ -159,11 +154,6 @@ class RotationMotion(MotionLaw):
         out[..., :3, 3] = self.point - rot @ self.point
         out[..., 3, 3] = 1.0
         return out
-
-    @property
-    def is_fixed(self) -> bool:
-        """False."""
-        return False
 
     def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
         return np.cross(self.omega * self.axis, points - self.point)

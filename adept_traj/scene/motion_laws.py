@@ -57,9 +57,10 @@ class MotionLaw(ValueObject, ABC):
         """
 
     @property
-    @abstractmethod
     def is_fixed(self) -> bool:
-        """True when the pose does not depend on time."""
+        """True when the pose does not depend on time (False but for :class:`FixedPose`:
+        a law is time-dependent by kind, even one that happens to stand still)."""
+        return False
 
     @abstractmethod
     def swept_ball(
@@ -381,11 +382,6 @@ class PendulumMotion(MotionLaw):
             out[..., i, 0] = c * swing + s * ez
             out[..., i, 2] = -s * swing + c * ez
         return out
-
-    @property
-    def is_fixed(self) -> bool:
-        """False (even for v0 = 0, the law is time-dependent by kind)."""
-        return False
 
     def swept_ball(
         self, point: Any = (0.0, 0.0, 0.0), radius: float = 0.0

@@ -11,10 +11,9 @@ overlapping an occupied cell is a collision (distance ≤ 0).
 **Broad phase.** Besides its bounding box, a cloud has a coarse distance field
 (:meth:`PointCloud.lower_bound`: cells of at least r, at most a million over the box, each
 with the distance from its centre to the nearest occupied cell's), so a robot near a cloud
-that surrounds it (a scanned fence) is bounded away from it without a coal call. Where a
-solid comes within the checker's influence distance of the cells, coal's octree distance
-is called, far costlier than for a primitive pair (``benchmarks/bench_cells.py``,
-``docs/performance.md``), so a dense cloud right at the path is slow to plan against.
+that surrounds it (a scanned fence) is bounded away from it without a coal call. Closer,
+the collision checker's own levels take over (:mod:`adept_traj.collision.cloud_bounds`,
+:mod:`adept_traj.collision.cloud_distance`; figures in ``docs/scene-files.md``).
 
 Files: ``.ply`` (ASCII or binary, the vertex element's x, y, z), ``.pcd`` (ASCII or binary,
 fields x, y, z), ``.xyz`` (text, the first three numbers of each line), ``.npy`` ((n, 3)

@@ -136,11 +136,6 @@ class RecordedMotion(MotionLaw):
         out[..., 3, 3] = 1.0
         return out
 
-    @property
-    def is_fixed(self) -> bool:
-        """False."""
-        return False
-
     def _point_velocity(self, t: np.ndarray, points: np.ndarray) -> np.ndarray:
         r""":math:`\dot o + \omega \times (p - o)` on each point's segment (0 where the
         pose is held)."""

@@ -178,11 +178,6 @@ class RobotSolidMotion(MotionLaw):
         poses = self.robot.geometry_poses(q)[:, self.solid]
         return (self.base @ poses).reshape(*times.shape, 4, 4)
 
-    @property
-    def is_fixed(self) -> bool:
-        """False."""
-        return False
-
     def _arms(self, point: np.ndarray, radius: float) -> tuple[np.ndarray, float]:
         """(nq,) lever arms r_j of the ball (module docstring) and its reach from the base
         origin [m]."""
