@@ -59,14 +59,6 @@ THREE_MOVES = cycle_text(
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
-    ) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
 def cycle_file(tmp_path_factory) -> Path:
     return write_cycle(tmp_path_factory.mktemp("cycle"), THREE_MOVES, file="three.toml")
 

@@ -67,14 +67,6 @@ def _files(folder: Path, cycle: str = CYCLE, scene: str = SWING) -> Path:
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
-    ) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
 def planned(tmp_path_factory, cluster) -> Path:
     folder = tmp_path_factory.mktemp("clock")
     path = _files(folder)
