@@ -110,3 +110,14 @@ def wait_for(condition, timeout: float = 60.0, step: float = 0.1) -> None:
         if time.monotonic() > end:
             raise AssertionError("the page did not get there in time")
         time.sleep(step)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A local Dask cluster of two single-threaded worker processes, one per test module
+    that asks for it (the cycle tests)."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    ) as c:
+        yield c

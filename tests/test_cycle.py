@@ -39,62 +39,28 @@ from adept_traj.errors import ConfigurationError, CycleError, UnreachableLocatio
 from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
+from adept_traj.testing.cycle_files import HOME, PLACE, cycle_text, write_cycle
 
 distributed = pytest.importorskip("distributed")
 
 #: Three moves in an obstacle-free scene with a tiny budget (8 × 3: certified, 0.1 s each);
 #: the slow tier plans them in the paper scene at 16 × 8.
-THREE_MOVES = """\
-name = "three"
-scene = "empty.toml"
-
-[plan]
-pop_size = 8
-n_gen = 3
-seed = 1
-
-[[location]]
-name = "home"
-joints = [0.1682, 1.3849, 0.08, -0.7555]
-
-[[location]]
-name = "pick"
-pose = [0.3, 0.5, 0.55, 0.0]
-elbow = "righty"
-
-[[location]]
-name = "place"
-joints = [-0.761, 0.245, 0.2, 1.0095]
-
-[[move]]
-from = "home"
-to = "pick"
-
-[[move]]
-from = "pick"
-to = "home"
-
-[[move]]
-from = "home"
-to = "place"
-seed = 1
-"""
-
-
-@pytest.fixture(scope="module")
-def cluster():
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
-    ) as c:
-        yield c
+THREE_MOVES = cycle_text(
+    "three",
+    scene="empty.toml",
+    plan={"pop_size": 8, "n_gen": 3, "seed": 1},
+    locations={
+        "home": {"joints": HOME},
+        "pick": {"pose": [0.3, 0.5, 0.55, 0.0], "elbow": "righty"},
+        "place": {"joints": PLACE},
+    },
+    moves=[("home", "pick"), ("pick", "home"), {"from": "home", "to": "place", "seed": 1}],
+)
 
 
 @pytest.fixture(scope="module")
 def cycle_file(tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("cycle") / "three.toml"
-    path.write_text(THREE_MOVES)
-    (path.parent / "empty.toml").write_text('name = "empty"\n')
-    return path
+    return write_cycle(tmp_path_factory.mktemp("cycle"), THREE_MOVES, file="three.toml")
 
 
 @pytest.fixture(scope="module")
@@ -119,10 +85,7 @@ def cycle_run(cycle_file, cluster) -> Path:
 
 
 def _write(tmp_path: Path, text: str) -> Path:
-    path = tmp_path / "c.toml"
-    path.write_text(text)
-    (tmp_path / "empty.toml").write_text('name = "empty"\n')
-    return path
+    return write_cycle(tmp_path, text)
 
 
 # --------------------------------------------------------------------------- the file

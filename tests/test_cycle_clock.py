@@ -28,6 +28,7 @@ from adept_traj.errors import CycleError
 from adept_traj.results import PlanningResult
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
+from adept_traj.testing.cycle_files import HOME, PLACE, cycle_text, write_cycle
 from adept_traj.testing.scene_clock import clearance_by_hand, pendulum_bob_by_hand
 
 distributed = pytest.importorskip("distributed")
@@ -48,53 +49,21 @@ swing_axis = [0.7779, -0.6283, 0.0]
 bob_radius = 0.08
 """
 
-CYCLE = """\
-name = "swing-cycle"
-scene = "swing.toml"
-repeat = 3
-
-[plan]
-pop_size = 8
-n_gen = 3
-seed = 1
-
-[dwell]
-step = 0.5
-max = 1.5
-
-[[location]]
-name = "home"
-joints = [0.1682, 1.3849, 0.08, -0.7555]
-
-[[location]]
-name = "place"
-joints = [-0.761, 0.245, 0.2, 1.0095]
-
-[[move]]
-from = "home"
-to = "place"
-
-[[move]]
-from = "place"
-to = "home"
-"""
+CYCLE = cycle_text(
+    "swing-cycle",
+    scene="swing.toml",
+    repeat=3,
+    plan={"pop_size": 8, "n_gen": 3, "seed": 1},
+    dwell={"step": 0.5, "max": 1.5},
+    locations={"home": {"joints": HOME}, "place": {"joints": PLACE}},
+    moves=[("home", "place"), ("place", "home")],
+)
 
 MARGIN = 0.01  # the default ProblemSettings margin [m]
 
 
 def _files(folder: Path, cycle: str = CYCLE, scene: str = SWING) -> Path:
-    (folder / "swing.toml").write_text(scene)
-    path = folder / "c.toml"
-    path.write_text(cycle)
-    return path
-
-
-@pytest.fixture(scope="module")
-def cluster():
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
-    ) as c:
-        yield c
+    return write_cycle(folder, cycle, scenes={"swing.toml": scene})
 
 
 @pytest.fixture(scope="module")
@@ -121,20 +90,21 @@ def _dense(folder: Path) -> tuple[np.ndarray, np.ndarray]:
     return rows[:, header.index("t")], rows[:, q_cols]
 
 
-@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
-def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path) -> None:
-    summary = json.loads((planned / "cycle.json").read_text())
-    scene = Scene.from_file(planned.parent / "swing.toml").to_dict()
-    robot = Robot.adept_one_xl()
-    clock = summary["clock"]
+def _clear_by_hand(out: Path, scene: dict, period: float) -> int:
+    """Re-check the cycle saved in ``out`` with the oracle (module doc): the pass time
+    re-derived from the dwells and the stored trajectories, then every move of every pass
+    and every dwell (the robot at rest at the move's start) and final dwell clear of the
+    obstacles of the scene file's mapping ``scene`` at its real scene times. Returns the
+    moves checked."""
+    summary = json.loads((out / "cycle.json").read_text())
+    robot, clock = Robot.adept_one_xl(), summary["clock"]
     assert clock["scene_clock"] == "periodic"
-    period = 2 * math.pi / scene["pendulum"][0]["omega"]  # by hand, from the file
     assert clock["period"] == pytest.approx(period, rel=1e-12)
     moves = clock["passes"][0]
     # the pass time by hand: dwells + travel times + the final dwell, a multiple of P
     ends, t = [], 0.0
     for m in moves:
-        dense_t, _ = _dense(planned / m["folder"])
+        dense_t, _ = _dense(out / m["folder"])
         t += m["dwell"]
         assert m["start_time"] == pytest.approx(t, abs=1e-12)
         t += dense_t[-1]
@@ -145,7 +115,7 @@ def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path)
     checked = 0
     for p in range(summary["repeat"]):
         for m in moves:
-            dense_t, dense_q = _dense(planned / m["folder"])
+            dense_t, dense_q = _dense(out / m["folder"])
             start = m["start_time"] + p * pass_time
             rows = np.r_[np.arange(0, len(dense_t), 12), len(dense_t) - 1]
             hand, _ = clearance_by_hand(robot, scene, dense_q[rows], start + dense_t[rows])
@@ -154,12 +124,20 @@ def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path)
             rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
             still = np.repeat(dense_q[:1], len(rest), axis=0)
             hand, _ = clearance_by_hand(robot, scene, still, rest)
-            assert hand.min() >= MARGIN - 1e-6
+            assert hand.min() >= MARGIN - 1e-6, (p, m["name"], "dwell", hand.min())
             checked += 1
         final = ends[-1] + p * pass_time + np.linspace(0.0, clock["final_dwell"], 40)
-        still = np.repeat(_dense(planned / moves[-1]["folder"])[1][-1:], len(final), axis=0)
+        still = np.repeat(_dense(out / moves[-1]["folder"])[1][-1:], len(final), axis=0)
         assert clearance_by_hand(robot, scene, still, final)[0].min() >= MARGIN - 1e-6
     assert checked == summary["repeat"] * len(moves)
+    return checked
+
+
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
+def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path) -> None:
+    scene = Scene.from_file(planned.parent / "swing.toml").to_dict()
+    period = 2 * math.pi / scene["pendulum"][0]["omega"]  # by hand, from the file
+    assert _clear_by_hand(planned, scene, period) == 6
 
 
 @pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
@@ -274,28 +252,13 @@ def test_dwell_on_a_fixed_scene_is_refused(tmp_path: Path) -> None:
         read_cycle_file(path)
 
 
-ONE_MOVE = """\
-name = "one"
-scene = "empty.toml"
-
-[plan]
-pop_size = 16
-n_gen = 4
-seed = 1
-
-[[location]]
-name = "home"
-joints = [0.1682, 1.3849, 0.08, -0.7555]
-
-[[location]]
-name = "place"
-joints = [-0.761, 0.245, 0.2, 1.0095]
-
-[[move]]
-from = "home"
-to = "place"
-choose = "fastest"
-"""
+ONE_MOVE = cycle_text(
+    "one",
+    scene="empty.toml",
+    plan={"pop_size": 16, "n_gen": 4, "seed": 1},
+    locations={"home": {"joints": HOME}, "place": {"joints": PLACE}},
+    moves=[{"from": "home", "to": "place", "choose": "fastest"}],
+)
 
 
 def test_a_move_asks_for_what_its_weights_say(tmp_path: Path) -> None:
@@ -305,9 +268,7 @@ def test_a_move_asks_for_what_its_weights_say(tmp_path: Path) -> None:
 
     from adept_traj.cycle import chosen_member, cycle_summary, cycle_tasks, plan_move
 
-    (tmp_path / "empty.toml").write_text('name = "empty"\n')
-    (tmp_path / "one.toml").write_text(ONE_MOVE)
-    cycle = read_cycle_file(tmp_path / "one.toml")
+    cycle = read_cycle_file(write_cycle(tmp_path, ONE_MOVE, file="one.toml"))
     move = cycle.moves[0]
     assert move.choose == "fastest"
     result = plan_move(cycle_tasks(cycle)[0])
@@ -334,54 +295,130 @@ def test_a_move_asks_for_what_its_weights_say(tmp_path: Path) -> None:
     assert summary["cycle_time"] == T[ok].min()
 
 
-def _brute_force(T: np.ndarray, ok: np.ndarray, P: float, phases: np.ndarray, rest_ok) -> float:
-    """The least pass time over every sequence of start phases, written out again."""
+def _brute_force(options, P: float, rest_ok, repeat: int, banned=frozenset()) -> float:
+    """The least pass time over every sequence of plans, written out again: move k with
+    plan (phase φ, T, certified) starts at the first time ≥ the previous end in phase φ."""
     import itertools
 
     best = math.inf
-    for seq in itertools.product(range(len(phases)), repeat=T.shape[0]):
+    for seq in itertools.product(*(range(len(o)) for o in options)):
         end, fine = 0.0, True
-        for k, j in enumerate(seq):
-            if not ok[k, j]:
-                fine = False
-                break
-            start = phases[j]
-            while start < end - 1e-12:  # the first time ≥ end in phase j
+        for k, i in enumerate(seq):
+            phase, T, ok = options[k][i]
+            start = phase
+            while start < end - 1e-12:
                 start += P
-            if not rest_ok(k, end, start - end):
+            if not ok or (k, i, start) in banned or not rest_ok(k, end, start - end):
                 fine = False
                 break
-            end = start + T[k, j]
-        if fine:
-            best = min(best, math.ceil(end / P - 1e-9) * P)
+            end = start + T
+        span = math.ceil(end / P - 1e-9) * P if repeat > 1 else end
+        if fine and (repeat == 1 or rest_ok(len(options), end, span - end)):
+            best = min(best, span)
     return best
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2, 3])
-def test_phase_grid_dynamic_programming_equals_brute_force(seed: int) -> None:
-    from adept_traj.cycle import PhaseTable, phase_schedules
+def _random_plans(seed: int, K: int = 4, N: int = 5, P: float = 2.0):
+    """Per move the N grid phases and two off-grid phases (as the arrivals' plans), each
+    with a random T and certificate; banned rest phases per location."""
+    from adept_traj.cycle import PhaseOption
 
     rng = np.random.default_rng(seed)
-    K, N, P = 4, 5, 2.0
-    phases = P * np.arange(N) / N
-    T = rng.uniform(0.5, 2.6, size=(K, N))
-    ok = rng.uniform(size=(K, N)) > 0.3
-    banned = {(k, j) for k in range(K) for j in range(N) if rng.uniform() < 0.15}
+    options = []
+    for _ in range(K):
+        phases = [*(P * np.arange(N) / N).tolist(), *rng.uniform(0, P, 2).tolist()]
+        options.append(
+            [
+                PhaseOption(f, float(rng.uniform(0.5, 2.6)), bool(rng.uniform() > 0.3))
+                for f in phases
+            ]
+        )
+    banned = {(k, j) for k in range(K + 1) for j in range(8) if rng.uniform() < 0.2}
 
-    def rest_ok(k, start, duration):  # a dwell ending in a banned phase is not certified
-        return duration <= 1e-12 or (k, round(((start + duration) % P) / P * N) % N) not in banned
+    def rest_ok(k, start, duration):  # a dwell meeting a banned eighth of P is refused
+        if duration <= 1e-12:
+            return True
+        cells = range(math.floor(start / P * 8), math.floor((start + duration) / P * 8) + 1)
+        return all((k, c % 8) not in banned for c in cells)
 
-    table = PhaseTable(P, phases, T, ok, np.zeros((K, N), dtype=int))
-    found = phase_schedules(table, rest_ok)
-    expected = _brute_force(T, ok, P, phases, rest_ok)
-    if found["optimised"] is None:
-        assert expected == math.inf
+    return options, rest_ok
+
+
+def _pass_time(path, options, P, repeat):
+    i, s = path[-1]
+    end = s + options[len(path) - 1][i].T
+    return math.ceil(end / P - 1e-9) * P if repeat > 1 else end
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4, 5])
+@pytest.mark.parametrize("repeat", [1, 3])
+def test_phase_grid_dynamic_programming_equals_brute_force(seed: int, repeat: int) -> None:
+    """Without a beam the dynamic programming over end times finds the least pass time of
+    every plan sequence; with one it never beats that, nor does the naive back-to-back
+    schedule beat it; every step it takes starts in its plan's phase, at or after the
+    previous end, with an allowed dwell and a certified plan, and no banned step."""
+    from adept_traj.cycle import phase_schedules
+
+    P = 2.0
+    options, rest_ok = _random_plans(seed, P=P)
+    raw = [[(o.phase, o.T, o.certified) for o in row] for row in options]
+    expected = _brute_force(raw, P, rest_ok, repeat)
+    full = phase_schedules(options, P, rest_ok, beam=10**6, repeat=repeat)
+    if expected == math.inf:
+        assert full["optimised"] is None
         return
-    j, start = found["optimised"][-1]
-    assert math.ceil((start + T[K - 1, j]) / P - 1e-9) * P == pytest.approx(expected)
-    if found["naive"] is not None:  # back to back: never better than the optimum
-        jn, sn = found["naive"][-1]
-        assert math.ceil((sn + T[K - 1, jn]) / P - 1e-9) * P >= expected - 1e-9
+    assert _pass_time(full["optimised"], options, P, repeat) == pytest.approx(expected)
+    narrow = phase_schedules(options, P, rest_ok, beam=2, repeat=repeat)
+    for name in ("optimised", "naive"):
+        path = narrow[name]
+        if path is None:
+            continue
+        assert _pass_time(path, options, P, repeat) >= expected - 1e-9
+        end = 0.0
+        for k, (i, s) in enumerate(path):
+            o = options[k][i]
+            assert o.certified
+            assert s >= end - 1e-9
+            assert rest_ok(k, end, s - end)
+            assert abs((s - o.phase) / P - round((s - o.phase) / P)) < 1e-9
+            end = s + o.T
+    if narrow["naive"] is not None:
+        span = _pass_time(narrow["naive"], options, P, repeat)
+        assert _pass_time(narrow["optimised"], options, P, repeat) <= span + 1e-9
+    # A banned step is never taken; the optimum without it is the brute force's.
+    i, s = full["optimised"][0]
+    ban = frozenset({(0, i, s)})
+    again = phase_schedules(options, P, rest_ok, beam=10**6, repeat=repeat, banned=ban)
+    expected = _brute_force(raw, P, rest_ok, repeat, ban)
+    if again["optimised"] is None:
+        assert expected == math.inf
+    else:
+        assert again["optimised"][0] != (i, s)
+        assert _pass_time(again["optimised"], options, P, repeat) == pytest.approx(expected)
+
+
+def test_rest_profile_is_conservative() -> None:
+    """A dwell the rest profile allows is certified by certify_rest at its real scene
+    times (several periods later too); the profile refuses the dwells certify_rest
+    refuses (the pendulum of the detour scene swings through its goal)."""
+    from adept_traj.cycle import RestProfile, certify_rest
+    from adept_traj.problem import ProblemSettings
+
+    scene, robot = Scene.shipped("detour"), Robot.adept_one_xl()
+    P = scene_period(scene)
+    q = np.array([-0.761, 0.245, 0.2, 1.0095])
+    settings = ProblemSettings()
+    profile = RestProfile.at(robot, scene, q, P, settings=settings, rate_hz=1000.0)
+    rng = np.random.default_rng(4)
+    seen = set()
+    for start, duration in zip(rng.uniform(0, 3 * P, 8), rng.uniform(0.01, 0.6, 8)):
+        exact = certify_rest(robot, scene, q, start, duration, settings=settings, rate_hz=1000.0)
+        allowed = profile.allows(start, duration)
+        seen.add(allowed)
+        assert not allowed or exact.certified
+    assert seen == {True, False}
+    assert profile.allows(1.0, 0.0)
+    assert not profile.allows(0.0, P)
 
 
 @pytest.mark.slow
@@ -441,3 +478,61 @@ def test_a_scene_that_is_not_periodic_plans_every_pass(tmp_path: Path, cluster, 
     code = main(["verify", str(out)])
     assert code == (0 if summary["all_certified"] else 1)
     assert capsys.readouterr().out.count("start ") == 4
+
+
+#: Issue 25's cycle on the shipped detour scene (a, b: its start and goal; repeat 5, seed 3)
+#: at a small budget, on a grid of 2 phases. The pendulum swings through b, so a robot that
+#: waits there is hit at some phases: before the arrivals' plans the phase grid found no
+#: certified schedule (every b → a started on the grid, after a dwell at b; measured: "no
+#: certified optimised schedule on a grid of 2 phases … a dwell was not certified at b").
+DETOUR_CYCLE = cycle_text(
+    "detour",
+    scene="detour",
+    repeat=5,
+    plan={"pop_size": 8, "n_gen": 3, "seed": 3},
+    locations={"a": {"joints": HOME}, "b": {"joints": PLACE}},
+    moves=[("a", "b"), ("b", "a")],
+)
+
+
+@pytest.fixture(scope="module")
+def detour_planned(tmp_path_factory, cluster) -> Path:
+    folder = tmp_path_factory.mktemp("detour")
+    out = folder / "out"
+    argv = ["cycle", str(write_cycle(folder, DETOUR_CYCLE, scenes={})), "--out", str(out)]
+    argv += ["--scheduler", cluster.scheduler_address, "--quiet", "--no-playback", "--no-plots"]
+    assert main([*argv, "--phase-grid", "2"]) == 0
+    return out
+
+
+@pytest.mark.slow  # the detour cycle on the phase grid: minutes
+def test_detour_cycle_on_the_phase_grid_is_certified_at_its_real_start_times(
+    detour_planned: Path, capsys
+) -> None:
+    """Every move and dwell of every pass of the phase-grid plan clear of the detour
+    scene's obstacles at its real scene time, by hand; ``verify`` agrees."""
+    summary = json.loads((detour_planned / "cycle.json").read_text())
+    assert summary["clock"]["mode"] == "phase grid (optimised)"
+    assert summary["all_certified"]
+    scene = Scene.shipped("detour").to_dict()
+    pend = scene["pendulum"][0]
+    assert _clear_by_hand(detour_planned, scene, 2 * math.pi / pend["omega"]) == 10
+    capsys.readouterr()
+    assert main(["verify", str(detour_planned)]) == 0
+    assert "every move and dwell certified" in capsys.readouterr().out
+
+
+@pytest.mark.slow  # the detour cycle on the phase grid: minutes
+def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Path) -> None:
+    """The same plans give the same schedule: the saved moves planned again by resume
+    into another folder (nothing planned anew) give the same cycle.json, bit for bit."""
+    import shutil
+
+    out = tmp_path / "again"
+    shutil.copytree(detour_planned / "moves", out / "moves")
+    source = json.loads((detour_planned / "cycle.json").read_text())["source"]
+    argv = ["cycle", source, "--out", str(out), "--workers", "1", "--resume", "--quiet"]
+    assert main([*argv, "--no-playback", "--no-plots", "--phase-grid", "2"]) == 0
+    first = json.loads((detour_planned / "cycle.json").read_text())
+    second = json.loads((out / "cycle.json").read_text())
+    assert first == second

@@ -13,6 +13,7 @@ import pytest
 from adept_traj.cli._run_folder import folder_lock
 from adept_traj.cli.app import main
 from adept_traj.errors import ConfigurationError
+from adept_traj.testing.cycle_files import HOME, PLACE, cycle_text, write_cycle
 
 _TINY = ["plan", "--pop", "8", "--gens", "2", "--quiet", "--no-html", "--no-plots"]
 
@@ -49,28 +50,17 @@ def test_the_lock_is_released_when_the_block_ends(tmp_path: Path) -> None:
     os.close(_held_elsewhere(out))  # free again
 
 
-_CYCLE = """\
-name = "one"
-scene = "empty.toml"
-
-[[location]]
-name = "home"
-joints = [0.1682, 1.3849, 0.08, -0.7555]
-
-[[location]]
-name = "place"
-joints = [-0.761, 0.245, 0.2, 1.0095]
-
-[[move]]
-from = "home"
-to = "place"
-"""
+_CYCLE = cycle_text(
+    "one",
+    scene="empty.toml",
+    locations={"home": {"joints": HOME}, "place": {"joints": PLACE}},
+    moves=[("home", "place")],
+)
 
 
 def test_cycle_holds_its_folder_too(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``cycle --resume`` started twice on one folder: the second is refused unwritten."""
-    (tmp_path / "c.toml").write_text(_CYCLE)
-    (tmp_path / "empty.toml").write_text('name = "empty"\n')
+    write_cycle(tmp_path, _CYCLE)
     out = tmp_path / "out"
     out.mkdir()
     fd = _held_elsewhere(out)

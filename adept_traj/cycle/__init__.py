@@ -15,8 +15,6 @@ from adept_traj.cycle.clock import (
     MAX_CLOCKED_MOVES,
     ClockedMove,
     CycleClock,
-    RestCheck,
-    certify_rest,
     check_chained,
     dwell_grid,
     plan_on_clock,
@@ -37,12 +35,8 @@ from adept_traj.cycle.cycle_playback import (
     cycle_html,
     cycle_playback,
 )
-from adept_traj.cycle.phase_grid import (
-    DEFAULT_PHASES,
-    PhaseTable,
-    phase_schedules,
-    plan_phase_grid,
-)
+from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
+from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
     MOVE_FILE,
     MOVES_FOLDER,
@@ -55,6 +49,7 @@ from adept_traj.cycle.runner import (
     run_planning_tasks,
     run_tasks,
 )
+from adept_traj.cycle.schedules import PhaseOption, phase_frontier, phase_schedules
 from adept_traj.cycle.study import (
     ALGORITHM_PAIR,
     METRICS,
@@ -100,6 +95,7 @@ __all__ = [
     "MOVES_FOLDER",
     "MOVE_FILE",
     "PLAYBACK_FILE",
+    "RECERTIFIED_PASSES",
     "RETRIES",
     "RUNS_FOLDER",
     "STUDY_FILE",
@@ -111,8 +107,9 @@ __all__ = [
     "Metric",
     "MoveSpec",
     "MoveTask",
-    "PhaseTable",
+    "PhaseOption",
     "RestCheck",
+    "RestProfile",
     "certify_rest",
     "check_chained",
     "chosen_member",
@@ -127,6 +124,7 @@ __all__ = [
     "dwell_grid",
     "fastest_certified",
     "parse_seeds",
+    "phase_frontier",
     "phase_schedules",
     "plan_move",
     "plan_on_clock",

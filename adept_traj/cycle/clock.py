@@ -34,9 +34,9 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.collision import CollisionChecker
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
+from adept_traj.cycle.rest import RestCheck, certify_rest
 from adept_traj.cycle.runner import (
     MOVES_FOLDER,
     cycle_tasks,
@@ -46,7 +46,6 @@ from adept_traj.cycle.runner import (
 from adept_traj.errors import CycleError
 from adept_traj.problem import ProblemSettings
 from adept_traj.results import PlanningResult
-from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 
 __all__ = [
@@ -54,8 +53,6 @@ __all__ = [
     "MAX_CLOCKED_MOVES",
     "ClockedMove",
     "CycleClock",
-    "RestCheck",
-    "certify_rest",
     "check_chained",
     "dwell_grid",
     "plan_on_clock",
@@ -69,8 +66,6 @@ MAX_CLOCKED_MOVES = 200
 DEFAULT_APERIODIC_DWELL = (0.25, 1.75)
 #: Dwell candidates of a periodic scene by default: P / 8 apart, over one period.
 _PERIODIC_STEPS = 8
-#: Finest sample spacing of a rest certificate: its grid is halved at most this often.
-_REST_REFINE = 12
 
 
 def scene_period(scene: Scene) -> float | None:
@@ -128,73 +123,6 @@ def check_chained(cycle: Cycle) -> None:
             f"{cycle.source}: repeat = {cycle.repeat} but the last move ends at "
             f"{moves[-1].goal!r}, not at the first move's start {moves[0].start!r}"
         )
-
-
-@dataclass(frozen=True)
-class RestCheck:
-    """The certificate of the robot at rest while the obstacles move.
-
-    Attributes
-    ----------
-    start, duration: the scene time [s] the rest starts and its length [s].
-    min_distance: lower bound [m] of the robot–obstacle distance over the rest (``inf``
-        for a rest of length 0).
-    certified: the bound is ≥ the margin at every instant of the rest.
-    """
-
-    start: float
-    duration: float
-    min_distance: float
-    certified: bool
-
-
-def certify_rest(
-    robot: Robot,
-    scene: Scene,
-    q: Any,
-    start: float,
-    duration: float,
-    *,
-    settings: ProblemSettings,
-    rate_hz: float,
-) -> RestCheck:
-    r"""Certify the robot at rest at ``q`` (nq,) [rad | m] over the scene times
-    ``[start, start + duration]`` [s] against the margin of ``settings``.
-
-    The distances to every obstacle are computed at samples h apart (from ``rate_hz``);
-    between two samples a and b an obstacle whose points move at most :math:`w_o` [m/s]
-    keeps
-
-    .. math::
-        d(t) \ge \tfrac12\,(d_a + d_b - w_o h),
-
-    and the grid is halved where this bound misses the margin (at most
-    :data:`_REST_REFINE` times). ``min_distance`` is the smallest bound.
-    """
-    if duration <= 0.0:
-        return RestCheck(float(start), 0.0, math.inf, True)
-    checker = CollisionChecker(robot, scene, settings.influence, float(start))
-    speeds = np.array(
-        [
-            ob.motion.max_point_speed(ob.offset[:3, 3], ob.shape.bounding_radius)
-            for ob in scene.obstacles
-        ]
-    )
-    qa = np.asarray(q, dtype=float)
-    n = max(2, math.ceil(duration * rate_hz) + 1)
-    bound = -math.inf
-    for _ in range(_REST_REFINE + 1):
-        t = np.linspace(0.0, duration, n)
-        if not checker.n_obstacles or not checker.n_solids:
-            return RestCheck(float(start), float(duration), math.inf, True)
-        d = checker.distances(np.broadcast_to(qa, (n, qa.size)), t).distance.min(axis=1)
-        h = duration / (n - 1)
-        low = 0.5 * (d[:-1] + d[1:] - speeds * h)  # (n - 1, n_obstacles)
-        bound = float(min(low.min(), d.min()))
-        if bound >= settings.margin or d.min() < settings.margin:
-            break
-        n = 2 * n - 1
-    return RestCheck(float(start), float(duration), bound, bound >= settings.margin)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.analysis import certify
-from adept_traj.cycle.clock import certify_rest
+from adept_traj.cycle.rest import certify_rest
 from adept_traj.cycle.summary import CYCLE_FILE
 from adept_traj.errors import CycleError
 from adept_traj.files import parse_json, read_bytes_bounded

@@ -1,35 +1,54 @@
 r"""A periodic cycle planned on a phase grid: every move × start phase a Dask task at once,
-then dynamic programming over the grid for the least certified pass time.
+then dynamic programming over the start times for the least certified pass time.
 
 On a scene whose moving obstacles are periodic with period P
 (:func:`~adept_traj.cycle.scene_period`), a move started at scene time s sees what it
-sees when started at :math:`s \bmod P`. So every move k is planned, independently and
-all at once (one Dask task per move × phase), for the N start phases
-:math:`\varphi_j = j P / N` (``phases``). A schedule then starts move k at a time
-:math:`s_k \equiv \varphi_{j_k} \pmod P`, the first such time at or after
-the previous move's end (the robot dwells at rest in between):
+sees when started at :math:`s \bmod P`. A **plan** of move k is the move planned for one
+start phase φ (``TrajectoryProblem(..., start_time=φ)``); it may run at any scene time
+:math:`s \equiv \varphi \pmod P`. A schedule starts move k with plan i at
 
 .. math::
-    s_k = \varphi_{j_k} + P \left\lceil \frac{e_{k-1} - \varphi_{j_k}}{P} \right\rceil,
-    \qquad e_k = s_k + T_{k, j_k}, \qquad e_{-1} = 0,
+    s_k = \varphi_i + P \left\lceil \frac{e_{k-1} - \varphi_i}{P} \right\rceil,
+    \qquad e_k = s_k + T_{k,i}, \qquad e_{-1} = 0,
 
-and the pass ends at the next multiple of P after :math:`e_{K-1}` (a final dwell), so that
-every pass repeats the first. :func:`phase_schedules` finds, by dynamic programming over
-(move, phase) — the earliest certified end :math:`E_k(j)` of move k started at phase j,
-:math:`E_k(j) = \min_i s(E_{k-1}(i), \varphi_j) + T_{k,j}` over certified moves and
-certified dwells — the schedule of least pass time (exact over the grid's start times:
-an earlier end never makes a later start; a dwell that is not certified only keeps the
-earliest end per phase), and for comparison the **naive back-to-back** schedule, which
-starts each move at the earliest grid time at or after the previous end whose move and
-dwell are certified (it waits only where it must). The chosen moves are re-certified at
-their exact start times (:func:`~adept_traj.analysis.certify`), and every dwell is
-certified (:func:`~adept_traj.cycle.certify_rest`).
+the first such time at or after the previous move's end, the robot dwelling at rest at
+the move's start location in between (dwell :math:`s_k - e_{k-1}`, 0 when
+:math:`e_{k-1} \equiv \varphi_i`); with ``repeat`` > 1 the pass ends at the next multiple
+of P after :math:`e_{K-1}` (a final dwell), so that every pass repeats the first.
+
+The plans, in rounds (one Dask cluster for all):
+
+1. **the grid**: every move at the N phases :math:`\varphi_j = j P / N`, all at once
+   (one task per move × phase);
+2. **the arrivals**: for k = 1 … K − 1 in turn, move k at the start phase
+   :math:`e \bmod P` of each of the ``beam`` earliest ends e of the schedules of moves
+   0 … k − 1 found so far and of the naive schedule's end (one task each, all of the
+   round at once): started there it needs no dwell, which matters where the robot may not
+   wait (a pendulum swinging through the location).
+
+The schedules (:func:`phase_schedules`), over every plan:
+
+- **optimised**: dynamic programming over the moves, a state being a schedule's end time
+  :math:`e_k` (states of equal end merged; the ``beam`` earliest kept per move, every one
+  at the last move); the schedule of least pass time, the earliest end on a tie;
+- **naive back-to-back**: each move at the earliest start at or after the previous end,
+  over the plans (it waits only where it must).
+
+A step is taken only where its dwell is allowed by the location's
+:class:`~adept_traj.cycle.RestProfile` (a conservative prefilter over one period) and its
+plan is certified at its phase. A chosen schedule is then **re-certified at its real scene
+times**: every move of every pass (:func:`~adept_traj.analysis.certify` at
+:math:`s_k + p \cdot` pass time) and every dwell and final dwell
+(:func:`~adept_traj.cycle.certify_rest`); a step that fails any of them is banned and the
+schedule chosen again, until a schedule passes every check or none is left. So only
+moves and dwells certified at the times they run are reported.
 """
 
 from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -38,86 +57,58 @@ import numpy as np
 
 from adept_traj.analysis import certify
 from adept_traj.cycle.choice import chosen_member
-from adept_traj.cycle.clock import (
-    ClockedMove,
-    CycleClock,
-    certify_rest,
-    check_chained,
-    scene_period,
-)
+from adept_traj.cycle.clock import ClockedMove, CycleClock, check_chained, scene_period
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
-from adept_traj.cycle.runner import MOVES_FOLDER, cycle_tasks, run_planning_tasks
+from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
+from adept_traj.cycle.runner import (
+    MOVES_FOLDER,
+    MoveTask,
+    cycle_tasks,
+    dask_client,
+    run_planning_tasks,
+)
+from adept_traj.cycle.schedules import (
+    PhaseOption,
+    Step,
+    congruent,
+    naive_schedule,
+    pass_end,
+    phase_frontier,
+    phase_schedules,
+)
 from adept_traj.errors import CycleError
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
 from adept_traj.results import PlanningResult
 from adept_traj.validation import as_integer
 
-__all__ = ["DEFAULT_PHASES", "PhaseTable", "phase_schedules", "plan_phase_grid"]
+__all__ = ["DEFAULT_PHASES", "RECERTIFIED_PASSES", "plan_phase_grid"]
 
 #: Start phases per period by default.
 DEFAULT_PHASES = 8
+#: Passes re-certified one by one at their scene times; later passes (congruent modulo P)
+#: are covered by the periodicity.
+RECERTIFIED_PASSES = 100
 
 
 @dataclass(frozen=True)
-class PhaseTable:
-    """Every move planned at every start phase.
+class _Plan:
+    """A planned task of the phase grid: its option, folder name, result and member."""
 
-    Attributes
-    ----------
-    period: P [s]; phases: (N,) start phases [s] in [0, P).
-    T: (K, N) travel time [s] of the member each move runs, per start phase.
-    certified: (K, N) that member is certified at that start phase.
-    members: (K, N) its row in the front.
-    """
-
-    period: float
-    phases: np.ndarray
-    T: np.ndarray
-    certified: np.ndarray
-    members: np.ndarray
+    option: PhaseOption
+    name: str
+    result: PlanningResult
+    member: int
 
 
-def _next_start(end: float, phase: float, period: float) -> float:
-    """The first scene time ≥ ``end`` [s] congruent to ``phase`` modulo ``period``."""
-    return phase + period * max(0, math.ceil((end - phase) / period - 1e-12))
-
-
-def phase_schedules(table: PhaseTable, rest_ok: Any) -> dict[str, list[tuple[int, float]] | None]:
-    """The dynamic-programming schedule (``"optimised"``) and the naive back-to-back one
-    (``"naive"``) over ``table`` (module doc): each a list of (phase index, start time [s])
-    per move, or ``None`` when no certified schedule exists. ``rest_ok(k, start, duration)``
-    says whether the robot may rest at move k's start over that scene time interval."""
-    P, phases = table.period, table.phases.tolist()
-    K, N = table.T.shape
-    best: list[dict[int, tuple[float, list[tuple[int, float]]]]] = []
-    for k in range(K):
-        row: dict[int, tuple[float, list[tuple[int, float]]]] = {}
-        previous = best[-1] if best else {-1: (0.0, [])}
-        for j in range(N):
-            if not table.certified[k, j]:
-                continue
-            options = sorted((_next_start(e, phases[j], P), i) for i, (e, _) in previous.items())
-            for start, i in options:  # the earliest start whose dwell is certified
-                e_prev, path = previous[i]
-                if rest_ok(k, e_prev, start - e_prev):
-                    row[j] = (start + float(table.T[k, j]), [*path, (j, start)])
-                    break
-        best.append(row)
-    finals = [(math.ceil(e / P - 1e-9), e, path) for e, path in best[-1].values()]
-    optimised = min(finals, default=None)
-    naive: list[tuple[int, float]] | None = []
-    end = 0.0
-    for k in range(K):
-        starts = sorted(
-            (_next_start(end, phases[j], P), j) for j in range(N) if table.certified[k, j]
+def _plans(tasks: Sequence[MoveTask], results: Sequence[PlanningResult]) -> list[_Plan]:
+    out = []
+    for t, r in zip(tasks, results):
+        m = chosen_member(r, t.move)
+        option = PhaseOption(
+            t.start_time, float(r.front.objectives[m, 0]), bool(r.front.feasible[m])
         )
-        chosen = next(((s, j) for s, j in starts if rest_ok(k, end, s - end)), None)
-        if chosen is None:
-            naive = None
-            break
-        naive.append((chosen[1], chosen[0]))
-        end = chosen[0] + float(table.T[k, chosen[1]])
-    return {"optimised": None if optimised is None else optimised[2], "naive": naive}
+        out.append(_Plan(option, t.move.name, r, m))
+    return out
 
 
 def plan_phase_grid(
@@ -125,6 +116,7 @@ def plan_phase_grid(
     out: str | os.PathLike[str],
     *,
     phases: int = DEFAULT_PHASES,
+    beam: int | None = None,
     schedule: str = "optimised",
     workers: int | None = None,
     scheduler: str | None = None,
@@ -132,17 +124,27 @@ def plan_phase_grid(
 ) -> tuple[CycleClock, list[list[PlanningResult]], dict[str, Any]]:
     """Plan a periodic ``cycle`` on the phase grid (module doc): returns the clock of the
     ``schedule`` (``"optimised"`` or ``"naive"``), the chosen results (one pass) and a
-    report ``{"optimised": pass time [s] | None, "naive": …, "table": PhaseTable}``.
-    Tasks are saved into ``out/moves/NAME.phJ/``.
+    report ``{"optimised": pass time [s] | None, "naive": …, "plans": plans per move,
+    "phases": (N,) grid [s]}``. Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase
+    J) and ``out/moves/NAME.xI/`` (arrival I).
+
+    ``beam``: schedules kept per move (default: ``phases``).
 
     Raises
     ------
     CycleError
-        The scene is not periodic; the moves do not chain; no certified schedule exists on
-        the grid; ``phases`` not in [1, MAX_DWELL_CANDIDATES]; ``out`` holds an earlier
+        The scene is not periodic; the moves do not chain; no certified schedule exists;
+        ``phases`` or ``beam`` not in [1, MAX_DWELL_CANDIDATES]; ``out`` holds an earlier
         run and ``resume`` is false.
     """
     n = as_integer(phases, "phases", minimum=1, maximum=MAX_DWELL_CANDIDATES, error=CycleError)
+    width = as_integer(
+        n if beam is None else beam,
+        "beam",
+        minimum=1,
+        maximum=MAX_DWELL_CANDIDATES,
+        error=CycleError,
+    )
     if schedule not in ("optimised", "naive"):
         raise CycleError(f"schedule must be 'optimised' or 'naive'; got {schedule!r}")
     check_chained(cycle)
@@ -157,113 +159,159 @@ def plan_phase_grid(
         raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
     grid = P * np.arange(n) / n
     base = cycle_tasks(cycle)
-    tasks = [
-        replace(t, move=replace(t.move, name=f"{t.move.name}.ph{j}"), start_time=float(s))
-        for t in base
-        for j, s in enumerate(grid.tolist())
-    ]
-    flat = run_planning_tasks(tasks, where, workers=workers, scheduler=scheduler, resume=True)
-    results = [flat[k * n : (k + 1) * n] for k in range(len(base))]
-    members = np.array([[chosen_member(r, t.move) for r in row] for t, row in zip(base, results)])
-    table = PhaseTable(
-        period=P,
-        phases=grid,
-        T=np.array(
-            [
-                [r.front.objectives[m, 0] for r, m in zip(row, ms)]
-                for row, ms in zip(results, members)
-            ]
-        ),
-        certified=np.array(
-            [
-                [bool(r.front.feasible[m]) for r, m in zip(row, ms)]
-                for row, ms in zip(results, members)
-            ]
-        ),
-        members=members,
-    )
+    K = len(base)
     robot, settings = cycle.robot.load(), ProblemSettings()
-    checked: dict[tuple[int, float, float], Any] = {}
+    sites = [t.start for t in base] + [base[-1].goal]  # move k's start; k = K: the last goal
+    profiles = [
+        RestProfile.at(robot, cycle.scene, q, P, settings=settings, rate_hz=cycle.rate_hz)
+        for q in sites
+    ]
 
-    def rest(k: int, start: float, duration: float) -> Any:
-        key = (k, start, duration)
-        if key not in checked:
-            q = base[k].start
-            checked[key] = certify_rest(
-                robot, cycle.scene, q, start, duration, settings=settings, rate_hz=cycle.rate_hz
+    def allowed(k: int, start: float, duration: float) -> bool:
+        return profiles[k].allows(start, duration)
+
+    def at(task: MoveTask, name: str, start: float) -> MoveTask:
+        return replace(task, move=replace(task.move, name=name), start_time=float(start))
+
+    plans: list[list[_Plan]] = []
+    with dask_client(workers, scheduler, K * n) as client:
+        tasks = [at(t, f"{t.move.name}.ph{j}", s) for t in base for j, s in enumerate(grid)]
+        flat = _plans(tasks, run_planning_tasks(tasks, where, resume=True, client=client))
+        plans = [flat[k * n : (k + 1) * n] for k in range(K)]
+        for k in range(1, K):
+            options = [[p.option for p in row] for row in plans[:k]]
+            ends = [e for e, _ in phase_frontier(options, P, allowed, beam=width)[-1][:width]]
+            naive = naive_schedule(options, P, allowed, frozenset())
+            ends += [] if naive is None else [naive[0]]
+            new: list[float] = []
+            for e in ends:  # a start phase not planned yet
+                known = [f.option.phase for f in plans[k]] + new
+                if not any(congruent(e, f, P) for f in known):
+                    new.append(math.fmod(e, P))
+            count = len(plans[k]) - n
+            extra = [at(base[k], f"{base[k].move.name}.x{count + i}", s) for i, s in enumerate(new)]
+            if extra:
+                done = run_planning_tasks(extra, where, resume=True, client=client)
+                plans[k] = plans[k] + _plans(extra, done)
+
+    options = [[p.option for p in row] for row in plans]
+    moves_ok: dict[tuple[int, int, float], bool] = {}
+    rests: dict[tuple[int, float, float], RestCheck] = {}
+
+    def move_ok(k: int, i: int, start: float) -> bool:
+        key = (k, i, start)
+        if key not in moves_ok:
+            p = plans[k][i]
+            problem = TrajectoryProblem(
+                robot, cycle.scene, base[k].start, base[k].goal, workers=1, start_time=start
             )
-        return checked[key]
+            try:  # the real start time, not the phase it was planned at
+                moves_ok[key] = bool(
+                    certify(problem, p.result.front.x[p.member], rate_hz=cycle.rate_hz).certified
+                )
+            finally:
+                problem.close()
+        return moves_ok[key]
 
-    found = phase_schedules(table, lambda k, s, d: rest(k, s, d).certified)
-    path = found[schedule]
+    def rest(k: int, start: float, duration: float) -> RestCheck:
+        key = (k, start, duration)
+        if key not in rests:
+            rests[key] = certify_rest(
+                robot,
+                cycle.scene,
+                sites[k],
+                start,
+                duration,
+                settings=settings,
+                rate_hz=cycle.rate_hz,
+            )
+        return rests[key]
+
+    def failures(path: tuple[Step, ...]) -> set[tuple[int, int, float]]:
+        """The steps of ``path`` not certified at their real scene times, every pass."""
+        end = path[-1][1] + options[-1][path[-1][0]].T
+        span = pass_end(end, P, cycle.repeat)
+        bad = set()
+        for p in range(min(cycle.repeat, RECERTIFIED_PASSES)):
+            shift, e = p * span, 0.0
+            for k, (i, s) in enumerate(path):
+                if not (move_ok(k, i, s + shift) and rest(k, e + shift, s - e).certified):
+                    bad.add((k, i, s))
+                e = s + options[k][i].T
+            if cycle.repeat > 1 and not rest(K, e + shift, span - e).certified:
+                bad.add((K - 1, *path[-1]))
+        return bad
+
+    chosen: dict[str, tuple[Step, ...] | None] = {}
+    for name in ("optimised", "naive"):
+        banned: frozenset[tuple[int, int, float]] = frozenset()
+        while True:
+            path = phase_schedules(
+                options, P, allowed, beam=width, repeat=cycle.repeat, banned=banned
+            )[name]
+            bad = set() if path is None else failures(path)
+            if not bad:
+                chosen[name] = path
+                break
+            banned = banned | bad
+    if chosen["optimised"] is not None and chosen["naive"] is not None:
+        span = {k: _span(v, options, P, cycle.repeat) for k, v in chosen.items()}
+        if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
+            chosen["optimised"] = chosen["naive"]
+    path = chosen[schedule]
     if path is None:
         counts = ", ".join(
-            f"{t.move.name} {int(c.sum())}/{n}" for t, c in zip(base, table.certified)
+            f"{t.move.name} {sum(p.option.certified for p in row)}/{len(row)}"
+            for t, row in zip(base, plans)
         )
-        unsafe = sorted({base[k].move.start for (k, _, _), v in checked.items() if not v.certified})
         raise CycleError(
-            f"{cycle.source}: no certified {schedule} schedule on a grid of {n} phases "
-            f"(certified start phases: {counts}; a move starts on the grid, so the robot "
-            f"dwells before it, and a dwell was not certified at {unsafe or 'no location'}); "
-            "plan the cycle without --phase-grid (its dwells may be 0)"
+            f"{cycle.source}: no {schedule} schedule certified at its real start times on "
+            f"a grid of {n} phases and the arrivals (plans certified at their phase: "
+            f"{counts}); plan the cycle without --phase-grid"
         )
-    row, chosen = [], []
+    row, results = [], []
     end = 0.0
-    for k, (j, start) in enumerate(path):
-        r, m = results[k][j], int(members[k, j])
-        problem = TrajectoryProblem(
-            robot, cycle.scene, base[k].start, base[k].goal, workers=1, start_time=start
-        )
-        try:  # the exact start time, not the grid phase it is congruent to
-            again = certify(problem, r.front.x[m], rate_hz=cycle.rate_hz)
-        finally:
-            problem.close()
+    for k, (i, start) in enumerate(path):
+        p = plans[k][i]
         row.append(
             ClockedMove(
                 pass_index=0,
                 index=k,
                 name=base[k].move.name,
-                folder=f"{MOVES_FOLDER}/{tasks[k * n + j].move.name}",
-                member=m,
+                folder=f"{MOVES_FOLDER}/{p.name}",
+                member=p.member,
                 start_time=start,
                 dwell=start - end,
-                T=float(table.T[k, j]),
-                move_certified=bool(again.certified),
+                T=p.option.T,
+                move_certified=move_ok(k, i, start),
                 rest=rest(k, end, start - end),
-                candidates=tuple(
-                    zip(grid.tolist(), table.T[k].tolist(), table.certified[k].tolist())
-                ),
+                candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
             )
         )
-        chosen.append(r)
-        end = start + float(table.T[k, j])
-    final = math.ceil(end / P - 1e-9) * P - end if cycle.repeat > 1 else 0.0
-    final_rest = None
-    if cycle.repeat > 1:
-        final_rest = certify_rest(
-            robot,
-            cycle.scene,
-            base[-1].goal,
-            end,
-            max(final, 0.0),
-            settings=settings,
-            rate_hz=cycle.rate_hz,
-        )
+        results.append(p.result)
+        end = start + p.option.T
+    final = pass_end(end, P, cycle.repeat) - end
     clock = CycleClock(
         period=P,
         passes=(tuple(row),),
         final_dwell=max(final, 0.0),
-        final_rest=final_rest,
+        final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 else None,
         repeat=cycle.repeat,
         dwells=tuple(grid.tolist()),
         mode=f"phase grid ({schedule})",
     )
-    report = {"table": table}
-    for name, p in found.items():
-        if p is None:
-            report[name] = None
-            continue
-        k_last, (j_last, s_last) = len(p) - 1, p[-1]
-        e = s_last + float(table.T[k_last, j_last])
-        report[name] = math.ceil(e / P - 1e-9) * P if cycle.repeat > 1 else e
-    return clock, [chosen], report
+    report: dict[str, Any] = {
+        name: None if v is None else _span(v, options, P, cycle.repeat)
+        for name, v in chosen.items()
+    }
+    report["plans"] = [len(r) for r in plans]
+    report["phases"] = grid
+    return clock, [results], report
+
+
+def _span(
+    path: tuple[Step, ...], options: Sequence[Sequence[PhaseOption]], period: float, repeat: int
+) -> float:
+    """Pass time [s] of the schedule ``path``."""
+    i, s = path[-1]
+    return pass_end(s + options[len(path) - 1][i].T, period, repeat)

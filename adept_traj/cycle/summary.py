@@ -26,8 +26,9 @@ import numpy as np
 
 from adept_traj.analysis import combined_objective
 from adept_traj.cycle.choice import chosen_member
-from adept_traj.cycle.clock import CycleClock, RestCheck
+from adept_traj.cycle.clock import CycleClock
 from adept_traj.cycle.cycle_file import Cycle, MoveSpec
+from adept_traj.cycle.rest import RestCheck
 from adept_traj.cycle.runner import MOVES_FOLDER
 from adept_traj.files import write_text_atomic
 from adept_traj.results import PlanningResult
@@ -143,7 +144,9 @@ def _rest(rest: RestCheck | None) -> dict[str, Any] | None:
 
 def clock_summary(clock: CycleClock) -> dict[str, Any]:
     """The ``clock`` entry of ``cycle.json``: the period, the dwell grid, the pass time and
-    every planned pass's moves (scene start time, dwell, T [s], certificates, candidates)."""
+    every planned pass's moves (scene start time, dwell, T [s], certificates, candidates:
+    per dwell of the grid, or per start phase a plan of the move was planned at)."""
+    key = "phase" if clock.mode.startswith("phase") else "dwell"
     return {
         "scene_clock": "periodic" if clock.period is not None else "every pass planned",
         "mode": clock.mode,
@@ -166,9 +169,7 @@ def clock_summary(clock: CycleClock) -> dict[str, Any]:
                     "certified": m.certified,
                     "move_certified": m.move_certified,
                     "rest": _rest(m.rest),
-                    "candidates": [
-                        {"dwell": d, "T": t, "certified": ok} for d, t, ok in m.candidates
-                    ],
+                    "candidates": [{key: d, "T": t, "certified": ok} for d, t, ok in m.candidates],
                 }
                 for m in moves
             ]

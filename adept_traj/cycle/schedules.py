@@ -1,0 +1,165 @@
+r"""Schedules of a periodic cycle over the plans of its moves: dynamic programming over the
+end times (:func:`phase_frontier`, :func:`phase_schedules`) and the naive back-to-back
+schedule (:func:`naive_schedule`); the arithmetic of the scene clock modulo the period
+(:func:`next_start`, :func:`congruent`, :func:`pass_end`). Pure functions of the plans'
+phases, travel times and certificates and of a rest predicate: what they mean and how the
+plans are made is :mod:`adept_traj.cycle.phase_grid`'s.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+__all__ = [
+    "SAME_TIME",
+    "PhaseOption",
+    "RestOk",
+    "Step",
+    "congruent",
+    "naive_schedule",
+    "next_start",
+    "pass_end",
+    "phase_frontier",
+    "phase_schedules",
+]
+
+#: Two scene times closer than this [s] are the same start (no dwell).
+SAME_TIME = 1e-9
+
+#: One step of a schedule: (plan index in the move's options, start time [s]).
+Step = tuple[int, float]
+
+
+@dataclass(frozen=True)
+class PhaseOption:
+    """One plan of a move: planned for start phase ``phase`` [s] in [0, P), travel time
+    ``T`` [s] of the member it runs, ``certified`` at that phase."""
+
+    phase: float
+    T: float
+    certified: bool
+
+
+def next_start(end: float, phase: float, period: float) -> float:
+    """The first scene time ≥ ``end`` [s] congruent to ``phase`` [s] modulo ``period`` [s]
+    (``end`` itself within :data:`SAME_TIME`)."""
+    s = phase + period * max(0, math.ceil((end - phase) / period - 1e-12))
+    return end if abs(s - end) <= SAME_TIME * max(1.0, abs(end)) else s
+
+
+RestOk = Callable[[int, float, float], bool]
+
+
+def _steps(
+    options: Sequence[PhaseOption],
+    k: int,
+    end: float,
+    period: float,
+    rest_ok: RestOk,
+    banned: frozenset[tuple[int, int, float]],
+) -> list[tuple[float, float, int]]:
+    """(start, end, plan) of every allowed step of move k after a schedule ending at
+    ``end`` [s], by start time then end time."""
+    out = []
+    for i, o in enumerate(options):
+        if not o.certified:
+            continue
+        s = next_start(end, o.phase, period)
+        if (k, i, s) not in banned and rest_ok(k, end, s - end):
+            out.append((s, s + o.T, i))
+    return sorted(out)
+
+
+def phase_frontier(
+    options: Sequence[Sequence[PhaseOption]],
+    period: float,
+    rest_ok: RestOk,
+    *,
+    beam: int,
+    banned: frozenset[tuple[int, int, float]] = frozenset(),
+) -> list[list[tuple[float, tuple[Step, ...]]]]:
+    """Per move k, every schedule of moves 0 … k as ``(end [s], steps)`` by end time (one
+    per end time), each extending one of the ``beam`` earliest of move k − 1 (module doc).
+
+    ``options[k]``: the plans of move k; ``rest_ok(k, start, duration)``: whether the robot
+    may rest at move k's start over those scene times [s]; ``banned``: steps
+    ``(k, plan, start)`` not to take."""
+    states: list[tuple[float, tuple[Step, ...]]] = [(0.0, ())]
+    stages = []
+    for k, opts in enumerate(options):
+        found: dict[float, tuple[float, tuple[Step, ...]]] = {}
+        for e, path in states:
+            for s, end, i in _steps(opts, k, e, period, rest_ok, banned):
+                key = round(end, 9)
+                if key not in found or end < found[key][0]:
+                    found[key] = (end, (*path, (i, s)))
+        stage = sorted(found.values())
+        stages.append(stage)
+        states = stage[:beam]
+    return stages
+
+
+def naive_schedule(
+    options: Sequence[Sequence[PhaseOption]],
+    period: float,
+    rest_ok: RestOk,
+    banned: frozenset[tuple[int, int, float]],
+) -> tuple[float, tuple[Step, ...]] | None:
+    """The naive back-to-back schedule (module doc): (end [s], steps) or ``None``."""
+    end, path = 0.0, ()
+    for k, opts in enumerate(options):
+        steps = _steps(opts, k, end, period, rest_ok, banned)
+        if not steps:
+            return None
+        s, end, i = steps[0]
+        path = (*path, (i, s))
+    return end, path
+
+
+def congruent(a: float, b: float, period: float) -> bool:
+    """Whether the scene times ``a`` and ``b`` [s] are the same phase modulo ``period``."""
+    d = abs(math.fmod(a - b, period))
+    return min(d, period - d) <= SAME_TIME * max(1.0, abs(a), abs(b))
+
+
+def pass_end(end: float, period: float, repeat: int) -> float:
+    """Scene time [s] a pass whose last move ends at ``end`` [s] ends: the next multiple of
+    ``period`` with ``repeat`` > 1 (every pass then repeats the first), else ``end``."""
+    return math.ceil(end / period - 1e-9) * period if repeat > 1 else end
+
+
+def phase_schedules(
+    options: Sequence[Sequence[PhaseOption]],
+    period: float,
+    rest_ok: RestOk,
+    *,
+    beam: int,
+    repeat: int,
+    banned: frozenset[tuple[int, int, float]] = frozenset(),
+) -> dict[str, tuple[Step, ...] | None]:
+    """The optimised and the naive back-to-back schedule (module doc) over ``options``
+    (per move its plans): ``{"optimised": steps | None, "naive": steps | None}``, steps
+    ``(plan, start [s])`` per move. ``rest_ok(k, start, duration)`` for k = K is the final
+    dwell at the last move's goal; the other arguments as :func:`phase_frontier`."""
+    K = len(options)
+
+    def finished(end: float) -> bool:
+        return repeat <= 1 or rest_ok(K, end, pass_end(end, period, repeat) - end)
+
+    last = phase_frontier(options, period, rest_ok, beam=beam, banned=banned)[-1]
+    ranked = sorted(last, key=lambda st: (pass_end(st[0], period, repeat), st[0]))
+    best = next((st for st in ranked if finished(st[0])), None)
+    naive = naive_schedule(options, period, rest_ok, banned)
+    if naive is not None and not finished(naive[0]):
+        naive = None
+    if naive is not None and (
+        best is None
+        or pass_end(naive[0], period, repeat) < pass_end(best[0], period, repeat) - SAME_TIME
+    ):
+        best = naive  # the beam may have left out the naive schedule's states
+    return {
+        "optimised": None if best is None else best[1],
+        "naive": None if naive is None else naive[1],
+    }
