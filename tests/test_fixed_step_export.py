@@ -17,7 +17,7 @@ from scipy.interpolate import BSpline
 
 from adept_traj.analysis import certify
 from adept_traj.cli import main
-from adept_traj.errors import InvalidInputError
+from adept_traj.errors import InvalidInputError, ResultFormatError
 from adept_traj.export import (
     FORMATS,
     MAX_SAMPLES,
@@ -28,6 +28,7 @@ from adept_traj.export import (
 )
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import BestSolution, Front, PlanningResult, Timing
+from adept_traj.scene.robot_motion import JointTrajectory
 from adept_traj.testing.paper_moves import lift_then_lower
 
 RATE = 1000.0  # [Hz]
@@ -139,7 +140,13 @@ def test_the_three_formats_read_back(result: PlanningResult, tmp_path: Path) -> 
     paths = {f: export_member(result, tmp_path / f, member=1, format=f, dt=0.002) for f in FORMATS}
     rows = list(csv.reader(paths["csv"].open(encoding="utf-8")))
     names = result.robot.joint_names
-    assert rows[0] == ["t", *(f"{p}_{n}" for p in ("q", "qd", "qdd") for n in names)]
+    assert rows[0] == [
+        "t [s]",
+        *("q_joint1 [rad]", "q_joint2 [rad]", "q_joint3 [m]", "q_joint4 [rad]"),
+        *("qd_joint1 [rad/s]", "qd_joint2 [rad/s]", "qd_joint3 [m/s]", "qd_joint4 [rad/s]"),
+        *("qdd_joint1 [rad/s^2]", "qdd_joint2 [rad/s^2]", "qdd_joint3 [m/s^2]"),
+        "qdd_joint4 [rad/s^2]",
+    ]
     table = np.array(rows[1:], dtype=float)
     assert np.array_equal(table, np.column_stack([tr.t, tr.q, tr.qd, tr.qdd]))  # exact
     for fmt, load in (("ros-json", json.loads), ("ros-yaml", yaml.safe_load)):
@@ -183,3 +190,77 @@ def test_the_command_writes_the_same_file(
                  "--output", str(tmp_path / "m2.csv")])  # fmt: skip
     assert code == 0
     assert (tmp_path / "m2.csv").exists()
+
+
+# ============================================================================ best_trajectory.csv
+def test_best_trajectory_csv_is_the_export_of_the_best_at_one_millisecond(
+    result: PlanningResult, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The result folder's file is, byte for byte, what ``adept-traj export DIR`` writes (one
+    mechanism), at t = 0, 1 ms, 2 ms, ..., the last row at T, and scipy's B-spline."""
+    folder = result.save(tmp_path / "run")
+    stored = (folder / "best_trajectory.csv").read_text(encoding="utf-8")
+    assert main(["export", str(folder), "--output", "-"]) == 0
+    assert capsys.readouterr().out == stored
+    assert export_member(result, tmp_path / "e.csv").read_text(encoding="utf-8") == stored
+    rows = list(csv.reader(stored.splitlines()))
+    assert rows[0][:2] == ["t [s]", "q_joint1 [rad]"]
+    table = np.array(rows[1:], dtype=float)
+    T = float(result.front.x[0, 0])
+    assert T == 2.1
+    assert table.shape == (2101, 13)
+    np.testing.assert_array_equal(table[:-1, 0], np.arange(2100) * 0.001)  # k · dt exactly
+    assert table[-1, 0] == T
+    q, qd, qdd = reference(result, 0, table[:, 0])
+    np.testing.assert_allclose(table[:, 1:5], q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table[:, 5:9], qd, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(table[:, 9:13], qdd, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(table[-1, 1:5], result.goal, rtol=0, atol=1e-15)  # at rest
+    np.testing.assert_allclose(table[-1, 5:], 0.0, atol=1e-9)
+
+
+def test_best_trajectory_csv_of_a_move_not_a_whole_number_of_steps(
+    problem: TrajectoryProblem, result: PlanningResult, tmp_path: Path
+) -> None:
+    x = lift_then_lower(problem, T=2.1004)[None]
+    ev = Front.from_evaluation(x, problem.evaluate_batch(x))
+    r = PlanningResult.from_problem(
+        problem,
+        algorithm="NSGA-II",
+        algorithm_settings={},
+        seed=1,
+        front=Front(ev.x, ev.objectives, ev.constraints, np.array([True]), 1),
+        best=BestSolution(0),
+        certificate=certify(problem, x[0], rate_hz=RATE),
+        timing=result.timing,
+    )
+    folder = r.save(tmp_path / "odd")
+    table = np.loadtxt(folder / "best_trajectory.csv", delimiter=",", skiprows=1)
+    assert table.shape[0] == 2102  # 0 … 2.1 every 1 ms, then T
+    np.testing.assert_array_equal(table[:-1, 0], np.arange(2101) * 0.001)
+    assert table[-1, 0] == 2.1004
+    assert PlanningResult.load(folder) == r
+
+
+def test_a_changed_sample_of_best_trajectory_csv_is_refused_on_load(
+    result: PlanningResult, tmp_path: Path
+) -> None:
+    folder = result.save(tmp_path / "run")
+    path = folder / "best_trajectory.csv"
+    lines = path.read_text(encoding="utf-8").splitlines()
+    cells = lines[100].split(",")
+    cells[2] = repr(float(cells[2]) + 1e-9)  # q_joint2, 1 nrad off
+    lines[100] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(ResultFormatError, match=r"row 100, column q_joint2 \[rad\]"):
+        PlanningResult.load(folder)
+
+
+def test_best_trajectory_csv_is_a_second_robots_joint_table(
+    result: PlanningResult, tmp_path: Path
+) -> None:
+    folder = result.save(tmp_path / "run")
+    table = JointTrajectory.from_csv(folder / "best_trajectory.csv")
+    assert table.q.shape == (2101, 4)
+    q, _, _ = reference(result, 0, table.times)
+    np.testing.assert_allclose(table.q, q, rtol=0, atol=1e-12)

@@ -121,9 +121,7 @@ function pyRepr(x) {  // Python's repr of a float (shortest round trip)
 }
 function fixedStep(k, dt) { const T = X[k * NVAR]; const t = fixedStepTimes(T, dt); return {t: t, ...sampleSpline(k, t, [0, 1, 2])}; }
 function csvText(k, dt) {
-  const s = fixedStep(k, dt), head = ["t"];
-  for (const p of ["q", "qd", "qdd"]) for (const n of D.joint_names) head.push(p + "_" + n);
-  const lines = [head.join(",")];
+  const s = fixedStep(k, dt), lines = [D.csv_header.join(",")];  // results.fixed_step.csv_header
   for (let i = 0; i < s.t.length; i++) lines.push([s.t[i], ...s.q[i], ...s.qd[i], ...s.qdd[i]].map(pyRepr).join(","));
   return lines.join("\n") + "\n";
 }
