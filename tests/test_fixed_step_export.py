@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 from scipy.interpolate import BSpline
 
-from adept_traj.analysis import certify
 from adept_traj.cli import main
 from adept_traj.errors import InvalidInputError, ResultFormatError
 from adept_traj.export import (
@@ -27,9 +26,9 @@ from adept_traj.export import (
     sample_member,
 )
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import BestSolution, Front, PlanningResult, Timing
+from adept_traj.results import PlanningResult
 from adept_traj.scene.robot_motion import JointTrajectory
-from adept_traj.testing.paper_moves import lift_then_lower
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 
 RATE = 1000.0  # [Hz]
 
@@ -45,20 +44,9 @@ def result(problem: TrajectoryProblem) -> PlanningResult:
             problem.trajectory.straight_line(1.5),
         ]
     )
-    cert = certify(problem, x[0], rate_hz=RATE)
-    assert cert.feasible
-    ev = Front.from_evaluation(x, problem.evaluate_batch(x))
-    front = Front(ev.x, ev.objectives, ev.constraints, np.array([True, True, False]), 2)
-    return PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=front,
-        best=BestSolution(0),
-        certificate=cert,
-        timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),
-    )
+    result = single_result(problem, x, RATE, certified=np.array([True, True, False]))
+    assert result.feasible
+    return result
 
 
 def reference(result: PlanningResult, member: int, t: np.ndarray) -> list[np.ndarray]:
@@ -220,20 +208,9 @@ def test_best_trajectory_csv_is_the_export_of_the_best_at_one_millisecond(
 
 
 def test_best_trajectory_csv_of_a_move_not_a_whole_number_of_steps(
-    problem: TrajectoryProblem, result: PlanningResult, tmp_path: Path
+    problem: TrajectoryProblem, tmp_path: Path
 ) -> None:
-    x = lift_then_lower(problem, T=2.1004)[None]
-    ev = Front.from_evaluation(x, problem.evaluate_batch(x))
-    r = PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=Front(ev.x, ev.objectives, ev.constraints, np.array([True]), 1),
-        best=BestSolution(0),
-        certificate=certify(problem, x[0], rate_hz=RATE),
-        timing=result.timing,
-    )
+    r = single_result(problem, lift_then_lower(problem, T=2.1004), RATE)
     folder = r.save(tmp_path / "odd")
     table = np.loadtxt(folder / "best_trajectory.csv", delimiter=",", skiprows=1)
     assert table.shape[0] == 2102  # 0 … 2.1 every 1 ms, then T

@@ -19,14 +19,11 @@ from adept_traj.analysis import certify
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import (
-    BestSolution,
-    Front,
     PlanningResult,
     Replay,
-    Timing,
     to_csv,
 )
-from adept_traj.testing.paper_moves import lift_then_lower
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 from adept_traj.viz.plots import motion
 
 RATE = 1000.0  # [Hz]
@@ -45,22 +42,11 @@ def result(problem: TrajectoryProblem) -> PlanningResult:
             problem.trajectory.straight_line(1.5),
         ]
     )
-    cert = certify(problem, x[0], rate_hz=RATE)
-    assert cert.feasible
     assert certify(problem, x[1], rate_hz=RATE).feasible
     assert not certify(problem, x[2], rate_hz=200.0).feasible
-    ev = Front.from_evaluation(x, problem.evaluate_batch(x))
-    front = Front(ev.x, ev.objectives, ev.constraints, np.array([True, True, False]), 2)
-    return PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=front,
-        best=BestSolution(0),
-        certificate=cert,
-        timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),
-    )
+    result = single_result(problem, x, RATE, certified=np.array([True, True, False]))
+    assert result.feasible
+    return result
 
 
 def read_csv(path: Path) -> tuple[list[str], np.ndarray]:

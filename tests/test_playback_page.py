@@ -10,14 +10,13 @@ from __future__ import annotations
 import html
 import io
 import re
-import socket
 import time
 import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import chromium_driver, wait_for
+from conftest import chromium_driver, fetch, refused, wait_for
 
 from adept_traj.cli import main
 from adept_traj.cli import show as show_command
@@ -138,20 +137,6 @@ def test_the_page_names_the_member_and_has_a_legend(run: PlanningResult, tmp_pat
     assert float(scrub[1]) == float(run.best_x[0])
 
 
-def fetch(url: str) -> tuple[int, bytes]:
-    with urllib.request.urlopen(url, timeout=10) as reply:
-        return reply.status, reply.read()
-
-
-def refused(port: int) -> bool:
-    """Nothing listens on 127.0.0.1:port."""
-    try:
-        socket.create_connection(("127.0.0.1", port), timeout=2).close()
-    except ConnectionRefusedError:
-        return True
-    return False
-
-
 class _FakeViewer:
     """Stands in for the live meshcat viewer (tested in test_viz_meshcat)."""
 
@@ -184,7 +169,7 @@ def test_show_serves_the_explorer_and_the_member_s_page(
     def fetch_then_stop(_seconds: float) -> None:  # the command's wait loop: fetch, then Ctrl-C
         urls.extend(re.findall(r"http://127\.0\.0\.1:\d+/\S+\.html", capsys.readouterr().out))
         for url in urls:
-            served[url.rsplit("/", 1)[1]] = fetch(url)
+            served[url.rsplit("/", 1)[1]] = fetch(url)[:2]
         raise KeyboardInterrupt
 
     monkeypatch.setattr(show_command.time, "sleep", fetch_then_stop)

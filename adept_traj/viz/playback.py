@@ -71,6 +71,7 @@ __all__ = [
     "SceneObject",
     "build_animation",
     "frame_times",
+    "framed_playback",
 ]
 
 #: Most frames an animation may have (``fps · T / speed``).
@@ -300,24 +301,59 @@ def build_animation(
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
     seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
     seen += [p.poses[None, :3, 3] for p in pivots]
-    seen_points = np.vstack(seen)
-    objects.extend(SceneObject(path, parts, pose) for path, parts, pose in floor(seen_points))
-    target, position = camera(seen_points)
+    return framed_playback(
+        objects,
+        np.vstack(seen),
+        times=times,
+        frame_numbers=frames,
+        q=q,
+        fps=fps,
+        speed=speed,
+        tool_path=tool,
+        member=index,
+        certified=bool(certified_members(result)[index]),
+        closest_points=closest,
+        closest_distance=distance,
+    )
+
+
+def framed_playback(
+    objects: Sequence[SceneObject],
+    seen: np.ndarray,
+    *,
+    times: np.ndarray,
+    frame_numbers: np.ndarray,
+    q: np.ndarray,
+    fps: float,
+    speed: float,
+    tool_path: np.ndarray,
+    member: int,
+    certified: bool,
+    closest_points: np.ndarray | None = None,
+    closest_distance: np.ndarray | None = None,
+) -> Playback:
+    """The :class:`Playback` of ``objects`` with the floor and the world axes under the
+    points ``seen`` (m, 3) [m] and a camera framing them (:mod:`~adept_traj.viz.framing`);
+    its duration is ``times[-1]`` [s]; the arrays are copied read-only. The one assembly
+    of a playback: of a member (:func:`build_animation`) and of a whole cycle
+    (:mod:`adept_traj.cycle.cycle_playback`)."""
+    objects = [*objects, *(SceneObject(path, p, pose) for path, p, pose in floor(seen))]
+    target, position = camera(seen)
     return Playback(
         objects=tuple(objects),
         times=readonly_copy(times),
-        frame_numbers=readonly_copy(frames),
+        frame_numbers=readonly_copy(frame_numbers),
         q=readonly_copy(q),
-        fps=fps,
-        speed=speed,
-        duration=duration,
-        tool_path=readonly_copy(tool),
-        closest_points=None if closest is None else readonly_copy(closest),
-        closest_distance=None if distance is None else readonly_copy(distance),
+        fps=float(fps),
+        speed=float(speed),
+        duration=float(times[-1]),
+        tool_path=readonly_copy(tool_path),
+        closest_points=None if closest_points is None else readonly_copy(closest_points),
+        closest_distance=None if closest_distance is None else readonly_copy(closest_distance),
         camera_target=readonly_copy(target),
         camera_position=readonly_copy(position),
-        member=index,
-        certified=bool(certified_members(result)[index]),
+        member=member,
+        certified=certified,
     )
 
 
