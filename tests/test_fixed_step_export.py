@@ -9,6 +9,8 @@ from __future__ import annotations
 import csv
 import json
 import math
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -67,7 +69,11 @@ def reference(result: PlanningResult, member: int, t: np.ndarray) -> list[np.nda
 def test_the_grid_is_a_fixed_step_ending_at_T() -> None:
     t = fixed_step_times(2.1, 0.001)
     assert t.shape == (2101,)
-    assert np.array_equal(t[:-1], np.arange(2100) * 0.001)  # exactly k·dt
+    # each t_k the double nearest to k ms (Fraction: exact rational arithmetic), so that it
+    # reads as k ms: 1.396, where 1396 * 0.001 is 1.3960000000000001
+    assert np.array_equal(t[:-1], [float(Fraction(k, 1000)) for k in range(2100)])
+    assert [Decimal(repr(v)) for v in t[:-1].tolist()] == [Decimal(k) / 1000 for k in range(2100)]
+    assert repr(float(t[1396])) == "1.396" != repr(1396 * 0.001)
     assert t[-1] == 2.1
     t = fixed_step_times(1.0005, 0.001)  # last step shorter: 0.5 ms
     assert t.shape == (1002,)
@@ -75,6 +81,10 @@ def test_the_grid_is_a_fixed_step_ending_at_T() -> None:
     assert t[-1] == 1.0005
     assert np.all(np.diff(t) > 0)
     assert np.array_equal(fixed_step_times(0.3, 0.3), [0.0, 0.3])
+    t = fixed_step_times(2.1, 0.0003)  # 0.3 ms: 7 · 0.0003 reads 0.0021
+    assert [Decimal(repr(v)) for v in t[:-1].tolist()] == [Decimal(3 * k) / 10_000 for k in range(7000)]
+    t = fixed_step_times(2.0, 1 / 3)  # no short decimal: k · dt, the product of doubles
+    assert np.array_equal(t[:-1], np.arange(6) * (1 / 3))
 
 
 @pytest.mark.parametrize("dt", [0.0, -0.001, 5.0, 1e-9, math.nan, "1ms", True])
@@ -197,7 +207,7 @@ def test_best_trajectory_csv_is_the_export_of_the_best_at_one_millisecond(
     T = float(result.front.x[0, 0])
     assert T == 2.1
     assert table.shape == (2101, 13)
-    np.testing.assert_array_equal(table[:-1, 0], np.arange(2100) * 0.001)  # k · dt exactly
+    assert [Decimal(row[0]) for row in rows[1:-1]] == [Decimal(k) / 1000 for k in range(2100)]
     assert table[-1, 0] == T
     q, qd, qdd = reference(result, 0, table[:, 0])
     np.testing.assert_allclose(table[:, 1:5], q, rtol=0, atol=1e-12)
@@ -214,7 +224,7 @@ def test_best_trajectory_csv_of_a_move_not_a_whole_number_of_steps(
     folder = r.save(tmp_path / "odd")
     table = np.loadtxt(folder / "best_trajectory.csv", delimiter=",", skiprows=1)
     assert table.shape[0] == 2102  # 0 … 2.1 every 1 ms, then T
-    np.testing.assert_array_equal(table[:-1, 0], np.arange(2101) * 0.001)
+    np.testing.assert_array_equal(table[:-1, 0], [float(Fraction(k, 1000)) for k in range(2101)])
     assert table[-1, 0] == 2.1004
     assert PlanningResult.load(folder) == r
 

@@ -11,8 +11,10 @@ times
     t_k = k \, \Delta t \quad (k = 0, 1, \dots,\ k\,\Delta t < T - 10^{-9}\Delta t),
     \qquad t_\text{last} = T,
 
-so every step is exactly ``dt`` but the last one, which is at most ``dt`` (and more than
+so every step is ``dt`` but the last one, which is at most ``dt`` (and more than
 :math:`10^{-9}\Delta t`): the last row is the move's end at rest, at ``T``, on the goal.
+Each :math:`t_k` is the double nearest to k times the decimal ``dt`` reads as, so the times
+read as written (``1.396``, not the ``1.3960000000000001`` of the product of doubles).
 With the default ``dt = 0.001 s`` a move of T = 2.1 s has 2 101 samples, t = 0, 0.001, …,
 2.099, 2.1; one of T = 1.0765 s has 1 078, the last step 0.5 ms.
 
@@ -27,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from decimal import Decimal
 
 import numpy as np
 
@@ -54,6 +57,8 @@ DEFAULT_DT = 0.001
 MAX_SAMPLES = 1_000_000
 #: Relative tolerance [·dt] under which the last grid time counts as T itself.
 _END_TOLERANCE = 1e-9
+#: Integers up to 2^53 are exact in doubles.
+_EXACT = 2**53
 #: The derivative prefixes of the CSV's joint columns and the time power of their units.
 _QUANTITIES = (("q", ""), ("qd", "/s"), ("qdd", "/s^2"))
 
@@ -88,9 +93,24 @@ def fixed_step_times(T: float, dt: float) -> np.ndarray:
             f"{MAX_SAMPLES} samples)"
         )
     k = math.ceil(T / step - _END_TOLERANCE)  # grid times k·dt < T − tol·dt: 0 … k − 1
-    grid = np.arange(k, dtype=np.float64) * step
+    grid = _multiples(step, k)
     grid = grid[grid < T - _END_TOLERANCE * step]
     return np.append(grid, T)
+
+
+def _multiples(step: float, n: int) -> np.ndarray:
+    """(n,) the times k·``step``, k = 0 … n − 1 [s], each the double nearest to k times the
+    decimal that ``step`` reads as (``repr``: 0.001 → 1/1000), so that they read as the
+    user writes them (1396 · 0.001 → ``1.396``, where the product of doubles gives
+    ``1.3960000000000001``): (k · m) / 10^e of exact integers, one correctly rounded
+    division. Where that is not exact in doubles (m·(n − 1) or 10^e ≥ 2^53), k · step.
+    The explorer page computes the same (``multiples`` in its script)."""
+    _, digits, exponent = Decimal(repr(step)).as_tuple()
+    m = int("".join(map(str, digits)))
+    num, den = (m * 10**exponent, 1) if exponent >= 0 else (m, 10**-exponent)
+    if den <= _EXACT and num * max(n - 1, 1) <= _EXACT:
+        return (np.arange(n, dtype=np.int64) * num) / den
+    return np.arange(n, dtype=np.float64) * step
 
 
 def file_step(T: float) -> float:

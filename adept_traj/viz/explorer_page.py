@@ -104,9 +104,16 @@ function sampleSpline(k, times, orders) {  // {q, qd, qdd}: arrays (n) of (nq)
 // ---------------------------------------------------------------- export (export.fixed_step)
 function fixedStepTimes(T, dt) {
   if (!(dt > 0) || dt > T || dt < T / 999999) throw new Error("dt = " + dt + " s must lie in [T/999999, T = " + T + " s]");
-  const k = Math.ceil(T / dt - 1e-9), t = [];
-  for (let i = 0; i < k; i++) { const v = i * dt; if (v < T - 1e-9 * dt) t.push(v); }
+  const k = Math.ceil(T / dt - 1e-9), t = [], mult = multiples(dt, k);
+  for (let i = 0; i < k; i++) { const v = mult(i); if (v < T - 1e-9 * dt) t.push(v); }
   t.push(T); return t;
+}
+function multiples(dt, n) {  // results.fixed_step._multiples: (i·m)/10^e, dt's decimal m·10^-e
+  const [mant, ex] = String(dt).toLowerCase().split("e"), dot = mant.indexOf(".");
+  const m = parseInt(mant.replace(".", ""), 10), e = (ex ? parseInt(ex, 10) : 0) - (dot < 0 ? 0 : mant.length - dot - 1);
+  const num = e >= 0 ? m * 10 ** e : m, den = e >= 0 ? 1 : 10 ** -e, exact = 2 ** 53;
+  if (den <= exact && num * Math.max(n - 1, 1) <= exact && Number.isSafeInteger(num)) return i => (i * num) / den;
+  return i => i * dt;
 }
 function pyRepr(x) {  // Python's repr of a float (shortest round trip)
   if (x === 0) return Object.is(x, -0) ? "-0.0" : "0.0";

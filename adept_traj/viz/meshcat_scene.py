@@ -52,7 +52,7 @@ __all__ = [
     "legend",
     "live_html",
     "member_label",
-    "page_titles",
+    "member_page",
     "render_html",
     "result_page",
     "static_html",
@@ -369,16 +369,20 @@ def result_page(
     playback = build_animation(
         result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )
-    title, label = page_titles(result, playback)
-    return render_html(playback, loop=loop, title=title, label=label)
+    return member_page(result, playback, loop=loop)
 
 
-def page_titles(result: PlanningResult, playback: Playback) -> tuple[str, str]:
-    """The page title and the label of a member of ``result`` shown by ``playback``, e.g.
-    ``"nsga2 · member 3 of 40 (the best trade-off) · T = 2.100 s · certified"``: the same
-    in ``playback.html`` and the live viewer."""
+def member_page(
+    result: PlanningResult, playback: Playback, *, loop: bool = True, live: bool = False
+) -> str:
+    """The page of a member of ``result`` drawn by ``playback``: :func:`render_html`
+    (``playback.html``) or, ``live``, :func:`live_html` (the live viewer's), both titled
+    and labelled alike, e.g. ``"nsga2 · member 3 of 40 (the best trade-off) · T = 2.100 s ·
+    certified"``."""
     best = playback.member == result.best.index
     label = f"{result.algorithm} · " + member_label(playback, best=best, of=len(result.front))
     title = f"adept_traj — {result.algorithm}, member {playback.member}, "
     title += f"T = {playback.duration:.3f} s"
-    return title, label
+    if live:
+        return live_html(playback, title=title, label=label)
+    return render_html(playback, loop=loop, title=title, label=label)

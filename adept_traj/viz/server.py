@@ -29,7 +29,7 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
 
 from adept_traj.errors import MeshcatServerError
 from adept_traj.results import PlanningResult, Replay
-from adept_traj.viz.meshcat_scene import draw, live_html, page_titles
+from adept_traj.viz.meshcat_scene import draw, member_page
 from adept_traj.viz.playback import build_animation
 
 __all__ = ["SERVER_TIMEOUT_S", "show"]
@@ -193,8 +193,7 @@ def show(
     playback = build_animation(
         result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )
-    title, label = page_titles(result, playback)
-    window = _LocalWindow(page=live_html(playback, title=title, label=label))
+    window = _LocalWindow(page=member_page(result, playback, live=True))
     vis = meshcat.Visualizer(window=window)
     try:
         draw(vis, playback, loop=loop)
