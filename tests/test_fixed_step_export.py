@@ -82,7 +82,8 @@ def test_the_grid_is_a_fixed_step_ending_at_T() -> None:
     assert np.all(np.diff(t) > 0)
     assert np.array_equal(fixed_step_times(0.3, 0.3), [0.0, 0.3])
     t = fixed_step_times(2.1, 0.0003)  # 0.3 ms: 7 · 0.0003 reads 0.0021
-    assert [Decimal(repr(v)) for v in t[:-1].tolist()] == [Decimal(3 * k) / 10_000 for k in range(7000)]
+    read = [Decimal(repr(v)) for v in t[:-1].tolist()]
+    assert read == [Decimal(3 * k) / 10_000 for k in range(7000)]
     t = fixed_step_times(2.0, 1 / 3)  # no short decimal: k · dt, the product of doubles
     assert np.array_equal(t[:-1], np.arange(6) * (1 / 3))
 

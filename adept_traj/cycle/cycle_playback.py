@@ -99,7 +99,15 @@ def _framed(objects: list[Any], tools: list[np.ndarray], **fields: Any) -> Any:
     from adept_traj.viz.playback import framed_playback
 
     seen = np.vstack([*tools, *(o.poses[..., :3, 3].reshape(-1, 3) for o in objects)])
-    return framed_playback(objects, seen, tool_path=np.vstack(tools), member=0, **fields)
+    return framed_playback(
+        objects,
+        seen,
+        tool_path=np.vstack(tools),
+        closest_points=None,
+        closest_distance=None,
+        member=0,
+        **fields,
+    )
 
 
 def clock_playback(
