@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,6 +23,7 @@ __all__ = [
     "as_batch",
     "as_finite_array",
     "as_integer",
+    "as_path",
     "as_scalar",
     "as_vector",
     "check_increasing",
@@ -143,6 +146,15 @@ def as_integer(
     if (minimum is not None and out < minimum) or (maximum is not None and out > maximum):
         raise error(f"{name} must be an integer in [{lo}, {hi}]; got {out}")
     return out
+
+
+def as_path(value: Any, name: str = "path") -> Path:
+    """``value`` (a ``str`` or ``os.PathLike``) as a :class:`~pathlib.Path`; anything else
+    raises :class:`~adept_traj.errors.InvalidInputError` naming ``name`` and its type."""
+    try:
+        return Path(os.fspath(value))
+    except TypeError:
+        raise InvalidInputError(f"{name} must be a file path; got {type(value).__name__}") from None
 
 
 def check_type(value: Any, kind: type | tuple[type, ...], name: str) -> None:

@@ -6,7 +6,10 @@ import contextlib
 import os
 import shutil
 import signal
+import socket
 import time
+import urllib.error
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -100,6 +103,26 @@ def chromium_driver(profile: Path, *flags: str):
         yield driver
     finally:
         driver.quit()
+
+
+# ---------------------------------------------------------------- local servers
+def fetch(url: str, method: str = "GET") -> tuple[int, bytes, dict[str, str]]:
+    """(status, body, headers) of a request to ``url`` (an HTTP error's status too)."""
+    request = urllib.request.Request(url, method=method)
+    try:
+        with urllib.request.urlopen(request, timeout=10) as reply:
+            return reply.status, reply.read(), dict(reply.headers)
+    except urllib.error.HTTPError as exc:
+        return exc.code, b"", dict(exc.headers)
+
+
+def refused(port: int) -> bool:
+    """Nothing listens on 127.0.0.1:port."""
+    try:
+        socket.create_connection(("127.0.0.1", port), timeout=2).close()
+    except ConnectionRefusedError:
+        return True
+    return False
 
 
 def wait_for(condition, timeout: float = 60.0, step: float = 0.1) -> None:

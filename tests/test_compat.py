@@ -1,5 +1,6 @@
 """A result folder written before the subpackage layout (commit 2ec18c4, flat modules) loads
-and re-verifies after it: the on-disk format did not change."""
+and re-verifies after it: the on-disk format did not change (but best_trajectory.csv, which
+issue #29 moved to a fixed step: the old file still loads)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import numpy as np
 
 import adept_traj as at
 from adept_traj.cli import main
+from adept_traj.export import export_member
 
 OLD = Path(__file__).parent / "data" / "result_v1"
 
@@ -30,11 +32,19 @@ def test_result_saved_by_the_flat_layout_reverifies(capsys):
 
 
 def test_result_saved_by_the_flat_layout_is_written_back_unchanged(tmp_path):
-    """Load and save reproduce the three files: the CSVs byte for byte, result.json as the
-    same JSON data (versions included: they record the run, not the reader)."""
-    at.PlanningResult.load(OLD).save(tmp_path)
-    for name in ("front.csv", "best_trajectory.csv"):
-        assert (tmp_path / name).read_bytes() == (OLD / name).read_bytes(), name
+    """Load and save reproduce front.csv byte for byte and result.json as the same JSON data
+    (versions included: they record the run, not the reader); best_trajectory.csv, on the
+    certificate's grid before issue #29, is written as the fixed-step file of adept-traj
+    export (and the folder loads again)."""
+    result = at.PlanningResult.load(OLD)
+    result.save(tmp_path)
+    assert (tmp_path / "front.csv").read_bytes() == (OLD / "front.csv").read_bytes()
+    assert (OLD / "best_trajectory.csv").read_text().startswith("t,q_joint1,")
+    new_csv = (tmp_path / "best_trajectory.csv").read_bytes()
+    exported = export_member(result, tmp_path / "e.csv", allow_uncertified=True).read_bytes()
+    assert new_csv == exported
+    assert new_csv.startswith(b"t [s],q_joint1 [rad],")
+    assert at.PlanningResult.load(tmp_path) == result
     old = json.loads((OLD / "result.json").read_text(encoding="utf-8"))
     new = json.loads((tmp_path / "result.json").read_text(encoding="utf-8"))
     assert new == old

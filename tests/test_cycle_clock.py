@@ -84,7 +84,7 @@ def planned(tmp_path_factory, cluster) -> Path:
 def _dense(folder: Path) -> tuple[np.ndarray, np.ndarray]:
     """(t (n,), q (n, nq)) of a move's stored dense trajectory, read as plain CSV."""
     text = (folder / "best_trajectory.csv").read_text().splitlines()
-    header = [h.strip() for h in text[0].split(",")]
+    header = [h.split(" [")[0].strip() for h in text[0].split(",")]  # "t [s]", "q_joint1 [rad]"
     rows = np.array([[float(v) for v in line.split(",")] for line in text[1:]])
     q_cols = [i for i, h in enumerate(header) if h.startswith("q_")]
     return rows[:, header.index("t")], rows[:, q_cols]

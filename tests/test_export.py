@@ -1,4 +1,5 @@
-"""adept_traj.results.ros_export: the CSV export equals best_trajectory.csv; the ROS JointTrajectory
+"""adept_traj.results.ros_export: the CSV export is the certificate's grid (the
+best_trajectory.csv of earlier versions, which still loads); the ROS JointTrajectory
 dictionary and JSON file carry the dense trajectory exactly, with a correct
 time_from_start, or the spline resampled at a given rate; bad inputs are refused.
 adept_traj.results.Replay: its samples are the certificate's, its torques the robot's
@@ -21,7 +22,7 @@ from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult, Replay, RobotInfo
 from adept_traj.results.ros_export import (
     MAX_ROS_POINTS,
-    _duration,
+    ros_duration,
     save_ros_joint_trajectory,
     to_csv,
     to_ros_joint_trajectory,
@@ -57,11 +58,17 @@ def times(msg: dict[str, Any]) -> np.ndarray:
 
 
 # ============================================================================ CSV
-def test_csv_equals_the_result_folder_file(result: PlanningResult, tmp_path: Path) -> None:
+def test_csv_is_the_certificate_grid_of_earlier_result_folders(
+    result: PlanningResult, tmp_path: Path
+) -> None:
+    """to_csv writes the certificate's grid, the best_trajectory.csv of folders written
+    before issue #29: such a folder loads."""
     folder = result.save(tmp_path / "run")
     out = to_csv(result, tmp_path / "new" / "trajectory.csv")
     assert out == tmp_path / "new" / "trajectory.csv"
-    assert out.read_bytes() == (folder / "best_trajectory.csv").read_bytes()
+    assert (folder / "best_trajectory.csv").read_bytes() != out.read_bytes()  # fixed step now
+    (folder / "best_trajectory.csv").write_bytes(out.read_bytes())
+    assert PlanningResult.load(folder) == result
 
 
 def test_csv_round_trip(result: PlanningResult, tmp_path: Path) -> None:
@@ -145,7 +152,7 @@ def test_time_from_start(result: PlanningResult) -> None:
     ],
 )
 def test_duration_split(t: float, expected: tuple[int, int]) -> None:
-    assert _duration(t) == {"sec": expected[0], "nanosec": expected[1]}
+    assert ros_duration(t) == {"sec": expected[0], "nanosec": expected[1]}
 
 
 def test_resampled_at_the_certificate_rate_equals_the_dense_samples(

@@ -9,15 +9,16 @@ from __future__ import annotations
 import csv
 import json
 import math
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.interpolate import BSpline
 
-from adept_traj.analysis import certify
 from adept_traj.cli import main
-from adept_traj.errors import InvalidInputError
+from adept_traj.errors import InvalidInputError, ResultFormatError
 from adept_traj.export import (
     FORMATS,
     MAX_SAMPLES,
@@ -27,8 +28,9 @@ from adept_traj.export import (
     sample_member,
 )
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import BestSolution, Front, PlanningResult, Timing
-from adept_traj.testing.paper_moves import lift_then_lower
+from adept_traj.results import PlanningResult
+from adept_traj.scene.robot_motion import JointTrajectory
+from adept_traj.testing.paper_moves import lift_then_lower, single_result
 
 RATE = 1000.0  # [Hz]
 
@@ -44,20 +46,9 @@ def result(problem: TrajectoryProblem) -> PlanningResult:
             problem.trajectory.straight_line(1.5),
         ]
     )
-    cert = certify(problem, x[0], rate_hz=RATE)
-    assert cert.feasible
-    ev = Front.from_evaluation(x, problem.evaluate_batch(x))
-    front = Front(ev.x, ev.objectives, ev.constraints, np.array([True, True, False]), 2)
-    return PlanningResult.from_problem(
-        problem,
-        algorithm="NSGA-II",
-        algorithm_settings={},
-        seed=1,
-        front=front,
-        best=BestSolution(0),
-        certificate=cert,
-        timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),
-    )
+    result = single_result(problem, x, RATE, certified=np.array([True, True, False]))
+    assert result.feasible
+    return result
 
 
 def reference(result: PlanningResult, member: int, t: np.ndarray) -> list[np.ndarray]:
@@ -78,7 +69,11 @@ def reference(result: PlanningResult, member: int, t: np.ndarray) -> list[np.nda
 def test_the_grid_is_a_fixed_step_ending_at_T() -> None:
     t = fixed_step_times(2.1, 0.001)
     assert t.shape == (2101,)
-    assert np.array_equal(t[:-1], np.arange(2100) * 0.001)  # exactly k·dt
+    # each t_k the double nearest to k ms (Fraction: exact rational arithmetic), so that it
+    # reads as k ms: 1.396, where 1396 * 0.001 is 1.3960000000000001
+    assert np.array_equal(t[:-1], [float(Fraction(k, 1000)) for k in range(2100)])
+    assert [Decimal(repr(v)) for v in t[:-1].tolist()] == [Decimal(k) / 1000 for k in range(2100)]
+    assert repr(float(t[1396])) == "1.396" != repr(1396 * 0.001)
     assert t[-1] == 2.1
     t = fixed_step_times(1.0005, 0.001)  # last step shorter: 0.5 ms
     assert t.shape == (1002,)
@@ -86,6 +81,11 @@ def test_the_grid_is_a_fixed_step_ending_at_T() -> None:
     assert t[-1] == 1.0005
     assert np.all(np.diff(t) > 0)
     assert np.array_equal(fixed_step_times(0.3, 0.3), [0.0, 0.3])
+    t = fixed_step_times(2.1, 0.0003)  # 0.3 ms: 7 · 0.0003 reads 0.0021
+    read = [Decimal(repr(v)) for v in t[:-1].tolist()]
+    assert read == [Decimal(3 * k) / 10_000 for k in range(7000)]
+    t = fixed_step_times(2.0, 1 / 3)  # no short decimal: k · dt, the product of doubles
+    assert np.array_equal(t[:-1], np.arange(6) * (1 / 3))
 
 
 @pytest.mark.parametrize("dt", [0.0, -0.001, 5.0, 1e-9, math.nan, "1ms", True])
@@ -139,7 +139,13 @@ def test_the_three_formats_read_back(result: PlanningResult, tmp_path: Path) -> 
     paths = {f: export_member(result, tmp_path / f, member=1, format=f, dt=0.002) for f in FORMATS}
     rows = list(csv.reader(paths["csv"].open(encoding="utf-8")))
     names = result.robot.joint_names
-    assert rows[0] == ["t", *(f"{p}_{n}" for p in ("q", "qd", "qdd") for n in names)]
+    assert rows[0] == [
+        "t [s]",
+        *("q_joint1 [rad]", "q_joint2 [rad]", "q_joint3 [m]", "q_joint4 [rad]"),
+        *("qd_joint1 [rad/s]", "qd_joint2 [rad/s]", "qd_joint3 [m/s]", "qd_joint4 [rad/s]"),
+        *("qdd_joint1 [rad/s^2]", "qdd_joint2 [rad/s^2]", "qdd_joint3 [m/s^2]"),
+        "qdd_joint4 [rad/s^2]",
+    ]
     table = np.array(rows[1:], dtype=float)
     assert np.array_equal(table, np.column_stack([tr.t, tr.q, tr.qd, tr.qdd]))  # exact
     for fmt, load in (("ros-json", json.loads), ("ros-yaml", yaml.safe_load)):
@@ -183,3 +189,66 @@ def test_the_command_writes_the_same_file(
                  "--output", str(tmp_path / "m2.csv")])  # fmt: skip
     assert code == 0
     assert (tmp_path / "m2.csv").exists()
+
+
+# ============================================================================ best_trajectory.csv
+def test_best_trajectory_csv_is_the_export_of_the_best_at_one_millisecond(
+    result: PlanningResult, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The result folder's file is, byte for byte, what ``adept-traj export DIR`` writes (one
+    mechanism), at t = 0, 1 ms, 2 ms, ..., the last row at T, and scipy's B-spline."""
+    folder = result.save(tmp_path / "run")
+    stored = (folder / "best_trajectory.csv").read_text(encoding="utf-8")
+    assert main(["export", str(folder), "--output", "-"]) == 0
+    assert capsys.readouterr().out == stored
+    assert export_member(result, tmp_path / "e.csv").read_text(encoding="utf-8") == stored
+    rows = list(csv.reader(stored.splitlines()))
+    assert rows[0][:2] == ["t [s]", "q_joint1 [rad]"]
+    table = np.array(rows[1:], dtype=float)
+    T = float(result.front.x[0, 0])
+    assert T == 2.1
+    assert table.shape == (2101, 13)
+    assert [Decimal(row[0]) for row in rows[1:-1]] == [Decimal(k) / 1000 for k in range(2100)]
+    assert table[-1, 0] == T
+    q, qd, qdd = reference(result, 0, table[:, 0])
+    np.testing.assert_allclose(table[:, 1:5], q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table[:, 5:9], qd, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(table[:, 9:13], qdd, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(table[-1, 1:5], result.goal, rtol=0, atol=1e-15)  # at rest
+    np.testing.assert_allclose(table[-1, 5:], 0.0, atol=1e-9)
+
+
+def test_best_trajectory_csv_of_a_move_not_a_whole_number_of_steps(
+    problem: TrajectoryProblem, tmp_path: Path
+) -> None:
+    r = single_result(problem, lift_then_lower(problem, T=2.1004), RATE)
+    folder = r.save(tmp_path / "odd")
+    table = np.loadtxt(folder / "best_trajectory.csv", delimiter=",", skiprows=1)
+    assert table.shape[0] == 2102  # 0 … 2.1 every 1 ms, then T
+    np.testing.assert_array_equal(table[:-1, 0], [float(Fraction(k, 1000)) for k in range(2101)])
+    assert table[-1, 0] == 2.1004
+    assert PlanningResult.load(folder) == r
+
+
+def test_a_changed_sample_of_best_trajectory_csv_is_refused_on_load(
+    result: PlanningResult, tmp_path: Path
+) -> None:
+    folder = result.save(tmp_path / "run")
+    path = folder / "best_trajectory.csv"
+    lines = path.read_text(encoding="utf-8").splitlines()
+    cells = lines[100].split(",")
+    cells[2] = repr(float(cells[2]) + 1e-9)  # q_joint2, 1 nrad off
+    lines[100] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(ResultFormatError, match=r"row 100, column q_joint2 \[rad\]"):
+        PlanningResult.load(folder)
+
+
+def test_best_trajectory_csv_is_a_second_robots_joint_table(
+    result: PlanningResult, tmp_path: Path
+) -> None:
+    folder = result.save(tmp_path / "run")
+    table = JointTrajectory.from_csv(folder / "best_trajectory.csv")
+    assert table.q.shape == (2101, 4)
+    q, _, _ = reference(result, 0, table.times)
+    np.testing.assert_allclose(table.q, q, rtol=0, atol=1e-12)

@@ -10,14 +10,13 @@ from __future__ import annotations
 import html
 import io
 import re
-import socket
 import time
 import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import chromium_driver, wait_for
+from conftest import chromium_driver, fetch, refused, wait_for
 
 from adept_traj.cli import main
 from adept_traj.cli import show as show_command
@@ -138,20 +137,6 @@ def test_the_page_names_the_member_and_has_a_legend(run: PlanningResult, tmp_pat
     assert float(scrub[1]) == float(run.best_x[0])
 
 
-def fetch(url: str) -> tuple[int, bytes]:
-    with urllib.request.urlopen(url, timeout=10) as reply:
-        return reply.status, reply.read()
-
-
-def refused(port: int) -> bool:
-    """Nothing listens on 127.0.0.1:port."""
-    try:
-        socket.create_connection(("127.0.0.1", port), timeout=2).close()
-    except ConnectionRefusedError:
-        return True
-    return False
-
-
 class _FakeViewer:
     """Stands in for the live meshcat viewer (tested in test_viz_meshcat)."""
 
@@ -184,7 +169,7 @@ def test_show_serves_the_explorer_and_the_member_s_page(
     def fetch_then_stop(_seconds: float) -> None:  # the command's wait loop: fetch, then Ctrl-C
         urls.extend(re.findall(r"http://127\.0\.0\.1:\d+/\S+\.html", capsys.readouterr().out))
         for url in urls:
-            served[url.rsplit("/", 1)[1]] = fetch(url)
+            served[url.rsplit("/", 1)[1]] = fetch(url)[:2]
         raise KeyboardInterrupt
 
     monkeypatch.setattr(show_command.time, "sleep", fetch_then_stop)
@@ -204,8 +189,9 @@ def test_show_serves_the_explorer_and_the_member_s_page(
 
 
 # ============================================================================ real browser
-#: The page must need no network: every host name resolves to nothing.
-NO_NETWORK = "--host-resolver-rules=MAP * ~NOTFOUND"
+#: The page must need no network: every host name resolves to nothing (but the loopback
+#: address, where the live viewer is served).
+NO_NETWORK = "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1"
 
 
 @pytest.fixture(scope="module")
@@ -235,12 +221,42 @@ return [m[12], m[13], m[14]];"""
 def test_play_pause_scrub_and_read_out_in_a_real_browser(
     result: PlanningResult, problem: TrajectoryProblem, browser, tmp_path: Path
 ) -> None:
+    page = meshcat_scene.static_html(result, tmp_path / "playback.html")
+    browser.get(page.resolve().as_uri())
+    check_label_legend_and_controls(browser, result, problem)
+
+
+@pytest.mark.slow  # a browser, a meshcat server and a 2.1 s animation
+def test_the_live_viewer_has_the_label_legend_and_controls_in_a_real_browser(
+    result: PlanningResult, problem: TrajectoryProblem, browser
+) -> None:
+    """``adept-traj show``'s live meshcat page (the scene and the animation sent over the
+    meshcat server's WebSocket) has the label, legend and controls of playback.html, and
+    they drive the live view; meshcat's own menu and page stay."""
+    from adept_traj.viz import server
+
+    vis = server.show(result)
+    try:
+        browser.get(vis.url())
+        check_label_legend_and_controls(browser, result, problem)
+        menus = browser.execute_script(
+            "return Array.from(document.querySelectorAll('.dg .title')).map(e => e.textContent)"
+        )
+        assert "Animations" in menus  # meshcat's own animation controls too
+        with urllib.request.urlopen(vis.url() + "index.html", timeout=10) as reply:
+            assert b"<title>MeshCat</title>" in reply.read()  # meshcat's plain page
+    finally:
+        vis.close()
+
+
+def check_label_legend_and_controls(browser, result: PlanningResult, problem) -> None:
+    """The page open in ``browser`` shows ``result``'s best trade-off with its label and
+    legend, plays on opening, pauses, scrubs to 80 % of T (read out and drawn there: the
+    gripper where the replay puts it) and plays on from there."""
     from selenium.webdriver.common.action_chains import ActionChains
 
-    page = meshcat_scene.static_html(result, tmp_path / "playback.html")
     pb = playback.build_animation(result)
     T = pb.duration
-    browser.get(page.resolve().as_uri())
     wait_for(lambda: browser.execute_script("return window.playbackReady === true"))
     assert browser.find_element("id", "member-label").text == (
         f"NSGA-II · member 0 of 1 (the best trade-off) · T = {T:.3f} s · certified"

@@ -7,6 +7,7 @@ import dataclasses
 import json
 import math
 import shutil
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -203,16 +204,22 @@ def test_csv_files(result: PlanningResult, saved: Path) -> None:
     )
     with (saved / "best_trajectory.csv").open(encoding="utf-8", newline="") as fh:
         rows = list(csv.reader(fh))
-    names = ("joint1", "joint2", "joint3", "joint4")
-    header = ["t"]
-    for prefix in ("q", "qd", "qdd", "qddd", "tau"):
-        header += [f"{prefix}_{n}" for n in names]
-    assert rows[0] == [*header, "min_distance"]
+    units = {"joint1": "rad", "joint2": "rad", "joint3": "m", "joint4": "rad"}
+    header = ["t [s]"]
+    for prefix, per in (("q", ""), ("qd", "/s"), ("qdd", "/s^2")):
+        header += [f"{prefix}_{n} [{u}{per}]" for n, u in units.items()]
+    assert rows[0] == header
+    # a fixed step of 1 ms: t = 0, 0.001, ..., 2.099, then T = 2.1 exactly as the last row
     assert len(rows) == 1 + 2101
     table = np.array(rows[1:], dtype=float)
-    np.testing.assert_array_equal(table[:, 0], result.certificate.dense.t)
-    np.testing.assert_array_equal(table[:, 17:21], result.certificate.dense.tau)
-    np.testing.assert_array_equal(table[:, -1], result.certificate.dense.min_distance)
+    assert [Decimal(row[0]) for row in rows[1:-1]] == [Decimal(k) / 1000 for k in range(2100)]
+    assert table[-1, 0] == result.best_x[0] == 2.1
+    # the same move as the certificate's samples (its grid T·k/2100 is within 1e-15 s of k ms)
+    d = result.certificate.dense
+    np.testing.assert_allclose(table[:, 1:5], d.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table[:, 5:9], d.qd, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(table[:, 9:13], d.qdd, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(table[-1, 1:5], result.goal, rtol=0, atol=1e-15)  # on the goal
 
 
 def test_infinite_values_become_null(problem: TrajectoryProblem, tmp_path: Path) -> None:
@@ -231,7 +238,7 @@ def test_infinite_values_become_null(problem: TrajectoryProblem, tmp_path: Path)
     assert data["certificate"]["closest_pair"] is None
     assert data["best_trajectory"]["min_distance"][:3] == [None] * 3
     assert data["history"] is None
-    assert "inf" in (folder / "best_trajectory.csv").read_text(encoding="utf-8").splitlines()[1]
+    assert "inf" not in (folder / "best_trajectory.csv").read_text(encoding="utf-8")  # no distance
     assert PlanningResult.load(folder) == r
 
 
@@ -418,7 +425,7 @@ def test_csv_cell_not_a_number(saved: Path) -> None:
     lines[4] = ",".join(cells)
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     assert "'abc' is not the number" in str(
-        expect_error(saved, "best_trajectory.csv", "row 4, column q_joint3")
+        expect_error(saved, "best_trajectory.csv", "row 4, column q_joint3 [m]")
     )
 
 

@@ -5,32 +5,11 @@ freed on close, bad input named. The command itself: tests/test_playback_page.py
 
 from __future__ import annotations
 
-import socket
-import urllib.error
-import urllib.request
-
 import pytest
+from conftest import fetch, refused
 
 from adept_traj.errors import InvalidInputError
 from adept_traj.viz.page_server import PageServer
-
-
-def fetch(url: str, method: str = "GET") -> tuple[int, bytes, dict[str, str]]:
-    request = urllib.request.Request(url, method=method)
-    try:
-        with urllib.request.urlopen(request, timeout=10) as reply:
-            return reply.status, reply.read(), dict(reply.headers)
-    except urllib.error.HTTPError as exc:
-        return exc.code, b"", dict(exc.headers)
-
-
-def refused(port: int) -> bool:
-    """Nothing listens on 127.0.0.1:port."""
-    try:
-        socket.create_connection(("127.0.0.1", port), timeout=2).close()
-    except ConnectionRefusedError:
-        return True
-    return False
 
 
 def test_the_page_server_serves_its_pages_only_on_the_loopback_address() -> None:

@@ -4,6 +4,7 @@ for real in headless Chromium (two instants), and the live viewer bound to 127.0
 from __future__ import annotations
 
 import base64
+import html
 import math
 import os
 import re
@@ -393,7 +394,24 @@ def test_show_serves_on_localhost(
         assert re.fullmatch(r"tcp://127\.0\.0\.1:\d+", window.zmq_url)
         with urllib.request.urlopen(url, timeout=10) as reply:
             assert reply.status == 200
-            assert b"meshcat" in reply.read().lower()
+            page = reply.read().decode("utf-8")
+        # the live page: the member's label, the legend and the controls of playback.html
+        # (driven in a real browser: tests/test_playback_page.py)
+        label = re.search(r'<div id="member-label">(.*?)</div>', page)
+        assert label is not None
+        T = float(result.best_x[0])
+        assert html.unescape(label[1]) == (
+            f"{result.algorithm} · member 0 of 1 (the best trade-off) · T = {T:.3f} s · certified"
+        )
+        for element in ('id="legend"', 'id="play-pause"', 'id="scrub"', 'id="time-readout"'):
+            assert element in page, element
+        assert "closest points, robot to nearest obstacle" in page  # show_closest's entry
+        assert '<script src="main.min.js"></script>' in page  # meshcat's viewer, from the server
+        assert "viewer.connect();" in page
+        with urllib.request.urlopen(url + "main.min.js", timeout=10) as reply:
+            assert reply.status == 200
+        with urllib.request.urlopen(url + "index.html", timeout=10) as reply:
+            assert b"<title>MeshCat</title>" in reply.read()  # meshcat's own page stays
     finally:
         vis.close()
     assert window.closed

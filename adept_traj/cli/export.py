@@ -4,7 +4,9 @@
 ``--format csv|ros-json|ros-yaml`` (default ``csv``), ``--dt DT`` the fixed time step [s]
 (default 0.001; every step exactly DT but the last, the move's last sample at T), and
 ``--output FILE`` (default ``DIR/member_N.csv``, ``.json`` or ``.yaml``; ``-``: standard
-output). An uncertified member is refused (exit status 2) unless ``--allow-uncertified``.
+output). The CSV of the best trade-off at the default step is the folder's
+``best_trajectory.csv``, byte for byte (one mechanism: :mod:`adept_traj.results.fixed_step`).
+An uncertified member is refused (exit status 2) unless ``--allow-uncertified``.
 Reads ``result.json`` only: no robot file is loaded (:mod:`adept_traj.export`).
 """
 
@@ -53,9 +55,7 @@ def run(args: argparse.Namespace) -> int:
     tr = export.sample_member(
         result, args.member, dt=args.dt, allow_uncertified=args.allow_uncertified
     )
-    writer = {"csv": export.csv_text, "ros-json": export.ros_json_text,
-              "ros-yaml": export.ros_yaml_text}[args.format]  # fmt: skip
-    text = writer(tr)
+    text = export.WRITERS[args.format](tr)
     if args.output == "-":
         sys.stdout.write(text)
         return status.OK

@@ -1,5 +1,7 @@
-"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1), and
-serve beside it, on 127.0.0.1 too (:class:`~adept_traj.viz.page_server.PageServer`), the
+"""``adept-traj show DIR``: play a saved result in the browser (meshcat on 127.0.0.1, in a
+page with the member's label, the legend, play/pause, a scrubber and a time read-out:
+:func:`~adept_traj.viz.meshcat_scene.live_html`), and serve beside it, on 127.0.0.1 too
+(:class:`~adept_traj.viz.page_server.PageServer`), the
 folder's front explorer (``explorer.html``, written first when missing) and the playback
 page of the member shown (the page ``plan`` writes as ``playback.html``: label, legend,
 play/pause, scrubber and time read-out), at ``http://127.0.0.1:PORT/explorer.html`` and
@@ -131,7 +133,11 @@ def _play(args: argparse.Namespace) -> NoReturn:
         label = f"{which} {index}, {'certified' if certified else 'NOT CERTIFIED'}"
         print(f"front explorer (any member): {pages.url(EXPLORER_PAGE)}")
         print(f"playback page (time read-out, scrubber): {pages.url(PLAYBACK_PAGE)}")
-        print(f"playing {args.folder} ({label}) at {vis.url()} (Ctrl-C to stop)", flush=True)
+        print(
+            f"playing {args.folder} ({label}) at {vis.url()} (live meshcat viewer: label, "
+            "legend, play/pause, scrubber; Ctrl-C to stop)",
+            flush=True,
+        )
         while True:
             time.sleep(1.0)
     finally:

@@ -47,8 +47,7 @@ def cycle_playback(
     named ``names``) played one after the other at real time and ``fps`` [1/s]; ``robot``
     and ``scene``: those of the runs (default: loaded from each result); ``members``: the
     row of each front to play (default: the best trade-offs)."""
-    from adept_traj.viz.framing import camera, floor
-    from adept_traj.viz.playback import Playback, SceneObject, build_animation
+    from adept_traj.viz.playback import SceneObject, build_animation
 
     rows = [r.best.index for r in results] if members is None else list(members)
     parts = [
@@ -81,24 +80,33 @@ def cycle_playback(
     for path, obj in fixed.items():
         poses = np.concatenate(animated[path]) if path in animated else obj.poses
         objects.append(SceneObject(path, obj.parts, poses))
-    seen = np.vstack([*tools, *(o.poses[..., :3, 3].reshape(-1, 3) for o in objects)])
-    objects.extend(SceneObject(path, obj_parts, pose) for path, obj_parts, pose in floor(seen))
-    target, position = camera(seen)
-    return Playback(
-        objects=tuple(objects),
+    return _framed(
+        objects,
+        tools,
         times=np.concatenate(times),
         frame_numbers=np.concatenate(frames),
         q=np.concatenate(q),
         fps=parts[0].fps,
         speed=parts[0].speed,
-        duration=float(times[-1][-1]),
+        certified=all(p.certified for p in parts),
+    )
+
+
+def _framed(objects: list[Any], tools: list[np.ndarray], **fields: Any) -> Any:
+    """The cycle's :class:`~adept_traj.viz.playback.Playback`
+    (:func:`~adept_traj.viz.playback.framed_playback`): the floor and camera frame every
+    tool path and every drawn node's positions."""
+    from adept_traj.viz.playback import framed_playback
+
+    seen = np.vstack([*tools, *(o.poses[..., :3, 3].reshape(-1, 3) for o in objects)])
+    return framed_playback(
+        objects,
+        seen,
         tool_path=np.vstack(tools),
         closest_points=None,
         closest_distance=None,
-        camera_target=target,
-        camera_position=position,
         member=0,
-        certified=all(p.certified for p in parts),
+        **fields,
     )
 
 
@@ -114,8 +122,7 @@ def clock_playback(
     clock: its planned passes (``results``: per pass the chosen results, in order) with
     every frame at its scene time [s] (keyframe = scene time × ``fps``), the dwells as
     frames of the robot at rest while the obstacles move."""
-    from adept_traj.viz.framing import camera, floor
-    from adept_traj.viz.playback import Playback, SceneObject, build_animation
+    from adept_traj.viz.playback import SceneObject, build_animation
 
     segments: list[tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]] = []
     fixed: dict[str, Any] = {}
@@ -143,23 +150,14 @@ def clock_playback(
     objects = [
         SceneObject(path, obj.parts, poses.get(path, obj.poses)) for path, obj in fixed.items()
     ]
-    seen = np.vstack([*tools, *(o.poses[..., :3, 3].reshape(-1, 3) for o in objects)])
-    objects.extend(SceneObject(path, obj_parts, pose) for path, obj_parts, pose in floor(seen))
-    target, position = camera(seen)
-    return Playback(
-        objects=tuple(objects),
+    return _framed(
+        objects,
+        tools,
         times=times,
         frame_numbers=times * fps,
         q=q,
         fps=fps,
         speed=1.0,
-        duration=float(times[-1]),
-        tool_path=np.vstack(tools),
-        closest_points=None,
-        closest_distance=None,
-        camera_target=target,
-        camera_position=position,
-        member=0,
         certified=certified,
     )
 

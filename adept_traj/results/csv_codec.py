@@ -2,13 +2,18 @@
 
 - ``front.csv``: header ``z1,…,z6,feasible,x0,…,x{n_var−1}``; one row per solution of the
   front, ``feasible`` as ``1``/``0``.
-- ``best_trajectory.csv``: header ``t, q_<joint>…, qd_<joint>…, qdd_<joint>…,
-  qddd_<joint>…, tau_<joint>…, min_distance``; one row per dense sample of the certificate
-  (units: s; rad | m; rad/s | m/s; rad/s² | m/s²; rad/s³ | m/s³; N·m | N; m).
+- ``best_trajectory.csv``: the best trade-off at a fixed step of 1 ms, exactly from its
+  spline, the file ``adept-traj export DIR --format csv`` writes
+  (:mod:`~adept_traj.results.fixed_step`): header ``t [s], q_<joint> [rad|m]…,
+  qd_<joint> [rad/s|m/s]…, qdd_<joint> [rad/s^2|m/s^2]…``, rows t = 0, 0.001, …, the last
+  at T. (Before issue #29 it held the certificate's grid, ⌈T·rate⌉ + 1 samples, with
+  ``qddd``, ``tau`` and ``min_distance``: those stay in ``result.json``'s
+  ``best_trajectory``, and such files of earlier versions still load.)
 
 Floats are written in Python's shortest round-trip form (``inf`` for an infinite distance),
 so they read back exactly. On load, both files must have the expected header, row count and
-values, the same as in ``result.json``; otherwise
+values: ``front.csv`` those of ``result.json``, exactly; ``best_trajectory.csv`` the best
+trade-off's spline sampled again (to 1e-12 relative); otherwise
 :class:`~adept_traj.errors.ResultFormatError` names the file and the field (``header``,
 ``row 2, column z2``). The schema is in ``docs/results.md``;
 :meth:`~adept_traj.results.PlanningResult.save`,
@@ -34,6 +39,7 @@ from adept_traj.results.reader import read_text
 from adept_traj.robot.limits import LIMITS
 
 if TYPE_CHECKING:  # the record imports this module
+    from adept_traj.results.fixed_step import FixedStepTrajectory
     from adept_traj.results.record import PlanningResult
 
 __all__ = [
@@ -45,8 +51,11 @@ __all__ = [
     "write_trajectory_csv",
 ]
 
-#: Derivative prefixes of the joint columns of ``best_trajectory.csv``, in order.
+#: Derivative prefixes of the joint columns of a ``best_trajectory.csv`` before issue #29.
 _JOINT_PREFIXES = tuple(kind.quantity for kind in LIMITS)
+#: Relative tolerance of the fixed-step file against its spline sampled again on load (the
+#: same code on the same numbers: equal but for a machine's rounding of the matrix products).
+_SAMPLE_RTOL = 1e-12
 
 
 # ============================================================================ front.csv
@@ -98,8 +107,19 @@ def check_front_csv(r: PlanningResult, path: Path) -> None:
 
 
 # ============================================================================ best_trajectory.csv
+def _best_fixed_step(r: PlanningResult) -> FixedStepTrajectory:
+    """What ``best_trajectory.csv`` holds: the best trade-off, certified or not, at the
+    fixed step :func:`~adept_traj.results.fixed_step.file_step` (1 ms)."""
+    from adept_traj.results import fixed_step  # it needs the record, which imports this
+
+    return fixed_step.sample_member(
+        r, dt=fixed_step.file_step(float(r.best_x[0])), allow_uncertified=True
+    )
+
+
 def trajectory_header(names: Sequence[str]) -> list[str]:
-    """The header of ``best_trajectory.csv``.
+    """The header of a ``best_trajectory.csv`` before issue #29 (the certificate's grid),
+    still read by :func:`check_trajectory_csv` and written by the ROS-free grid exports.
 
     Parameters
     ----------
@@ -114,14 +134,15 @@ def trajectory_header(names: Sequence[str]) -> list[str]:
     return ["t", *(f"{p}_{n}" for p in _JOINT_PREFIXES for n in names), "min_distance"]
 
 
-def _trajectory_table(r: PlanningResult) -> np.ndarray:
-    """(n, 2 + 5·nq) the rows of ``best_trajectory.csv``."""
+def _legacy_trajectory_table(r: PlanningResult) -> np.ndarray:
+    """(n, 2 + 5·nq) the rows of a ``best_trajectory.csv`` before issue #29."""
     d = r.certificate.dense
     return np.column_stack([d.t, d.q, d.qd, d.qdd, d.qddd, d.tau, d.min_distance])
 
 
 def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
-    """Write ``best_trajectory.csv`` of a result (atomically).
+    """Write ``best_trajectory.csv`` of a result (atomically): the best trade-off at the
+    fixed step of 1 ms (:mod:`~adept_traj.results.fixed_step`).
 
     Parameters
     ----------
@@ -135,12 +156,16 @@ def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
     pathlib.Path
         ``path``.
     """
-    text = csv_text(trajectory_header(r.robot.joint_names), _trajectory_table(r))
-    return write_text_atomic(path, text)
+    from adept_traj.results import fixed_step  # it needs the record, which imports this
+
+    return write_text_atomic(path, fixed_step.csv_text(_best_fixed_step(r)))
 
 
 def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
-    """Check that ``best_trajectory.csv`` agrees with a result read from ``result.json``.
+    """Check that ``best_trajectory.csv`` agrees with a result read from ``result.json``:
+    the fixed-step file with the best trade-off's spline (to :data:`_SAMPLE_RTOL`); a file
+    of an earlier version (the certificate's grid) with ``result.json``'s dense samples,
+    exactly.
 
     Parameters
     ----------
@@ -154,7 +179,17 @@ def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
     ResultFormatError
         Another header, row count or value (naming the row and column).
     """
-    _check_csv(path, trajectory_header(r.robot.joint_names), _trajectory_table(r))
+    legacy = trajectory_header(r.robot.joint_names)
+    text = read_text(path)
+    if text.split("\n", 1)[0].rstrip("\r") == ",".join(legacy):
+        _check_csv(path, legacy, _legacy_trajectory_table(r), text=text)
+        return
+    from adept_traj.results import fixed_step  # it needs the record, which imports this
+
+    tr = _best_fixed_step(r)
+    header = fixed_step.csv_header(tr.joint_names, tr.units)
+    table = np.column_stack([tr.t, tr.q, tr.qd, tr.qdd])
+    _check_csv(path, header, table, text=text, rtol=_SAMPLE_RTOL, source="the best move's spline")
 
 
 # ============================================================================ both
@@ -184,17 +219,27 @@ def csv_text(header: list[str], rows: np.ndarray, int_columns: Sequence[int] = (
     return "\n".join(lines) + "\n"
 
 
-def _check_csv(path: Path, header: list[str], expected: np.ndarray) -> None:
-    """Check that the CSV file at ``path`` has ``header`` and the values of ``expected``
-    (n, m), exactly; raise :class:`ResultFormatError` naming the first bad row and column."""
-    rows = list(csv.reader(io.StringIO(read_text(path))))
+def _check_csv(
+    path: Path,
+    header: list[str],
+    expected: np.ndarray,
+    *,
+    text: str | None = None,
+    rtol: float = 0.0,
+    source: str = "result.json",
+) -> None:
+    """Check that the CSV file at ``path`` (its ``text`` when already read) has ``header``
+    and the values of ``expected`` (n, m): exactly (``rtol = 0``), else each within
+    ``rtol · (1 + |expected|)``; raise :class:`ResultFormatError` naming the first bad row
+    and column and ``source``, where the expected values come from."""
+    rows = list(csv.reader(io.StringIO(read_text(path) if text is None else text)))
     if not rows or rows[0] != header:
         got = rows[0] if rows else "nothing"
         raise ResultFormatError(path, "header", f"expected {','.join(header)}; got {got}")
     body = [row for row in rows[1:] if row]
     if len(body) != expected.shape[0]:
         raise ResultFormatError(
-            path, None, f"expected {expected.shape[0]} data rows as in result.json; got {len(body)}"
+            path, None, f"expected {expected.shape[0]} data rows as in {source}; got {len(body)}"
         )
     widths = np.fromiter(map(len, body), dtype=int, count=len(body))
     short = np.flatnonzero(widths != len(header))
@@ -205,13 +250,14 @@ def _check_csv(path: Path, header: list[str], expected: np.ndarray) -> None:
         values = cells.astype(float)
     except ValueError:  # a cell numpy does not read: read each as Python does (NaN if bad)
         values = np.vectorize(_number, otypes=[float])(cells)
-    bad = np.isnan(values) | (values != expected)
+    bad = np.isnan(values) | ~(np.abs(values - expected) <= rtol * (1.0 + np.abs(expected)))
+    bad &= values != expected  # the same infinities
     if bad.any():
         i, j = (int(k) for k in np.argwhere(bad)[0])
         raise ResultFormatError(
             path,
             f"row {i + 1}, column {header[j]}",
-            f"{body[i][j]!r} is not the number in result.json ({float(expected[i, j])!r})",
+            f"{body[i][j]!r} is not the number in {source} ({float(expected[i, j])!r})",
         )
 
 

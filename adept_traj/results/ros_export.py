@@ -1,10 +1,12 @@
 """Export a trajectory of a planning result: CSV and ROS ``JointTrajectory`` JSON.
 
-- :func:`to_csv` writes a member's trajectory (default: the best trade-off's certified
-  dense samples) in exactly the format of the result folder's ``best_trajectory.csv``
-  (``docs/results.md``): header ``t, q_<joint>…, qd_<joint>…, qdd_<joint>…,
-  qddd_<joint>…, tau_<joint>…, min_distance``, one row per sample of the certificate's
-  grid, floats in Python's shortest round-trip form.
+- :func:`to_csv` writes a member's trajectory on the certificate's grid (default: the best
+  trade-off's certified dense samples, ``result.best_trajectory``) with its torques and
+  distances: header ``t, q_<joint>…, qd_<joint>…, qdd_<joint>…, qddd_<joint>…,
+  tau_<joint>…, min_distance``, one row per sample of the certificate's grid, floats in
+  Python's shortest round-trip form (the format the result folder's
+  ``best_trajectory.csv`` had before issue #29; that file is now the fixed-step CSV of
+  :mod:`adept_traj.results.fixed_step`, as ``adept-traj export`` writes it).
 - :func:`to_ros_joint_trajectory` builds a dictionary shaped like a ROS 2
   ``trajectory_msgs/msg/JointTrajectory`` (``time_from_start`` as
   ``builtin_interfaces/Duration``: ``sec``, ``nanosec``); :func:`save_ros_joint_trajectory`
@@ -46,10 +48,12 @@ from adept_traj.results.members import (
 )
 from adept_traj.results.record import PlanningResult
 from adept_traj.results.replay import Replay
-from adept_traj.validation import as_scalar, check_type
+from adept_traj.validation import as_path, as_scalar, check_type
 
 __all__ = [
     "MAX_ROS_POINTS",
+    "ros_duration",
+    "ros_json_text",
     "save_ros_joint_trajectory",
     "to_csv",
     "to_ros_joint_trajectory",
@@ -65,13 +69,6 @@ def _as_result(result: Any) -> PlanningResult:
     return result
 
 
-def _as_path(path: Any, name: str = "path") -> Path:
-    try:
-        return Path(os.fspath(path))
-    except TypeError:
-        raise InvalidInputError(f"{name} must be a file path; got {type(path).__name__}") from None
-
-
 # ============================================================================ CSV
 def to_csv(
     result: PlanningResult,
@@ -81,18 +78,18 @@ def to_csv(
     allow_infeasible: bool = False,
     replay: Replay | None = None,
 ) -> Path:
-    """Write a member's trajectory (default: the best trade-off) as CSV, in the format of
-    ``best_trajectory.csv``.
+    """Write a member's trajectory (default: the best trade-off) on the certificate's grid
+    as CSV, with its jerks, torques and distances (for a fixed step:
+    :func:`adept_traj.export.export_member`).
 
     Columns: ``t`` [s], ``q_<joint>`` [rad | m], ``qd_<joint>`` [rad/s | m/s],
     ``qdd_<joint>`` [rad/s² | m/s²], ``qddd_<joint>`` [rad/s³ | m/s³], ``tau_<joint>``
     [N·m | N], ``min_distance`` [m] (``inf`` when the scene has no obstacle); one row per
     sample of the certificate's grid, values in shortest round-trip form.
     For the best trade-off the rows are its stored dense samples
-    (``result.best_trajectory``) and the file is byte-identical to the one
-    :meth:`PlanningResult.save` writes. For another member they are its spline resampled
-    on the same grid (``ceil(T·certificate.rate_hz) + 1`` samples), torques from the
-    robot's inverse dynamics and exact distances by coal
+    (``result.best_trajectory``, as ``result.json`` stores them). For another member they
+    are its spline resampled on the same grid (``ceil(T·certificate.rate_hz) + 1``
+    samples), torques from the robot's inverse dynamics and exact distances by coal
     (:func:`~adept_traj.results.members.member_dense`).
 
     Parameters
@@ -118,7 +115,7 @@ def to_csv(
         ``replay`` not a Replay of the member.
     """
     r = _as_result(result)
-    out = _as_path(path)
+    out = as_path(path)
     index = member_index(r, member)
     check_type(allow_infeasible, bool, "allow_infeasible")
     _refuse_uncertified(r, index, allow_infeasible)
@@ -148,8 +145,9 @@ def _rate(rate_hz: Any) -> float:
     return as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
 
 
-def _duration(t: float) -> dict[str, int]:
-    """ROS 2 ``builtin_interfaces/Duration`` of ``t`` ≥ 0 seconds, rounded to 1 ns."""
+def ros_duration(t: float) -> dict[str, int]:
+    """ROS 2 ``builtin_interfaces/Duration`` of ``t`` ≥ 0 [s], rounded to 1 ns:
+    ``{"sec": …, "nanosec": …}`` with 0 ≤ nanosec < 10⁹."""
     sec, nanosec = divmod(round(t * _NS_PER_S), _NS_PER_S)
     return {"sec": int(sec), "nanosec": int(nanosec)}
 
@@ -301,7 +299,7 @@ def to_ros_joint_trajectory(
             "velocities": qd[k].tolist(),
             "accelerations": qdd[k].tolist(),
             "effort": tau[k].tolist(),
-            "time_from_start": _duration(float(t[k])),
+            "time_from_start": ros_duration(float(t[k])),
         }
         for k in range(t.shape[0])
     ]
@@ -328,21 +326,20 @@ def save_ros_joint_trajectory(
     ``"warning"``, ``"member"`` and ``"best_tradeoff"`` (see
     :func:`to_ros_joint_trajectory`).
     Returns the path written. Arguments and errors as :func:`to_ros_joint_trajectory`."""
-    out = _as_path(path)
+    out = as_path(path)
     msg = to_ros_joint_trajectory(
         result, member=member, rate_hz=rate_hz, allow_infeasible=allow_infeasible, replay=replay
     )
+    return write_text_atomic(out, ros_json_text(msg))
+
+
+def ros_json_text(message: dict[str, Any]) -> str:
+    """A ``JointTrajectory`` dictionary as JSON text: UTF-8, one top-level entry per line and
+    one point per line, floats in shortest round-trip form, no NaN (``"points"`` last)."""
 
     def dump(value: Any) -> str:
         return json.dumps(value, allow_nan=False, ensure_ascii=False)
 
-    head = [f"  {dump(key)}: {dump(value)}," for key, value in msg.items() if key != "points"]
-    lines = [
-        "{",
-        *head,
-        '  "points": [',
-        ",\n".join(f"    {dump(p)}" for p in msg["points"]),
-        "  ]",
-        "}",
-    ]
-    return write_text_atomic(out, "\n".join(lines) + "\n")
+    head = [f"  {dump(key)}: {dump(value)}," for key, value in message.items() if key != "points"]
+    body = ",\n".join(f"    {dump(p)}" for p in message["points"])
+    return "\n".join(["{", *head, '  "points": [', body, "  ]", "}"]) + "\n"

@@ -78,14 +78,15 @@ class JointTrajectory(ValueObject):
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str]) -> JointTrajectory:
-        """Read a CSV whose header names ``t`` and the joint columns ``q_<joint>`` (as
+        """Read a CSV whose header names ``t`` and the joint columns ``q_<joint>``, each
+        name optionally followed by its unit (``t [s]``, ``q_joint1 [rad]``: as
         ``best_trajectory.csv``; other columns ignored). Errors (missing file, a bad
         number, a time not increasing) are :class:`~adept_traj.errors.MotionFileError`
         naming the file and line."""
         p = Path(path)
         text = read_bytes_bounded(p, MotionFileError, what="joint trajectory CSV")
         lines = text.decode("utf-8", errors="replace").splitlines()
-        header = [c.strip() for c in lines[0].split(",")] if lines else []
+        header = [c.split(" [")[0].strip() for c in lines[0].split(",")] if lines else []
         cols = [i for i, c in enumerate(header) if c.startswith("q_")]
         if not header or header[0] != "t" or not cols:
             raise MotionFileError(

@@ -25,19 +25,32 @@ def lift_then_lower(problem: TrajectoryProblem, T: float = 2.1, late: float = 0.
     return traj.encode(T, free)
 
 
-def single_result(problem: TrajectoryProblem, x: np.ndarray, rate_hz: float = 1000.0):
-    """A PlanningResult whose front is the single decision vector ``x``, certified at
-    ``rate_hz`` (no optimisation run; nominal timings)."""
+def single_result(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    rate_hz: float = 1000.0,
+    *,
+    certified: np.ndarray | None = None,
+):
+    """A PlanningResult whose front is the decision vector ``x`` (n_var,), or the vectors
+    ``x`` (k, n_var), the first the best trade-off, certified at ``rate_hz`` (no
+    optimisation run; nominal timings). ``certified`` (k,) bool: the members' certificate
+    verdicts, as when every member was certified (``front.feasible``, ``n_certified``);
+    ``None``: the engine's feasibility, members not certified."""
     from adept_traj.analysis import certify
     from adept_traj.results import BestSolution, Front, PlanningResult, Timing
 
     x = np.atleast_2d(x)
+    front = Front.from_evaluation(x, problem.evaluate_batch(x))
+    if certified is not None:
+        verdict = np.asarray(certified, dtype=bool)
+        front = Front(front.x, front.objectives, front.constraints, verdict, int(verdict.sum()))
     return PlanningResult.from_problem(
         problem,
         algorithm="NSGA-II",
         algorithm_settings={},
         seed=1,
-        front=Front.from_evaluation(x, problem.evaluate_batch(x)),
+        front=front,
         best=BestSolution(0),
         certificate=certify(problem, x[0], rate_hz=rate_hz),
         timing=Timing(total_s=1.0, evaluation_s=0.5, n_evaluations=10, n_generations=1),

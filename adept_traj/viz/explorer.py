@@ -42,7 +42,7 @@ import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS, MemberCertificate
 from adept_traj.errors import InvalidInputError
-from adept_traj.export import DEFAULT_DT
+from adept_traj.export import DEFAULT_DT, csv_header
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult, Replay, certified_members
@@ -58,7 +58,7 @@ from adept_traj.scene import (
     Scene,
     Sphere,
 )
-from adept_traj.validation import check_type
+from adept_traj.validation import as_path, check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
 
 __all__ = ["EXPLORER_FILE", "VIEW_DT", "explorer_data", "explorer_html", "write_explorer"]
@@ -286,6 +286,7 @@ def explorer_data(
             "x": _b64(front.x, "<f8"),
         },
         "export_dt": DEFAULT_DT,
+        "csv_header": csv_header(names, lim.units),
         "view": {
             "dt": VIEW_DT,
             "counts": counts.tolist(),
@@ -329,8 +330,5 @@ def write_explorer(
         shape the page cannot draw.
     """
     check_type(result, PlanningResult, "result")
-    try:
-        out = Path(os.fspath(path))
-    except TypeError:
-        raise InvalidInputError(f"path must be a file path; got {type(path).__name__}") from None
+    out = as_path(path)
     return write_text_atomic(out, explorer_html(result, robot=robot, scene=scene))

@@ -104,9 +104,16 @@ function sampleSpline(k, times, orders) {  // {q, qd, qdd}: arrays (n) of (nq)
 // ---------------------------------------------------------------- export (export.fixed_step)
 function fixedStepTimes(T, dt) {
   if (!(dt > 0) || dt > T || dt < T / 999999) throw new Error("dt = " + dt + " s must lie in [T/999999, T = " + T + " s]");
-  const k = Math.ceil(T / dt - 1e-9), t = [];
-  for (let i = 0; i < k; i++) { const v = i * dt; if (v < T - 1e-9 * dt) t.push(v); }
+  const k = Math.ceil(T / dt - 1e-9), t = [], mult = multiples(dt, k);
+  for (let i = 0; i < k; i++) { const v = mult(i); if (v < T - 1e-9 * dt) t.push(v); }
   t.push(T); return t;
+}
+function multiples(dt, n) {  // results.fixed_step._multiples: (i·m)/10^e, dt's decimal m·10^-e
+  const [mant, ex] = String(dt).toLowerCase().split("e"), dot = mant.indexOf(".");
+  const m = parseInt(mant.replace(".", ""), 10), e = (ex ? parseInt(ex, 10) : 0) - (dot < 0 ? 0 : mant.length - dot - 1);
+  const num = e >= 0 ? m * 10 ** e : m, den = e >= 0 ? 1 : 10 ** -e, exact = 2 ** 53;
+  if (den <= exact && num * Math.max(n - 1, 1) <= exact && Number.isSafeInteger(num)) return i => (i * num) / den;
+  return i => i * dt;
 }
 function pyRepr(x) {  // Python's repr of a float (shortest round trip)
   if (x === 0) return Object.is(x, -0) ? "-0.0" : "0.0";
@@ -121,9 +128,7 @@ function pyRepr(x) {  // Python's repr of a float (shortest round trip)
 }
 function fixedStep(k, dt) { const T = X[k * NVAR]; const t = fixedStepTimes(T, dt); return {t: t, ...sampleSpline(k, t, [0, 1, 2])}; }
 function csvText(k, dt) {
-  const s = fixedStep(k, dt), head = ["t"];
-  for (const p of ["q", "qd", "qdd"]) for (const n of D.joint_names) head.push(p + "_" + n);
-  const lines = [head.join(",")];
+  const s = fixedStep(k, dt), lines = [D.csv_header.join(",")];  // results.fixed_step.csv_header
   for (let i = 0; i < s.t.length; i++) lines.push([s.t[i], ...s.q[i], ...s.qd[i], ...s.qdd[i]].map(pyRepr).join(","));
   return lines.join("\n") + "\n";
 }

@@ -39,6 +39,7 @@ __all__ = [
     "Part",
     "hex_colour",
     "pendulum_pivots",
+    "rotations_y_to",
     "shape_parts",
     "solid_parts",
     "translation",
@@ -186,3 +187,19 @@ def pendulum_pivots(scene: Scene, color: int) -> list[tuple[str, tuple[Part, ...
         pose[:3, 3] = motion.pivot
         nodes.append((f"pivots/{name}", (ball, axle), pose))
     return nodes
+
+
+def rotations_y_to(u: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations taking the y axis (that of meshcat's cylinders) onto the unit
+    vectors ``u`` (n, 3) (Rodrigues; a half turn about x for ``u = -y``)."""
+    c = u[:, 1]  # y · u
+    v = np.stack([u[:, 2], np.zeros_like(c), -u[:, 0]], axis=-1)  # y × u
+    vx = np.zeros((len(u), 3, 3))
+    vx[:, 0, 1], vx[:, 0, 2] = -v[:, 2], v[:, 1]
+    vx[:, 1, 0], vx[:, 1, 2] = v[:, 2], -v[:, 0]
+    vx[:, 2, 0], vx[:, 2, 1] = -v[:, 1], v[:, 0]
+    flip = c < -1.0 + 1e-12
+    scale = 1.0 / np.where(flip, 1.0, 1.0 + c)
+    out = np.eye(3) + vx + (vx @ vx) * scale[:, None, None]
+    out[flip] = np.diag([1.0, -1.0, -1.0])
+    return out

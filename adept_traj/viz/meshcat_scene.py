@@ -50,7 +50,9 @@ __all__ = [
     "BACKGROUND_RGB",
     "draw",
     "legend",
+    "live_html",
     "member_label",
+    "member_page",
     "render_html",
     "result_page",
     "static_html",
@@ -256,6 +258,38 @@ def render_html(
     window = _RecordingWindow()
     draw(meshcat.Visualizer(window=window), playback, loop=loop)
     commands = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in window.commands)
+    viewer = (
+        f"<script>\n{_viewer_js()}\n</script>\n"
+        "<script>\n"
+        'var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));\n'
+        f"var adeptTrajCommands = [\n{commands}\n];\n"
+        "adeptTrajCommands.forEach(function (b64) {\n"
+        "  var s = atob(b64), bytes = new Uint8Array(s.length);\n"
+        "  for (var i = 0; i < s.length; i++) { bytes[i] = s.charCodeAt(i); }\n"
+        "  viewer.handle_command_bytearray(bytes);\n"
+        "});\n"
+    )
+    return _page(playback, title=title, label=label, viewer=viewer)
+
+
+def live_html(playback: Playback, *, title: str = "adept_traj", label: str | None = None) -> str:
+    """The page of the live viewer (:func:`~adept_traj.viz.server.show`): the label, legend
+    and controls of :func:`render_html` around meshcat's viewer, which loads its script
+    (``main.min.js``) from the meshcat server serving the page and receives the scene and
+    the animation over that server's WebSocket (``viewer.connect()``), as meshcat's own
+    page does."""
+    viewer = (
+        '<script src="main.min.js"></script>\n'
+        "<script>\n"
+        'var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));\n'
+        "viewer.connect();\n"
+    )
+    return _page(playback, title=title, label=label, viewer=viewer)
+
+
+def _page(playback: Playback, *, title: str, label: str | None, viewer: str) -> str:
+    """The page around a meshcat viewer: ``viewer`` is the HTML that makes ``viewer`` and
+    fills it, ending inside an open ``<script>`` element that the page's controls close."""
     label = member_label(playback) if label is None else label
     items = "\n".join(
         f'<li><span class="swatch" style="background: {colour}"></span>{html.escape(text)}</li>'
@@ -274,15 +308,7 @@ def render_html(
         f'<input id="scrub" type="range" min="0" max="{playback.duration!r}" step="0.001" '
         'value="0" aria-label="time [s]">\n<span id="time-readout" data-time="0">'
         f"t = 0.000 s / T = {playback.duration:.3f} s</span>\n</div>\n"
-        f"<script>\n{_viewer_js()}\n</script>\n"
-        "<script>\n"
-        'var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));\n'
-        f"var adeptTrajCommands = [\n{commands}\n];\n"
-        "adeptTrajCommands.forEach(function (b64) {\n"
-        "  var s = atob(b64), bytes = new Uint8Array(s.length);\n"
-        "  for (var i = 0; i < s.length; i++) { bytes[i] = s.charCodeAt(i); }\n"
-        "  viewer.handle_command_bytearray(bytes);\n"
-        "});\n"
+        f"{viewer}"
         f"var adeptTrajPlayback = {info};\n"
         f"{_PAGE_SCRIPT}\n"
         "</script>\n</body>\n</html>\n"
@@ -343,8 +369,20 @@ def result_page(
     playback = build_animation(
         result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )
+    return member_page(result, playback, loop=loop)
+
+
+def member_page(
+    result: PlanningResult, playback: Playback, *, loop: bool = True, live: bool = False
+) -> str:
+    """The page of a member of ``result`` drawn by ``playback``: :func:`render_html`
+    (``playback.html``) or, ``live``, :func:`live_html` (the live viewer's), both titled
+    and labelled alike, e.g. ``"nsga2 · member 3 of 40 (the best trade-off) · T = 2.100 s ·
+    certified"``."""
     best = playback.member == result.best.index
     label = f"{result.algorithm} · " + member_label(playback, best=best, of=len(result.front))
     title = f"adept_traj — {result.algorithm}, member {playback.member}, "
     title += f"T = {playback.duration:.3f} s"
+    if live:
+        return live_html(playback, title=title, label=label)
     return render_html(playback, loop=loop, title=title, label=label)

@@ -30,6 +30,7 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -56,6 +57,7 @@ from adept_traj.viz.meshcat_geometry import (
     Part,
     hex_colour,
     pendulum_pivots,
+    rotations_y_to,
     shape_parts,
     solid_parts,
     translation,
@@ -71,6 +73,7 @@ __all__ = [
     "SceneObject",
     "build_animation",
     "frame_times",
+    "framed_playback",
 ]
 
 #: Most frames an animation may have (``fps · T / speed``).
@@ -144,6 +147,7 @@ class Playback:
     certified: whether that member is certified
         (:func:`~adept_traj.results.certified_members`).
     tool_path: (n_points, 3) world tool positions along the dense trajectory [m].
+    (The arrays are kept as read-only copies.)
     closest_points: (n_frames, 2, 3) world points on the robot and on the nearest obstacle
         at each frame [m], or ``None`` (not requested, or no obstacle).
     closest_distance: (n_frames,) their signed distance [m] (negative: penetration), or
@@ -165,6 +169,13 @@ class Playback:
     camera_position: np.ndarray
     member: int = 0
     certified: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("times", "frame_numbers", "q", "tool_path", "camera_target",
+                     "camera_position", "closest_points", "closest_distance"):  # fmt: skip
+            value = getattr(self, name)
+            object.__setattr__(self, name, None if value is None else readonly_copy(value))
+        object.__setattr__(self, "objects", tuple(self.objects))
 
     @property
     def n_frames(self) -> int:
@@ -300,25 +311,33 @@ def build_animation(
     seen = [tool, solid_poses[..., :3, 3].reshape(-1, 3)]
     seen += [obstacle_poses[i, :, :3, 3] for i in range(len(scene.obstacles))]
     seen += [p.poses[None, :3, 3] for p in pivots]
-    seen_points = np.vstack(seen)
-    objects.extend(SceneObject(path, parts, pose) for path, parts, pose in floor(seen_points))
-    target, position = camera(seen_points)
-    return Playback(
-        objects=tuple(objects),
-        times=readonly_copy(times),
-        frame_numbers=readonly_copy(frames),
-        q=readonly_copy(q),
+    return framed_playback(
+        objects,
+        np.vstack(seen),
+        times=times,
+        frame_numbers=frames,
+        q=q,
         fps=fps,
         speed=speed,
-        duration=duration,
-        tool_path=readonly_copy(tool),
-        closest_points=None if closest is None else readonly_copy(closest),
-        closest_distance=None if distance is None else readonly_copy(distance),
-        camera_target=readonly_copy(target),
-        camera_position=readonly_copy(position),
+        tool_path=tool,
+        closest_points=closest,
+        closest_distance=distance,
         member=index,
         certified=bool(certified_members(result)[index]),
     )
+
+
+def framed_playback(objects: Sequence[SceneObject], seen: np.ndarray, **fields: Any) -> Playback:
+    """The :class:`Playback` of ``objects`` and of the floor and world axes under the points
+    ``seen`` (m, 3) [m], with a camera framing them (:mod:`~adept_traj.viz.framing`) and
+    ``duration = times[-1]``; ``fields``: the other fields. The one assembly of a playback:
+    of a member (:func:`build_animation`) and of a whole cycle
+    (:mod:`adept_traj.cycle.cycle_playback`)."""
+    target, position = camera(seen)
+    nodes = (*objects, *(SceneObject(path, p, pose) for path, p, pose in floor(seen)))
+    duration = float(fields["times"][-1])
+    return Playback(nodes, duration=duration, camera_target=target, camera_position=position,
+                    **fields)  # fmt: skip
 
 
 def _tool_path(result: PlanningResult, replay: Replay, index: int) -> np.ndarray:
@@ -350,22 +369,6 @@ def _tool_path_objects(tool: np.ndarray) -> list[SceneObject]:
     return objects
 
 
-def _rotations_y_to(u: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) rotations taking the y axis onto the unit vectors ``u`` (n, 3) (Rodrigues;
-    a half turn about x for ``u = -y``)."""
-    c = u[:, 1]  # y · u
-    v = np.stack([u[:, 2], np.zeros_like(c), -u[:, 0]], axis=-1)  # y × u
-    vx = np.zeros((len(u), 3, 3))
-    vx[:, 0, 1], vx[:, 0, 2] = -v[:, 2], v[:, 1]
-    vx[:, 1, 0], vx[:, 1, 2] = v[:, 2], -v[:, 0]
-    vx[:, 2, 0], vx[:, 2, 1] = -v[:, 1], v[:, 0]
-    flip = c < -1.0 + 1e-12
-    scale = 1.0 / np.where(flip, 1.0, 1.0 + c)
-    out = np.eye(3) + vx + (vx @ vx) * scale[:, None, None]
-    out[flip] = np.diag([1.0, -1.0, -1.0])
-    return out
-
-
 def _closest_objects(points: np.ndarray) -> list[SceneObject]:
     """The closest-point segment (a unit cylinder along y, scaled and turned onto the
     segment at each frame) and its two end spheres, for ``points`` (n, 2, 3) [m]."""
@@ -375,7 +378,7 @@ def _closest_objects(points: np.ndarray) -> list[SceneObject]:
     seg_poses = np.tile(np.eye(4), (n, 1, 1))
     seg_poses[:, :3, 3] = 0.5 * (points[:, 0] + points[:, 1])
     turn = length > 1e-9
-    seg_poses[turn, :3, :3] = _rotations_y_to(d[turn] / length[turn, None])
+    seg_poses[turn, :3, :3] = rotations_y_to(d[turn] / length[turn, None])
     scales = np.ones((n, 3))
     scales[:, 1] = np.maximum(length, 1e-6)
     material = mg.MeshLambertMaterial(color=CLOSEST_COLOR)

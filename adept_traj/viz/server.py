@@ -29,7 +29,7 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
 
 from adept_traj.errors import MeshcatServerError
 from adept_traj.results import PlanningResult, Replay
-from adept_traj.viz.meshcat_scene import draw
+from adept_traj.viz.meshcat_scene import draw, member_page
 from adept_traj.viz.playback import build_animation
 
 __all__ = ["SERVER_TIMEOUT_S", "show"]
@@ -38,13 +38,24 @@ __all__ = ["SERVER_TIMEOUT_S", "show"]
 SERVER_TIMEOUT_S = 30.0
 
 # The meshcat 0.3.2 server binds its web server on every interface (tornado's listen() with
-# no address) although it prints a 127.0.0.1 URL; this launcher binds it to 127.0.0.1.
+# no address) although it prints a 127.0.0.1 URL; this launcher binds it to 127.0.0.1. It
+# also serves the page read from its standard input (when not empty) at /static/, the URL
+# the server hands out, ahead of meshcat's own page (still at /static/index.html).
 _SERVER_SCRIPT = """
 import functools, sys
+import tornado.web
 from meshcat.servers import zmqserver as z
+PAGE = sys.stdin.buffer.read()
+class Page(tornado.web.RequestHandler):
+    def get(self):
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.set_header("Cache-Control", "no-store, no-cache, must-revalidate, max-age=0")
+        self.write(PAGE)
 _make_app = z.ZMQWebSocketBridge.make_app
 def make_app(self):
     app = _make_app(self)
+    if PAGE:
+        app.add_handlers(r".*", [(r"/static/", Page)])
     app.listen = functools.partial(app.listen, address=self.host)
     return app
 z.ZMQWebSocketBridge.make_app = make_app
@@ -54,18 +65,27 @@ z.main()
 
 
 class _LocalWindow(ViewerWindow):
-    """A meshcat server of our own on 127.0.0.1 (ZeroMQ and web), silent, closable."""
+    """A meshcat server of our own on 127.0.0.1 (ZeroMQ and web), silent, closable, serving
+    ``page`` (when given) at its URL, ``…/static/``."""
 
-    def __init__(self, timeout: float = SERVER_TIMEOUT_S) -> None:  # no super(): it prints
+    def __init__(self, timeout: float = SERVER_TIMEOUT_S, page: str = "") -> None:
+        # no super(): it prints
         self._closed = False
         self.server_proc = subprocess.Popen(
             [sys.executable, "-u", "-c", _SERVER_SCRIPT],
-            stdin=subprocess.DEVNULL,
+            stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
         )
         atexit.register(self.close)
+        stdin = self.server_proc.stdin
+        if stdin is not None:  # the page served at /static/ ("": meshcat's own)
+            try:
+                stdin.write(page.encode("utf-8"))
+                stdin.close()
+            except BrokenPipeError:  # the server died at once: said below
+                pass
         lines: queue.Queue[str | None] = queue.Queue()
         stdout = self.server_proc.stdout
 
@@ -144,7 +164,12 @@ def show(
 
     The server (a subprocess) listens on 127.0.0.1 only: its ZeroMQ socket and its web
     server. Nothing is printed; ``vis.url()`` is the page to open, ``vis.close()`` stops the
-    server (it is also stopped when Python exits).
+    server (it is also stopped when Python exits). The page
+    (:func:`~adept_traj.viz.meshcat_scene.live_html`) is that of ``playback.html`` around
+    the live viewer: the member's label (``#member-label``: algorithm, member, T,
+    certified or not), the legend (``#legend``), play/pause (``#play-pause``), a scrubber
+    (``#scrub``) and a time read-out (``#time-readout``), beside meshcat's own controls;
+    meshcat's plain page stays at ``…/static/index.html``.
 
     Parameters
     ----------
@@ -168,7 +193,7 @@ def show(
     playback = build_animation(
         result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )
-    window = _LocalWindow()
+    window = _LocalWindow(page=member_page(result, playback, live=True))
     vis = meshcat.Visualizer(window=window)
     try:
         draw(vis, playback, loop=loop)
