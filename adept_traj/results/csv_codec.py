@@ -2,7 +2,7 @@
 
 - ``front.csv``: header ``z1,…,z6,feasible,x0,…,x{n_var−1}``; one row per solution of the
   front, ``feasible`` as ``1``/``0``.
-- ``best_trajectory.csv``: the best trade-off at a fixed step of 1 ms, exactly from its
+- ``best_trajectory.csv``: the best trade-off at a fixed step of 0.001 s, exactly from its
   spline, the file ``adept-traj export DIR --format csv`` writes
   (:mod:`~adept_traj.results.fixed_step`): header ``t [s], q_<joint> [rad|m]…,
   qd_<joint> [rad/s|m/s]…, qdd_<joint> [rad/s^2|m/s^2]…``, rows t = 0, 0.001, …, the last
@@ -109,7 +109,7 @@ def check_front_csv(r: PlanningResult, path: Path) -> None:
 # ============================================================================ best_trajectory.csv
 def _best_fixed_step(r: PlanningResult) -> FixedStepTrajectory:
     """What ``best_trajectory.csv`` holds: the best trade-off, certified or not, at the
-    fixed step :func:`~adept_traj.results.fixed_step.file_step` (1 ms)."""
+    fixed step :func:`~adept_traj.results.fixed_step.file_step` (0.001 s)."""
     from adept_traj.results import fixed_step  # it needs the record, which imports this
 
     return fixed_step.sample_member(
@@ -142,7 +142,7 @@ def _legacy_trajectory_table(r: PlanningResult) -> np.ndarray:
 
 def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
     """Write ``best_trajectory.csv`` of a result (atomically): the best trade-off at the
-    fixed step of 1 ms (:mod:`~adept_traj.results.fixed_step`).
+    fixed step of 0.001 s (:mod:`~adept_traj.results.fixed_step`).
 
     Parameters
     ----------

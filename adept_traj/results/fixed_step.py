@@ -16,7 +16,7 @@ so every step is ``dt`` but the last one, which is at most ``dt`` (and more than
 Each :math:`t_k` is the double nearest to k times the decimal ``dt`` reads as, so the times
 read as written (``1.396``, not the ``1.3960000000000001`` of the product of doubles).
 With the default ``dt = 0.001 s`` a move of T = 2.1 s has 2 101 samples, t = 0, 0.001, …,
-2.099, 2.1; one of T = 1.0765 s has 1 078, the last step 0.5 ms.
+2.099, 2.1; one of T = 1.0765 s has 1 078, the last step 0.0005 s.
 
 The CSV (:func:`csv_text`): a header naming each column and its unit (:func:`csv_header`),
 ``t [s]``, ``q_<joint> [rad]`` (``[m]`` for a prismatic joint), ``qd_<joint> [rad/s]``,
@@ -175,7 +175,7 @@ def sample_member(
     ----------
     result: the planning result.
     member: a row of ``result.front`` in [0, n − 1]; ``None``: ``result.best.index``.
-    dt: time step [s] (default 1 ms), in [T/(MAX_SAMPLES − 1), T] (:func:`fixed_step_times`).
+    dt: time step [s] (default 0.001 s), in [T/(MAX_SAMPLES − 1), T] (:func:`fixed_step_times`).
     allow_uncertified: sample a member that is not certified too.
 
     Returns
