@@ -76,6 +76,10 @@ BUFFERS = (0.0, 0.003, 0.006)
 #: A certified distance below margin + search buffer + DIP_TOLERANCE [m] adds a sample.
 DIP_TOLERANCE = 0.001
 
+#: No buffer is tried when the best move of the rounds is more than FAR [m] inside an
+#: obstacle.
+FAR = 0.02
+
 #: Stretch factors of the fixed-obstacle optimum.
 STRETCHES = (1.0, 1.1, 1.25, 1.5, 2.0)
 
@@ -198,8 +202,8 @@ def refine(problem: at.TrajectoryProblem, x0: np.ndarray, iters: int, rounds: in
             if new.size == 0 and cert.min_distance >= problem.settings.margin:
                 break  # not a distance failure (a torque or a limit): no sample to add
             extra = np.unique(np.r_[extra, new])
-        if iters <= SCREEN_ITERATIONS:
-            break
+        if iters <= SCREEN_ITERATIONS or best[1].min_distance < -FAR:
+            break  # a buffer does not help a move that far inside an obstacle
     return best
 
 
@@ -344,7 +348,7 @@ def main() -> None:
             "scene": scene_arg,
         }
         previous = PREVIOUS.get(key)
-        if previous and (drake is None or previous[0] <= drake):
+        if previous and (drake is None or previous[0] * (1.0 - 1e-4) <= drake):
             entry["T"], entry["source"] = previous[0], previous[1]
         elif drake is not None:
             entry["T"], entry["source"] = drake, "Drake + SNOPT (this script)"
@@ -352,7 +356,7 @@ def main() -> None:
             entry["T"], entry["source"] = None, "no certified move found"
         moves[key] = entry
         if best is not None:
-            vectors[key] = {"T": best["T"], "x": best["x"]}
+            vectors[key] = {"T": best["T"], "source": "Drake + SNOPT", "x": best["x"]}
         print(f"{key}: best certified T = {drake} s (best known {entry['T']})", flush=True)
         moves_path.write_text(json.dumps(moves, indent=2) + "\n")
         vectors_path.write_text(json.dumps(vectors, indent=1) + "\n")

@@ -70,12 +70,21 @@ def test_the_crane_load_blocks_the_goal_pose_when_it_passes() -> None:
         assert list(d < problem.settings.margin) == expected
 
 
-@pytest.mark.slow  # ~4 s per scene: a 1 kHz certificate and a coal loop over its samples
-@pytest.mark.parametrize("name", sorted(VECTORS))
-def test_the_reference_move_is_certified(name: str) -> None:
+#: The stored moves of the unseen scenes: (scene, vector key, the reference_moves field
+#: holding its T); ``<scene>_drake`` is Drake's move where the best known one is not.
+STORED = [
+    (key.removesuffix("_drake"), key, "drake_T" if key.endswith("_drake") else "T")
+    for key in sorted(VECTORS)
+    if key.removesuffix("_drake") in SCENES
+]
+
+
+@pytest.mark.slow  # ~4 s per move: a 1 kHz certificate and a coal loop over its samples
+@pytest.mark.parametrize(("name", "key", "field"), STORED)
+def test_the_reference_move_is_certified(name: str, key: str, field: str) -> None:
     problem = problem_of(name)
-    x = np.array(VECTORS[name]["x"], dtype=float)
-    assert MOVES[name]["drake_T"] == pytest.approx(x[0], abs=1e-6)
+    x = np.array(VECTORS[key]["x"], dtype=float)
+    assert MOVES[name][field] == pytest.approx(x[0], abs=1e-6)
     c = certify(problem, x)
     assert c.feasible, c.violations
     best, _ = coal_min_distances(problem, c.dense.q, c.dense.t)
