@@ -1,8 +1,11 @@
 """Optimal where obstacles bind (issue #24): the fastest certified move of NSGA-II, MODE
-and the time-optimal mode against the best known move, on the paper and detour scenes.
+and the time-optimal mode against the best known move, on the paper and detour scenes and
+on scene files the project was not tuned on.
 
-Run: ``python benchmarks/bench_hard.py [--scenes paper,detour] [--seeds 1-5]
-[--algorithms nsga2,mode,time-optimal] [--out DIR]``.
+Run: ``python benchmarks/bench_hard.py [--scenes paper,detour] [--scene-file FILE ...]
+[--seeds 1-5] [--algorithms nsga2,mode,time-optimal] [--out DIR]``; e.g. the two unseen
+scenes: ``--scenes "" --scene-file benchmarks/scenes/wall_crane.toml --scene-file
+benchmarks/scenes/post_two_pendulums.toml``.
 
 Every run is the command as a user types it (``adept-traj plan --scene S --algorithm A
 --seed N --out DIR --quiet``, the paper's budgets: NSGA-II 100 × 100, MODE 500 × 100), timed
@@ -10,14 +13,20 @@ as a whole process; the fastest certified travel time is read back from its
 ``result.json`` (``front.feasible`` is the certificate's verdict). Each is printed as a
 ratio to the scene's best known move (:data:`BEST_KNOWN`) with the target ≤ 1.01 on every
 seed, and the time-optimal mode's wall time against its targets (≤ 1.5 s on the paper
-scene, ≤ 5 s on detour). A run that beats the best known move is reported as such: the
-best known value is then the new one (``docs/detour-scene.md`` says how each was found).
+scene, ≤ 5 s on detour; none on the other scenes). A run that beats the best known move is
+reported as such: the best known value is then the new one. The best known moves are read
+from ``benchmarks/results/reference_moves.json`` (written by
+``benchmarks/reference_drake.py``; ``docs/reference-moves.md`` says how each was made);
+:data:`BEST_KNOWN` holds the paper's and detour's values if that file lacks them. Every
+run that ends with no certified move or above 1.01 × the best known move is listed at the
+end with the command that reproduces it.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 import subprocess
 import tempfile
@@ -27,7 +36,11 @@ from pathlib import Path
 from _results import figure, recorded  # benchmarks/_results.py
 from _timing import load_average
 
-#: The best known move of each scene [s] and where it comes from (docs/detour-scene.md).
+#: The reference moves written by benchmarks/reference_drake.py.
+REFERENCE_MOVES = Path(__file__).parent / "results" / "reference_moves.json"
+
+#: The best known move of each shipped scene [s] and where it comes from
+#: (docs/reference-moves.md), used where REFERENCE_MOVES lacks the scene.
 BEST_KNOWN = {
     "paper": (1.0766, "Drake KTO + SNOPT (issue #12); adept_traj 1.0765924 s"),
     "detour": (
@@ -39,6 +52,17 @@ BEST_KNOWN = {
 
 #: Wall-time targets of the time-optimal mode [s].
 TIME_OPTIMAL_TARGET = {"paper": 1.5, "detour": 5.0}
+
+
+def best_known() -> dict[str, tuple[float, str]]:
+    """(T [s], source) of every scene with a best known move: :data:`BEST_KNOWN` updated
+    by :data:`REFERENCE_MOVES` (its ``T`` and ``source`` per scene key, the file stem)."""
+    known = dict(BEST_KNOWN)
+    if REFERENCE_MOVES.exists():
+        for key, entry in json.loads(REFERENCE_MOVES.read_text()).items():
+            if entry.get("T") is not None:
+                known[key] = (float(entry["T"]), str(entry["source"]))
+    return known
 
 
 def seeds(text: str) -> list[int]:
@@ -72,37 +96,63 @@ def run(scene: str, algorithm: str, seed: int, out: Path) -> tuple[float, float,
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scenes", default="paper,detour")
+    parser.add_argument("--scenes", default="paper,detour", help="shipped scene names")
+    parser.add_argument(
+        "--scene-file",
+        action="append",
+        default=[],
+        type=Path,
+        help="a scene TOML file (repeatable); its best known move is looked up by its stem",
+    )
     parser.add_argument("--seeds", default="1-5")
     parser.add_argument("--algorithms", default="nsga2,mode,time-optimal")
     parser.add_argument("--out", type=Path, default=None, help="keep the result folders here")
     args = parser.parse_args()
     base = args.out or Path(tempfile.mkdtemp(prefix="bench_hard_"))
+    known = best_known()
+    scenes = [(name, name) for name in args.scenes.split(",") if name]
+    scenes += [(path.stem, str(path)) for path in args.scene_file]
+    for key, _ in scenes:
+        if key not in known:
+            raise SystemExit(
+                f"no best known move for scene '{key}' in {REFERENCE_MOVES} or BEST_KNOWN: "
+                "run benchmarks/reference_drake.py on it first"
+            )
     print(f"load average before: {load_average()}")
-    for scene in args.scenes.split(","):
-        best, source = BEST_KNOWN[scene]
-        print(f"\n{scene}: best known {best:.4f} s ({source})")
+    flagged = []
+    for key, scene in scenes:
+        best, source = known[key]
+        print(f"\n{key}: best known {best:.4f} s ({source})")
         print(f"{'algorithm':<14}{'seed':>5}{'T [s]':>10}{'ratio':>8}{'wall [s]':>10}{'exit':>6}")
         for algorithm in args.algorithms.split(","):
             ratios, walls = [], []
             for seed in seeds(args.seeds):
-                folder = base / f"{scene}-{algorithm}-{seed}"
+                folder = base / f"{key}-{algorithm}-{seed}"
                 T, wall, status = run(scene, algorithm, seed, folder)
                 ratios.append(T / best)
                 walls.append(wall)
                 flag = "  (faster than the best known)" if best * (1 - 1e-4) > T else ""
+                if math.isnan(T) or T / best > 1.01:  # NaN: no certified move
+                    flag = "  NO CERTIFIED MOVE" if math.isnan(T) else "  > 1.01 x the best known"
+                    flagged.append(
+                        f"{key} {algorithm} seed {seed}: {flag.strip()} "
+                        f"(T = {T:.4f} s, exit {status}, {wall:.0f} s wall): "
+                        f"adept-traj plan --scene {scene} --algorithm {algorithm} "
+                        f"--seed {seed} --out {folder} --quiet --overwrite"
+                    )
                 print(
                     f"{algorithm:<14}{seed:>5}{T:>10.4f}{T / best:>8.3f}{wall:>10.1f}"
                     f"{status:>6}{flag}",
                     flush=True,
                 )
+            worst = max(ratios, key=lambda r: (math.isnan(r), r))  # NaN: none certified
             line = (
-                f"  {algorithm}: worst ratio {max(ratios):.3f} (target ≤ 1.01: "
-                f"{'met' if max(ratios) <= 1.01 else 'NOT met'}), median wall "
+                f"  {algorithm}: worst ratio {worst:.3f} (target ≤ 1.01: "
+                f"{'met' if worst <= 1.01 else 'NOT met'}), median wall "
                 f"{statistics.median(walls):.1f} s"
             )
-            if algorithm == "time-optimal":
-                target = TIME_OPTIMAL_TARGET[scene]
+            if algorithm == "time-optimal" and key in TIME_OPTIMAL_TARGET:
+                target = TIME_OPTIMAL_TARGET[key]
                 met = "met" if statistics.median(walls) <= target else "NOT met"
                 line += f" (target ≤ {target} s: {met})"
             print(line)
@@ -120,6 +170,10 @@ def main() -> None:
                 runs=[round(w, 2) for w in walls],
             )  # fmt: skip
     print(f"\nload average after: {load_average()}; result folders in {base}")
+    if flagged:
+        print("\nruns with no certified move or above 1.01 x the best known (to reproduce):")
+        for line in flagged:
+            print(f"  {line}")
 
 
 if __name__ == "__main__":
