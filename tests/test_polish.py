@@ -98,13 +98,14 @@ def test_minimum_time_from_the_straight_move_reaches_drakes_optimum(problem) -> 
     """From the straight move, SLSQP reaches Drake's T (within 0.1 %), at ≥ the kinematic
     lower bound, and the move passes the 1 kHz certificate with the continuous guarantee;
     the same start gives the same vector, and the T the central-difference derivatives
-    gave before the analytic ones (1.0765924346 s)."""
+    gave before the analytic ones (1.0765924346 s) to 1e-7 s (the elastic first solve from
+    outside the rows, issue #24, ends 4e-8 s above it)."""
     first = time_optimal(problem, seed=1, n_starts=1)[0]
     again = time_optimal(problem, seed=1, n_starts=1)[0]
     np.testing.assert_array_equal(first.x, again.x)
     assert first.feasible
     assert problem.lower_bound.T_min <= first.x[0] <= 1.001 * DRAKE_T
-    assert first.x[0] == pytest.approx(1.0765924346, abs=1e-9)
+    assert first.x[0] == pytest.approx(1.0765924346, abs=1e-7)
     assert certify(problem, first.x, rate_hz=1000.0).certified
 
 

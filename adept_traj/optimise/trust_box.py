@@ -3,9 +3,11 @@ r"""The trust-box SQP of the certified local solver
 the smooth per-sample rows of :func:`~adept_traj.problem.local_constraints`.
 
 :func:`trust_box_solve` runs scipy's SLSQP first over the whole decision domain (from a
-start near its optimum, as on the paper scene, a few iterations reach it), then in **trust
-boxes** around the current point (half-width :data:`BOX` of each control point's range and
-:data:`BOX_T` of T), each on the **elastic** problem
+start near its optimum, as on the paper scene, a few iterations reach it; from a start
+outside the rows on the elastic problem below, whose subproblem stays compatible there:
+``docs/engine.md``), then in **trust boxes** around the current point (half-width
+:data:`BOX` of each control point's range and :data:`BOX_T` of T), each on the **elastic**
+problem
 
 .. math::
     \min_{x, e} \; T + \mu e \quad \text{s.t.} \quad g_k(x) \le e - \tau \ \ (k \in W),
@@ -55,11 +57,6 @@ BOX, BOX_T = 0.10, 0.20
 #: SLSQP iterations per box, and of the first solve over the whole domain (from a start
 #: near its optimum, as on the paper scene, that solve converges in 3–10).
 _BOX_ITERATIONS, _FREE_ITERATIONS = 10, 15
-
-#: SLSQP iterations of the first solve from a start outside the rows (from the paper
-#: scene's straight move, through cube 1, it converges in 4–5; from one through the detour
-#: scene's post it never does).
-_FREE_ITERATIONS_OUTSIDE = 8
 
 #: Rows kept in a box's working set: those whose linear bound reaches −slack.
 _ROW_SLACK = 0.05
@@ -126,11 +123,10 @@ def trust_box_solve(
         live = ((g + np.abs(J) @ half > -_ROW_SLACK) | binding) & np.any(J != 0.0, axis=1)
         free = beta == math.inf
         iterations = _FREE_ITERATIONS if free else _BOX_ITERATIONS
-        if free and inside is None:
-            iterations = _FREE_ITERATIONS_OUTSIDE
+        elastic = not free or inside is None  # from outside: elastic over the whole domain too
         for _ in range(_WORKING_SET_ROUNDS):
             found, violated, converged = _box_solve(
-                problem, x, extra, buffer, lower, upper, live, iterations, free is False, counts
+                problem, x, extra, buffer, lower, upper, live, iterations, elastic, counts
             )
             binding |= violated & ~live
             progress = found is not None and (inside is None or found[0] < inside[0])
