@@ -15,7 +15,7 @@ ratio to the scene's best known move (:data:`BEST_KNOWN`) with the target ≤ 1.
 seed, and the time-optimal mode's wall time against its targets (≤ 1.5 s on the paper
 scene, ≤ 5 s on detour; none on the other scenes). A run that beats the best known move is
 reported as such: the best known value is then the new one. The best known moves are read
-from ``benchmarks/results/reference_moves.json`` (written by
+from ``benchmarks/reference/reference_moves.json`` (written by
 ``benchmarks/reference_drake.py``; ``docs/reference-moves.md`` says how each was made);
 :data:`BEST_KNOWN` holds the paper's and detour's values if that file lacks them. Every
 run that ends with no certified move or above 1.01 × the best known move is listed at the
@@ -37,7 +37,7 @@ from _results import figure, recorded  # benchmarks/_results.py
 from _timing import load_average
 
 #: The reference moves written by benchmarks/reference_drake.py.
-REFERENCE_MOVES = Path(__file__).parent / "results" / "reference_moves.json"
+REFERENCE_MOVES = Path(__file__).parent / "reference" / "reference_moves.json"
 
 #: The best known move of each shipped scene [s] and where it comes from
 #: (docs/reference-moves.md), used where REFERENCE_MOVES lacks the scene.

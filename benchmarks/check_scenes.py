@@ -6,7 +6,7 @@ Run: ``python benchmarks/check_scenes.py [benchmarks/scenes/*.toml]``.
 For each scene file: the straight joint-space move at five travel times, certified
 (``adept_traj.certify``) against the whole scene and against its fixed obstacles alone (the
 wall or the post must block it without the pendulums); then the scene's stored reference
-move (``benchmarks/results/reference_vectors.json``, by the file's stem) certified at
+move (``benchmarks/reference/reference_vectors.json``, by the file's stem) certified at
 1 kHz with the continuous bound and its distances re-checked at 4 kHz by a plain loop —
 Pinocchio placements and one ``coal.distance`` per (robot solid, obstacle) pair and
 sample, the pendulums at their pose at that instant, sharing no code with the checker but
@@ -26,7 +26,7 @@ import pinocchio as pin
 
 import adept_traj as at
 
-VECTORS = Path(__file__).parent / "results" / "reference_vectors.json"
+VECTORS = Path(__file__).parent / "reference" / "reference_vectors.json"
 SCENES = sorted((Path(__file__).parent / "scenes").glob("*.toml"))
 
 

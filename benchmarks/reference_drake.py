@@ -2,7 +2,7 @@
 ``adept_traj.certify`` (issue #24).
 
 Run: ``python benchmarks/reference_drake.py [--scenes paper,detour,FILE.toml,...]
-[--members DIR,...] [--vias N] [--out benchmarks/results]``.
+[--members DIR,...] [--vias N] [--out benchmarks/reference]``.
 
 What it is, exactly. Not Drake's ``KinematicTrajectoryOptimization`` class: a Drake
 ``MathematicalProgram`` over **adept_traj's own decision vector** ``x = [T, free B-spline
@@ -315,7 +315,7 @@ def main() -> None:
     )
     parser.add_argument("--members", default="", help="result folders per scene: a;b,c;...")
     parser.add_argument("--vias", type=int, default=8)
-    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "reference")
     args = parser.parse_args()
     scenes = args.scenes.split(",")
     members = [m.split(";") if m else [] for m in args.members.split(",")] if args.members else []

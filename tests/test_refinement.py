@@ -285,7 +285,7 @@ def test_an_elastic_first_solve_enters_the_rows_from_through_the_crane_load() ->
     """On the unseen wall-and-crane scene the relaxed problem's optimum (no crane load;
     tests/data/wall_crane_moves.json) stretched ×1.1 passes through the swinging load; a
     screening refinement (one round, three boxes) ends certified within 1 % of the best
-    known move (1.7143 s, benchmarks/results/reference_moves.json), its distances re-checked
+    known move (1.7143 s, benchmarks/reference/reference_moves.json), its distances re-checked
     by coal pair by pair. (Before the elastic first solve it found no point inside.)"""
     root = Path(__file__).parent.parent
     scene = at.Scene.from_file(root / "benchmarks" / "scenes" / "wall_crane.toml")

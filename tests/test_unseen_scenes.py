@@ -4,7 +4,7 @@ The scene files are benchmarks, not shipped data; these tests check that they sa
 their comments claim: each loads, its fixed obstacle (the wall, the post) alone blocks the
 straight joint-space move at every speed, the pendulums block the rest poses at the
 stated instants, and the reference move stored for it in
-benchmarks/results/reference_vectors.json is certified — its distances re-checked by
+benchmarks/reference/reference_vectors.json is certified — its distances re-checked by
 coal called pair by pair (``test_verification.coal_min_distances``).
 """
 
@@ -24,8 +24,8 @@ from adept_traj.collision import distance_gradients
 
 BENCHMARKS = Path(__file__).parent.parent / "benchmarks"
 SCENES = {path.stem: path for path in sorted((BENCHMARKS / "scenes").glob("*.toml"))}
-VECTORS = json.loads((BENCHMARKS / "results" / "reference_vectors.json").read_text())
-MOVES = json.loads((BENCHMARKS / "results" / "reference_moves.json").read_text())
+VECTORS = json.loads((BENCHMARKS / "reference" / "reference_vectors.json").read_text())
+MOVES = json.loads((BENCHMARKS / "reference" / "reference_moves.json").read_text())
 
 #: The fixed obstacle of each scene that blocks the straight move.
 BLOCKER = {"wall_crane": "wall", "post_two_pendulums": "post"}
