@@ -64,6 +64,7 @@ def test_bad_input_is_one_line_without_traceback(
     assert re.search(message, err), err
 
 
+@pytest.mark.slow  # ≥ 5 s (the default tier measured 192 s after the merges)
 def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
     # this tiny run's search finds no feasible member; the polish's global stage finds a

@@ -316,6 +316,7 @@ def test_a_population_smaller_than_the_workers_is_cut_into_fewer_chunks() -> Non
     assert one.objectives[0, 1] == os.getpid()
 
 
+@pytest.mark.slow  # ≥ 5 s (the default tier measured 192 s after the merges)
 def test_a_worker_killed_between_populations_is_a_broken_pool() -> None:
     """A worker that died while idle (its pipe broken) is reported as a broken pool, not
     as a bare ``BrokenPipeError``; the next population is evaluated by new workers."""

@@ -76,6 +76,7 @@ def test_untampered_infeasible_result_exits_1_without_mismatch(old, capsys) -> N
     assert "NOT FEASIBLE" in out
 
 
+@pytest.mark.slow  # ≥ 5 s (the default tier measured 192 s after the merges)
 def test_untampered_feasible_run_passes_the_audit(tmp_path: Path) -> None:
     result = _planar_run(tmp_path)
     assert result.feasible
@@ -170,6 +171,7 @@ def test_changed_metric_is_named(old, capsys) -> None:
     assert found == {"metrics.SSM": (repr(2 * ssm), repr(ssm))}
 
 
+@pytest.mark.slow  # ≥ 5 s (the default tier measured 192 s after the merges)
 def test_feasible_run_with_changed_hypervolume_and_robot_file(tmp_path: Path) -> None:
     result = _planar_plan(tmp_path)  # its own parameter file, changed below
     metrics = dataclasses.replace(result.metrics, hv=result.metrics.hv * 0.9)
