@@ -141,6 +141,7 @@ def test_bad_seed(problem: at.TrajectoryProblem) -> None:
         at.plan(problem, seed=-1, pop_size=4, n_gen=1)
 
 
+@pytest.mark.slow  # ≈ 3 s (the default tier measured 192 s after the merges)
 def test_search_buffer_recorded_and_certificate_keeps_margin(
     problem: at.TrajectoryProblem, tmp_path: Path
 ) -> None:
