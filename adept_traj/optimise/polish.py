@@ -32,7 +32,7 @@ from adept_traj.optimise.refinement import (
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
 from adept_traj.optimise.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
-from adept_traj.problem import CONSTRAINT_KINDS, TrajectoryProblem
+from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_integer
 
 __all__ = [
@@ -57,9 +57,6 @@ MAX_BASINS = 3
 
 #: Factors of the fixed-obstacle optimum's T at which :func:`global_starts` offers it.
 STRETCHES = (1.0, 1.1, 1.25)
-
-#: Index of the distance rows in :data:`~adept_traj.problem.CONSTRAINT_KINDS`.
-_DISTANCE = CONSTRAINT_KINDS.index("distance")
 
 
 def time_optimal(
