@@ -34,7 +34,7 @@ from adept_traj.optimise.repair import kinematic_time
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
 from adept_traj.validation import as_integer, as_scalar, as_vector
 
-__all__ = ["PolishOutcome", "minimum_time"]
+__all__ = ["PolishOutcome", "at_kinematic_minimum", "minimum_time"]
 
 #: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.repair`).
 _SLACK = 1e-9
@@ -187,10 +187,18 @@ def _minimum_time(
     )
 
 
-def _evaluated(problem: Any, x: np.ndarray) -> tuple[np.ndarray, Any]:
-    """``x`` (n_var,) clipped to the bounds with T raised to its kinematic minimum, and its
-    evaluation by the problem."""
+def at_kinematic_minimum(problem: Any, x: np.ndarray) -> np.ndarray:
+    """(n_var,) a new copy of ``x`` (n_var,) clipped to the bounds, its T [s] raised to the
+    spline's exact kinematic minimum (:func:`~adept_traj.optimise.kinematic_time`, with a
+    relative slack of 1e-9) where a solver's samples missed a peak, and kept ≤ the upper
+    bound."""
     x = np.clip(x, problem.xl, problem.xu)
     t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
     x[0] = min(max(x[0], t_kin), problem.xu[0])
+    return x
+
+
+def _evaluated(problem: Any, x: np.ndarray) -> tuple[np.ndarray, Any]:
+    """:func:`at_kinematic_minimum` of ``x`` and its evaluation by the problem."""
+    x = at_kinematic_minimum(problem, x)
     return x, problem.evaluate_batch(x)

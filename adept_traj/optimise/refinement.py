@@ -57,7 +57,7 @@ import numpy as np
 
 from adept_traj.analysis.member_certificate import MemberCertificate, certify_member
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.repair import kinematic_time
+from adept_traj.optimise.minimum_time import at_kinematic_minimum
 from adept_traj.optimise.trust_box import SolveCounts, trust_box_solve
 from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_integer, as_scalar, as_vector
@@ -100,9 +100,6 @@ SCREEN_BOXES, SCREEN_KEEP = 3, 2
 #: Most adaptive samples of one refinement (each adds one distance row per obstacle and
 #: two torque rows per joint).
 MAX_EXTRA_SAMPLES = 400
-
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.polish`).
-_SLACK = 1e-9
 
 #: Samples closer than this (normalised time) to an existing one are not added.
 _SAMPLE_GAP = 2e-4
@@ -363,11 +360,9 @@ def _failing_samples(problem: Any, certificate: Any, existing: np.ndarray) -> np
 
 
 def _evaluated(problem: Any, x: np.ndarray) -> tuple[np.ndarray, Any]:
-    """``x`` (n_var,) clipped to the bounds with T raised to its kinematic minimum, and its
-    evaluation by the problem."""
-    x = np.clip(x, problem.xl, problem.xu)
-    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
-    x[0] = min(max(x[0], t_kin), problem.xu[0])
+    """:func:`~adept_traj.optimise.minimum_time.at_kinematic_minimum` of ``x`` (n_var,),
+    refused unless its T is finite, and its evaluation by the problem."""
+    x = at_kinematic_minimum(problem, x)
     if not math.isfinite(x[0]):
         raise ConfigurationError(f"the refined travel time is not finite: {x[0]}")
     return x, problem.evaluate_batch(x)
