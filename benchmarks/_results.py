@@ -38,6 +38,8 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from adept_traj.problem import available_cores
+
 RESULTS = Path(__file__).resolve().parent / "results"
 
 _current: dict[str, Any] | None = None
@@ -53,13 +55,9 @@ def machine() -> dict[str, Any]:
                 break
     except OSError:
         pass
-    try:
-        available = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        available = os.cpu_count() or 1
     return {
         "cpu": model,
-        "cores_available": available,
+        "cores_available": available_cores(),
         "cores": os.cpu_count(),
         "python": platform.python_version(),
         "os": f"{platform.system()} {platform.release()}",

@@ -28,8 +28,6 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import os
-import platform
 import shutil
 import statistics
 import subprocess
@@ -40,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 from _results import figure, recorded  # benchmarks/_results.py
+from _results import machine as results_machine
 from _timing import load_average  # benchmarks/_timing.py
 from cell_scene import cell_scene  # benchmarks/cell_scene.py
 
@@ -60,18 +59,11 @@ print(len(paths), time.perf_counter() - t1)
 
 
 def machine() -> str:
-    """CPU model, cores available / in the machine, Python and OS."""
-    model = platform.processor() or "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    """CPU model, cores available / in the machine, Python and OS (:func:`_results.machine`)."""
+    m = results_machine()
     return (
-        f"{model}; {available_cores()} cores available of {os.cpu_count()}; "
-        f"Python {platform.python_version()}; {platform.system()} {platform.release()}; "
+        f"{m['cpu']}; {m['cores_available']} cores available of {m['cores']}; "
+        f"Python {m['python']}; {m['os']}; "
         f"load average at start {load_average()} (other jobs on the machine slow every figure)"
     )
 
