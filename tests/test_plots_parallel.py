@@ -80,17 +80,22 @@ def test_an_error_of_a_figure_in_a_worker_is_raised_here(
     assert children() == []  # every worker reaped
 
 
-def test_a_killed_worker_has_its_figures_drawn_here(
-    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    parent = os.getpid()
+def _killed_outside(parent: int, name: str):
+    """A fake figure ``name`` whose drawing kills its process unless it is ``parent``."""
 
     def draw(_results, path, **_kwargs):
         if os.getpid() != parent:
             os.kill(os.getpid(), signal.SIGKILL)
-        return _fake("joint_motion")(_results, path)
+        return _fake(name)(_results, path)
 
-    _patch(monkeypatch, joint_motion=draw)
+    return draw
+
+
+def test_a_killed_worker_has_its_figures_drawn_here(
+    result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parent = os.getpid()
+    _patch(monkeypatch, joint_motion=_killed_outside(parent, "joint_motion"))
     paths = plots.save_all(result, tmp_path, processes=2)
     assert _writers(paths)["joint_motion_nsga2.png"] == parent
     assert children() == []
@@ -179,13 +184,7 @@ def test_a_killed_forked_process_has_its_figures_drawn_here(
     result: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     parent = os.getpid()
-
-    def draw(_results, path, **_kwargs):
-        if os.getpid() != parent:
-            os.kill(os.getpid(), signal.SIGKILL)
-        return _fake("tool_path_3d")(_results, path)
-
-    _patch(monkeypatch, tool_path_3d=draw)
+    _patch(monkeypatch, tool_path_3d=_killed_outside(parent, "tool_path_3d"))
     paths = plots.start_save_all(result, tmp_path, processes=1).wait()
     assert _writers(paths)["tool_path_nsga2.png"] == parent
 
