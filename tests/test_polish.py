@@ -12,7 +12,7 @@ from adept_traj.optimise import (
     RampSampling,
     minimum_time,
     near_lower_bound,
-    refine_minimum_time,
+    screen_starts,
     time_optimal,
 )
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
@@ -121,12 +121,13 @@ def small_runs(problem: TrajectoryProblem):
 def test_plan_polishes_the_fastest_feasible_member(problem, small_runs) -> None:
     """The polished run's front holds the certified refinement of the unpolished run's
     fastest feasible member (same seed: same population; its basin is the fastest, and its
-    refinement reaches the kinematic bound to 1 %, so no other basin is refined), faster
-    than every unpolished member; its evaluations are the run's plus the solver's."""
+    screening — one round of the certified solver — reaches the kinematic bound to 1 %, so
+    no other basin is screened and nothing is refined further), faster than every
+    unpolished member; its evaluations are the run's plus the screening's."""
     raw, polished = small_runs
     ok = np.flatnonzero(np.all(raw.front.constraints <= 0.0, axis=1))
     start = raw.front.x[ok[np.argmin(raw.front.x[ok, 0])]]
-    expected = refine_minimum_time(problem, start)
+    expected = screen_starts(problem, start[None])[0]
     assert near_lower_bound(problem, [expected])  # the only basin refined (paper scene)
     rows = np.flatnonzero(np.all(polished.front.x == expected.x, axis=1))
     assert len(rows) == 1

@@ -37,8 +37,9 @@ The returned move is the fastest certified one met (the start itself when it is 
 and nothing faster is): **never worse than a certified start, and never uncertified when
 the start was certified**.
 
-The solve is :func:`~adept_traj.optimise.trust_box.trust_box_solve` (SLSQP over the whole
-domain, then in elastic trust boxes; its module says why). A start outside the rows (the
+The solve is :func:`~adept_traj.optimise.trust_box.trust_box_solve` (an SQP,
+:func:`~adept_traj.optimise.sqp.sqp`, over the whole domain, then in elastic trust boxes;
+its module says why). A start outside the rows (the
 straight move through an obstacle) is solved from too; a refinement that finds no point
 inside the rows ends at once with the start (``certified`` False).
 
@@ -121,7 +122,7 @@ class Refinement:
     start_certified: whether the start passed its certificate.
     start_certificate: the summary of the start's certificate.
     n_rounds: certify-and-resample rounds.
-    n_iterations: SLSQP iterations, all rounds and boxes.
+    n_iterations: SQP iterations, all rounds and boxes.
     n_evaluations: constraint-and-Jacobian evaluations plus evaluator calls.
     extra_samples: (k,) the adaptive samples [normalised time] of the last solve.
     buffer: the extra distance buffer [m] of the last solve.

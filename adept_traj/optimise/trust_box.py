@@ -2,7 +2,8 @@ r"""The trust-box SQP of the certified local solver
 (:func:`~adept_traj.optimise.refine_minimum_time`): the fastest move near a start inside
 the smooth per-sample rows of :func:`~adept_traj.problem.local_constraints`.
 
-:func:`trust_box_solve` runs scipy's SLSQP first over the whole decision domain (from a
+:func:`trust_box_solve` runs the SQP of :func:`~adept_traj.optimise.sqp.sqp` (Kraft's
+SLSQP method, DAQP for its subproblem) first over the whole decision domain (from a
 start near its optimum, as on the paper scene, a few iterations reach it; from a start
 outside the rows on the elastic problem below, whose subproblem stays compatible there:
 ``docs/engine.md``), then in **trust boxes** around the current point (half-width
@@ -14,11 +15,11 @@ problem
     \quad e \ge 0, \quad x \in \text{box},
 
 over a working set W of the rows that may bind inside the box by their linear bound
-(SLSQP's subproblem costs grow with its rows; a left-out row that binds at the answer is
+(the subproblem's cost grows with its rows; a left-out row that binds at the answer is
 added and the box solved again). The box keeps a step from jumping through a thin obstacle
 (a pendulum's rod), where the linearised distance rows mislead; the elastic e keeps the
-linearisations compatible from a start outside the rows (SLSQP's plain subproblem becomes
-"incompatible" there and stops, measured on the detour scene). When SLSQP's answer lies
+linearisations compatible from a start outside the rows (the plain subproblem becomes
+infeasible there and the solve stops, measured on the detour scene). When the answer lies
 outside the rows, shorter steps towards it (:data:`FRACTIONS`) are tried. The next box is
 centred at the fastest point met inside every row; a box without progress is followed by
 one half as wide, and a second one ends the solve (a local optimum).
@@ -32,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.optimise.sqp import sqp
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
 
 __all__ = ["BOX", "BOX_T", "FRACTIONS", "SolveCounts", "constraint_rows", "trust_box_solve"]
@@ -42,7 +44,7 @@ _DISTANCE = CONSTRAINT_KINDS.index("distance")
 #: Penalty μ of the elastic variable [s per unit of normalised violation].
 _PENALTY = 100.0
 
-#: Tightening τ of the rows handed to SLSQP (normalised units): its answers then lie
+#: Tightening τ of the rows handed to the SQP (normalised units): its answers then lie
 #: inside the rows, not on them to rounding.
 _TIGHTEN = 1e-7
 
@@ -54,7 +56,7 @@ _INSIDE = 1e-8
 #: point's range, and of T (the T part scaled with it when the box shrinks).
 BOX, BOX_T = 0.10, 0.20
 
-#: SLSQP iterations per box, and of the first solve over the whole domain (from a start
+#: SQP iterations per box, and of the first solve over the whole domain (from a start
 #: near its optimum, as on the paper scene, that solve converges in 3–10).
 _BOX_ITERATIONS, _FREE_ITERATIONS = 10, 15
 
@@ -62,7 +64,7 @@ _BOX_ITERATIONS, _FREE_ITERATIONS = 10, 15
 _ROW_SLACK = 0.05
 
 #: Fractions of the way from the box's start to the solver's answer that are tried, in
-#: turn, when the answer lies outside the rows (SLSQP meets the nonlinear rows only to
+#: turn, when the answer lies outside the rows (the SQP meets the nonlinear rows only to
 #: first order; a shorter step in its direction often stays inside).
 FRACTIONS = 0.5 ** np.arange(6)
 
@@ -76,7 +78,7 @@ _PROGRESS = 1e-4
 
 
 class SolveCounts:
-    """Work done by one refinement: SLSQP iterations, constraint-and-Jacobian and
+    """Work done by one refinement: SQP iterations, constraint-and-Jacobian and
     evaluator calls, and the seconds spent in them [s] (mutable counters)."""
 
     def __init__(self) -> None:
@@ -164,11 +166,9 @@ def _box_solve(
     elastic: bool,
     counts: SolveCounts,
 ) -> tuple[np.ndarray | None, np.ndarray, bool]:
-    """SLSQP in the box on min T, g_live ≤ 0 or (``elastic``) on min T + μ e,
+    """The SQP in the box on min T, g_live ≤ 0 or (``elastic``) on min T + μ e,
     g_live ≤ e − τ, e ≥ 0: the fastest point met inside every row (``None``: none), the
-    rows violated at the solver's answer (bool (m,)) and whether SLSQP converged."""
-    from scipy.optimize import minimize  # lazy: scipy.optimize is heavy
-
+    rows violated at the solver's answer (bool (m,)) and whether the SQP converged."""
     n = problem.n_var
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
     best: list[Any] = [None]
@@ -184,47 +184,35 @@ def _box_solve(
         return cache[key]
 
     g0 = rows(x)[0]
-    m = int(live.sum())
-    if elastic:  # y = [x, e]
+    if elastic:  # y = [x, e]: g_live − e + τ ≤ 0, e ≥ 0
         cost = np.zeros(n + 1)
         cost[0], cost[-1] = 1.0, _PENALTY
         y0 = np.concatenate([x, [max(0.0, float(np.max(g0[live], initial=0.0)))]])
-        bounds = [*zip(lower, upper), (0.0, None)]
+        low, high = np.append(lower, 0.0), np.append(upper, np.inf)
+        column = -np.ones((int(live.sum()), 1))
 
-        def fun(y: np.ndarray) -> np.ndarray:
-            return y[-1] - rows(y)[0][live] - _TIGHTEN
+        def constraints(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            g, J = rows(y)
+            return g[live] - y[-1] + _TIGHTEN, np.hstack([J[live], column])
 
-        def jac(y: np.ndarray) -> np.ndarray:
-            return np.hstack([-rows(y)[1][live], np.ones((m, 1))])
-
-    else:  # y = x
+    else:  # y = x: g_live ≤ 0
         cost = np.zeros(n)
         cost[0] = 1.0
-        y0, bounds = x, list(zip(lower, upper))
+        y0, low, high = x, lower, upper
 
-        def fun(y: np.ndarray) -> np.ndarray:
-            return -rows(y)[0][live]
+        def constraints(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            g, J = rows(y)
+            return g[live], J[live]
 
-        def jac(y: np.ndarray) -> np.ndarray:
-            return -rows(y)[1][live]
-
-    res = minimize(
-        lambda y: float(cost @ y),
-        y0,
-        jac=lambda y: cost,
-        method="SLSQP",
-        bounds=bounds,
-        constraints=[{"type": "ineq", "fun": fun, "jac": jac}],  # scipy: fun(y) ≥ 0
-        options={"maxiter": iterations, "ftol": 1e-10},
-    )
+    res = sqp(cost, y0, low, high, constraints, max_iter=iterations, tol=1e-10)
     counts.iterations += int(res.nit)
     end = np.clip(res.x[:n], problem.xl, problem.xu)
     g_end = rows(end)[0]
     if best[0] is not None and best[0][0] <= end[0]:
-        return best[0], g_end > _INSIDE, bool(res.status == 0)
+        return best[0], g_end > _INSIDE, res.converged
     start = best[0] if best[0] is not None else x
     for fraction in FRACTIONS[1:]:  # the answer is outside: the way to it, shorter
         if np.max(g_end) <= _INSIDE or (best[0] is not None and best[0][0] <= end[0]):
             break
         rows(start + fraction * (end - start))
-    return best[0], g_end > _INSIDE, bool(res.status == 0)
+    return best[0], g_end > _INSIDE, res.converged
