@@ -7,7 +7,9 @@ the finish (:class:`~adept_traj.viz.finisher.Finisher`), the figures
 (:func:`~adept_traj.viz.plots.save_all`, :func:`~adept_traj.viz.plots.start_save_all`),
 the polish (:class:`~adept_traj.optimise.Polisher`) and the front's certificates
 (:class:`~adept_traj.optimise.EarlyCertificates`,
-:func:`~adept_traj.optimise.certify_front_members`) are workers; only Dask (cycles, seed
+:func:`~adept_traj.optimise.certify_front_members`) and the local solver's screenings and
+refinements (:func:`map_forked` in :func:`~adept_traj.optimise.screen_starts`,
+:func:`~adept_traj.optimise.refine_starts`) are workers; only Dask (cycles, seed
 studies) and meshcat's viewer run processes of their own.
 
 Every worker, the same way:
@@ -51,7 +53,7 @@ import sys
 import threading
 import traceback
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection, Pipe
 from typing import Any
 
@@ -68,6 +70,7 @@ __all__ = [
     "Worker",
     "can_fork",
     "children",
+    "map_forked",
     "prepare_quietly",
     "serve",
 ]
@@ -159,6 +162,32 @@ def serve(channel: Channel, function: Callable[..., Any]) -> None:
     send back ``function(*args)``, until the caller closes the pipe."""
     while True:
         channel.send(function(*channel.recv()))
+
+
+def map_forked(function: Callable[[Any], Any], items: Sequence[Any], processes: int) -> list:
+    """``[function(item) for item in items]`` on up to ``processes`` processes at once:
+    the first item of every group of ``processes`` in this one, the others each in a
+    :class:`Worker` forked for it (it inherits ``function``; its value comes back
+    pickled, its error is raised here). In order; the same values as the loop when
+    ``function`` is deterministic. One process (or no ``fork``): the loop itself."""
+    out: list = []
+    step = max(1, int(processes)) if can_fork() else 1
+    for i in range(0, len(items), step):
+        forked: list[Worker] = []
+        try:
+            for item in items[i + 1 : i + step]:
+                forked.append(Worker(_call, function, item, note="raised in map_forked"))
+            out.append(function(items[i]))
+            out.extend(worker.recv() for worker in forked)
+        finally:  # Ctrl-C or an error included: the workers are stopped at once
+            for worker in forked:
+                worker.close()
+    return out
+
+
+def _call(channel: Channel, function: Callable[[Any], Any], item: Any) -> None:
+    """A worker of :func:`map_forked`: send ``function(item)``."""
+    channel.send(function(item))
 
 
 class Worker:

@@ -26,6 +26,7 @@ from adept_traj.process_pool import (
     Channel,
     Worker,
     children,
+    map_forked,
     prepare_quietly,
     serve,
 )
@@ -284,3 +285,24 @@ def test_a_killed_plan_command_leaves_no_process_behind(tmp_path: Path) -> None:
                 time.sleep(0.01)
     finally:
         os.close(fd)
+
+
+def test_map_forked_is_the_loop_in_order_and_raises_a_workers_error() -> None:
+    """map_forked: the values of the plain loop, in order, for every group size; the
+    values are computed in other processes (their pids differ from this one's, except the
+    first of each group); an error raised in a worker is raised here."""
+    items = list(range(7))
+    for processes in (1, 2, 3, 8):
+        out = map_forked(lambda k: (k * k, os.getpid()), items, processes)
+        assert [v for v, _ in out] == [k * k for k in items]
+        here = [k for k, (_, pid) in enumerate(out) if pid == os.getpid()]
+        assert here == list(range(0, len(items), processes))
+
+    def fails(k: int) -> int:
+        if k == 1:
+            raise ValueError("item 1 is bad")
+        return k
+
+    with pytest.raises(ValueError, match="item 1 is bad"):
+        map_forked(fails, [0, 1], 2)
+    assert children() == []  # every worker reaped

@@ -25,6 +25,8 @@ from adept_traj.optimise import (
     basin_labels,
     near_lower_bound,
     refine_minimum_time,
+    refine_starts,
+    screen_starts,
     time_optimal,
     via_point_starts,
 )
@@ -107,6 +109,36 @@ def test_refinement_of_a_certified_paper_move(problem) -> None:
     assert problem.lower_bound.T_min <= first.x[0] <= 1.001 * 1.0766
     assert certify(problem, first.x).certified  # the exact certificate agrees
     assert first.certificate == certify_members(problem, first.x[None])[0]
+
+
+def test_screening_on_two_processes_is_screening_one_at_a_time(problem) -> None:
+    """screen_starts with processes=2 (the second start refined in a forked worker): the
+    same moves, bit for bit, and the same counts as one at a time; the stop rule asked in
+    order (a stop at the first start drops the second's); refine_starts: the slow test
+    below."""
+    starts = np.stack([lift_then_lower(problem, 2.1), lift_then_lower(problem, 2.6)])
+    one = screen_starts(problem, starts, processes=1, max_boxes=2)
+    two = screen_starts(problem, starts, processes=2, max_boxes=2)
+    assert len(one) == len(two) == 2
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert (a.n_evaluations, a.certificate) == (b.n_evaluations, b.certificate)
+    stopped = screen_starts(problem, starts, processes=2, max_boxes=2, stop=lambda o: True)
+    assert len(stopped) == 1
+    np.testing.assert_array_equal(stopped[0].x, one[0].x)
+
+
+@pytest.mark.slow  # ~4 s: two screenings and two full refinements, twice
+def test_full_refinements_on_two_processes_are_those_one_at_a_time(problem) -> None:
+    """refine_starts with processes=2: the same moves and counts as one at a time."""
+    starts = np.stack([lift_then_lower(problem, 2.1), lift_then_lower(problem, 2.6)])
+    screened = screen_starts(problem, starts, processes=1, max_boxes=2)
+    one = refine_starts(problem, screened, processes=1)
+    two = refine_starts(problem, screened, processes=2)
+    assert len(one) == len(two) == 2
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert (a.n_evaluations, a.certificate) == (b.n_evaluations, b.certificate)
 
 
 @pytest.mark.slow  # ~10 s: one refinement on the detour scene, a 4 kHz coal loop

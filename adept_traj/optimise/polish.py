@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -60,7 +61,13 @@ STRETCHES = (1.0, 1.1, 1.25)
 
 
 def time_optimal(
-    problem: Any, seed: int = 1, n_starts: int = 4, *, rate_hz: float = 1000.0, **options: Any
+    problem: Any,
+    seed: int = 1,
+    n_starts: int = 4,
+    *,
+    rate_hz: float = 1000.0,
+    processes: int | None = None,
+    **options: Any,
 ) -> list[Refinement]:
     """Refinements (:func:`~adept_traj.optimise.refine_minimum_time`) from the straight
     move and the ``n_starts − 1`` kinematically fastest of ``8 (n_starts − 1)`` seeded
@@ -84,6 +91,8 @@ def time_optimal(
         Number of starts (≥ 1).
     rate_hz:
         Rate [Hz] of the certificates (> 0).
+    processes:
+        Refinements run at once (≥ 1; default: the problem's ``workers``).
     options:
         ``max_boxes`` of the screening (:func:`~adept_traj.optimise.screen_starts`).
     """
@@ -91,16 +100,17 @@ def time_optimal(
     n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
     near = functools.partial(near_lower_bound, problem)
     starts = _feasible_first(problem, _starts(problem, seed, n_starts))
-    screened = screen_starts(problem, starts[:1], rate_hz=rate_hz, stop=near, **options)
+    options = {"rate_hz": rate_hz, "processes": processes, **options}
+    screened = screen_starts(problem, starts[:1], stop=near, **options)
     if not near(screened):  # the relaxed problem's optimum before the other starts
-        stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz)
+        stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes)
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        for more in (stage.relaxed, starts[1:], stage.via):
-            if not near(screened):
-                screened += screen_starts(problem, more, rate_hz=rate_hz, stop=near, **options)
+        for more in (lambda: stage.relaxed, lambda: starts[1:], lambda: stage.via):
+            if not near(screened):  # the via points drawn only if still needed
+                screened += screen_starts(problem, more(), stop=near, **options)
     if near(screened):
         return screened
-    return screened + refine_starts(problem, screened, rate_hz=rate_hz)
+    return screened + refine_starts(problem, screened, rate_hz=rate_hz, processes=processes)
 
 
 @dataclass(frozen=True)
@@ -112,17 +122,23 @@ class GlobalStage:
     relaxed:
         (k, n_var) the relaxed problem's fastest certified move at :data:`STRETCHES` × its
         T (k = 0 without moving obstacles, or when the relaxed problem has none).
-    via:
-        (m, n_var) the via-point moves and ramps of
-        :func:`~adept_traj.optimise.via_point_starts`.
     floor:
         The relaxed problem's fastest certified T [s] (0 when there is none): the floor of
         :func:`~adept_traj.optimise.near_lower_bound`.
+    make_via:
+        Makes :attr:`via` when it is first asked for (a search that ends at the relaxed
+        problem's starts never draws them).
     """
 
     relaxed: np.ndarray
-    via: np.ndarray
     floor: float
+    make_via: Callable[[], np.ndarray] = dataclasses.field(repr=False, compare=False)
+
+    @functools.cached_property
+    def via(self) -> np.ndarray:
+        """(m, n_var) the via-point moves and ramps of
+        :func:`~adept_traj.optimise.via_point_starts`."""
+        return self.make_via()
 
     @property
     def starts(self) -> np.ndarray:
@@ -135,7 +151,9 @@ def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -
     return global_stage(problem, n_starts=n_starts, rate_hz=rate_hz).starts
 
 
-def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -> GlobalStage:
+def global_stage(
+    problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0, processes: int | None = None
+) -> GlobalStage:
     """The global stage's starts and the floor [s] of
     :func:`~adept_traj.optimise.near_lower_bound`. Where obstacles move: the fastest
     certified move of the problem **without its moving obstacles** (its own
@@ -145,9 +163,11 @@ def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) ->
     :func:`~adept_traj.optimise.via_point_starts` with
     :data:`~adept_traj.optimise.GLOBAL_SEED` (a function of the problem alone). Without
     moving obstacles, or when the relaxed problem has no certified move, the floor is 0.
+    The relaxed problem's refinements run ``processes`` at once (default: the problem's
+    ``workers``); the via points are drawn when first asked for.
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
-    via = via_point_starts(problem, GLOBAL_SEED, n_starts=n_starts)
+    via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts)
     relaxed, floor = np.empty((0, problem.n_var)), 0.0
     scene = problem.scene
     if scene.moving:
@@ -155,14 +175,15 @@ def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) ->
         fixed = TrajectoryProblem(
             problem.robot, still, problem.start, problem.goal, problem.settings, workers=1
         )
-        outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz)
+        processes = problem.settings.workers if processes is None else processes
+        outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
         done = [o for o in outcomes if o.certified]
         if done:
             best = min(done, key=lambda o: float(o.x[0])).x
             stretched = np.repeat(best[None], len(STRETCHES), axis=0)
             stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
             relaxed, floor = stretched, float(best[0])
-    return GlobalStage(relaxed=relaxed, via=via, floor=floor)
+    return GlobalStage(relaxed=relaxed, floor=floor, make_via=via)
 
 
 def fastest_of_basins(
@@ -203,7 +224,9 @@ def fastest_of_basins(
     if not near(screened):
         stage = global_stage(problem, n_starts=max_basins, rate_hz=rate_hz)
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        screened += screen_starts(problem, stage.starts, rate_hz=rate_hz, stop=near)
+        for more in (lambda: stage.relaxed, lambda: stage.via):
+            if not near(screened):  # the via points drawn only if still needed
+                screened += screen_starts(problem, more(), rate_hz=rate_hz, stop=near)
     if near(screened):
         return screened  # no other basin can be faster by more than GLOBAL_GAP
     return screened + refine_starts(problem, screened, rate_hz=rate_hz)

@@ -56,10 +56,15 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.member_certificate import MemberCertificate, certify_member
+from adept_traj.analysis.member_certificate import (
+    MemberCertificate,
+    certify_member,
+    certifying_problem,
+)
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.minimum_time import at_kinematic_minimum
 from adept_traj.optimise.trust_box import SolveCounts, trust_box_solve
+from adept_traj.process_pool import map_forked
 from adept_traj.robot.limits import LIMITS
 from adept_traj.validation import as_integer, as_scalar, as_vector
 
@@ -210,38 +215,64 @@ def screen_starts(
     rate_hz: float = 1000.0,
     stop: Any = None,
     max_boxes: int = SCREEN_BOXES,
+    processes: int | None = None,
 ) -> list[Refinement]:
     """A short refinement (one round, ``max_boxes`` trust boxes) of each of ``starts``
     (k, n_var), in order; ``stop(outcomes)`` (optional) is asked after each and ends the
-    screening when true."""
+    screening when true. ``processes`` starts (default: the problem's ``workers``) are
+    screened at once (:func:`~adept_traj.process_pool.map_forked`), the stop asked after
+    each in order: the same outcomes as one at a time."""
+    xs = list(np.atleast_2d(np.asarray(starts, dtype=float)))
+    n_proc = _processes(problem, processes, len(xs))
+
+    def screen(x: np.ndarray) -> Refinement:
+        return refine_minimum_time(problem, x, rate_hz=rate_hz, max_rounds=1, max_boxes=max_boxes)
+
     screened: list[Refinement] = []
-    for x in np.atleast_2d(np.asarray(starts, dtype=float)):
-        one = refine_minimum_time(problem, x, rate_hz=rate_hz, max_rounds=1, max_boxes=max_boxes)
-        screened.append(one)
-        if stop is not None and stop(screened):
-            break
+    for i in range(0, len(xs), n_proc):
+        for one in map_forked(screen, xs[i : i + n_proc], n_proc):
+            screened.append(one)
+            if stop is not None and stop(screened):
+                return screened
     return screened
 
 
 def refine_starts(
-    problem: Any, screened: list[Refinement], *, rate_hz: float = 1000.0
+    problem: Any,
+    screened: list[Refinement],
+    *,
+    rate_hz: float = 1000.0,
+    processes: int | None = None,
 ) -> list[Refinement]:
     """The full refinements (:func:`refine_minimum_time`) of the :data:`SCREEN_KEEP`
     fastest screened moves (:func:`screen_starts`) that reached a point inside the
     constraints, from where their screening ended: a multi-start that spends its
-    iterations on the most promising starts (each with its screening's adaptive samples)."""
+    iterations on the most promising starts (each with its screening's adaptive samples),
+    ``processes`` at once (default: the problem's ``workers``)."""
     inside = [o for o in screened if o.message != NO_MOVE_INSIDE]
     inside.sort(key=lambda o: float(o.x[0]))
-    return [
-        refine_minimum_time(
+    kept = inside[:SCREEN_KEEP]
+
+    def refine(o: Refinement) -> Refinement:
+        return refine_minimum_time(
             problem,
             o.x,
             rate_hz=rate_hz,
             start_certificate=o.certificate,
             extra_samples=o.extra_samples,
         )
-        for o in inside[:SCREEN_KEEP]
-    ]
+
+    return map_forked(refine, kept, _processes(problem, processes, len(kept)))
+
+
+def _processes(problem: Any, processes: int | None, n: int) -> int:
+    """Processes for ``n`` refinements at once (≥ 1; the certifying problem made first,
+    so that forked ones inherit it)."""
+    wanted = problem.settings.workers if processes is None else processes
+    n_proc = max(1, min(as_integer(wanted, "processes", minimum=1), n))
+    if n_proc > 1:
+        certifying_problem(problem)
+    return n_proc
 
 
 def _refine(
