@@ -40,13 +40,40 @@ def _as_stored(summary: MemberCertificate) -> dict:
     return json.loads(json.dumps(dataclasses.asdict(summary)))
 
 
+#: Relative tolerance of the floats compared with the stored summaries: the last bits of a
+#: sum depend on the NumPy and BLAS builds installed (numpy 2.4.6 moved some by 1e-15).
+REL = 1e-12
+
+
+def _assert_same(now: dict, stored: dict) -> None:
+    """Every field equal; floats to :data:`REL`. A worst sample's time may differ only
+    where that worst value itself moved in its last bits (two samples tied to rounding:
+    which one is the argmax is then a matter of rounding)."""
+    assert now.keys() == stored.keys()
+    for key, value in stored.items():
+        if key == "t_worst":
+            moved = [a != b for a, b in zip(now["worst"], stored["worst"])]
+            kept = [a for a, m in zip(now[key], moved) if not m]
+            assert kept == pytest.approx([b for b, m in zip(value, moved) if not m], rel=REL)
+        elif isinstance(value, float) or (
+            isinstance(value, list) and value and all(isinstance(v, float) for v in value)
+        ):
+            assert now[key] == pytest.approx(value, rel=REL, abs=1e-15), key
+        elif isinstance(value, dict):
+            _assert_same(now[key], value)
+        else:
+            assert now[key] == value, key
+
+
 def _check(problem: at.TrajectoryProblem, name: str) -> None:
     x, before = _stored(name)
     sizes = [dense_samples(T, 1000.0) for T in x[:, 0]]
     most = batch_samples(certifying_problem(problem)[0])
     assert sum(sizes[:2]) <= most < sum(sizes)  # batches of several, and several
     batched = certify_members(problem, x, rate_hz=1000.0)
-    assert [_as_stored(s) for s in batched] == before  # every field, exactly
+    assert len(batched) == len(before)
+    for summary, stored in zip(batched, before):  # every field
+        _assert_same(_as_stored(summary), stored)
     fast, influence = certifying_problem(problem)
     for k in (0, len(x) - 1):  # each alone, the library called directly
         alone = MemberCertificate.of(certify(fast, x[k], exact=False), influence)
@@ -62,7 +89,8 @@ def test_paper_summaries_are_unchanged(problem: at.TrajectoryProblem) -> None:
     x, before = _stored("paper")
     on = [_as_stored(s) for s in certify_members(problem, x, rate_hz=1000.0)]
     assert all(s.pop("self_distance")["min_distance"] > 0.01 for s in on)  # above the margin
-    assert on == [{k: v for k, v in s.items() if k != "self_distance"} for s in before]
+    for summary, stored in zip(on, before, strict=True):
+        _assert_same(summary, {k: v for k, v in stored.items() if k != "self_distance"})
 
 
 @pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
