@@ -138,10 +138,11 @@ def recorded(
     """Run a benchmark's body, collecting its :func:`figure` calls and its printed output,
     and write its results file when the body ends without an exception (or with
     ``sys.exit(0)``). A run whose arguments hold one of ``child_flags`` (the script started
-    by itself as a measuring child) is not recorded."""
+    by itself as a measuring child), or ``-h``/``--help`` (nothing measured), is not
+    recorded."""
     global _current
     argv = list(sys.argv[1:] if argv is None else argv)
-    if any(flag in argv for flag in child_flags):
+    if any(flag in argv for flag in (*child_flags, "-h", "--help")):
         yield None
         return
     name = Path(script).stem
