@@ -31,6 +31,7 @@ from adept_traj.optimise.refinement import (
 )
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.timed_starts import timed_roadmap_starts
 from adept_traj.optimise.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_integer
@@ -95,7 +96,7 @@ def time_optimal(
     if not near(screened):  # the relaxed problem's optimum before the other starts
         stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz)
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        for more in (stage.relaxed, starts[1:], stage.via):
+        for more in (stage.relaxed, stage.timed, starts[1:], stage.via):
             if not near(screened):
                 screened += screen_starts(problem, more, rate_hz=rate_hz, stop=near, **options)
     if near(screened):
@@ -112,6 +113,10 @@ class GlobalStage:
     relaxed:
         (k, n_var) the relaxed problem's fastest certified move at :data:`STRETCHES` × its
         T (k = 0 without moving obstacles, or when the relaxed problem has none).
+    timed:
+        (j, n_var) the timed trees' starts (:func:`~adept_traj.optimise.timed_roadmap_starts`,
+        guided by the relaxed problem's fastest move: its way at the moving obstacles'
+        phases); j = 0 without moving obstacles.
     via:
         (m, n_var) the via-point moves and ramps of
         :func:`~adept_traj.optimise.via_point_starts`.
@@ -121,13 +126,14 @@ class GlobalStage:
     """
 
     relaxed: np.ndarray
+    timed: np.ndarray
     via: np.ndarray
     floor: float
 
     @property
     def starts(self) -> np.ndarray:
-        """(k + m, n_var) every start, the relaxed problem's first."""
-        return np.concatenate([self.relaxed, self.via])
+        """(k + j + m, n_var) every start: the relaxed problem's, the timed, the via-point."""
+        return np.concatenate([self.relaxed, self.timed, self.via])
 
 
 def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -> np.ndarray:
@@ -148,8 +154,8 @@ def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) ->
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
     via = via_point_starts(problem, GLOBAL_SEED, n_starts=n_starts)
-    relaxed, floor = np.empty((0, problem.n_var)), 0.0
-    scene = problem.scene
+    relaxed = timed = np.empty((0, problem.n_var))
+    floor, scene = 0.0, problem.scene
     if scene.moving:
         still = dataclasses.replace(scene, obstacles=scene.fixed)
         fixed = TrajectoryProblem(
@@ -162,7 +168,9 @@ def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) ->
             stretched = np.repeat(best[None], len(STRETCHES), axis=0)
             stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
             relaxed, floor = stretched, float(best[0])
-    return GlobalStage(relaxed=relaxed, via=via, floor=floor)
+        guide = relaxed[:1] if len(relaxed) else None
+        timed = timed_roadmap_starts(problem, GLOBAL_SEED, guides=guide, n_starts=n_starts)
+    return GlobalStage(relaxed=relaxed, timed=timed, via=via, floor=floor)
 
 
 def fastest_of_basins(
