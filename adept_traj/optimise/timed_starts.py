@@ -2,8 +2,9 @@ r"""Starts for the certified local solver from the timed trees of
 :mod:`~adept_traj.optimise.timed_roadmap`: their earliest joined paths fitted into the
 problem's B-spline decision vector.
 
-:func:`timed_roadmap_starts` fits each of the :data:`PATHS` earliest arrivals' paths
-(:func:`~adept_traj.optimise.timed_paths`, shortcut), held at the goal up to
+:func:`timed_roadmap_starts` fits each of the earliest arrivals' paths
+(:func:`~adept_traj.optimise.timed_paths`, shortcut: at most
+:data:`~adept_traj.optimise.timed_roadmap.JOINED_PATHS`), held at the goal up to
 :data:`HOLDS` × its arrival time (the phase of the way is kept: the rest is a wait at the
 goal), by least squares on the free control points with a weight on the accelerations
 (:func:`fit_timed_path`, at each of :data:`SMOOTHINGS`: a path of straight edges has
@@ -29,7 +30,6 @@ __all__ = [
     "DISTANCE_WEIGHT",
     "FIT_SAMPLES",
     "HOLDS",
-    "PATHS",
     "SMOOTHINGS",
     "fit_timed_path",
     "timed_roadmap_starts",
@@ -46,9 +46,6 @@ DISTANCE_WEIGHT = 10.0
 
 #: Instants of the least-squares fit.
 FIT_SAMPLES = 80
-
-#: Earliest arrivals fitted by :func:`timed_roadmap_starts`.
-PATHS = 4
 
 
 def fit_timed_path(problem: Any, q: Any, t: Any, T: float, smoothing: float = 0.0) -> np.ndarray:
@@ -103,7 +100,7 @@ def timed_roadmap_starts(
     problem: Any, seed: int, *, guides: Any = None, n_starts: int = 3
 ) -> np.ndarray:
     """(k ≤ n_starts, n_var) starts from the timed trees (:func:`timed_paths`): the fits
-    (:func:`fit_timed_path`) of their :data:`PATHS` earliest arrivals, held to
+    (:func:`fit_timed_path`) of their earliest arrivals, held to
     :data:`HOLDS` × their arrival time (at most the largest T), at each of
     :data:`SMOOTHINGS`; the evaluator-feasible ones first (fastest first), then the others
     by their distance violation × :data:`DISTANCE_WEIGHT` + their other violations (a
