@@ -115,6 +115,9 @@ from adept_traj.optimise.survival import (
     RankAndCrowdingSurvival,
     crowding_distance,
 )
+from adept_traj.optimise.timed_edges import edges_clear, shortcut
+from adept_traj.optimise.timed_roadmap import TimedPaths, timed_paths
+from adept_traj.optimise.timed_starts import fit_timed_path, timed_roadmap_starts
 from adept_traj.optimise.tournament import (
     TournamentArrays,
     binary_tournament,
@@ -178,6 +181,7 @@ __all__ = [
     "RankAndCrowdingSurvival",
     "Refinement",
     "RunState",
+    "TimedPaths",
     "TournamentArrays",
     "ViaPointSampling",
     "basin_labels",
@@ -189,9 +193,11 @@ __all__ = [
     "check_population_memory",
     "checkpoint_arrays",
     "crowding_distance",
+    "edges_clear",
     "epsilon_step",
     "fastest_of_basins",
     "feasible_front",
+    "fit_timed_path",
     "global_stage",
     "global_starts",
     "has_checkpoint",
@@ -220,10 +226,13 @@ __all__ = [
     "sbx_children",
     "screen_starts",
     "select_parents",
+    "shortcut",
     "start_early_certificates",
     "start_polisher",
     "time_optimal",
     "time_optimal_run",
+    "timed_paths",
+    "timed_roadmap_starts",
     "via_point_starts",
     "warn_missing_limits",
     "weighted_descent",

@@ -32,6 +32,7 @@ from adept_traj.optimise.refinement import (
 )
 from adept_traj.optimise.repair import kinematic_time
 from adept_traj.optimise.sampling import RampSampling
+from adept_traj.optimise.timed_starts import timed_roadmap_starts
 from adept_traj.optimise.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_integer
@@ -105,8 +106,13 @@ def time_optimal(
     if not near(screened):  # the relaxed problem's optimum before the other starts
         stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes)
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        for more in (lambda: stage.relaxed, lambda: starts[1:], lambda: stage.via):
-            if not near(screened):  # the via points drawn only if still needed
+        for more in (
+            lambda: stage.relaxed,
+            lambda: stage.timed,
+            lambda: starts[1:],
+            lambda: stage.via,
+        ):
+            if not near(screened):  # the timed and via-point starts made only if needed
                 screened += screen_starts(problem, more(), stop=near, **options)
     if near(screened):
         return screened
@@ -125,14 +131,23 @@ class GlobalStage:
     floor:
         The relaxed problem's fastest certified T [s] (0 when there is none): the floor of
         :func:`~adept_traj.optimise.near_lower_bound`.
-    make_via:
-        Makes :attr:`via` when it is first asked for (a search that ends at the relaxed
-        problem's starts never draws them).
+    make_timed, make_via:
+        Make :attr:`timed` and :attr:`via` when they are first asked for (a search that
+        ends at the relaxed problem's starts never grows the trees nor draws the vias).
     """
 
     relaxed: np.ndarray
     floor: float
+    make_timed: Callable[[], np.ndarray] = dataclasses.field(repr=False, compare=False)
     make_via: Callable[[], np.ndarray] = dataclasses.field(repr=False, compare=False)
+
+    @functools.cached_property
+    def timed(self) -> np.ndarray:
+        """(j, n_var) the timed trees' starts
+        (:func:`~adept_traj.optimise.timed_roadmap_starts`, guided by the relaxed problem's
+        fastest move: its way at the moving obstacles' phases); j = 0 without moving
+        obstacles."""
+        return self.make_timed()
 
     @functools.cached_property
     def via(self) -> np.ndarray:
@@ -142,8 +157,8 @@ class GlobalStage:
 
     @property
     def starts(self) -> np.ndarray:
-        """(k + m, n_var) every start, the relaxed problem's first."""
-        return np.concatenate([self.relaxed, self.via])
+        """(k + j + m, n_var) every start: the relaxed problem's, the timed, the via-point."""
+        return np.concatenate([self.relaxed, self.timed, self.via])
 
 
 def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -> np.ndarray:
@@ -168,8 +183,8 @@ def global_stage(
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
     via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts)
-    relaxed, floor = np.empty((0, problem.n_var)), 0.0
-    scene = problem.scene
+    relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
+    timed = functools.partial(np.empty, (0, problem.n_var))
     if scene.moving:
         still = dataclasses.replace(scene, obstacles=scene.fixed)
         fixed = TrajectoryProblem(
@@ -183,7 +198,11 @@ def global_stage(
             stretched = np.repeat(best[None], len(STRETCHES), axis=0)
             stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
             relaxed, floor = stretched, float(best[0])
-    return GlobalStage(relaxed=relaxed, floor=floor, make_via=via)
+        guide = relaxed[:1] if len(relaxed) else None
+        timed = functools.partial(
+            timed_roadmap_starts, problem, GLOBAL_SEED, guides=guide, n_starts=n_starts
+        )
+    return GlobalStage(relaxed=relaxed, floor=floor, make_timed=timed, make_via=via)
 
 
 def fastest_of_basins(
@@ -224,8 +243,8 @@ def fastest_of_basins(
     if not near(screened):
         stage = global_stage(problem, n_starts=max_basins, rate_hz=rate_hz)
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        for more in (lambda: stage.relaxed, lambda: stage.via):
-            if not near(screened):  # the via points drawn only if still needed
+        for more in (lambda: stage.relaxed, lambda: stage.timed, lambda: stage.via):
+            if not near(screened):  # the timed and via-point starts made only if needed
                 screened += screen_starts(problem, more(), rate_hz=rate_hz, stop=near)
     if near(screened):
         return screened  # no other basin can be faster by more than GLOBAL_GAP
