@@ -18,7 +18,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
         pytest.param(
             "plan_paper.py",
             ["--gens", "2", "--small"],
-            "mode: 41 evaluations",
+            "mode: 42 evaluations",
             marks=pytest.mark.slow,  # ~3.5 s: the default tier's budget
         ),
         pytest.param(

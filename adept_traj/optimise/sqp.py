@@ -41,6 +41,10 @@ _ARMIJO, _LINE_TRIALS, _MIN_STEP = 0.1, 10, 0.1
 #: Powell's damping threshold of the BFGS update.
 _DAMPING = 0.2
 
+#: DAQP's primal feasibility tolerance on the linearised rows (its default, 1e-6, leaves
+#: answers outside the rows by more than the trust box's test of a point inside, 1e-8).
+_PRIMAL_TOL = 1e-12
+
 #: An infinite bound for DAQP.
 _INF = 1e30
 
@@ -160,7 +164,9 @@ def _subproblem(
     upper = np.concatenate([du, -h])
     lower = np.concatenate([dl, np.full(len(h), -_INF)])
     sense = np.zeros(len(upper), dtype=np.intc)
-    d, _, flag, info = daqp.solve(B, c, np.ascontiguousarray(J), upper, lower, sense)
+    d, _, flag, info = daqp.solve(
+        B, c, np.ascontiguousarray(J), upper, lower, sense, primal_tol=_PRIMAL_TOL
+    )
     if flag < 1:
         return None, np.zeros(len(h))
     return np.asarray(d, dtype=float), np.maximum(np.asarray(info["lam"])[len(c) :], 0.0)
