@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
+from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.optimise.sqp import sqp
 
 
@@ -87,3 +88,22 @@ def test_an_infeasible_subproblem_and_the_iteration_limit_are_reported() -> None
               _ball(np.array([3.0, 3.0]), 1.0), max_iter=1)  # fmt: skip
     assert not one.converged
     assert one.nit == 1
+
+
+def test_bad_input_is_refused_before_any_row_is_evaluated() -> None:
+    """Shapes that disagree, max_iter < 1 and tol ≤ 0: the library's errors, naming the
+    value, before ``rows`` is called."""
+    calls: list[int] = []
+
+    def rows(y):
+        calls.append(1)
+        return np.zeros(1), np.zeros((1, len(y)))
+
+    free = np.full(2, np.inf)
+    with pytest.raises(InputShapeError, match="one shape"):
+        sqp(np.ones(2), np.zeros(3), -free, free, rows, max_iter=5)
+    with pytest.raises(ConfigurationError, match="max_iter"):
+        sqp(np.ones(2), np.zeros(2), -free, free, rows, max_iter=0)
+    with pytest.raises(ConfigurationError, match="tol"):
+        sqp(np.ones(2), np.zeros(2), -free, free, rows, max_iter=5, tol=0.0)
+    assert calls == []

@@ -32,6 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from adept_traj.errors import ConfigurationError, InputShapeError
+from adept_traj.validation import as_finite_array, as_integer, as_scalar
+
 __all__ = ["SqpResult", "sqp"]
 
 #: Armijo factor of the line search, its most trials per iteration and the smallest
@@ -95,7 +98,15 @@ def sqp(
     max_iter:
         Most iterations (≥ 1).
     tol:
-        Tolerance of the first-order test on the cost's change and the rows' violation.
+        Tolerance of the first-order test on the cost's change and the rows' violation
+        (> 0).
+
+    Raises
+    ------
+    InputShapeError
+        ``cost`` not a vector (n,), or ``y0``, ``lower`` or ``upper`` of another shape.
+    ConfigurationError
+        ``max_iter`` < 1 or ``tol`` ≤ 0.
 
     Notes
     -----
@@ -104,6 +115,15 @@ def sqp(
     iterates amplify the last-bit differences — the same start would end elsewhere in a
     worker process than in the main one.
     """
+    c = as_finite_array(cost, "cost")
+    n = len(c) if c.ndim == 1 else -1
+    shapes = {"y0": np.shape(y0), "lower": np.shape(lower), "upper": np.shape(upper)}
+    if n < 1 or any(shape != (n,) for shape in shapes.values()):
+        raise InputShapeError(
+            f"cost, y0, lower and upper must have one shape (n,); got {c.shape} and {shapes}"
+        )
+    max_iter = as_integer(max_iter, "max_iter", minimum=1, error=ConfigurationError)
+    tol = as_scalar(tol, "tol", minimum=0.0, strict=True, error=ConfigurationError)
     from threadpoolctl import threadpool_limits  # lazy, as the solver
 
     with threadpool_limits(limits=1, user_api="blas"):
@@ -144,7 +164,8 @@ def _sqp(
             change = c @ yn + rho @ np.maximum(hn, 0.0) - phi0
             if change <= _ARMIJO * alpha * slope:
                 break
-            alpha *= max(_MIN_STEP, 0.5 * slope * alpha / (slope * alpha - change))
+            drop = slope * alpha - change  # < 0 along a descent direction
+            alpha *= max(_MIN_STEP, 0.5 * slope * alpha / drop) if drop < 0.0 else _MIN_STEP
         else:
             return SqpResult(y, k, False)
         B = _bfgs(B, yn - y, (Jn - J).T @ lam)
