@@ -80,24 +80,38 @@ def test_explorer_in_a_real_browser(folder: Path, browser, tmp_path: Path) -> No
     count = int(browser.find_element("id", "selected-count").text.split()[0])
     assert 0 < count < n
 
-    # --- click another certified member in the scatter plot
-    certified = [k for k in range(n) if result.front.feasible[k] and k != result.best.index]
-    member = certified[len(certified) // 2]
+    # --- click another certified member in the scatter plot, one whose marker no other
+    # marker covers: Plotly's click takes the topmost marker under the cursor (all markers
+    # under it are equally close), so of two members 1 px apart a user can click only the
+    # one drawn last (its number in the hover label). Which members crowd so depends on the
+    # front, hence on the machine's floating point; the pixels are the page's own.
     browser.find_element("id", "play").click()  # pause: the view changes by the click only
     before = png(browser, "view3d")
-    xy = browser.execute_script(
-        """const gd = document.getElementById('scatter'), L = gd._fullLayout, k = arguments[0];
-        for (const tr of gd.data) { const i = tr.customdata.indexOf(k); if (i >= 0)
-          return [L._size.l + L.xaxis.d2p(tr.x[i]), L._size.t + L.yaxis.d2p(tr.y[i])]; }""",
-        member,
-    )
+    drawn = browser.execute_script(
+        """const gd = document.getElementById('scatter'), L = gd._fullLayout, out = [];
+        for (const tr of gd.data) tr.customdata.forEach((k, i) => out.push([k,
+          L._size.l + L.xaxis.d2p(tr.x[i]), L._size.t + L.yaxis.d2p(tr.y[i]), tr.marker.size / 2]));
+        return out;"""
+    )  # [member, x [px], y [px], marker radius [px]] of every marker, in drawing order
+    drawn = [d for d in drawn if d[1] is not None and d[2] is not None]  # NaN: not drawn
+
+    def free(k: int) -> float:
+        """[px] from member k's centre to the nearest edge of another member's marker."""
+        x, y = next((d[1], d[2]) for d in drawn if d[0] == k)
+        return min(np.hypot(x - d[1], y - d[2]) - d[3] for d in drawn if d[0] != k)
+
+    certified = [k for k in range(n) if result.front.feasible[k] and k != result.best.index]
+    member = max(certified, key=free)
+    assert free(member) > 2.0, free(member)  # the cursor lands within 0.5 px of the centre
+    xy = next((d[1], d[2]) for d in drawn if d[0] == member)
     plot = browser.find_element("css selector", "#scatter .main-svg")
-    size = plot.size
+    size = plot.size  # Selenium 4: the offset is from the element's centre
     ActionChains(browser).move_to_element_with_offset(
-        plot, int(xy[0] - size["width"] / 2), int(xy[1] - size["height"] / 2)
+        plot, round(xy[0] - size["width"] / 2), round(xy[1] - size["height"] / 2)
     ).click().perform()
     wait_for(lambda: f"member {member}" in browser.find_element("id", "certificate").text)
     assert browser.find_element("id", "certificate").get_attribute("data-member") == str(member)
+    assert f"member {member} " in browser.find_element("id", "shown-member").text + " "
     time.sleep(1.0)  # the 3-D redraw
     after = png(browser, "view3d")
     assert before.shape == after.shape
