@@ -18,9 +18,10 @@ with :math:`g` a subgradient of :math:`\varphi` at :math:`c`,
     \min_{x \in B} \varphi(x) \;\ge\; \varphi(c) - \sum_k |g_k|\, e_k =: \ell(B)
 
 (exact for a face-to-face contact). When the solid and a leaf are apart, their distance is
-:math:`\min_B \varphi \ge \ell`; when they overlap, :math:`\ell < 0`. Leaves are computed
-by coal in increasing order of :math:`\ell` (a bucket's :math:`\ell`, of the box around its
-leaves, bounds each of its leaves') until the next bound is at least the best value
+:math:`\min_B \varphi \ge \ell`; when they overlap, :math:`\ell < 0`. A bucket's
+:math:`\ell`, of the box around its leaves, bounds each of its leaves': the buckets above
+``cap`` are left out, the leaves of the others get their :math:`\ell` in one batch, and
+those within ``cap`` are computed by coal in increasing order of :math:`\ell` until the next bound is at least the best value
 :math:`v` so far (less :data:`TIE`; the value returned is then
 :math:`\min(v, \ell_\text{next})`, never above the minimum over the leaves), or :math:`v`
 is negative (a penetration: the depth of that leaf, one leaf's as coal's octree reports).
@@ -305,26 +306,24 @@ class CloudDistance:
             self.last_calls = 0
             return far
         box_lb = bound(cells.box_centre[near], cells.box_half[near])
-        order = np.argsort(box_lb, kind="stable")
-        box_lb, order = box_lb[order], near[order]
-        leaf_lb, leaf_ix = np.empty(0), np.empty(0, dtype=np.int64)  # opened, sorted
-        best, best_leaf, calls, bi, li = np.inf, -1, 0, 0, 0
-        while True:
-            nb = box_lb[bi] if bi < len(box_lb) else np.inf
-            nl = leaf_lb[li] if li < len(leaf_lb) else np.inf
-            low = min(nb, nl)  # every leaf not computed is at least this far
-            if best < 0.0 or low >= best - TIE or low > self.cap:
+        # every leaf of a bucket whose bound is above the cap is above it too: the leaves
+        # of the other buckets, all at once (one bound call), in increasing bound order
+        inner = box_lb <= self.cap
+        low = min(float(box_lb[~inner].min(initial=np.inf)), far)  # the leaves not gathered
+        picked = near[inner]
+        counts = cells.start[picked + 1] - cells.start[picked]
+        shift = np.repeat(cells.start[picked] - np.cumsum(counts) + counts, counts)
+        leaves = np.arange(int(counts.sum())) + shift  # the leaves of the picked buckets
+        leaf_lb = bound(cells.centre[leaves], cells.half[leaves])
+        keep = leaf_lb <= self.cap
+        low = min(low, float(leaf_lb[~keep].min(initial=np.inf)))
+        sort = np.argsort(leaf_lb[keep], kind="stable")
+        leaf_lb, leaf_ix = leaf_lb[keep][sort].tolist(), leaves[keep][sort].tolist()
+        best, best_leaf, calls = np.inf, -1, 0
+        for lb, leaf in zip(leaf_lb, leaf_ix):
+            if best < 0.0 or lb >= best - TIE:
+                low = min(low, lb)  # every leaf not computed is at least this far
                 break
-            if nb <= nl:  # open the bucket: its leaves join the pending ones, sorted
-                b = int(order[bi])
-                s, e = cells.start[b], cells.start[b + 1]
-                lbs = np.concatenate([leaf_lb[li:], bound(cells.centre[s:e], cells.half[s:e])])
-                ixs = np.concatenate([leaf_ix[li:], np.arange(s, e)])
-                sort = np.argsort(lbs, kind="stable")
-                leaf_lb, leaf_ix, li, bi = lbs[sort], ixs[sort], 0, bi + 1
-                continue
-            leaf = int(leaf_ix[li])
-            li += 1
             self._tf_leaf.setTransform(ro, to + ro @ cells.centre[leaf])
             self._scratch.clear()
             d = self._functors[float(cells.half[leaf])](
@@ -334,7 +333,6 @@ class CloudDistance:
             if d < best:
                 best, best_leaf = d, leaf
         self.last_calls = calls
-        low = min(low, far)  # the buckets not gathered: beyond cap + ε
         if best_leaf < 0:  # every leaf beyond the cap: that bound
             result.min_distance = low
             return float(low)
