@@ -21,8 +21,8 @@ with :math:`g` a subgradient of :math:`\varphi` at :math:`c`,
 :math:`\min_B \varphi \ge \ell`; when they overlap, :math:`\ell < 0`. A bucket's
 :math:`\ell`, of the box around its leaves, bounds each of its leaves': the buckets above
 ``cap`` are left out, the leaves of the others get their :math:`\ell` in one batch, and
-those within ``cap`` are computed by coal in increasing order of :math:`\ell` until the next bound is at least the best value
-:math:`v` so far (less :data:`TIE`; the value returned is then
+those within ``cap`` are computed by coal in increasing order of :math:`\ell` until the
+next bound is at least the best value :math:`v` so far (less :data:`TIE`; the value returned is then
 :math:`\min(v, \ell_\text{next})`, never above the minimum over the leaves), or :math:`v`
 is negative (a penetration: the depth of that leaf, one leaf's as coal's octree reports).
 
@@ -46,6 +46,8 @@ from typing import Any
 import coal
 import numpy as np
 
+from adept_traj.scene.point_clouds import cube_field_step
+
 __all__ = [
     "BUCKET_EDGE",
     "FAR_MARGIN",
@@ -56,9 +58,6 @@ __all__ = [
     "solid_distance_bound",
     "solid_half_sides",
 ]
-
-#: Most cells of the field of :meth:`CloudCells.point_bound` (32 MB of float32).
-_FIELD_CELLS = 8_000_000
 
 #: Margin [m] beyond the cap of the leaves not gathered (their distance exceeds cap + it).
 FAR_MARGIN = 1e-3
@@ -149,9 +148,7 @@ class CloudCells:
         leaf = 2.0 * float(self.half.min())
         lo = self.centre.min(axis=0) - self.half.max()
         hi = self.centre.max(axis=0) + self.half.max()
-        h = leaf
-        while np.prod(np.ceil((hi - lo) / h) + 3) > _FIELD_CELLS:
-            h *= 2.0
+        h, _ = cube_field_step(lo, hi, leaf)  # counted in the memory budget (point_clouds)
         origin = np.floor(lo / h) * h - h  # a multiple of h (leaves sit at multiples of
         dims = (np.ceil((hi - origin) / h) + 1).astype(np.int64)  # their edge), one spare
         occupied = np.zeros(tuple(dims.tolist()), dtype=bool)
