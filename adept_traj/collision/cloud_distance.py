@@ -30,8 +30,11 @@ Only the buckets near the solid are searched: those whose grid cell meets the so
 grown by ``cap`` + :data:`FAR_MARGIN` + the largest leaf half edge; every other leaf is
 farther than ``cap`` + :data:`FAR_MARGIN`. So a distance at most ``cap`` (the checker's
 ``influence``) is exact; a larger one is returned as a lower bound above ``cap``, as the
-broad phase's bounds are (:class:`~adept_traj.collision.CollisionChecker`). Solids of
-another kind (a link's convex hull) keep coal's octree distance.
+broad phase's bounds are (:class:`~adept_traj.collision.CollisionChecker`). A URDF
+link's convex hull (``ConvexBase``) takes the same path, with the largest of its face
+planes' signed distances as :math:`\varphi` (convex, never above its signed distance, so
+:math:`\ell` is still a lower bound; the leaves' distances are still coal's); solids of
+another kind (a triangle mesh) keep coal's octree distance.
 
 :meth:`CloudCells.point_bound` is the broad phase's bound of a point's distance to the
 leaves (level 5 of :mod:`adept_traj.collision.broad_phase`).
@@ -55,6 +58,7 @@ __all__ = [
     "CloudCells",
     "CloudDistance",
     "cloud_cells",
+    "hull_planes",
     "solid_distance_bound",
     "solid_half_sides",
 ]
@@ -180,7 +184,16 @@ def cloud_cells(octree: coal.OcTree, key: object) -> CloudCells:
 def solid_distance_bound(solid: coal.CollisionGeometry, p: np.ndarray) -> tuple[Any, Any] | None:
     r"""Signed distance (n,) [m] of points ``p`` (n, 3) in the frame of a coal ``Box``,
     ``Cylinder`` (axis z), ``Capsule`` (axis z) or ``Sphere``, and a subgradient (n, 3)
-    of it (unit where the distance is positive); None for another geometry."""
+    of it (unit where the distance is positive); for a convex polytope (``ConvexBase``:
+    a URDF link's hull) a convex function never above its signed distance,
+    :math:`\max_i (n_i \cdot x - b_i)` over its face planes (exact inside; outside, the
+    distance to the farthest supporting half-space), with the unit normal of that face
+    as subgradient; None for another geometry."""
+    if isinstance(solid, coal.ConvexBase):
+        planes = hull_planes(solid)
+        side = p @ planes[:, :3].T + planes[:, 3]  # (n, faces)
+        face = side.argmax(axis=1)
+        return side[np.arange(len(p)), face], planes[face, :3]
     if isinstance(solid, coal.Sphere):
         n = np.linalg.norm(p, axis=1)
         g = p / np.where(n > 0, n, 1.0)[:, None]
@@ -208,15 +221,35 @@ def solid_distance_bound(solid: coal.CollisionGeometry, p: np.ndarray) -> tuple[
 
 def solid_half_sides(solid: coal.CollisionGeometry) -> np.ndarray | None:
     """Half sides (3,) [m] of the box about the origin holding a primitive solid (a coal
-    ``Box``, ``Cylinder``, ``Capsule`` or ``Sphere``); None for another geometry."""
+    ``Box``, ``Cylinder``, ``Capsule`` or ``Sphere``) or a convex polytope (its vertices'
+    largest coordinates); None for another geometry."""
     if isinstance(solid, coal.Sphere):
         return np.full(3, solid.radius)
+    if isinstance(solid, coal.ConvexBase):
+        return np.abs(np.asarray(solid.points(), dtype=float)).max(axis=0)
     if isinstance(solid, coal.Box):
         return np.asarray(solid.halfSide, dtype=float).copy()
     if not isinstance(solid, (coal.Cylinder, coal.Capsule)):
         return None
     tip = solid.halfLength + (solid.radius if isinstance(solid, coal.Capsule) else 0.0)
     return np.array([solid.radius, solid.radius, tip])
+
+
+#: The face planes of each convex solid, by its id, with the solid (kept alive with them).
+_PLANES: dict[int, tuple[coal.ConvexBase, np.ndarray]] = {}
+
+
+def hull_planes(solid: coal.ConvexBase) -> np.ndarray:
+    """The face planes (f, 4) of a convex polytope, ``(n, -b)`` with unit outward normals
+    ``n`` (f, 3) and offsets ``b`` [m] (``n · x ≤ b`` inside; qhull through scipy, once a
+    solid)."""
+    entry = _PLANES.get(id(solid))
+    if entry is None or entry[0] is not solid:
+        from scipy.spatial import ConvexHull
+
+        equations = ConvexHull(np.asarray(solid.points(), dtype=float)).equations
+        entry = _PLANES[id(solid)] = (solid, np.ascontiguousarray(equations))
+    return entry[1]
 
 
 def _box_sdf(p: np.ndarray, h: np.ndarray, signed_axes: tuple[int, ...] | None = None):
@@ -255,6 +288,12 @@ class CloudDistance:
             h: coal.ComputeDistance(solid, box) for h, box in self.cells.sizes.items()
         }
         self._half_local = solid_half_sides(solid)
+        #: a convex polytope's box (centre (3,), half sides (3,)) [m], its frame: a cheap
+        #: first bound of the leaves before the one over its faces
+        self._hull_box = None
+        if isinstance(solid, coal.ConvexBase):
+            v = np.asarray(solid.points(), dtype=float)
+            self._hull_box = (0.5 * (v.min(0) + v.max(0)), 0.5 * (v.max(0) - v.min(0)))
         self._scratch = coal.DistanceResult()
         self._tf_leaf = coal.Transform3s()
         #: coal calls made by the last evaluation.
@@ -311,6 +350,12 @@ class CloudDistance:
         counts = cells.start[picked + 1] - cells.start[picked]
         shift = np.repeat(cells.start[picked] - np.cumsum(counts) + counts, counts)
         leaves = np.arange(int(counts.sum())) + shift  # the leaves of the picked buckets
+        if self._hull_box is not None:  # the polytope's box holds it: a lower bound first
+            c, e = self._hull_box
+            d, g = _box_sdf((cells.centre[leaves] - pos) @ rot - c, e)
+            box_leaf = d - np.abs(g @ rot.T).sum(1) * cells.half[leaves]
+            low = min(low, float(box_leaf[box_leaf > self.cap].min(initial=np.inf)))
+            leaves = leaves[box_leaf <= self.cap]
         leaf_lb = bound(cells.centre[leaves], cells.half[leaves])
         keep = leaf_lb <= self.cap
         low = min(low, float(leaf_lb[~keep].min(initial=np.inf)))
