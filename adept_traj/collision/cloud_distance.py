@@ -305,7 +305,11 @@ class CloudDistance:
         tf_cloud: coal.Transform3s,
         request: coal.DistanceRequest,
         result: coal.DistanceResult,
+        cap: float | None = None,
     ) -> float:
+        """The distance [m] (exact up to :attr:`cap`, or up to ``cap`` [m] if smaller:
+        a caller that only needs to know whether the distance is below a value passes
+        it, and a larger distance comes back as a lower bound above it, for less work)."""
         rs, ts = np.asarray(tf_solid.getRotation()), np.asarray(tf_solid.getTranslation())
         ro, to = np.asarray(tf_cloud.getRotation()), np.asarray(tf_cloud.getTranslation())
         rot = ro.T @ rs  # solid frame -> cloud frame
@@ -320,7 +324,8 @@ class CloudDistance:
 
         # the buckets whose grid cell meets the solid's box grown by cap + ε + the
         # largest leaf half edge: any other leaf is farther than cap + ε (module doc)
-        far = self.cap + FAR_MARGIN
+        cap = self.cap if cap is None else min(self.cap, float(cap))
+        far = cap + FAR_MARGIN
         grow = self._half_local @ np.abs(rot.T) + far + cells.hmax
         k0 = np.floor((pos - grow - cells.origin) / cells.edge).astype(np.int64)
         k1 = np.floor((pos + grow - cells.origin) / cells.edge).astype(np.int64)
@@ -344,7 +349,7 @@ class CloudDistance:
         box_lb = bound(cells.box_centre[near], cells.box_half[near])
         # every leaf of a bucket whose bound is above the cap is above it too: the leaves
         # of the other buckets, all at once (one bound call), in increasing bound order
-        inner = box_lb <= self.cap
+        inner = box_lb <= cap
         low = min(float(box_lb[~inner].min(initial=np.inf)), far)  # the leaves not gathered
         picked = near[inner]
         counts = cells.start[picked + 1] - cells.start[picked]
@@ -354,10 +359,10 @@ class CloudDistance:
             c, e = self._hull_box
             d, g = _box_sdf((cells.centre[leaves] - pos) @ rot - c, e)
             box_leaf = d - np.abs(g @ rot.T).sum(1) * cells.half[leaves]
-            low = min(low, float(box_leaf[box_leaf > self.cap].min(initial=np.inf)))
-            leaves = leaves[box_leaf <= self.cap]
+            low = min(low, float(box_leaf[box_leaf > cap].min(initial=np.inf)))
+            leaves = leaves[box_leaf <= cap]
         leaf_lb = bound(cells.centre[leaves], cells.half[leaves])
-        keep = leaf_lb <= self.cap
+        keep = leaf_lb <= cap
         low = min(low, float(leaf_lb[~keep].min(initial=np.inf)))
         sort = np.argsort(leaf_lb[keep], kind="stable")
         leaf_lb, leaf_ix = leaf_lb[keep][sort].tolist(), leaves[keep][sort].tolist()
