@@ -186,3 +186,55 @@ def test_meshcat_draws_a_subsample_of_a_large_cloud():
     assert drawn.shape == (3, 83_334)
     assert drawn.shape[1] <= MAX_DRAWN_POINTS
     np.testing.assert_allclose(drawn.T, cloud.points[::3], atol=1e-7)  # float32
+
+
+def test_cube_field_counted_and_refused_before_any_field(tmp_path, monkeypatch):
+    """A few points spread over 20 m: the points alone fit a 120 MiB budget, the checker's
+    cube-distance field (8·10⁶ cells) does not — refused once read, naming the file, the
+    field's cells and the limit, before any distance field is made."""
+    from adept_traj.scene import point_clouds
+
+    rng = np.random.default_rng(7)
+    spread = rng.uniform(0.0, 20.0, (3000, 3))
+    np.save(tmp_path / "hall.npy", spread)
+
+    def no_field(*args):
+        raise AssertionError("a distance field was made before the memory check")
+
+    monkeypatch.setattr(point_clouds, "_coarse_field", no_field)
+    with pytest.raises(
+        ResourceLimitError,
+        match=r"hall\.npy.*3000 points.*120.0 MiB.*cube-distance field, \d+ cells",
+    ):
+        PointCloud.from_file(tmp_path / "hall.npy", 0.01, budget=120 * 2**20)
+    monkeypatch.setattr(at.memory, "memory_budget", lambda: 120 * 2**20)  # an array too
+    with pytest.raises(ResourceLimitError, match=r"an array \(3000 points\).*cube-distance"):
+        PointCloud(spread, 0.01)
+
+
+def test_cloud_estimate_bounds_the_measured_peak():
+    """tracemalloc's peak while a cloud, its leaf arrays and its cube-distance field are
+    made (numpy and scipy; coal's octree is C++, counted separately in the estimate) stays
+    below :func:`cloud_bytes` of its points and field cells."""
+    import tracemalloc
+
+    from adept_traj.collision.cloud_distance import CloudCells
+    from adept_traj.scene.point_clouds import cloud_bytes, cube_field_step
+
+    rng = np.random.default_rng(8)
+    a = rng.uniform(0.0, 2.0 * np.pi, 60_000)
+    p = np.column_stack([0.6 * np.cos(a), 0.6 * np.sin(a), rng.uniform(0.0, 0.5, len(a))])
+    octree = coal.makeOctree(p, 0.01)
+    tracemalloc.start()
+    try:
+        cloud = PointCloud(p, 0.01)
+        cells = CloudCells(octree)
+        field = cells.field[2]
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    _, n_cells = cube_field_step(p.min(axis=0) - 0.01, p.max(axis=0) + 0.01, 0.01)
+    assert field.size <= n_cells
+    assert cloud.n_points == len(p)
+    assert field.size > 500_000  # the field is the large part here
+    assert peak <= cloud_bytes(len(p), n_cells), (peak, cloud_bytes(len(p), n_cells))

@@ -179,7 +179,8 @@ def _walk(
                 pose_o = obstacle_poses[o_l[c]]
                 if pose_o.ndim == 3:
                     pose_o = pose_o[samples_l[c]]
-                d = checker._narrow(poses[slot_l[c]], pose_o, solids_l[c], o_l[c])
+                # only a distance below v matters: a larger one may come as a bound ≥ v
+                d = checker._narrow(poses[slot_l[c]], pose_o, solids_l[c], o_l[c], v)
                 calls += 1
             if d < v:
                 v, w = d, cand_l[c]

@@ -22,6 +22,7 @@ import numpy as np
 
 from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
+from adept_traj.collision.cloud_distance import CloudDistance
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
@@ -257,13 +258,25 @@ class CollisionChecker:
     def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:
         return poses if poses.ndim == 2 else poses[n]
 
-    def _narrow(self, solid_pose: np.ndarray, obstacle_pose: np.ndarray, s: int, o: int) -> float:
-        """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses."""
+    def _narrow(
+        self,
+        solid_pose: np.ndarray,
+        obstacle_pose: np.ndarray,
+        s: int,
+        o: int,
+        below: float | None = None,
+    ) -> float:
+        """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses;
+        with ``below`` [m], a distance not below it may come back as a lower bound of it
+        that is at least ``below`` (a point cloud's narrow phase then does less work)."""
         tf_solid, tf_obstacle = self._tf
         tf_solid.setTransform(solid_pose[:3, :3], solid_pose[:3, 3])  # one call, not two
         tf_obstacle.setTransform(obstacle_pose[:3, :3], obstacle_pose[:3, 3])
         self._result.clear()
-        return self._functors[s][o](tf_solid, tf_obstacle, self._request, self._result)
+        functor = self._functors[s][o]
+        if below is not None and isinstance(functor, CloudDistance):
+            return functor(tf_solid, tf_obstacle, self._request, self._result, below)
+        return functor(tf_solid, tf_obstacle, self._request, self._result)
 
     def _min_distances(self, q: np.ndarray, t: np.ndarray, frames: np.ndarray) -> MinDistances:
         """Leave out the fixed obstacles that no motion comes within ``influence`` of

@@ -18,10 +18,11 @@ with :math:`g` a subgradient of :math:`\varphi` at :math:`c`,
     \min_{x \in B} \varphi(x) \;\ge\; \varphi(c) - \sum_k |g_k|\, e_k =: \ell(B)
 
 (exact for a face-to-face contact). When the solid and a leaf are apart, their distance is
-:math:`\min_B \varphi \ge \ell`; when they overlap, :math:`\ell < 0`. Leaves are computed
-by coal in increasing order of :math:`\ell` (a bucket's :math:`\ell`, of the box around its
-leaves, bounds each of its leaves') until the next bound is at least the best value
-:math:`v` so far (less :data:`TIE`; the value returned is then
+:math:`\min_B \varphi \ge \ell`; when they overlap, :math:`\ell < 0`. A bucket's
+:math:`\ell`, of the box around its leaves, bounds each of its leaves': the buckets above
+``cap`` are left out, the leaves of the others get their :math:`\ell` in one batch, and
+those within ``cap`` are computed by coal in increasing order of :math:`\ell` until the
+next bound is at least the best value :math:`v` so far (less :data:`TIE`; the value returned is then
 :math:`\min(v, \ell_\text{next})`, never above the minimum over the leaves), or :math:`v`
 is negative (a penetration: the depth of that leaf, one leaf's as coal's octree reports).
 
@@ -29,8 +30,11 @@ Only the buckets near the solid are searched: those whose grid cell meets the so
 grown by ``cap`` + :data:`FAR_MARGIN` + the largest leaf half edge; every other leaf is
 farther than ``cap`` + :data:`FAR_MARGIN`. So a distance at most ``cap`` (the checker's
 ``influence``) is exact; a larger one is returned as a lower bound above ``cap``, as the
-broad phase's bounds are (:class:`~adept_traj.collision.CollisionChecker`). Solids of
-another kind (a link's convex hull) keep coal's octree distance.
+broad phase's bounds are (:class:`~adept_traj.collision.CollisionChecker`). A URDF
+link's convex hull (``ConvexBase``) takes the same path, with the largest of its face
+planes' signed distances as :math:`\varphi` (convex, never above its signed distance, so
+:math:`\ell` is still a lower bound; the leaves' distances are still coal's); solids of
+another kind (a triangle mesh) keep coal's octree distance.
 
 :meth:`CloudCells.point_bound` is the broad phase's bound of a point's distance to the
 leaves (level 5 of :mod:`adept_traj.collision.broad_phase`).
@@ -45,6 +49,8 @@ from typing import Any
 import coal
 import numpy as np
 
+from adept_traj.scene.point_clouds import cube_field_step
+
 __all__ = [
     "BUCKET_EDGE",
     "FAR_MARGIN",
@@ -52,12 +58,10 @@ __all__ = [
     "CloudCells",
     "CloudDistance",
     "cloud_cells",
+    "hull_planes",
     "solid_distance_bound",
     "solid_half_sides",
 ]
-
-#: Most cells of the field of :meth:`CloudCells.point_bound` (32 MB of float32).
-_FIELD_CELLS = 8_000_000
 
 #: Margin [m] beyond the cap of the leaves not gathered (their distance exceeds cap + it).
 FAR_MARGIN = 1e-3
@@ -148,9 +152,7 @@ class CloudCells:
         leaf = 2.0 * float(self.half.min())
         lo = self.centre.min(axis=0) - self.half.max()
         hi = self.centre.max(axis=0) + self.half.max()
-        h = leaf
-        while np.prod(np.ceil((hi - lo) / h) + 3) > _FIELD_CELLS:
-            h *= 2.0
+        h, _ = cube_field_step(lo, hi, leaf)  # counted in the memory budget (point_clouds)
         origin = np.floor(lo / h) * h - h  # a multiple of h (leaves sit at multiples of
         dims = (np.ceil((hi - origin) / h) + 1).astype(np.int64)  # their edge), one spare
         occupied = np.zeros(tuple(dims.tolist()), dtype=bool)
@@ -182,7 +184,16 @@ def cloud_cells(octree: coal.OcTree, key: object) -> CloudCells:
 def solid_distance_bound(solid: coal.CollisionGeometry, p: np.ndarray) -> tuple[Any, Any] | None:
     r"""Signed distance (n,) [m] of points ``p`` (n, 3) in the frame of a coal ``Box``,
     ``Cylinder`` (axis z), ``Capsule`` (axis z) or ``Sphere``, and a subgradient (n, 3)
-    of it (unit where the distance is positive); None for another geometry."""
+    of it (unit where the distance is positive); for a convex polytope (``ConvexBase``:
+    a URDF link's hull) a convex function never above its signed distance,
+    :math:`\max_i (n_i \cdot x - b_i)` over its face planes (exact inside; outside, the
+    distance to the farthest supporting half-space), with the unit normal of that face
+    as subgradient; None for another geometry."""
+    if isinstance(solid, coal.ConvexBase):
+        planes = hull_planes(solid)
+        side = p @ planes[:, :3].T + planes[:, 3]  # (n, faces)
+        face = side.argmax(axis=1)
+        return side[np.arange(len(p)), face], planes[face, :3]
     if isinstance(solid, coal.Sphere):
         n = np.linalg.norm(p, axis=1)
         g = p / np.where(n > 0, n, 1.0)[:, None]
@@ -210,15 +221,35 @@ def solid_distance_bound(solid: coal.CollisionGeometry, p: np.ndarray) -> tuple[
 
 def solid_half_sides(solid: coal.CollisionGeometry) -> np.ndarray | None:
     """Half sides (3,) [m] of the box about the origin holding a primitive solid (a coal
-    ``Box``, ``Cylinder``, ``Capsule`` or ``Sphere``); None for another geometry."""
+    ``Box``, ``Cylinder``, ``Capsule`` or ``Sphere``) or a convex polytope (its vertices'
+    largest coordinates); None for another geometry."""
     if isinstance(solid, coal.Sphere):
         return np.full(3, solid.radius)
+    if isinstance(solid, coal.ConvexBase):
+        return np.abs(np.asarray(solid.points(), dtype=float)).max(axis=0)
     if isinstance(solid, coal.Box):
         return np.asarray(solid.halfSide, dtype=float).copy()
     if not isinstance(solid, (coal.Cylinder, coal.Capsule)):
         return None
     tip = solid.halfLength + (solid.radius if isinstance(solid, coal.Capsule) else 0.0)
     return np.array([solid.radius, solid.radius, tip])
+
+
+#: The face planes of each convex solid, by its id, with the solid (kept alive with them).
+_PLANES: dict[int, tuple[coal.ConvexBase, np.ndarray]] = {}
+
+
+def hull_planes(solid: coal.ConvexBase) -> np.ndarray:
+    """The face planes (f, 4) of a convex polytope, ``(n, -b)`` with unit outward normals
+    ``n`` (f, 3) and offsets ``b`` [m] (``n · x ≤ b`` inside; qhull through scipy, once a
+    solid)."""
+    entry = _PLANES.get(id(solid))
+    if entry is None or entry[0] is not solid:
+        from scipy.spatial import ConvexHull
+
+        equations = ConvexHull(np.asarray(solid.points(), dtype=float)).equations
+        entry = _PLANES[id(solid)] = (solid, np.ascontiguousarray(equations))
+    return entry[1]
 
 
 def _box_sdf(p: np.ndarray, h: np.ndarray, signed_axes: tuple[int, ...] | None = None):
@@ -257,6 +288,12 @@ class CloudDistance:
             h: coal.ComputeDistance(solid, box) for h, box in self.cells.sizes.items()
         }
         self._half_local = solid_half_sides(solid)
+        #: a convex polytope's box (centre (3,), half sides (3,)) [m], its frame: a cheap
+        #: first bound of the leaves before the one over its faces
+        self._hull_box = None
+        if isinstance(solid, coal.ConvexBase):
+            v = np.asarray(solid.points(), dtype=float)
+            self._hull_box = (0.5 * (v.min(0) + v.max(0)), 0.5 * (v.max(0) - v.min(0)))
         self._scratch = coal.DistanceResult()
         self._tf_leaf = coal.Transform3s()
         #: coal calls made by the last evaluation.
@@ -268,7 +305,11 @@ class CloudDistance:
         tf_cloud: coal.Transform3s,
         request: coal.DistanceRequest,
         result: coal.DistanceResult,
+        cap: float | None = None,
     ) -> float:
+        """The distance [m] (exact up to :attr:`cap`, or up to ``cap`` [m] if smaller:
+        a caller that only needs to know whether the distance is below a value passes
+        it, and a larger distance comes back as a lower bound above it, for less work)."""
         rs, ts = np.asarray(tf_solid.getRotation()), np.asarray(tf_solid.getTranslation())
         ro, to = np.asarray(tf_cloud.getRotation()), np.asarray(tf_cloud.getTranslation())
         rot = ro.T @ rs  # solid frame -> cloud frame
@@ -283,7 +324,8 @@ class CloudDistance:
 
         # the buckets whose grid cell meets the solid's box grown by cap + ε + the
         # largest leaf half edge: any other leaf is farther than cap + ε (module doc)
-        far = self.cap + FAR_MARGIN
+        cap = self.cap if cap is None else min(self.cap, float(cap))
+        far = cap + FAR_MARGIN
         grow = self._half_local @ np.abs(rot.T) + far + cells.hmax
         k0 = np.floor((pos - grow - cells.origin) / cells.edge).astype(np.int64)
         k1 = np.floor((pos + grow - cells.origin) / cells.edge).astype(np.int64)
@@ -305,26 +347,30 @@ class CloudDistance:
             self.last_calls = 0
             return far
         box_lb = bound(cells.box_centre[near], cells.box_half[near])
-        order = np.argsort(box_lb, kind="stable")
-        box_lb, order = box_lb[order], near[order]
-        leaf_lb, leaf_ix = np.empty(0), np.empty(0, dtype=np.int64)  # opened, sorted
-        best, best_leaf, calls, bi, li = np.inf, -1, 0, 0, 0
-        while True:
-            nb = box_lb[bi] if bi < len(box_lb) else np.inf
-            nl = leaf_lb[li] if li < len(leaf_lb) else np.inf
-            low = min(nb, nl)  # every leaf not computed is at least this far
-            if best < 0.0 or low >= best - TIE or low > self.cap:
+        # every leaf of a bucket whose bound is above the cap is above it too: the leaves
+        # of the other buckets, all at once (one bound call), in increasing bound order
+        inner = box_lb <= cap
+        low = min(float(box_lb[~inner].min(initial=np.inf)), far)  # the leaves not gathered
+        picked = near[inner]
+        counts = cells.start[picked + 1] - cells.start[picked]
+        shift = np.repeat(cells.start[picked] - np.cumsum(counts) + counts, counts)
+        leaves = np.arange(int(counts.sum())) + shift  # the leaves of the picked buckets
+        if self._hull_box is not None:  # the polytope's box holds it: a lower bound first
+            c, e = self._hull_box
+            d, g = _box_sdf((cells.centre[leaves] - pos) @ rot - c, e)
+            box_leaf = d - np.abs(g @ rot.T).sum(1) * cells.half[leaves]
+            low = min(low, float(box_leaf[box_leaf > cap].min(initial=np.inf)))
+            leaves = leaves[box_leaf <= cap]
+        leaf_lb = bound(cells.centre[leaves], cells.half[leaves])
+        keep = leaf_lb <= cap
+        low = min(low, float(leaf_lb[~keep].min(initial=np.inf)))
+        sort = np.argsort(leaf_lb[keep], kind="stable")
+        leaf_lb, leaf_ix = leaf_lb[keep][sort].tolist(), leaves[keep][sort].tolist()
+        best, best_leaf, calls = np.inf, -1, 0
+        for lb, leaf in zip(leaf_lb, leaf_ix):
+            if best < 0.0 or lb >= best - TIE:
+                low = min(low, lb)  # every leaf not computed is at least this far
                 break
-            if nb <= nl:  # open the bucket: its leaves join the pending ones, sorted
-                b = int(order[bi])
-                s, e = cells.start[b], cells.start[b + 1]
-                lbs = np.concatenate([leaf_lb[li:], bound(cells.centre[s:e], cells.half[s:e])])
-                ixs = np.concatenate([leaf_ix[li:], np.arange(s, e)])
-                sort = np.argsort(lbs, kind="stable")
-                leaf_lb, leaf_ix, li, bi = lbs[sort], ixs[sort], 0, bi + 1
-                continue
-            leaf = int(leaf_ix[li])
-            li += 1
             self._tf_leaf.setTransform(ro, to + ro @ cells.centre[leaf])
             self._scratch.clear()
             d = self._functors[float(cells.half[leaf])](
@@ -334,7 +380,6 @@ class CloudDistance:
             if d < best:
                 best, best_leaf = d, leaf
         self.last_calls = calls
-        low = min(low, far)  # the buckets not gathered: beyond cap + ε
         if best_leaf < 0:  # every leaf beyond the cap: that bound
             result.min_distance = low
             return float(low)

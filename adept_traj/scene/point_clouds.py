@@ -19,7 +19,9 @@ Files: ``.ply`` (ASCII or binary, the vertex element's x, y, z), ``.pcd`` (ASCII
 fields x, y, z), ``.xyz`` (text, the first three numbers of each line), ``.npy`` ((n, 3)
 floats). The number of points is read from the header before the data, and a cloud whose
 octree would need more memory than the budget (:mod:`adept_traj.memory`) is refused
-before it is read.
+before it is read; once read, the cloud with its distance fields (the checker's
+cube-distance field up to :data:`CUBE_FIELD_CELLS` cells, sized from the points' box) is
+checked again before any field or octree is made (:func:`check_cloud_memory`).
 """
 
 from __future__ import annotations
@@ -38,22 +40,90 @@ from adept_traj.memory import check_memory
 from adept_traj.scene.shapes import Shape
 from adept_traj.validation import as_finite_array, as_scalar, readonly_copy
 
-__all__ = ["CLOUD_SUFFIXES", "PointCloud", "cloud_bytes", "read_cloud_points"]
+__all__ = [
+    "CLOUD_SUFFIXES",
+    "CUBE_FIELD_CELLS",
+    "PointCloud",
+    "check_cloud_memory",
+    "cloud_bytes",
+    "cube_field_step",
+    "read_cloud_points",
+]
 
 #: File suffixes read as point clouds.
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".npy")
 
-#: Bytes per point of a cloud: its (n, 3) float64 array twice (read, then kept) and coal's
-#: octree (at most 480 B per point measured, for points each in a cell of its own).
-_BYTES_PER_POINT = 48 + 600
+#: Bytes per point of a cloud: its (n, 3) float64 array twice (read, then kept), coal's
+#: octree (at most 480 B per point measured, for points each in a cell of its own), the
+#: coarse field's passes over the points (≈ 100 B) and the checker's leaf arrays
+#: (:class:`~adept_traj.collision.cloud_distance.CloudCells`: ≤ 600 B per leaf, a leaf
+#: per point at most; ``tracemalloc`` peaks, ``benchmarks/bench_memory.py``).
+_BYTES_PER_POINT = 48 + 480 + 100 + 600
 
 #: Most cells of a cloud's coarse distance field (4 MB of float32).
 _FIELD_CELLS = 1_000_000
 
+#: Most cells of the checker's cube-distance field
+#: (:meth:`~adept_traj.collision.cloud_distance.CloudCells.point_bound`; 32 MB of float32).
+CUBE_FIELD_CELLS = 8_000_000
 
-def cloud_bytes(n_points: int) -> int:
-    """Memory [B] a cloud of ``n_points`` points may need (arrays and octree)."""
-    return int(n_points) * _BYTES_PER_POINT
+#: Peak bytes per cell of the cube-distance field while it is built (the occupied and
+#: dilated grids, scipy's distance transform with its feature transform, the float32
+#: result kept): 51.4–51.8 B measured with ``tracemalloc``; plus the coarse field's.
+_BYTES_PER_FIELD_CELL = 56
+
+
+def cube_field_step(lo: Any, hi: Any, leaf: float) -> tuple[float, int]:
+    """The cube edge h [m] of the cube-distance field over the box ``lo``–``hi`` (3,) [m]
+    of the leaves, edge ``leaf`` [m]: the smallest power-of-2 multiple of ``leaf`` for at
+    most :data:`CUBE_FIELD_CELLS` cells (with spares); and that number of cells."""
+    extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
+    h = float(leaf)
+    while np.prod(np.ceil(extent / h) + 3) > CUBE_FIELD_CELLS:
+        h *= 2.0
+    return h, int(np.prod(np.ceil(extent / h) + 3))
+
+
+def cloud_bytes(n_points: int, field_cells: int = 0) -> int:
+    """Memory [B] a cloud of ``n_points`` points may need: its arrays and octree, and the
+    distance fields — the coarse one (:data:`_FIELD_CELLS` at most) and the checker's
+    cube-distance field of ``field_cells`` cells (:func:`cube_field_step`; 0 when not yet
+    known, before the points are read)."""
+    fields = _FIELD_CELLS * _BYTES_PER_FIELD_CELL if field_cells else 0
+    return int(n_points) * _BYTES_PER_POINT + int(field_cells) * _BYTES_PER_FIELD_CELL + fields
+
+
+def check_cloud_memory(
+    points: np.ndarray, resolution: float, source: str, budget: int | None = None
+) -> None:
+    """Refuse a cloud whose arrays, octree and distance fields (:func:`cloud_bytes`, the
+    cube-distance field's size from the points' box) exceed the memory budget, before any
+    of them is made.
+
+    Parameters
+    ----------
+    points: (n, 3) the cloud's points [m].
+    resolution: the octree's cell edge [m].
+    source: the file the points come from ("" for an array), for the message.
+    budget: the limit [B] (default :func:`~adept_traj.memory.memory_budget`).
+
+    Raises
+    ------
+    ResourceLimitError
+        Naming the cloud (its file, or "an array"), its points, the estimate, the
+        cube-distance field's cells and the limit.
+    """
+    lo, hi = points.min(axis=0) - resolution, points.max(axis=0) + resolution
+    _, cells = cube_field_step(lo, hi, resolution)
+    name = repr(source) if source else "an array"
+    try:
+        what = f"{name} ({len(points)} points)"
+        check_memory(cloud_bytes(len(points), cells), "point cloud", what, budget)
+    except ResourceLimitError as exc:
+        raise ResourceLimitError(
+            f"{exc} (about {_BYTES_PER_POINT} B per point and {_BYTES_PER_FIELD_CELL} B per "
+            f"cell of its cube-distance field, {cells} cells at {resolution:g} m)"
+        ) from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +147,7 @@ class PointCloud(Shape):
         if p.ndim != 2 or p.shape[1] != 3 or len(p) == 0:
             raise InvalidInputError(f"points must have shape (n, 3) [m], n ≥ 1; got {p.shape}")
         r = as_scalar(self.resolution, "resolution", "[m]", minimum=0.0, strict=True)
+        check_cloud_memory(p, r, str(self.source))  # before the fields and the octree
         object.__setattr__(self, "points", readonly_copy(p))
         object.__setattr__(self, "resolution", r)
         object.__setattr__(self, "source", str(self.source))
@@ -90,7 +161,9 @@ class PointCloud(Shape):
     ) -> PointCloud:
         """Read a cloud file (:func:`read_cloud_points`) at the octree ``resolution`` [m]."""
         r = as_scalar(resolution, "resolution", "[m]", minimum=0.0, strict=True)
-        return cls(read_cloud_points(path, budget=budget), r, str(Path(path).resolve()))
+        points, source = read_cloud_points(path, budget=budget), str(Path(path).resolve())
+        check_cloud_memory(points, r, source, budget)  # with the distance fields
+        return cls(points, r, source)
 
     @property
     def n_points(self) -> int:
