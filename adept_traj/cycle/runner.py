@@ -40,8 +40,8 @@ from adept_traj.scene import Scene
 from adept_traj.validation import as_integer
 
 __all__ = [
-    "MOVES_FOLDER",
     "CLOSE_TIMEOUT",
+    "MOVES_FOLDER",
     "MOVE_FILE",
     "RETRIES",
     "MoveTask",
