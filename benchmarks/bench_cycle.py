@@ -264,11 +264,13 @@ def bench(name: str, args: argparse.Namespace, root: Path) -> bool:
     file = write_cycle(folder, cycle_file_text(name, pop, gens), file=f"{name}.toml", scenes={})
     grid = ["--phase-grid", str(args.phases)]
     base = ["adept-traj", "cycle", str(file), "--quiet", "--no-plots", "--no-playback", "--out"]
-    local = [c for c in ("1", "2") if c in args.configs]
+    configs = ["2"] if name in args.once else args.configs
+    repeats = 1 if name in args.once else args.repeat
+    local = [c for c in ("1", "2") if c in configs]
     # per configuration: (wall [s], CPU [s], load before, workers' CPU [s]) of each run
-    rows: dict[str, list[tuple[float, float, str, list[float]]]] = {c: [] for c in args.configs}
+    rows: dict[str, list[tuple[float, float, str, list[float]]]] = {c: [] for c in configs}
     outs, err = [], ""
-    for r in range(args.repeat):
+    for r in range(repeats):
         for c in pair_order(local, r):  # paired, alternating: 1, 2 / 2, 1 / …
             out, load = folder / f"{c}workers.{r}", load_average()
             wall, cpu, err, per_worker = timed([*base, str(out), "--workers", c, *grid])
@@ -276,7 +278,7 @@ def bench(name: str, args: argparse.Namespace, root: Path) -> bool:
             outs.append(out)
             print(f"  run {r} on {c} worker(s): wall {wall:.1f} s, CPU {cpu:.1f} s "
                   f"(workers {_runs(per_worker)}), load before {load}", flush=True)  # fmt: skip
-        if "tcp" in args.configs:
+        if "tcp" in configs and r == 0:  # once: the same results bit for bit over TCP
             out, load = folder / f"tcp.{r}", load_average()
             wall, cpu, err, per_worker = run_on_tcp(file, out, grid)
             rows["tcp"].append((wall, cpu, load, per_worker))
@@ -357,7 +359,13 @@ def main() -> None:
         nargs="+",
         choices=["1", "2", "tcp"],
         default=["1", "2", "tcp"],
-        help="1 / 2 local workers, a scheduler + 2 workers over TCP",
+        help="1 / 2 local workers, a scheduler + 2 workers over TCP (its first repeat only)",
+    )
+    parser.add_argument(
+        "--once",
+        nargs="*",
+        default=[],
+        help="cycles run once on 2 local workers only (their cycle times; no scaling)",
     )
     parser.add_argument("--out", type=Path, help="output folder (default: a temporary one)")
     args = parser.parse_args()
