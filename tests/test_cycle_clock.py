@@ -21,6 +21,7 @@ from adept_traj.cli import main
 from adept_traj.cycle import (
     MAX_CLOCKED_MOVES,
     clock_playback,
+    plan_phase_grid,
     read_cycle_file,
     scene_period,
 )
@@ -493,6 +494,20 @@ def test_phase_grid_cycle_is_certified_at_its_start_times(tmp_path: Path, cluste
             rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
             still = np.repeat(q[:1], len(rest), axis=0)
             assert clearance_by_hand(robot, scene, still, rest)[0].min() >= MARGIN - 1e-6
+    # the naive schedule is every pass back to back: played on one continuous clock, each
+    # move at the scene time it runs (not the phase it was planned at: the bob never jumps)
+    cycle = read_cycle_file(path)
+    clock, passes, _ = plan_phase_grid(
+        cycle, out, phases=4, schedule="naive", resume=True, scheduler=cluster.scheduler_address
+    )
+    assert clock.period is None
+    assert len(clock.passes) == summary["repeat"]
+    play = clock_playback(clock, passes, robot=robot, scene=cycle.scene, fps=20)
+    assert np.all(np.diff(play.times) > 0)
+    assert play.duration == pytest.approx(clock.cycle_time, abs=1e-12)
+    bob = next(o for o in play.objects if o.path == "obstacles/pendulum.bob")
+    hand = np.array([pendulum_bob_by_hand(scene["pendulum"][0], t) for t in play.times])
+    np.testing.assert_allclose(bob.poses[:, :3, 3], hand, atol=1e-12)
     capsys.readouterr()
     assert main(["verify", str(out)]) == 0
     assert "every move and dwell certified" in capsys.readouterr().out
