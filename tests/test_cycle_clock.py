@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from adept_traj.cli import main
 from adept_traj.cycle import (
     MAX_CLOCKED_MOVES,
     clock_playback,
+    plan_phase_grid,
     read_cycle_file,
     scene_period,
 )
@@ -397,6 +399,44 @@ def test_phase_grid_dynamic_programming_equals_brute_force(seed: int, repeat: in
         assert _pass_time(again["optimised"], options, P, repeat) == pytest.approx(expected)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_back_to_back_waits_only_where_it_must(seed: int) -> None:
+    """Every pass back to back: each move starts at the previous end with the fastest
+    plan certified there, and waits (to a plan's phase, with an allowed dwell) only where
+    no plan is certified at the previous end; no final dwell. Where every plan is
+    certified at every start, the cycle time is repeat × Σ_k min T (closed form)."""
+    from adept_traj.cycle import back_to_back
+
+    P, repeat = 2.0, 3
+    options, rest_ok = _random_plans(seed, P=P)
+
+    def move_ok(k, i, s):  # certified at its own phase, elsewhere on a random share
+        o = options[k][i]
+        at_phase = abs((s - o.phase) / P - round((s - o.phase) / P)) < 1e-9
+        return o.certified and (at_phase or math.cos(3.7 * s + 1.3 * i + k) > 0.2)
+
+    runs = back_to_back(options, P, repeat, move_ok, rest_ok)
+    assert runs is not None  # these seeds have a certified step for every move
+    assert len(runs) == repeat
+    assert all(len(path) == len(options) for path in runs)
+    end = 0.0
+    for path in runs:
+        for k, (i, s) in enumerate(path):
+            ready = [j for j in range(len(options[k])) if move_ok(k, j, end)]
+            assert move_ok(k, i, s)
+            if ready:
+                assert s == end
+                assert min(options[k][j].T for j in ready) == options[k][i].T
+            else:
+                assert s > end
+                assert rest_ok(k, end, s - end)
+            end = s + options[k][i].T
+    always = back_to_back(options, P, repeat, lambda k, i, s: options[k][i].certified, rest_ok)
+    fastest = sum(min(o.T for o in row if o.certified) for row in options)
+    i, s = always[-1][-1]
+    assert s + options[-1][i].T == pytest.approx(repeat * fastest, rel=1e-12)
+
+
 def test_rest_profile_is_conservative() -> None:
     """A dwell the rest profile allows is certified by certify_rest at its real scene
     times (several periods later too); the profile refuses the dwells certify_rest
@@ -426,20 +466,48 @@ def test_phase_grid_cycle_is_certified_at_its_start_times(tmp_path: Path, cluste
     path = _files(tmp_path, CYCLE.replace("[dwell]\nstep = 0.5\nmax = 1.5\n", ""))
     out = tmp_path / "out"
     argv = ["cycle", str(path), "--out", str(out), "--scheduler", cluster.scheduler_address]
+    capsys.readouterr()
     assert main([*argv, "--quiet", "--no-playback", "--no-plots", "--phase-grid", "4"]) == 0
+    line = capsys.readouterr().err
     summary = json.loads((out / "cycle.json").read_text())
     clock = summary["clock"]
-    assert clock["mode"] == "phase grid (optimised)"
+    assert clock["mode"].startswith("phase grid (optimised")
     assert len(clock["phase_grid"]) == 4
+    # the shorter of the periodic and the back-to-back schedules (both printed)
+    found = re.search(
+        r"periodic ([0-9.]+|–) s(?: \(not re-certified\))?, back to back ([0-9.]+|–) s", line
+    )
+    times = [float(v) for v in found.groups() if v != "–"]
+    assert summary["cycle_time"] == pytest.approx(min(times), abs=1e-3)
+    back = clock["period"] is None
+    assert back == ("back to back" in clock["mode"])
+    assert len(clock["passes"]) == (summary["repeat"] if back else 1)
     scene = Scene.from_file(tmp_path / "swing.toml").to_dict()
     robot = Robot.adept_one_xl()
     for p in range(summary["repeat"]):
-        for m in clock["passes"][0]:
+        for m in clock["passes"][p if back else 0]:
             t, q = _dense(out / m["folder"])
             rows = np.r_[np.arange(0, len(t), 12), len(t) - 1]
-            start = m["start_time"] + p * clock["pass_time"]
+            start = m["start_time"] + (0.0 if back else p * clock["pass_time"])
             hand, _ = clearance_by_hand(robot, scene, q[rows], start + t[rows])
             assert hand.min() >= MARGIN - 1e-6
+            rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
+            still = np.repeat(q[:1], len(rest), axis=0)
+            assert clearance_by_hand(robot, scene, still, rest)[0].min() >= MARGIN - 1e-6
+    # the naive schedule is every pass back to back: played on one continuous clock, each
+    # move at the scene time it runs (not the phase it was planned at: the bob never jumps)
+    cycle = read_cycle_file(path)
+    clock, passes, _ = plan_phase_grid(
+        cycle, out, phases=4, schedule="naive", resume=True, scheduler=cluster.scheduler_address
+    )
+    assert clock.period is None
+    assert len(clock.passes) == summary["repeat"]
+    play = clock_playback(clock, passes, robot=robot, scene=cycle.scene, fps=20)
+    assert np.all(np.diff(play.times) > 0)
+    assert play.duration == pytest.approx(clock.cycle_time, abs=1e-12)
+    bob = next(o for o in play.objects if o.path == "obstacles/pendulum.bob")
+    hand = np.array([pendulum_bob_by_hand(scene["pendulum"][0], t) for t in play.times])
+    np.testing.assert_allclose(bob.poses[:, :3, 3], hand, atol=1e-12)
     capsys.readouterr()
     assert main(["verify", str(out)]) == 0
     assert "every move and dwell certified" in capsys.readouterr().out

@@ -38,6 +38,7 @@ from adept_traj.cycle.cycle_playback import (
 from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
 from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
+    CLOSE_TIMEOUT,
     MOVE_FILE,
     MOVES_FOLDER,
     RETRIES,
@@ -49,7 +50,7 @@ from adept_traj.cycle.runner import (
     run_planning_tasks,
     run_tasks,
 )
-from adept_traj.cycle.schedules import PhaseOption, phase_frontier, phase_schedules
+from adept_traj.cycle.schedules import PhaseOption, back_to_back, phase_frontier, phase_schedules
 from adept_traj.cycle.study import (
     ALGORITHM_PAIR,
     METRICS,
@@ -84,6 +85,7 @@ __all__ = [
     "ALGORITHM_PAIR",
     "BOXPLOT_FIGURE",
     "CHOICES",
+    "CLOSE_TIMEOUT",
     "CYCLE_FILE",
     "CYCLE_REPORT",
     "DEFAULT_PHASES",
@@ -110,6 +112,7 @@ __all__ = [
     "PhaseOption",
     "RestCheck",
     "RestProfile",
+    "back_to_back",
     "certify_rest",
     "check_chained",
     "chosen_member",

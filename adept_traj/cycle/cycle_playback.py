@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -130,6 +131,8 @@ def clock_playback(
     certified = clock.certified
     entries = [(m, r) for moves, rs in zip(clock.passes, results) for m, r in zip(moves, rs)]
     for n, (m, r) in enumerate(entries):
+        if r.problem_settings.start_time != m.start_time:  # run at another time than planned
+            r = replace(r, problem_settings=replace(r.problem_settings, start_time=m.start_time))
         replay = Replay.of(r, r.front.x[m.member], robot=robot, scene=scene)
         part = build_animation(r, fps=fps, replay=replay, member=m.member)
         animated = {o.path: o.poses for o in part.objects if o.animated}

@@ -42,6 +42,16 @@ times**: every move of every pass (:func:`~adept_traj.analysis.certify` at
 (:func:`~adept_traj.cycle.certify_rest`); a step that fails any of them is banned and the
 schedule chosen again, until a schedule passes every check or none is left. So only
 moves and dwells certified at the times they run are reported.
+
+With ``repeat`` > 1 the final dwell that makes a pass a multiple of P is a choice, not a
+need: where ``repeat`` × K ≤ :data:`~adept_traj.cycle.MAX_CLOCKED_MOVES`, every pass is
+also scheduled **back to back** (:func:`~adept_traj.cycle.back_to_back`: each move at the
+previous end with the fastest plan certified there, whatever phase it was planned at, a
+dwell only where none is; no final dwell), each move re-certified at its real start time.
+That is the **naive** schedule then (it waits only where it must), and the optimised one
+when its cycle time is shorter than ``repeat`` × the periodic schedule's pass time: the
+clock then holds every pass (``period`` ``None``, mode ``"phase grid (optimised, back to
+back)"``).
 """
 
 from __future__ import annotations
@@ -57,7 +67,13 @@ import numpy as np
 
 from adept_traj.analysis import certify
 from adept_traj.cycle.choice import chosen_member
-from adept_traj.cycle.clock import ClockedMove, CycleClock, check_chained, scene_period
+from adept_traj.cycle.clock import (
+    MAX_CLOCKED_MOVES,
+    ClockedMove,
+    CycleClock,
+    check_chained,
+    scene_period,
+)
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
 from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
@@ -68,8 +84,10 @@ from adept_traj.cycle.runner import (
     run_planning_tasks,
 )
 from adept_traj.cycle.schedules import (
+    SAME_TIME,
     PhaseOption,
     Step,
+    back_to_back,
     congruent,
     naive_schedule,
     pass_end,
@@ -123,10 +141,14 @@ def plan_phase_grid(
     resume: bool = False,
 ) -> tuple[CycleClock, list[list[PlanningResult]], dict[str, Any]]:
     """Plan a periodic ``cycle`` on the phase grid (module doc): returns the clock of the
-    ``schedule`` (``"optimised"`` or ``"naive"``), the chosen results (one pass) and a
-    report ``{"optimised": pass time [s] | None, "naive": …, "plans": plans per move,
-    "phases": (N,) grid [s]}``. Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase
-    J) and ``out/moves/NAME.xI/`` (arrival I).
+    ``schedule`` (``"optimised"`` or ``"naive"``), the chosen results (per pass of the
+    clock: one, or every pass back to back) and a report ``{"optimised": cycle time [s] |
+    None, "naive": …, "periodic": the periodic schedule's cycle time [s] | None,
+    "periodic_certified": whether it was re-certified (not when the back-to-back schedule
+    is no longer: then "periodic" is its uncertified cycle time), "back_to_back": the
+    back-to-back schedule's | None, "plans": plans per move, "phases": (N,) grid [s]}``.
+    Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase J) and ``out/moves/NAME.xI/``
+    (arrival I).
 
     ``beam``: schedules kept per move (default: ``phases``).
 
@@ -242,13 +264,32 @@ def plan_phase_grid(
                 bad.add((K - 1, *path[-1]))
         return bad
 
-    chosen: dict[str, tuple[Step, ...] | None] = {}
-    for name in ("optimised", "naive"):
+    runs = None  # every pass back to back, no final dwell (module doc)
+    if cycle.repeat > 1 and cycle.repeat * K <= MAX_CLOCKED_MOVES:
+        runs = back_to_back(
+            options,
+            P,
+            cycle.repeat,
+            move_ok,
+            lambda k, s, d: allowed(k, s, d) and rest(k, s, d).certified,
+        )
+    runs_time = None
+    if runs is not None:
+        i, s = runs[-1][-1]
+        runs_time = s + options[-1][i].T
+    chosen: dict[str, tuple[Step, ...] | None] = {"optimised": None, "naive": None}
+    bound = None  # a periodic schedule no shorter than the back-to-back one, not re-certified
+    for name in ("optimised",) if runs is not None else ("optimised", "naive"):
         banned: frozenset[tuple[int, int, float]] = frozenset()
         while True:
             path = phase_schedules(
                 options, P, allowed, beam=width, repeat=cycle.repeat, banned=banned
             )[name]
+            if path is not None and runs_time is not None:
+                span = cycle.repeat * _span(path, options, P, cycle.repeat)
+                if span >= runs_time - SAME_TIME:
+                    bound = span
+                    break
             bad = set() if path is None else failures(path)
             if not bad:
                 chosen[name] = path
@@ -258,8 +299,24 @@ def plan_phase_grid(
         span = {k: _span(v, options, P, cycle.repeat) for k, v in chosen.items()}
         if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
             chosen["optimised"] = chosen["naive"]
-    path = chosen[schedule]
-    if path is None:
+    times = {
+        name: None if v is None else cycle.repeat * _span(v, options, P, cycle.repeat)
+        for name, v in chosen.items()
+    }
+    report: dict[str, Any] = {
+        "periodic": times["optimised"] if bound is None else bound,
+        "periodic_certified": times["optimised"] is not None,
+        "back_to_back": runs_time,
+    }
+    back = False
+    if runs_time is not None:  # the naive schedule is the back-to-back one
+        times["naive"] = runs_time
+        periodic = times["optimised"]
+        if periodic is None or runs_time < periodic - SAME_TIME:
+            times["optimised"] = runs_time
+            back = True  # and so is the optimised one
+        back = back or schedule == "naive"
+    if chosen[schedule] is None and not back:
         counts = ", ".join(
             f"{t.move.name} {sum(p.option.certified for p in row)}/{len(row)}"
             for t, row in zip(base, plans)
@@ -269,44 +326,49 @@ def plan_phase_grid(
             f"a grid of {n} phases and the arrivals (plans certified at their phase: "
             f"{counts}); plan the cycle without --phase-grid"
         )
-    row, results = [], []
+    if back and runs is not None:
+        chosen_passes = runs
+    else:  # not None: refused above otherwise
+        chosen_passes = [path for path in (chosen[schedule],) if path is not None]
+    rows, results = [], []
     end = 0.0
-    for k, (i, start) in enumerate(path):
-        p = plans[k][i]
-        row.append(
-            ClockedMove(
-                pass_index=0,
-                index=k,
-                name=base[k].move.name,
-                folder=f"{MOVES_FOLDER}/{p.name}",
-                member=p.member,
-                start_time=start,
-                dwell=start - end,
-                T=p.option.T,
-                move_certified=move_ok(k, i, start),
-                rest=rest(k, end, start - end),
-                candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
+    for q, path in enumerate(chosen_passes):
+        row, row_results = [], []
+        for k, (i, start) in enumerate(path):
+            p = plans[k][i]
+            row.append(
+                ClockedMove(
+                    pass_index=q,
+                    index=k,
+                    name=base[k].move.name,
+                    folder=f"{MOVES_FOLDER}/{p.name}",
+                    member=p.member,
+                    start_time=start,
+                    dwell=start - end,
+                    T=p.option.T,
+                    move_certified=move_ok(k, i, start),
+                    rest=rest(k, end, start - end),
+                    candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
+                )
             )
-        )
-        results.append(p.result)
-        end = start + p.option.T
-    final = pass_end(end, P, cycle.repeat) - end
+            row_results.append(p.result)
+            end = start + p.option.T
+        rows.append(tuple(row))
+        results.append(row_results)
+    final = 0.0 if back else pass_end(end, P, cycle.repeat) - end
     clock = CycleClock(
-        period=P,
-        passes=(tuple(row),),
+        period=None if back else P,
+        passes=tuple(rows),
         final_dwell=max(final, 0.0),
-        final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 else None,
+        final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 and not back else None,
         repeat=cycle.repeat,
         dwells=tuple(grid.tolist()),
-        mode=f"phase grid ({schedule})",
+        mode=f"phase grid ({schedule}{', back to back' if back else ''})",
     )
-    report: dict[str, Any] = {
-        name: None if v is None else _span(v, options, P, cycle.repeat)
-        for name, v in chosen.items()
-    }
+    report.update({"optimised": times["optimised"], "naive": times["naive"]})
     report["plans"] = [len(r) for r in plans]
     report["phases"] = grid
-    return clock, [results], report
+    return clock, results, report
 
 
 def _span(

@@ -40,6 +40,7 @@ from adept_traj.scene import Scene
 from adept_traj.validation import as_integer
 
 __all__ = [
+    "CLOSE_TIMEOUT",
     "MOVES_FOLDER",
     "MOVE_FILE",
     "RETRIES",
@@ -58,6 +59,10 @@ MOVES_FOLDER = "moves"
 MOVE_FILE = "move.json"
 #: Times a task that raised is submitted again.
 RETRIES = 2
+#: Seconds [s] a local worker process is given to exit by itself when the cluster stops
+#: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
+#: workers and warns "Worker process still alive after 4.0 seconds, killing").
+CLOSE_TIMEOUT = 60.0
 
 
 @dataclass(frozen=True)
@@ -194,7 +199,8 @@ def run_tasks(
 def dask_client(workers: int | None, scheduler: str | None, n_tasks: int) -> Iterator[Any]:
     """A ``distributed.Client``: of a new local cluster of ``min(workers, n_tasks)``
     single-threaded worker processes (default: one per core), or of the scheduler at
-    address ``scheduler``; closed (and the cluster stopped) on leaving."""
+    address ``scheduler``; closed (and the cluster stopped, each worker process given
+    :data:`CLOSE_TIMEOUT` to exit) on leaving."""
     from distributed import Client, LocalCluster
 
     if scheduler is None:
@@ -213,7 +219,24 @@ def dask_client(workers: int | None, scheduler: str | None, n_tasks: int) -> Ite
     finally:
         client.close()
         if cluster is not None:
+            _stop_workers(cluster, CLOSE_TIMEOUT)
             cluster.close()
+
+
+def _stop_workers(cluster: Any, timeout: float) -> None:
+    """Close every worker of the local ``cluster`` (its nanny and worker process),
+    waiting up to 0.8 × ``timeout`` [s] for each process to exit by itself before it is
+    killed; ``cluster.close()`` then finds them closed. (``LocalCluster.close`` closes each
+    nanny with Dask's default of 5 s: a worker process that needs longer to exit — its
+    interpreter's teardown on a loaded machine — is killed, with a warning.)"""
+    import asyncio
+
+    nannies = list(cluster.workers.values())
+
+    async def close_all() -> None:
+        await asyncio.gather(*(n.close(timeout=timeout) for n in nannies))
+
+    cluster.sync(close_all)
 
 
 def _run_on(

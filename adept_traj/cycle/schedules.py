@@ -1,9 +1,10 @@
 r"""Schedules of a periodic cycle over the plans of its moves: dynamic programming over the
 end times (:func:`phase_frontier`, :func:`phase_schedules`) and the naive back-to-back
 schedule (:func:`naive_schedule`); the arithmetic of the scene clock modulo the period
-(:func:`next_start`, :func:`congruent`, :func:`pass_end`). Pure functions of the plans'
-phases, travel times and certificates and of a rest predicate: what they mean and how the
-plans are made is :mod:`adept_traj.cycle.phase_grid`'s.
+(:func:`next_start`, :func:`congruent`, :func:`pass_end`); every pass back to back without
+a final dwell (:func:`back_to_back`). Pure functions of the plans' phases, travel times and
+certificates and of rest and certificate predicates: what they mean and how the plans are
+made is :mod:`adept_traj.cycle.phase_grid`'s.
 """
 
 from __future__ import annotations
@@ -14,9 +15,11 @@ from dataclasses import dataclass
 
 __all__ = [
     "SAME_TIME",
+    "MoveOk",
     "PhaseOption",
     "RestOk",
     "Step",
+    "back_to_back",
     "congruent",
     "naive_schedule",
     "next_start",
@@ -50,6 +53,9 @@ def next_start(end: float, phase: float, period: float) -> float:
 
 
 RestOk = Callable[[int, float, float], bool]
+#: ``move_ok(k, plan, start)``: whether plan ``plan`` of move k is certified started at the
+#: scene time ``start`` [s] (re-certified there, whatever phase it was planned at).
+MoveOk = Callable[[int, int, float], bool]
 
 
 def _steps(
@@ -163,3 +169,50 @@ def phase_schedules(
         "optimised": None if best is None else best[1],
         "naive": None if naive is None else naive[1],
     }
+
+
+def back_to_back(
+    options: Sequence[Sequence[PhaseOption]],
+    period: float,
+    repeat: int,
+    move_ok: MoveOk,
+    rest_ok: RestOk,
+) -> list[tuple[Step, ...]] | None:
+    """Every one of the ``repeat`` passes planned back to back, with no final dwell: each
+    move starts at the previous end with the plan of least T that ``move_ok`` certifies
+    started there (any phase: it is re-certified at that scene time), and only where none
+    is, at the earliest start ≥ the previous end in a plan's phase whose dwell ``rest_ok``
+    allows and whose plan ``move_ok`` certifies (the robot waits only where it must).
+    Returns per pass its steps ``(plan, start [s])``, or ``None`` when a move has no
+    certified step."""
+    end, passes = 0.0, []
+    for _ in range(repeat):
+        path: tuple[Step, ...] = ()
+        for k, opts in enumerate(options):
+            step = _first_step(opts, k, end, period, move_ok, rest_ok)
+            if step is None:
+                return None
+            path = (*path, step)
+            end = step[1] + opts[step[0]].T
+        passes.append(path)
+    return passes
+
+
+def _first_step(
+    opts: Sequence[PhaseOption],
+    k: int,
+    end: float,
+    period: float,
+    move_ok: MoveOk,
+    rest_ok: RestOk,
+) -> Step | None:
+    """:func:`back_to_back`'s step of move k after ``end`` [s]."""
+    good = [i for i, o in enumerate(opts) if o.certified]
+    for i in sorted(good, key=lambda i: (opts[i].T, i)):  # no dwell
+        if move_ok(k, i, end):
+            return i, end
+    later = sorted((next_start(end, opts[i].phase, period), opts[i].T, i) for i in good)
+    for s, _, i in later:
+        if s > end and rest_ok(k, end, s - end) and move_ok(k, i, s):
+            return i, s
+    return None

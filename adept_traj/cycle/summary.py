@@ -223,6 +223,13 @@ def _clock_markdown(summary: dict[str, Any]) -> list[str]:
             f"{c['pass_time']:.3f} s a multiple of P, so every one of the "
             f"{summary['repeat']} passes sees the same obstacle phases."
         )
+    elif "back to back" in c.get("mode", ""):
+        how = (
+            f"All {c['passes_planned']} passes run back to back, with no final dwell "
+            "(shorter than rounding each pass up to a multiple of the obstacles' period): "
+            "each pass sees other obstacle phases, and each move is re-certified at its "
+            "real start time."
+        )
     else:
         how = (
             f"The moving obstacles are not periodic: all {c['passes_planned']} passes are planned."
