@@ -13,8 +13,8 @@ from typing import Any as _Any
 #: adept_traj`` (and ``adept-traj --help``) loads none of pinocchio, coal, pymoo or scipy
 #: before a name that needs them is used.
 _PUBLIC = {
-    "Certificate": "adept_traj.analysis.certificate",
-    "certify": "adept_traj.analysis.certificate",
+    "Certificate": "adept_traj.certification.certificate",
+    "certify": "adept_traj.certification.certificate",
     "PAPER_WEIGHTS": "adept_traj.analysis.decision",
     "average_fitness": "adept_traj.analysis.decision",
     "best_tradeoff": "adept_traj.analysis.decision",
@@ -29,8 +29,8 @@ _PUBLIC = {
     "ResultFormatError": "adept_traj.errors",
     "RobotModelError": "adept_traj.errors",
     "SceneError": "adept_traj.errors",
-    "ALGORITHMS": "adept_traj.optimise.algorithms",
-    "make_algorithm": "adept_traj.optimise.algorithms",
+    "ALGORITHMS": "adept_traj.optimise.search.algorithms",
+    "make_algorithm": "adept_traj.optimise.search.algorithms",
     "plan": "adept_traj.optimise.planner",
     "BSplineTrajectory": "adept_traj.problem",
     "Evaluation": "adept_traj.problem",
@@ -39,7 +39,7 @@ _PUBLIC = {
     "TrajectoryProblem": "adept_traj.problem",
     "kinematic_lower_bound": "adept_traj.problem",
     "paper_penalty": "adept_traj.problem",
-    "audit": "adept_traj.results.audit",
+    "audit": "adept_traj.certification.audit",
     "PlanningResult": "adept_traj.results.record",
     "JointLimits": "adept_traj.robot.limits",
     "RobotParameters": "adept_traj.robot.parameter_file",

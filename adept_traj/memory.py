@@ -4,7 +4,7 @@ whose estimated need exceeds it, before any long work starts.
 The budget is the smaller of :data:`MAX_MEMORY_BYTES` (a documented ceiling, 16 GiB) and the
 memory the machine has available right now (``MemAvailable`` of ``/proc/meminfo`` on
 Linux, else ``SC_AVPHYS_PAGES × SC_PAGE_SIZE``). The estimates themselves live beside what
-they estimate (:func:`~adept_traj.analysis.certificate.certificate_bytes`,
+they estimate (:func:`~adept_traj.certification.certificate.certificate_bytes`,
 :meth:`~adept_traj.problem.TrajectoryProblem.run_bytes`, …); each gives its formula, fitted
 to :mod:`tracemalloc` peaks measured on small sizes (``benchmarks/bench_memory.py``).
 """

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 from _results import recorded  # benchmarks/_results.py
 
-import adept_traj.optimise.weighted_move as weighted_move
+import adept_traj.optimise.local.weighted_move as weighted_move
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
 from adept_traj.analysis import WeightedSum, certify_members, weighted_sum
 from adept_traj.optimise import time_optimal, weighted_descent

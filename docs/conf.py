@@ -1,6 +1,6 @@
 """Sphinx configuration of the adept_traj documentation.
 
-Build (exactly what ``tests/test_docs.py`` and CI run; warnings are errors)::
+Build (exactly what ``tests/docs/test_docs.py`` and CI run; warnings are errors)::
 
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
@@ -54,7 +54,7 @@ myst_heading_anchors = 3
 
 # -- API reference (autodoc + napoleon) --------------------------------------------------
 
-# The docstrings use numpy sections ("Parameters" + dashes) only (tests/test_style.py fails
+# The docstrings use numpy sections ("Parameters" + dashes) only (tests/package/test_style.py fails
 # on a Google-style "Args:" section): napoleon's Google parser is off.
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True

@@ -2,23 +2,6 @@
 
 from __future__ import annotations
 
-from adept_traj.analysis.certificate import (
-    DEFAULT_RATE_HZ,
-    Certificate,
-    certificate_bytes,
-    certify,
-    check_certificate_memory,
-)
-from adept_traj.analysis.continuous import (
-    CONTINUOUS,
-    DEFAULT_MAX_DEPTH,
-    DistanceGuarantee,
-    continuous_distance,
-    continuous_self_distance,
-    obstacle_jump_intervals,
-    obstacle_speeds,
-    solid_lever_arms,
-)
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -27,14 +10,6 @@ from adept_traj.analysis.decision import (
     combined_objective,
     normalise,
     objective_weights,
-)
-from adept_traj.analysis.dense_trajectory import (
-    BATCH_SAMPLES,
-    BATCH_VALUES,
-    DenseStates,
-    DenseTrajectory,
-    batch_samples,
-    dense_samples,
 )
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
@@ -45,8 +20,41 @@ from adept_traj.analysis.indicators import (
     objective_bounds,
     to_unit_minimisation,
 )
-from adept_traj.analysis.limit_check import DEFAULT_TOLERANCE, LimitCheck
-from adept_traj.analysis.member_certificate import (
+from adept_traj.analysis.paper_measures import (
+    algorithm_effort,
+    optimizer_overhead,
+    ratio_non_dominated,
+    spread,
+)
+from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
+from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
+from adept_traj.certification.certificate import (
+    DEFAULT_RATE_HZ,
+    Certificate,
+    certificate_bytes,
+    certify,
+    check_certificate_memory,
+)
+from adept_traj.certification.continuous import (
+    CONTINUOUS,
+    DEFAULT_MAX_DEPTH,
+    DistanceGuarantee,
+    continuous_distance,
+    continuous_self_distance,
+    obstacle_jump_intervals,
+    obstacle_speeds,
+    solid_lever_arms,
+)
+from adept_traj.certification.dense_trajectory import (
+    BATCH_SAMPLES,
+    BATCH_VALUES,
+    DenseStates,
+    DenseTrajectory,
+    batch_samples,
+    dense_samples,
+)
+from adept_traj.certification.limit_check import DEFAULT_TOLERANCE, LimitCheck
+from adept_traj.certification.member_certificate import (
     FRONT_INFLUENCE_ABOVE_MARGIN,
     MemberCertificate,
     certify_member,
@@ -55,16 +63,8 @@ from adept_traj.analysis.member_certificate import (
     problem_parts,
     same_parts,
 )
-from adept_traj.analysis.paper_measures import (
-    algorithm_effort,
-    optimizer_overhead,
-    ratio_non_dominated,
-    spread,
-)
-from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
-from adept_traj.analysis.rest_poses import check_rest_poses, rest_pose_contacts
-from adept_traj.analysis.self_distance import SelfDistance, self_distance
-from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
+from adept_traj.certification.rest_poses import check_rest_poses, rest_pose_contacts
+from adept_traj.certification.self_distance import SelfDistance, self_distance
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [

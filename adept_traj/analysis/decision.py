@@ -185,7 +185,7 @@ def combined_objective(
     :data:`PAPER_WEIGHTS`) this definition gives f_c = 0.267611 (NSGA-II) and 0.221221
     (MODE); the paper prints 0.497040 and 0.467136. Other natural definitions (Σ w n,
     Σ w z/Z_max with or without a reversed z4, unweighted variants, …) do not give them
-    either (see ``tests/test_decision.py`` and ``docs/decision-and-metrics.md``); the paper
+    either (see ``tests/analysis/test_decision.py`` and ``docs/decision-and-metrics.md``); the paper
     probably normalised by per-front values it does not print. Our definition keeps the
     paper's ordering (MODE < NSGA-II).
 

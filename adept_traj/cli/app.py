@@ -48,7 +48,7 @@ _DESCRIPTION = "Multi-objective, collision-free trajectory planning of industria
 #: Each command's module (``add_parser(sub)`` declares it, ``run(args)`` runs it) and its
 #: line in ``adept-traj --help``. Only the module of the command given is imported: the
 #: listing of ``adept-traj --help`` loads none of them (nor pinocchio, coal or pymoo).
-#: Each module's own ``help=`` is the same line (tests/test_cli_startup.py checks it).
+#: Each module's own ``help=`` is the same line (tests/cli/test_cli_startup.py checks it).
 _COMMANDS = {
     "plan": ("plan", "plan a trajectory and save a verified result"),
     "compare": ("compare", "NSGA-II vs MODE: the paper's Tables 3-5"),

@@ -10,7 +10,7 @@ whether the member is certified, and its minimum clearance [m] from its certific
 (``result.json`` version 2 stores one per certified member; ``-``: not certified, or a
 version-1 file, which holds the best trade-off's only). A clearance shown as ``≥ d`` is a
 lower bound: the member stays farther than ``margin + 0.01 m`` from everything, where its
-certificate keeps the broad phase's bounds (:mod:`adept_traj.analysis.member_certificate`).
+certificate keeps the broad phase's bounds (:mod:`adept_traj.certification.member_certificate`).
 The best trade-off (``result.best.index``) is marked ``*``; its clearance is always exact.
 The last two columns are the member's gaps: ``T`` over the kinematic lower bound
 (``result.lower_bound.T_min``) and over T_best (``result.metrics.t_best``, the best T the

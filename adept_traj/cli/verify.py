@@ -6,7 +6,7 @@ collision checker): re-certification needs it. Exit status (:mod:`adept_traj.cli
 0 if the best trade-off is feasible and the folder holds what its decision vectors give,
 1 (:data:`~adept_traj.cli.status.NOT_CERTIFIED`) if the best trade-off is not feasible,
 3 (:data:`~adept_traj.cli.status.MISMATCH`) if a stored value differs from its
-recomputation (:func:`~adept_traj.results.audit`; one ``mismatch:`` line each), whatever
+recomputation (:func:`~adept_traj.certification.audit.audit`; one ``mismatch:`` line each), whatever
 the verdict.
 
 ``--robot URDF [--params TOML] [--srdf FILE] [--tool-frame NAME] [--package-dir DIR]``

@@ -5,7 +5,7 @@ A point :math:`p` of solid :math:`s` moves at
 the solid, axis :math:`a_j` through :math:`o_j`) :math:`+ \sum_j \dot q_j a_j` (prismatic), so
 :math:`\lVert \dot p \rVert \le \sum_j r_{sj} |\dot q_j|` with the configuration-free
 factors of :func:`solid_lever_arms` (module docstring of
-:mod:`adept_traj.analysis.continuous` for the formula).
+:mod:`adept_traj.certification.continuous` for the formula).
 
 **Pairs of solids.** A joint that moves both solids of a pair moves them as one rigid body
 and leaves their distance unchanged, so (:func:`pair_lever_arms`)

@@ -31,7 +31,7 @@ penetration (d < 0)       0 ≤ e ≤ 3.0 µm         0 ≤ e ≤ 3.4 µm
 so a distance is never understated and, at the safety margins that matter (≥ 1 mm),
 within 2 nm. Capsules, spheres and boxes against a box face come out to rounding
 (~1e-15 m). The cost was measured within the noise of the shared machine, both for
-``evaluate_batch`` and for :func:`~adept_traj.analysis.certificate.certify`
+``evaluate_batch`` and for :func:`~adept_traj.certification.certificate.certify`
 (``benchmarks/results/notebook.md``).
 """
 

@@ -5,63 +5,11 @@ polishing (``polish``) and :func:`plan`."""
 
 from __future__ import annotations
 
-from adept_traj.optimise.algorithms import (
-    ALGORITHMS,
-    AlgorithmSettings,
-    make_algorithm,
-)
-from adept_traj.optimise.basins import THRESHOLD as BASIN_THRESHOLD
-from adept_traj.optimise.basins import basin_labels
-from adept_traj.optimise.checkpoint import (
-    CHECKPOINT_VERSION,
-    CapturedCheckpoint,
-    capture_checkpoint,
-    checkpoint_arrays,
-    has_checkpoint,
-    load_checkpoint,
-    restore_algorithm,
-    save_checkpoint,
-    write_checkpoint,
-)
-from adept_traj.optimise.crossover import (
-    sbx_children,
-)
-from adept_traj.optimise.duplicates import (
-    BLOCK_PAIRS,
-    BlockedDuplicateElimination,
-)
-from adept_traj.optimise.early_certificates import (
-    EARLY_SHARE,
-    EarlyCertificates,
-    feasible_front,
-    start_early_certificates,
-)
-from adept_traj.optimise.fast_end import (
-    FastEndSearch,
-)
-from adept_traj.optimise.front_certificates import (
-    certify_front_members,
-)
-from adept_traj.optimise.loop import (
-    CHECKPOINT_INTERVAL,
-    GenerationInfo,
-    PlanningInterrupted,
-    RunState,
-    optimise,
-)
-from adept_traj.optimise.mating import (
-    ArrayMating,
-)
-from adept_traj.optimise.member_polish import MAX_EVALUATIONS, epsilon_step
-from adept_traj.optimise.minimum_time import PolishOutcome, minimum_time
-from adept_traj.optimise.mutation import (
-    mutate,
-)
-from adept_traj.optimise.planner import (
-    plan,
-    warn_missing_limits,
-)
-from adept_traj.optimise.polish import (
+from adept_traj.optimise.local.basins import THRESHOLD as BASIN_THRESHOLD
+from adept_traj.optimise.local.basins import basin_labels
+from adept_traj.optimise.local.epsilon_constraint import MAX_EVALUATIONS, epsilon_step
+from adept_traj.optimise.local.minimum_time import PolishOutcome, minimum_time
+from adept_traj.optimise.local.multi_start import (
     MAX_BASINS,
     STRETCHES,
     GlobalStage,
@@ -70,7 +18,7 @@ from adept_traj.optimise.polish import (
     global_starts,
     time_optimal,
 )
-from adept_traj.optimise.polish_step import (
+from adept_traj.optimise.local.polish_modes import (
     GRADIENT_COST,
     POLISH_MODES,
     POLISH_SHARE,
@@ -83,63 +31,115 @@ from adept_traj.optimise.polish_step import (
     polish_run_with_certificates,
     time_optimal_run,
 )
-from adept_traj.optimise.polisher import (
-    Polisher,
-    check_polisher,
-    polish_with_certificates,
-    start_polisher,
-)
-from adept_traj.optimise.population import (
-    ArrayEvaluator,
-    cache_violations,
-    optimum,
-    population_values,
-    ranked_optimum,
-)
-from adept_traj.optimise.refinement import (
+from adept_traj.optimise.local.refinement import (
     Refinement,
     refine_minimum_time,
     refine_starts,
     screen_starts,
 )
-from adept_traj.optimise.repair import (
-    KinematicTimeRepair,
-    kinematic_time,
-)
-from adept_traj.optimise.sampling import (
-    RampSampling,
-    check_population_memory,
-    population_bytes,
-)
-from adept_traj.optimise.survival import (
-    RankAndCrowdingSurvival,
-    crowding_distance,
-)
-from adept_traj.optimise.timed_edges import edges_clear, shortcut
-from adept_traj.optimise.timed_roadmap import TimedPaths, timed_paths
-from adept_traj.optimise.timed_starts import fit_timed_path, timed_roadmap_starts
-from adept_traj.optimise.tournament import (
-    TournamentArrays,
-    binary_tournament,
-    select_parents,
-)
-from adept_traj.optimise.variant import (
-    ArrayVariant,
-)
-from adept_traj.optimise.via_points import (
+from adept_traj.optimise.local.timed_edges import edges_clear, shortcut
+from adept_traj.optimise.local.timed_roadmap import TimedPaths, timed_paths
+from adept_traj.optimise.local.timed_starts import fit_timed_path, timed_roadmap_starts
+from adept_traj.optimise.local.via_points import (
     GLOBAL_GAP,
     GLOBAL_SEED,
     ViaPointSampling,
     near_lower_bound,
     via_point_starts,
 )
-from adept_traj.optimise.weighted_move import (
+from adept_traj.optimise.local.weighted_move import (
     MAX_EVALUATIONS_PER_START,
     STEP_EVALUATIONS,
     STOP_DECREASE,
     WEIGHTED_BOX,
     weighted_descent,
     weighted_run,
+)
+from adept_traj.optimise.operators.crossover import (
+    sbx_children,
+)
+from adept_traj.optimise.operators.de_variant import (
+    ArrayVariant,
+)
+from adept_traj.optimise.operators.duplicates import (
+    BLOCK_PAIRS,
+    BlockedDuplicateElimination,
+)
+from adept_traj.optimise.operators.mating import (
+    ArrayMating,
+)
+from adept_traj.optimise.operators.mutation import (
+    mutate,
+)
+from adept_traj.optimise.operators.population import (
+    ArrayEvaluator,
+    cache_violations,
+    optimum,
+    population_values,
+    ranked_optimum,
+)
+from adept_traj.optimise.operators.repair import (
+    KinematicTimeRepair,
+    kinematic_time,
+)
+from adept_traj.optimise.operators.survival import (
+    RankAndCrowdingSurvival,
+    crowding_distance,
+)
+from adept_traj.optimise.operators.tournament import (
+    TournamentArrays,
+    binary_tournament,
+    select_parents,
+)
+from adept_traj.optimise.parallel.early_certificates import (
+    EARLY_SHARE,
+    EarlyCertificates,
+    feasible_front,
+    start_early_certificates,
+)
+from adept_traj.optimise.parallel.front_certificates import (
+    certify_front_members,
+)
+from adept_traj.optimise.parallel.polish_worker import (
+    Polisher,
+    check_polisher,
+    polish_with_certificates,
+    start_polisher,
+)
+from adept_traj.optimise.planner import (
+    plan,
+    warn_missing_limits,
+)
+from adept_traj.optimise.search.algorithms import (
+    ALGORITHMS,
+    AlgorithmSettings,
+    make_algorithm,
+)
+from adept_traj.optimise.search.checkpoint import (
+    CHECKPOINT_VERSION,
+    CapturedCheckpoint,
+    capture_checkpoint,
+    checkpoint_arrays,
+    has_checkpoint,
+    load_checkpoint,
+    restore_algorithm,
+    save_checkpoint,
+    write_checkpoint,
+)
+from adept_traj.optimise.search.fast_end_search import (
+    FastEndSearch,
+)
+from adept_traj.optimise.search.loop import (
+    CHECKPOINT_INTERVAL,
+    GenerationInfo,
+    PlanningInterrupted,
+    RunState,
+    optimise,
+)
+from adept_traj.optimise.search.sampling import (
+    RampSampling,
+    check_population_memory,
+    population_bytes,
 )
 
 __all__ = [

@@ -43,7 +43,6 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import Certificate, certify
 from adept_traj.analysis.decision import PAPER_WEIGHTS, best_tradeoff, objective_weights
 from adept_traj.analysis.indicators import (
     DEFAULT_HV_REFERENCE,
@@ -51,7 +50,6 @@ from adept_traj.analysis.indicators import (
     normalised_hypervolume,
     objective_bounds,
 )
-from adept_traj.analysis.member_certificate import MemberCertificate
 from adept_traj.analysis.paper_measures import (
     algorithm_effort,
     optimizer_overhead,
@@ -59,15 +57,21 @@ from adept_traj.analysis.paper_measures import (
     spread,
 )
 from adept_traj.analysis.weighted_sum import WeightedSum
+from adept_traj.certification.certificate import Certificate, certify
+from adept_traj.certification.member_certificate import MemberCertificate
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.algorithms import make_algorithm
-from adept_traj.optimise.early_certificates import feasible_front, start_early_certificates
-from adept_traj.optimise.front_certificates import certify_front_members
-from adept_traj.optimise.loop import GenerationInfo, optimise
-from adept_traj.optimise.polish_step import TIME_OPTIMAL, polish_mode, time_optimal_run
-from adept_traj.optimise.polisher import Polisher, check_polisher, polish_with_certificates
-from adept_traj.optimise.sampling import check_population_memory
-from adept_traj.optimise.weighted_move import weighted_run
+from adept_traj.optimise.local.polish_modes import TIME_OPTIMAL, polish_mode, time_optimal_run
+from adept_traj.optimise.local.weighted_move import weighted_run
+from adept_traj.optimise.parallel.early_certificates import feasible_front, start_early_certificates
+from adept_traj.optimise.parallel.front_certificates import certify_front_members
+from adept_traj.optimise.parallel.polish_worker import (
+    Polisher,
+    check_polisher,
+    polish_with_certificates,
+)
+from adept_traj.optimise.search.algorithms import make_algorithm
+from adept_traj.optimise.search.loop import GenerationInfo, optimise
+from adept_traj.optimise.search.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results.record import (
     NO_FEASIBLE_WARNING,

@@ -126,7 +126,7 @@ def local_constraints(
     extra_samples:
         (k,) normalised times :math:`s \in [0, 1]` where the torque and distance rows are
         also imposed, after those at ``problem.s`` (``None``: none): the adaptive samples
-        of the certified local solver (:mod:`adept_traj.optimise.refinement`), placed where
+        of the certified local solver (:mod:`adept_traj.optimise.local.refinement`), placed where
         a certificate found the distance dipping between the problem's samples.
 
     Returns

@@ -44,7 +44,7 @@ their Jacobians): as a **constraint**, :math:`z_4 \ge z_4^0` is exactly
 obstacle comes closer than before); as an **objective**, the epigraph: maximise a level
 :math:`s` with :math:`w(q_k) \ge s` for all k, and minimise :math:`\sum_o \varphi(m_o)` with
 :math:`d_{k,o} \ge m_o` (φ decreasing: at the optimum :math:`s` and :math:`m_o` are the
-minima). See :mod:`adept_traj.optimise.member_polish`.
+minima). See :mod:`adept_traj.optimise.local.epsilon_constraint`.
 """
 
 from __future__ import annotations

@@ -7,8 +7,9 @@
 
 from __future__ import annotations
 
+from adept_traj.certification.audit import Audit, audit
+from adept_traj.certification.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.errors import ResultFormatError
-from adept_traj.results.audit import Audit, audit
 from adept_traj.results.members import (
     MAX_MEMBER_SAMPLES,
     certified_members,
@@ -16,7 +17,6 @@ from adept_traj.results.members import (
     member_index,
     member_replay,
 )
-from adept_traj.results.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.results.parts import (
     SHIPPED_ROBOT,
     BestSolution,

@@ -11,8 +11,8 @@ import math
 from typing import Any
 
 from adept_traj.analysis import SelfDistance
-from adept_traj.analysis.certificate import Certificate, DenseTrajectory, LimitCheck
-from adept_traj.analysis.member_certificate import MemberCertificate
+from adept_traj.certification.certificate import Certificate, DenseTrajectory, LimitCheck
+from adept_traj.certification.member_certificate import MemberCertificate
 from adept_traj.results.json_values import json_float, json_floats
 from adept_traj.results.parts import Front
 from adept_traj.robot.limits import LIMIT_KINDS, LIMITS

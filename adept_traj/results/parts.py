@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.member_certificate import MemberCertificate
+from adept_traj.certification.member_certificate import MemberCertificate
 from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
 from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
 from adept_traj.robot import RobotSource

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import Certificate, DenseTrajectory
+from adept_traj.certification.certificate import Certificate, DenseTrajectory
 from adept_traj.collision import SelfPairs
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import (

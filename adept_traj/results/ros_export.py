@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis.certificate import dense_samples
+from adept_traj.certification.certificate import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.files import write_text_atomic
 from adept_traj.results.csv_codec import csv_text, trajectory_header

@@ -1,0 +1,277 @@
+r"""The time-optimal mode and the polish's fastest basins: multi-start certified local
+solves (:func:`time_optimal`, :func:`fastest_of_basins`) and the global stage
+(:func:`global_stage`).
+
+:func:`time_optimal` runs the certified local solver
+(:func:`~adept_traj.optimise.refine_minimum_time`) from several starts — the straight move
+and the ``n_starts − 1`` kinematically fastest of 8 × (``n_starts`` − 1) ramps of
+:class:`~adept_traj.optimise.RampSampling` drawn from a generator seeded by ``seed``, each
+at its kinematic minimum T — and returns every outcome. When none of them ends certified
+within :data:`~adept_traj.optimise.GLOBAL_GAP` of the kinematic lower bound (the straight
+move blocked, as on the detour scene), it adds the refinements of the global stage's
+starts (:func:`global_stage`; ``docs/engine.md``). Everything is
+deterministic: the same problem and seed give the same vectors.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.local.basins import basin_labels
+from adept_traj.optimise.local.refinement import (
+    Refinement,
+    refine_starts,
+    screen_starts,
+)
+from adept_traj.optimise.local.timed_starts import timed_roadmap_starts
+from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
+from adept_traj.optimise.operators.repair import kinematic_time
+from adept_traj.optimise.search.sampling import RampSampling
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.validation import as_integer
+
+__all__ = [
+    "MAX_BASINS",
+    "STRETCHES",
+    "GlobalStage",
+    "fastest_of_basins",
+    "global_stage",
+    "global_starts",
+    "time_optimal",
+]
+
+#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.operators.repair`).
+_SLACK = 1e-9
+
+#: Ramps drawn per ramp start of :func:`time_optimal` (the fastest ones are used).
+_RAMPS_PER_START = 8
+
+#: Basins refined by :func:`polish_fastest` (the fastest move of each of the fastest
+#: basins), and most starts of the global stage.
+MAX_BASINS = 3
+
+#: Factors of the fixed-obstacle optimum's T at which :func:`global_starts` offers it.
+STRETCHES = (1.0, 1.1, 1.25)
+
+
+def time_optimal(
+    problem: Any,
+    seed: int = 1,
+    n_starts: int = 4,
+    *,
+    rate_hz: float = 1000.0,
+    processes: int | None = None,
+    **options: Any,
+) -> list[Refinement]:
+    """Refinements (:func:`~adept_traj.optimise.refine_minimum_time`) from the straight
+    move and the ``n_starts − 1`` kinematically fastest of ``8 (n_starts − 1)`` seeded
+    ramps (each at its kinematic minimum T; the evaluator-feasible ones first) and, unless
+    one of them ends **certified** within :data:`~adept_traj.optimise.GLOBAL_GAP` of the
+    kinematic lower bound, from the global stage's starts
+    (:func:`~adept_traj.optimise.via_point_starts`: feasible via-point moves and ramps of
+    distinct basins, and the least infeasible): every start screened
+    (:func:`~adept_traj.optimise.screen_starts`, stopping at the first near the bound),
+    then the fastest screened moves refined to the end
+    (:func:`~adept_traj.optimise.refine_starts`).
+
+    Parameters
+    ----------
+    problem:
+        The :class:`~adept_traj.problem.TrajectoryProblem`.
+    seed:
+        Seed of the ramps' generator (≥ 0); the global stage's is
+        :data:`~adept_traj.optimise.GLOBAL_SEED`.
+    n_starts:
+        Number of starts (≥ 1).
+    rate_hz:
+        Rate [Hz] of the certificates (> 0).
+    processes:
+        Refinements run at once (≥ 1; default: the problem's ``workers``).
+    options:
+        ``max_boxes`` of the screening (:func:`~adept_traj.optimise.screen_starts`).
+    """
+    seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
+    n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
+    near = functools.partial(near_lower_bound, problem)
+    starts = _feasible_first(problem, _starts(problem, seed, n_starts))
+    options = {"rate_hz": rate_hz, "processes": processes, **options}
+    screened = screen_starts(problem, starts[:1], stop=near, **options)
+    if not near(screened):  # the relaxed problem's optimum before the other starts
+        stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes)
+        near = functools.partial(near_lower_bound, problem, floor=stage.floor)
+        # the relaxed optimum always (a start near the floor may be a worse basin's; the
+        # stop sees the relaxed outcomes only), then the others while none is near
+        screened += screen_starts(problem, stage.relaxed, stop=near, **options)
+        for more in (lambda: stage.timed, lambda: starts[1:], lambda: stage.via):
+            if not near(screened):  # the timed and via-point starts made only if needed
+                screened += screen_starts(problem, more(), stop=near, **options)
+    if near(screened):
+        return screened
+    return screened + refine_starts(problem, screened, rate_hz=rate_hz, processes=processes)
+
+
+@dataclass(frozen=True)
+class GlobalStage:
+    """The starts of the global stage (:func:`global_stage`).
+
+    Attributes
+    ----------
+    relaxed:
+        (k, n_var) the relaxed problem's fastest certified move at :data:`STRETCHES` × its
+        T (k = 0 without moving obstacles, or when the relaxed problem has none).
+    floor:
+        The relaxed problem's fastest certified T [s] (0 when there is none): the floor of
+        :func:`~adept_traj.optimise.near_lower_bound`.
+    make_timed, make_via:
+        Make :attr:`timed` and :attr:`via` when they are first asked for (a search that
+        ends at the relaxed problem's starts never grows the trees nor draws the vias).
+    """
+
+    relaxed: np.ndarray
+    floor: float
+    make_timed: Callable[[], np.ndarray] = dataclasses.field(repr=False, compare=False)
+    make_via: Callable[[], np.ndarray] = dataclasses.field(repr=False, compare=False)
+
+    @functools.cached_property
+    def timed(self) -> np.ndarray:
+        """(j, n_var) the timed trees' starts
+        (:func:`~adept_traj.optimise.timed_roadmap_starts`, guided by the relaxed problem's
+        fastest move: its way at the moving obstacles' phases); j = 0 without moving
+        obstacles."""
+        return self.make_timed()
+
+    @functools.cached_property
+    def via(self) -> np.ndarray:
+        """(m, n_var) the via-point moves and ramps of
+        :func:`~adept_traj.optimise.via_point_starts`."""
+        return self.make_via()
+
+    @property
+    def starts(self) -> np.ndarray:
+        """(k + j + m, n_var) every start: the relaxed problem's, the timed, the via-point."""
+        return np.concatenate([self.relaxed, self.timed, self.via])
+
+
+def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -> np.ndarray:
+    """(k, n_var) the starts of :func:`global_stage`, the relaxed problem's first."""
+    return global_stage(problem, n_starts=n_starts, rate_hz=rate_hz).starts
+
+
+def global_stage(
+    problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0, processes: int | None = None
+) -> GlobalStage:
+    """The global stage's starts and the floor [s] of
+    :func:`~adept_traj.optimise.near_lower_bound`. Where obstacles move: the fastest
+    certified move of the problem **without its moving obstacles** (its own
+    :func:`time_optimal`, which has no moving obstacle to recurse on) at :data:`STRETCHES` ×
+    its T — the same path passing the moving obstacles at other phases —, and its T as the
+    floor (that relaxed problem's feasible set contains this one's); then
+    :func:`~adept_traj.optimise.via_point_starts` with
+    :data:`~adept_traj.optimise.GLOBAL_SEED` (a function of the problem alone). Without
+    moving obstacles, or when the relaxed problem has no certified move, the floor is 0.
+    The relaxed problem's refinements run ``processes`` at once (default: the problem's
+    ``workers``); the via points are drawn when first asked for.
+
+    Measured figures on the detour scene: ``docs/detour-scene.md``."""
+    via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts)
+    relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
+    timed = functools.partial(np.empty, (0, problem.n_var))
+    if scene.moving:
+        still = dataclasses.replace(scene, obstacles=scene.fixed)
+        fixed = TrajectoryProblem(
+            problem.robot, still, problem.start, problem.goal, problem.settings, workers=1
+        )
+        processes = problem.settings.workers if processes is None else processes
+        outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
+        done = [o for o in outcomes if o.certified]
+        if done:
+            best = min(done, key=lambda o: float(o.x[0])).x
+            stretched = np.repeat(best[None], len(STRETCHES), axis=0)
+            stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
+            relaxed, floor = stretched, float(best[0])
+        guide = relaxed[:1] if len(relaxed) else None
+        timed = functools.partial(
+            timed_roadmap_starts, problem, GLOBAL_SEED, guides=guide, n_starts=n_starts
+        )
+    return GlobalStage(relaxed=relaxed, floor=floor, make_timed=timed, make_via=via)
+
+
+def fastest_of_basins(
+    problem: Any,
+    x: Any,
+    *,
+    rate_hz: float = 1000.0,
+    max_basins: int = MAX_BASINS,
+) -> list[Refinement]:
+    """Refinements (:func:`~adept_traj.optimise.refine_minimum_time`) of the fastest move
+    of each of the ``max_basins`` fastest basins (:func:`~adept_traj.optimise.basin_labels`)
+    of the moves ``x`` (n, n_var) and, unless one of them comes within
+    :data:`~adept_traj.optimise.GLOBAL_GAP` of the kinematic lower bound (no other basin
+    can then be faster by more than that), of the global stage's starts
+    (:func:`~adept_traj.optimise.global_starts`): every start screened
+    (:func:`~adept_traj.optimise.screen_starts`, fastest basin first, stopping once one is
+    near the bound), then the fastest screened moves refined to the end
+    (:func:`~adept_traj.optimise.refine_starts`). Screened and full refinements, in that
+    order.
+
+    Parameters
+    ----------
+    problem: the :class:`~adept_traj.problem.TrajectoryProblem`.
+    x: (n, n_var) moves (e.g. the feasible members of a final population).
+    rate_hz: rate [Hz] of the certificates.
+    max_basins: most basins refined (≥ 1), and most via-point starts.
+    """
+    xs = np.asarray(x, dtype=float).reshape(-1, problem.n_var)
+    max_basins = as_integer(max_basins, "max_basins", minimum=1, error=ConfigurationError)
+    near = functools.partial(near_lower_bound, problem)
+    screened: list[Refinement] = []
+    if len(xs):
+        xs = xs[np.argsort(xs[:, 0], kind="stable")]
+        _, first = np.unique(basin_labels(problem, xs), return_index=True)
+        screened = screen_starts(
+            problem, xs[np.sort(first)[:max_basins]], rate_hz=rate_hz, stop=near
+        )
+    if not near(screened):
+        stage = global_stage(problem, n_starts=max_basins, rate_hz=rate_hz)
+        near = functools.partial(near_lower_bound, problem, floor=stage.floor)
+        # the relaxed optimum always: a member within GLOBAL_GAP of the floor may be a
+        # worse basin's (measured on detour, NSGA-II seed 2: 1.1110 s, a local optimum,
+        # where the stretched relaxed optimum refines to 1.0991 s)
+        screened += screen_starts(problem, stage.relaxed, rate_hz=rate_hz, stop=near)
+        for more in (lambda: stage.timed, lambda: stage.via):
+            if not near(screened):  # the timed and via-point starts made only if needed
+                screened += screen_starts(problem, more(), rate_hz=rate_hz, stop=near)
+    if near(screened):
+        return screened  # no other basin can be faster by more than GLOBAL_GAP
+    return screened + refine_starts(problem, screened, rate_hz=rate_hz)
+
+
+def _feasible_first(problem: Any, starts: np.ndarray) -> np.ndarray:
+    """``starts`` (k, n_var) with the evaluator-feasible ones first (each group in its
+    order): a refinement from inside the constraints is cheap and seldom fails."""
+    ok = np.all(problem.evaluate_batch(starts).constraints <= 0.0, axis=1) if len(starts) else []
+    return np.concatenate([starts[ok], starts[~np.asarray(ok, dtype=bool)]])
+
+
+def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
+    """(n_starts, n_var): the straight move, then the ``n_starts − 1`` ramps of smallest
+    kinematic minimum T among ``_RAMPS_PER_START`` × as many seeded ramps, each at its
+    kinematic minimum T (SLSQP from a slow detour rarely converges in a few dozen
+    iterations: ``docs/engine.md``)."""
+    traj = problem.trajectory
+    straight = traj.straight_line(problem.xl[0])[None]
+    n_ramps = _RAMPS_PER_START * (n_starts - 1)
+    ramps = RampSampling().ramps(problem, n_ramps, np.random.default_rng(seed))
+    x = np.concatenate([straight, ramps])
+    t_kin = kinematic_time(problem, x)
+    order = np.concatenate([[0], 1 + np.argsort(t_kin[1:], kind="stable")])[:n_starts]
+    x, t_kin = x[order], t_kin[order]
+    x[:, 0] = np.clip(t_kin * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
+    return x

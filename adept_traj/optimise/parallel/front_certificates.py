@@ -1,0 +1,117 @@
+"""The front members' certificates on the problem's worker processes.
+
+:func:`~adept_traj.analysis.certify_members` certifies one batch of members after the
+other (its cost per member: docs/performance.md).
+:func:`certify_front_members` gives each of ``workers`` processes (this one and
+``workers - 1`` worker processes, :class:`~adept_traj.process_pool.Worker`) every
+``workers``-th member (the trade-off order interleaved, so that each gets as many of the
+costly and the cheap ones), each process calls
+:func:`~adept_traj.analysis.certify_members` once on its share, and the summaries come
+back in the members' rows. Every certificate depends on its member alone, so the result is
+the serial one, field for field (tested). The fork hands the problem and the decision
+vectors to the workers (nothing is pickled but the summaries).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from adept_traj.certification.member_certificate import (
+    MemberCertificate,
+    certify_members,
+    certifying_problem,
+)
+from adept_traj.errors import InputShapeError
+from adept_traj.problem import TrajectoryProblem
+from adept_traj.process_pool import Channel, Worker, can_fork
+from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
+
+__all__ = ["certify_front_members", "checked_members"]
+
+
+def certify_front_members(
+    problem: TrajectoryProblem,
+    x: Any,
+    members: Sequence[int],
+    *,
+    rate_hz: float,
+    workers: int | None = None,
+) -> tuple[MemberCertificate | None, ...]:
+    """:func:`~adept_traj.analysis.certify_members` of ``members`` on ``workers`` processes.
+
+    Parameters
+    ----------
+    problem: the problem the members were planned on.
+    x: (n, n_var) decision vectors ``[T [s], free control points]``.
+    members: the rows of ``x`` to certify; the others get ``None``.
+    rate_hz: the dense grid's minimum rate [Hz] (> 0).
+    workers: processes certifying at once, ≥ 1 (default: the problem's ``workers``); 1,
+        one member, or a platform without ``fork`` certifies in this process.
+
+    Returns
+    -------
+    tuple
+        (n,) a :class:`~adept_traj.analysis.MemberCertificate` per certified row, ``None``
+        for the others — the same as :func:`~adept_traj.analysis.certify_members`.
+    """
+    xs, rows, rate = checked_members(problem, x, members, rate_hz)
+    n_proc = problem.settings.workers if workers is None else workers
+    n_proc = min(as_integer(n_proc, "workers", minimum=1), len(rows))
+    if n_proc <= 1 or not can_fork():
+        return certify_members(problem, xs, rows, rate_hz=rate)
+    certifying_problem(problem)  # made once here: the workers inherit it
+    shares = [rows[i::n_proc] for i in range(n_proc)]
+    forked: list[Worker] = []
+    try:
+        for share in shares[:-1]:
+            note = "raised while certifying front members in a worker process"
+            forked.append(Worker(_certify_share, problem, xs, share, rate, note=note))
+        last = certify_members(problem, xs, shares[-1], rate_hz=rate)  # this process' share
+        parts = [worker.recv() for worker in forked]
+        parts.append([last[k] for k in shares[-1]])
+    finally:  # Ctrl-C or an error included: the workers are stopped at once
+        for worker in forked:
+            worker.close()
+    out: list[MemberCertificate | None] = [None] * len(xs)
+    for share, part in zip(shares, parts):
+        for k, certificate in zip(share, part):
+            out[k] = certificate
+    return tuple(out)
+
+
+def checked_members(
+    problem: Any, x: Any, members: Sequence[int], rate_hz: Any
+) -> tuple[np.ndarray, list[int], float]:
+    """The input of a front's certificates, checked: ``problem`` a
+    :class:`~adept_traj.problem.TrajectoryProblem`, ``x`` (n, n_var) decision vectors,
+    ``members`` rows of ``x``, ``rate_hz`` [Hz] > 0.
+
+    Returns
+    -------
+    tuple
+        (``x`` as a float array (n, n_var), the rows as integers, the rate [Hz]).
+
+    Raises
+    ------
+    InvalidInputError
+        A value out of its range (:class:`~adept_traj.errors.InputShapeError`: ``x`` of
+        another shape).
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    xs = as_batch(x, "x", problem.n_var)
+    if xs.ndim != 2:
+        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
+    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
+    return xs, rows, rate
+
+
+def _certify_share(
+    channel: Channel, problem: TrajectoryProblem, x: np.ndarray, rows: list[int], rate_hz: float
+) -> None:
+    """A worker: send the summaries of ``rows``, in that order."""
+    out = certify_members(problem, x, rows, rate_hz=rate_hz)
+    channel.send([out[k] for k in rows])

@@ -1,0 +1,292 @@
+"""The package's layout rules, read from the source: data flows one way between the
+subpackages (docs/architecture.md), private names stay inside their module, and every
+exception class lives in errors.py."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[2] / "adept_traj"
+
+#: Rank of each subpackage in the data flow; a module may import its own subpackage and any
+#: of lower rank. Equal ranks are siblings that must not import each other.
+RANK = {
+    "errors": 0, "data": 0, "urdf": 0,
+    "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
+    "transforms": 2, "schema": 2,
+    "robot": 3,
+    "scene": 4,
+    "collision": 5,
+    "problem": 6,
+    "analysis": 7,
+    "results": 8,
+    "export": 8.5,  # fixed-step exports of a result's members; used by viz's explorer
+    "optimise": 9,
+    "viz": 9,
+    "testing": 10,
+    "cycle": 10,
+    "cli": 11,
+}  # fmt: skip
+
+
+def _modules() -> list[Path]:
+    return sorted(p for p in PACKAGE.rglob("*.py") if "urdf" not in p.parts)
+
+
+def _owner(path: Path) -> str:
+    rel = path.relative_to(PACKAGE)
+    return rel.parts[0].removesuffix(".py")
+
+
+def _imports(path: Path) -> list[tuple[str, list[str], int]]:
+    """(module, imported names, line) of every ``adept_traj`` import, relative ones resolved."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    here = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = here[: len(here) - node.level]
+                module = ".".join([*base, *(node.module.split(".") if node.module else [])])
+            else:
+                module = node.module or ""
+            if module.split(".")[0] == "adept_traj":
+                found.append((module, [a.name for a in node.names], node.lineno))
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == "adept_traj":
+                    found.append((alias.name, [], node.lineno))
+    return found
+
+
+def test_every_top_level_name_has_a_rank():
+    names = {p.name.removesuffix(".py") for p in PACKAGE.iterdir() if not p.name.startswith("_")}
+    names -= {"__pycache__"}
+    assert names <= set(RANK), sorted(names - set(RANK))
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_imports_flow_one_way(path: Path):
+    owner = _owner(path)
+    if owner == "__init__":
+        return  # the top-level package re-exports the public API
+    for module, names, line in _imports(path):
+        parts = module.split(".")
+        target = parts[1] if len(parts) > 1 else None
+        # "from adept_traj import X": X is a subpackage or module
+        targets = names if target is None else [target]
+        for t in targets:
+            if t == owner or t == "__version__":
+                continue
+            assert t in RANK, f"{path.name}:{line} imports unknown adept_traj.{t}"
+            assert RANK[t] < RANK[owner], (
+                f"{path.relative_to(PACKAGE)}:{line} imports adept_traj.{t} "
+                f"(rank {RANK[t]}) from {owner} (rank {RANK[owner]}): data flows one way"
+            )
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_private_names_stay_in_their_subpackage(path: Path):
+    owner = _owner(path)
+    for module, names, line in _imports(path):
+        parts = module.split(".")
+        target = parts[1] if len(parts) > 1 else owner
+        private = [n for n in names if n.startswith("_") and n != "__version__"]
+        private_module = any(p.startswith("_") for p in parts[1:])
+        if target != owner:
+            where = f"{path.relative_to(PACKAGE)}:{line}"
+            assert not private, f"{where} imports private names {private} from {module}"
+            assert not private_module, f"{where} imports the private module {module}"
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def private_names_used(path: Path, package: Path) -> list[str]:
+    """Every private name (``_x``, not a dunder) that the module at ``path`` takes from
+    another module of ``package``: ``from M import _x`` (also relative), and ``m._x`` on a
+    name ``m`` bound to a module of the package (``import a.b as m``, ``from a import b``).
+    A private *module* of the importer's own subpackage may be imported (``from . import
+    _heap``): it is that subpackage's."""
+    root = package.parent
+    here = list(path.relative_to(root).with_suffix("").parts)
+    me = ".".join(here).removesuffix(".__init__")
+
+    def is_module(dotted: str) -> bool:
+        base = root.joinpath(*dotted.split("."))
+        return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
+
+    def subpackage(dotted: str) -> str:
+        parts = dotted.split(".")
+        return parts[1] if len(parts) > 2 else ""  # "" for the top-level modules
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    modules: dict[str, str] = {}  # local name → module it is bound to
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = here[: len(here) - node.level]
+                module = ".".join([*base, *(node.module.split(".") if node.module else [])])
+            else:
+                module = node.module or ""
+            if module.split(".")[0] != package.name:
+                continue
+            for alias in node.names:
+                target = f"{module}.{alias.name}"
+                if is_module(target):
+                    modules[alias.asname or alias.name] = target
+                    own = subpackage(target) == subpackage(me) and subpackage(me)
+                    if _is_private(alias.name) and not own:
+                        found.append(f"{node.lineno}: from {module} import {alias.name}")
+                elif _is_private(alias.name) and module != me:
+                    found.append(f"{node.lineno}: from {module} import {alias.name}")
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == package.name and alias.asname:
+                    modules[alias.asname] = alias.name
+    for node in ast.walk(tree):
+        if (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id in modules
+            and _is_private(node.attr)
+            and modules[node.value.id] != me
+        ):
+            found.append(f"{node.lineno}: {node.value.id}.{node.attr} ({modules[node.value.id]})")
+    return found
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_no_private_name_is_taken_from_another_module(path: Path):
+    """What another module needs is public in its subpackage (documented), or the two are
+    one module."""
+    rel = str(path.relative_to(PACKAGE))
+    found = private_names_used(path, PACKAGE)
+    assert not found, f"{rel} takes private names of other modules: {found}"
+
+
+def test_the_private_name_check_finds_each_form(tmp_path: Path):
+    """The check above on a made-up package: each form of a private name taken across
+    modules is found, and what is allowed is not."""
+    pkg = tmp_path / "adept_traj"
+    (pkg / "sub").mkdir(parents=True)
+    for name in ("__init__.py", "sub/__init__.py", "sub/_hidden.py", "sub/other.py", "top.py"):
+        (pkg / name).write_text("", encoding="utf-8")
+    (pkg / "sub" / "mine.py").write_text(
+        "from adept_traj.sub.other import _a, public\n"  # found
+        "from .other import _b\n"  # found
+        "import adept_traj.sub.other as other_module\n"
+        "from adept_traj.sub import other\n"
+        "from . import _hidden\n"  # allowed: a private module of its own subpackage
+        "from adept_traj.sub.other import __version__\n"  # allowed: a dunder
+        "x = other_module._c + other._d + other.e + _hidden.f\n"  # _c, _d found
+        "def _own():\n    return _own\n",  # allowed: its own private name
+        encoding="utf-8",
+    )
+    (pkg / "top.py").write_text("from adept_traj.sub import _hidden\n", encoding="utf-8")
+    found = private_names_used(pkg / "sub" / "mine.py", pkg)
+    assert [f.split(": ", 1)[1] for f in found] == [
+        "from adept_traj.sub.other import _a",
+        "from adept_traj.sub.other import _b",
+        "other_module._c (adept_traj.sub.other)",
+        "other._d (adept_traj.sub.other)",
+    ]
+    # a private module of another subpackage (here: of sub, from the top level) is found
+    assert private_names_used(pkg / "top.py", pkg) == ["1: from adept_traj.sub import _hidden"]
+
+
+def test_every_exception_class_is_in_errors_py():
+    elsewhere = []
+    for path in _modules():
+        if path.name == "errors.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ClassDef) and any(
+                (isinstance(b, ast.Name) and (b.id.endswith(("Error", "Exception", "Interrupted"))))
+                or (isinstance(b, ast.Attribute) and b.attr.endswith(("Error", "Exception")))
+                for b in node.bases
+            ):
+                elsewhere.append(f"{path.relative_to(PACKAGE)}:{node.lineno} {node.name}")
+    assert not elsewhere, elsewhere
+
+
+def test_every_subpackage_ships_in_the_wheel():
+    """pyproject.toml lists every package folder (a missing one is left out of the wheel:
+    `pip install .` then fails where an editable install works)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+
+    pyproject = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    listed = set(pyproject["tool"]["setuptools"]["packages"])
+    folders = {
+        ".".join(p.parent.relative_to(PACKAGE.parent).parts) for p in PACKAGE.rglob("__init__.py")
+    }
+    assert folders <= listed, sorted(folders - listed)
+
+
+def test_every_exception_class_is_defined_in_errors_py():
+    """Imported, not read: any class of the package deriving from BaseException or Warning
+    (directly or not) is defined in adept_traj.errors."""
+    import importlib
+    import inspect
+
+    elsewhere = []
+    for path in _modules():
+        if path.name == "__main__.py":  # runs the command when imported
+            continue
+        rel = path.relative_to(PACKAGE.parent).with_suffix("")
+        name = ".".join(rel.parts).removesuffix(".__init__")
+        module = importlib.import_module(name)
+        for obj in vars(module).values():
+            if (
+                inspect.isclass(obj)
+                and issubclass(obj, (BaseException, Warning))
+                and obj.__module__.startswith("adept_traj")
+                and obj.__module__ != "adept_traj.errors"
+            ):
+                elsewhere.append(f"{obj.__module__}.{obj.__qualname__}")
+    assert not elsewhere, sorted(set(elsewhere))
+
+
+#: Modules allowed past the 400-line target, with the reason (a split would cut a concept).
+LONG_MODULES = {
+    "problem/bspline.py": "BSplineTrajectory's public methods, half of it docstrings and math",
+    "schema.py": "the one reader of three file formats (Node and its typed accessors)",
+    "collision/broad_phase.py": "the conservative bounds of every shape pair, one algorithm",
+    "scene/scene_file.py": "the reader and writer of every scene-file table (its mesh, cloud, "
+    "motion and robot entries are in machine_entries)",
+    "scene/motion_laws.py": "the MotionLaw contract (pose, speed bound, jumps) and the paper's "
+    "pendulum, half of it docstrings",
+    "certification/certificate.py": "certify, its Certificate record and the certificate of dense "
+    "states already computed (member certificates share it), half of it docstrings",
+    "problem/spline_segments.py": "the per-segment arithmetic behind BSplineTrajectory (basis, "
+    "samples, exact extrema and integrals), half of it docstrings and math",
+    "results/json_codec.py": "the one encoder and decoder of result.json (its certificates in "
+    "certificate_codec, JSON values in json_values)",
+    "robot/robot.py": "Robot: construction, its frozen copy (replace) and the batched dynamics, "
+    "kinematics and manipulability, half of it docstrings",
+    "process_pool.py": "the one process mechanism: the caller's side (Worker) and the "
+    "worker's (its start, Channel, parent death, error transport), half of it docstrings",
+}
+
+
+def test_modules_are_small():
+    """One concept per module: ≲ 400 lines, except the few listed with their reason, and
+    none past 460. A numpy section's underline (a line of dashes) is layout, not content:
+    it is not counted (issue #27 made every docstring numpy)."""
+    long = {}
+    for path in _modules():
+        lines = path.read_text(encoding="utf-8").splitlines()
+        n = sum(1 for line in lines if not re.fullmatch(r"\s*-{3,}\s*", line))
+        rel = str(path.relative_to(PACKAGE))
+        if n > 460 or (n > 400 and rel not in LONG_MODULES):
+            long[rel] = n
+    assert not long, long
