@@ -3,12 +3,18 @@
 :mod:`~adept_traj.results.csv_codec`), the motion built once for viewing
 (:mod:`~adept_traj.results.replay`), the choice of a front member
 (:mod:`~adept_traj.results.members`) and the ROS export
-(:mod:`~adept_traj.results.ros_export`)."""
+(:mod:`~adept_traj.results.ros_export`).
+
+The audit behind ``adept-traj verify`` lives in :mod:`adept_traj.certification.audit` (it
+reads a :class:`PlanningResult`, so it sits after this package); ``Audit``, ``audit``,
+``AUDIT_RTOL`` and ``Mismatch`` are still found here, imported on first use, for code
+written before it moved."""
 
 from __future__ import annotations
 
-from adept_traj.certification.audit import Audit, audit
-from adept_traj.certification.mismatches import AUDIT_RTOL, Mismatch
+import importlib as _importlib
+from typing import Any as _Any
+
 from adept_traj.errors import ResultFormatError
 from adept_traj.results.members import (
     MAX_MEMBER_SAMPLES,
@@ -47,7 +53,6 @@ from adept_traj.results.ros_export import (
 )
 
 __all__ = [
-    "AUDIT_RTOL",
     "FORMAT",
     "FRONT_FILE",
     "MAX_MEMBER_SAMPLES",
@@ -57,18 +62,15 @@ __all__ = [
     "SHIPPED_ROBOT",
     "TRAJECTORY_FILE",
     "VERSION",
-    "Audit",
     "BestSolution",
     "Front",
     "GenerationRecord",
     "Metrics",
-    "Mismatch",
     "PlanningResult",
     "Replay",
     "ResultFormatError",
     "RobotInfo",
     "Timing",
-    "audit",
     "certified_members",
     "member_dense",
     "member_index",
@@ -78,3 +80,20 @@ __all__ = [
     "to_csv",
     "to_ros_joint_trajectory",
 ]
+
+#: The names that moved to :mod:`adept_traj.certification` (issue #27), by module.
+_MOVED = {
+    "Audit": "adept_traj.certification.audit",
+    "audit": "adept_traj.certification.audit",
+    "AUDIT_RTOL": "adept_traj.certification.mismatches",
+    "Mismatch": "adept_traj.certification.mismatches",
+}
+
+
+def __getattr__(name: str) -> _Any:
+    """The moved names of :data:`_MOVED`, imported on first use (PEP 562)."""
+    if name in _MOVED:
+        value = getattr(_importlib.import_module(_MOVED[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,8 +22,10 @@ RANK = {
     "scene": 4,
     "collision": 5,
     "problem": 6,
+    "certification": 6.5,
     "analysis": 7,
     "results": 8,
+    "certification.audit": 8.2,  # the audit behind verify reads a PlanningResult
     "export": 8.5,  # fixed-step exports of a result's members; used by viz's explorer
     "optimise": 9,
     "viz": 9,
@@ -38,8 +40,21 @@ def _modules() -> list[Path]:
 
 
 def _owner(path: Path) -> str:
-    rel = path.relative_to(PACKAGE)
-    return rel.parts[0].removesuffix(".py")
+    """The unit of :data:`RANK` a module belongs to: its subpackage (or top-level module),
+    or ``"subpackage.module"`` where RANK names that module apart."""
+    rel = path.relative_to(PACKAGE).with_suffix("")
+    dotted = ".".join(rel.parts[:2])
+    return dotted if dotted in RANK else rel.parts[0]
+
+
+def _target(module: str) -> str | None:
+    """The unit of :data:`RANK` that ``import adept_traj.a.b...`` imports (None for the
+    package itself)."""
+    parts = module.split(".")
+    if len(parts) < 2:
+        return None
+    dotted = ".".join(parts[1:3])
+    return dotted if dotted in RANK else parts[1]
 
 
 def _imports(path: Path) -> list[tuple[str, list[str], int]]:
@@ -75,8 +90,7 @@ def test_imports_flow_one_way(path: Path):
     if owner == "__init__":
         return  # the top-level package re-exports the public API
     for module, names, line in _imports(path):
-        parts = module.split(".")
-        target = parts[1] if len(parts) > 1 else None
+        target = _target(module)
         # "from adept_traj import X": X is a subpackage or module
         targets = names if target is None else [target]
         for t in targets:
@@ -89,9 +103,44 @@ def test_imports_flow_one_way(path: Path):
             )
 
 
+#: The parts of optimise/, in the same one-way order: a module of optimise/ imports its own
+#: part and parts of lower rank only (pymoo's operators know nothing of the search, the
+#: search nothing of the local solver, neither of the worker processes beside plan()).
+OPTIMISE_RANK = {
+    "operators": 0, "search": 1, "local": 2, "parallel": 3, "planner": 4, "__init__": 5,
+}  # fmt: skip
+
+
+def _optimise_part(dotted: str) -> str:
+    return dotted.split(".")[2].removesuffix(".py")
+
+
+@pytest.mark.parametrize(
+    "path",
+    sorted((PACKAGE / "optimise").rglob("*.py")),
+    ids=lambda p: str(p.relative_to(PACKAGE)),
+)
+def test_optimise_parts_flow_one_way(path: Path):
+    """Every module of optimise/ sits in one of its parts (a new module goes into the part
+    that says what it holds), and imports only from its part and lower ones."""
+    rel = path.relative_to(PACKAGE / "optimise")
+    part = rel.parts[0].removesuffix(".py")
+    assert part in OPTIMISE_RANK, f"optimise/{rel} is in none of {sorted(OPTIMISE_RANK)}"
+    for module, _, line in _imports(path):
+        if not module.startswith("adept_traj.optimise.") or len(module.split(".")) < 3:
+            continue
+        target = _optimise_part(module)
+        assert target in OPTIMISE_RANK, f"optimise/{rel}:{line} imports {module}"
+        if part != "__init__" and target != part:
+            assert OPTIMISE_RANK[target] < OPTIMISE_RANK[part], (
+                f"optimise/{rel}:{line} imports {module} ({target}, rank "
+                f"{OPTIMISE_RANK[target]}) from {part} (rank {OPTIMISE_RANK[part]})"
+            )
+
+
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_private_names_stay_in_their_subpackage(path: Path):
-    owner = _owner(path)
+    owner = path.relative_to(PACKAGE).parts[0].removesuffix(".py")
     for module, names, line in _imports(path):
         parts = module.split(".")
         target = parts[1] if len(parts) > 1 else owner
