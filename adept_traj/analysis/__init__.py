@@ -1,4 +1,10 @@
-"""Analysis of moves and fronts: certificate, decision making, indicators, the paper's measures."""
+"""Analysis of fronts: decision making (:mod:`~adept_traj.analysis.decision`), indicators
+(:mod:`~adept_traj.analysis.indicators`), the paper's measures
+(:mod:`~adept_traj.analysis.paper_measures`), the weighted sum of a move and the
+plausibility warnings of a scene.
+
+The certificate moved to :mod:`adept_traj.certification` (issue #27); its names are still
+found here (``from adept_traj.analysis import certify``) for code written before."""
 
 from __future__ import annotations
 
@@ -28,43 +34,40 @@ from adept_traj.analysis.paper_measures import (
 )
 from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
-from adept_traj.certification.certificate import (
-    DEFAULT_RATE_HZ,
-    Certificate,
-    certificate_bytes,
-    certify,
-    check_certificate_memory,
-)
-from adept_traj.certification.continuous import (
-    CONTINUOUS,
-    DEFAULT_MAX_DEPTH,
-    DistanceGuarantee,
-    continuous_distance,
-    continuous_self_distance,
-    obstacle_jump_intervals,
-    obstacle_speeds,
-    solid_lever_arms,
-)
-from adept_traj.certification.dense_trajectory import (
+from adept_traj.certification import (
     BATCH_SAMPLES,
     BATCH_VALUES,
+    CONTINUOUS,
+    DEFAULT_MAX_DEPTH,
+    DEFAULT_RATE_HZ,
+    DEFAULT_TOLERANCE,
+    FRONT_INFLUENCE_ABOVE_MARGIN,
+    Certificate,
     DenseStates,
     DenseTrajectory,
-    batch_samples,
-    dense_samples,
-)
-from adept_traj.certification.limit_check import DEFAULT_TOLERANCE, LimitCheck
-from adept_traj.certification.member_certificate import (
-    FRONT_INFLUENCE_ABOVE_MARGIN,
+    DistanceGuarantee,
+    LimitCheck,
     MemberCertificate,
+    SelfDistance,
+    batch_samples,
+    certificate_bytes,
+    certify,
     certify_member,
     certify_members,
     certifying_problem,
+    check_certificate_memory,
+    check_rest_poses,
+    continuous_distance,
+    continuous_self_distance,
+    dense_samples,
+    obstacle_jump_intervals,
+    obstacle_speeds,
     problem_parts,
+    rest_pose_contacts,
     same_parts,
+    self_distance,
+    solid_lever_arms,
 )
-from adept_traj.certification.rest_poses import check_rest_poses, rest_pose_contacts
-from adept_traj.certification.self_distance import SelfDistance, self_distance
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
