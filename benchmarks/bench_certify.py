@@ -29,7 +29,7 @@ import numpy as np
 from _results import figure, recorded  # benchmarks/_results.py
 
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
-from adept_traj.analysis import certify_members
+from adept_traj.certification import certify_members
 
 #: Target wall time [s] of one front's certification (issue #11), per algorithm.
 TARGETS = {"nsga2": 1.0, "mode": 5.0}

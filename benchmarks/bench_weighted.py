@@ -35,7 +35,8 @@ from _results import recorded  # benchmarks/_results.py
 
 import adept_traj.optimise.local.weighted_move as weighted_move
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
-from adept_traj.analysis import WeightedSum, certify_members, weighted_sum
+from adept_traj.analysis import WeightedSum, weighted_sum
+from adept_traj.certification import certify_members
 from adept_traj.optimise import time_optimal, weighted_descent
 
 #: Weight vectors measured: name → w1…w6.

@@ -60,12 +60,9 @@ from numpy.typing import ArrayLike
 from adept_traj.analysis import (
     DEFAULT_HV_REFERENCE,
     PAPER_WEIGHTS,
-    Certificate,
     WeightedSum,
     algorithm_effort,
     best_tradeoff,
-    certify,
-    certify_members,
     non_dominated,
     normalised_hypervolume,
     objective_bounds,
@@ -74,6 +71,7 @@ from adept_traj.analysis import (
     spread,
     weighted_sum,
 )
+from adept_traj.certification import Certificate, certify, certify_members
 from adept_traj.certification.mismatches import Mismatch, MismatchLog, close
 from adept_traj.problem import OBJECTIVE_NAMES, TrajectoryProblem
 from adept_traj.results.record import PlanningResult

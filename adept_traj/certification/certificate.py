@@ -34,8 +34,8 @@ ratio 0). The certificate is feasible when every value is within its bound plus
 ``tolerance`` (default 1e-9) **and** the smallest distance over all samples and pairs is at
 least the problem's safety margin (no tolerance).
 
-**Between the samples** (``continuous=True``, the default), :mod:`~adept_traj.certification.continuous`
-bounds the distance on every sample interval from the robot's and the obstacles' point
+**Between the samples** (``continuous=True``, the default),
+:mod:`~adept_traj.certification.continuous` bounds the distance on every sample interval from the robot's and the obstacles' point
 speeds and bisects the intervals where the bound misses the margin; the refined samples join
 the distance check. :attr:`Certificate.guarantee` then says ``"continuous"`` (the distance is
 at least the margin at every instant: :attr:`Certificate.distance_bound` ≥ margin) or

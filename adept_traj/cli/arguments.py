@@ -13,7 +13,8 @@ import sys
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS, check_rest_poses, unit_warnings
+from adept_traj.analysis import PAPER_WEIGHTS, unit_warnings
+from adept_traj.certification import check_rest_poses
 from adept_traj.cli.robot_options import add_robot_arguments, check_task, robot_from_arguments
 from adept_traj.errors import (
     CollidingConfigurationError,

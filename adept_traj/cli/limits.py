@@ -12,7 +12,7 @@ allows); the table of limits is in ``docs/cli.md``.
 
 from __future__ import annotations
 
-from adept_traj.analysis import check_certificate_memory
+from adept_traj.certification import check_certificate_memory
 from adept_traj.optimise import TIME_OPTIMAL, check_population_memory, make_algorithm
 from adept_traj.problem import TrajectoryProblem
 

@@ -32,11 +32,13 @@ from pathlib import Path
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS, LimitCheck, certify, check_certificate_memory
+from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.certification import LimitCheck, certify, check_certificate_memory
+from adept_traj.certification.audit import audit
 from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
-from adept_traj.results import PlanningResult, audit
+from adept_traj.results import PlanningResult
 from adept_traj.results.unchecked import unchecked_of
 from adept_traj.robot import JointLimits
 from adept_traj.scene import scene_notes

@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.cycle.rest import certify_rest
 from adept_traj.cycle.summary import CYCLE_FILE
 from adept_traj.errors import CycleError

@@ -65,7 +65,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
     MAX_CLOCKED_MOVES,

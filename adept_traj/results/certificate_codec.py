@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from adept_traj.analysis import SelfDistance
+from adept_traj.certification import SelfDistance
 from adept_traj.certification.certificate import Certificate, DenseTrajectory, LimitCheck
 from adept_traj.certification.member_certificate import MemberCertificate
 from adept_traj.results.json_values import json_float, json_floats

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis import DenseTrajectory, dense_samples
+from adept_traj.certification import DenseTrajectory, dense_samples
 from adept_traj.collision import CollisionChecker
 from adept_traj.errors import InvalidInputError
 from adept_traj.results.record import PlanningResult

@@ -37,7 +37,7 @@ def single_result(
     optimisation run; nominal timings). ``certified`` (k,) bool: the members' certificate
     verdicts, as when every member was certified (``front.feasible``, ``n_certified``);
     ``None``: the engine's feasibility, members not certified."""
-    from adept_traj.analysis import certify
+    from adept_traj.certification import certify
     from adept_traj.results import BestSolution, Front, PlanningResult, Timing
 
     x = np.atleast_2d(x)

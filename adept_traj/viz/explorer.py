@@ -40,7 +40,8 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.analysis import PAPER_WEIGHTS, MemberCertificate
+from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.certification import MemberCertificate
 from adept_traj.errors import InvalidInputError
 from adept_traj.export import DEFAULT_DT, csv_header
 from adept_traj.files import write_text_atomic

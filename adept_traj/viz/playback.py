@@ -40,7 +40,7 @@ with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.
     from meshcat.animation import Animation, AnimationFrameVisualizer
     from meshcat.path import Path as MeshcatPath
 
-from adept_traj.analysis import dense_samples
+from adept_traj.certification import dense_samples
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import (
     PlanningResult,

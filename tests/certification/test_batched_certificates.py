@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import (
+from adept_traj.certification import (
     MemberCertificate,
     batch_samples,
     certify,

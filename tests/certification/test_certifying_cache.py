@@ -10,7 +10,7 @@ import inspect
 
 import pytest
 
-from adept_traj.analysis import (
+from adept_traj.certification import (
     certify,
     certify_members,
     certifying_problem,

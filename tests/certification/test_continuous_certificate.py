@@ -16,7 +16,7 @@ import pinocchio as pin
 import pytest
 
 from adept_traj import PlanningResult, Robot, Scene
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.scene import Cylinder, FixedPose, Obstacle, PendulumMotion
 from adept_traj.testing.paper_moves import lift_then_lower, single_result

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import (
+from adept_traj.certification import (
     FRONT_INFLUENCE_ABOVE_MARGIN,
     MemberCertificate,
     certify,

@@ -10,7 +10,8 @@ import pinocchio as pin
 import pytest
 
 from adept_traj import Scene
-from adept_traj.analysis import LIMIT_KINDS, Certificate, certify
+from adept_traj.analysis import LIMIT_KINDS
+from adept_traj.certification import Certificate, certify
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.testing.paper_moves import lift_then_lower

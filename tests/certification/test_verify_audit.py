@@ -19,10 +19,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from adept_traj.certification import AUDIT_RTOL
+from adept_traj.certification.audit import audit
 from adept_traj.cli import main, status
 from adept_traj.optimise import plan
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.results import AUDIT_RTOL, Front, PlanningResult, audit
+from adept_traj.results import Front, PlanningResult
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 

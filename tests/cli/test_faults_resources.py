@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from adept_traj import memory
-from adept_traj.analysis import certificate_bytes, certify
+from adept_traj.certification import certificate_bytes, certify
 from adept_traj.cli.app import main
 from adept_traj.cli.robot import samples_bytes
 from adept_traj.errors import (

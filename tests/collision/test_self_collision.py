@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adept_traj.analysis import certify, certify_members
+from adept_traj.certification import certify, certify_members
 from adept_traj.cli import main
 from adept_traj.collision import (
     SelfCollision,

@@ -12,7 +12,7 @@ import pytest
 
 import adept_traj.optimise.parallel.early_certificates as early_module
 from adept_traj import TrajectoryProblem
-from adept_traj.analysis import certify_members
+from adept_traj.certification import certify_members
 from adept_traj.errors import InvalidInputError
 from adept_traj.optimise import (
     RampSampling,

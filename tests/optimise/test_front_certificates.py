@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem
-from adept_traj.analysis import certify_members
+from adept_traj.certification import certify_members
 from adept_traj.errors import InvalidInputError
 from adept_traj.optimise import RampSampling, certify_front_members, kinematic_time
 

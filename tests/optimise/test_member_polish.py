@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem, plan
-from adept_traj.analysis import PAPER_WEIGHTS, certify_members
+from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.certification import certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     MAX_EVALUATIONS,

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem, plan
-from adept_traj.analysis import MemberCertificate, certify_members
+from adept_traj.certification import MemberCertificate, certify_members
 from adept_traj.optimise import MAX_BASINS
 
 

@@ -88,8 +88,7 @@ from types import SimpleNamespace
 import numpy as np
 from threadpoolctl import threadpool_info
 from adept_traj.optimise.local import epsilon_constraint as member_polish
-import importlib
-polish = importlib.import_module("adept_traj.optimise.local.minimum_time")  # the module, not the function
+from adept_traj.optimise.local import minimum_time as polish
 
 assert "scipy" not in sys.modules  # as in a run: scipy is first imported by the polish
 seen = []

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.optimise import planner
 from adept_traj.results import NO_FEASIBLE_WARNING
 

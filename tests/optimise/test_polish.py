@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from adept_traj import Scene, TrajectoryProblem, plan
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.optimise import (
     RampSampling,

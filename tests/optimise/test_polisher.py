@@ -17,7 +17,8 @@ import adept_traj.cli.plan as plan_command
 import adept_traj.optimise.parallel.early_certificates as early_module
 import adept_traj.optimise.parallel.polish_worker as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
-from adept_traj.analysis import PAPER_WEIGHTS, certify_members
+from adept_traj.analysis import PAPER_WEIGHTS
+from adept_traj.certification import certify_members
 from adept_traj.cli.app import main
 from adept_traj.errors import ConfigurationError, FrozenObjectError, InvalidInputError
 from adept_traj.optimise import (

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import certify, certify_member, certify_members
+from adept_traj.certification import certify, certify_member, certify_members
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
     BASIN_THRESHOLD,

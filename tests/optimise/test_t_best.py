@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 
 from adept_traj import TrajectoryProblem, plan
+from adept_traj.certification.audit import audit
 from adept_traj.cli.front import front_table
 from adept_traj.cli.report import summary
 from adept_traj.errors import InvalidInputError
 from adept_traj.optimise import refine_minimum_time
-from adept_traj.results import Metrics, PlanningResult, audit
+from adept_traj.results import Metrics, PlanningResult
 
 OLD = Path(__file__).parents[1] / "data" / "result_v1"
 

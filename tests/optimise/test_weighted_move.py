@@ -8,10 +8,12 @@ import numpy as np
 import pytest
 
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
-from adept_traj.analysis import WeightedSum, certify_members, weighted_sum
+from adept_traj.analysis import WeightedSum, weighted_sum
+from adept_traj.certification import certify_members
+from adept_traj.certification.audit import audit
 from adept_traj.errors import ConfigurationError, InputShapeError, InvalidInputError
 from adept_traj.optimise import RampSampling, time_optimal, weighted_descent
-from adept_traj.results import PlanningResult, audit
+from adept_traj.results import PlanningResult
 from adept_traj.testing.paper_moves import lift_then_lower
 
 #: Weights on the energy z2 alone, and the paper's.

@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import (

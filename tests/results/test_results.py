@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from adept_traj import Robot, Scene
-from adept_traj.analysis import certify, certify_members
+from adept_traj.certification import certify, certify_members
 from adept_traj.errors import AdeptTrajError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import (

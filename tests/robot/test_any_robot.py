@@ -375,7 +375,7 @@ def _coal_reference(urdf: Path, q: list[float]) -> dict[frozenset[str], tuple[bo
 
 
 def test_self_collision_is_on_without_an_srdf_and_agrees_with_coal_on_the_raw_meshes() -> None:
-    from adept_traj.analysis import rest_pose_contacts
+    from adept_traj.certification import rest_pose_contacts
 
     urdf = _ur5_urdf()
     robot = Robot.from_urdf(urdf)  # no SRDF, no parameter file

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from adept_traj.analysis import rest_pose_contacts
+from adept_traj.certification import rest_pose_contacts
 from adept_traj.cli import main
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot import Robot, installed_data_dirs

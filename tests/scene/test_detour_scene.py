@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.cli import main
 from adept_traj.errors import SceneError
 from adept_traj.scene import SHIPPED_SCENES

@@ -221,7 +221,7 @@ def test_certificate_is_sound_across_a_wrap_around():
     part = Obstacle("part", Box([0.1, 0.1, 0.1]), law, offset)
     scene = Scene((part,), robot_base=paper.robot_base, start=paper.start, goal=paper.goal)
     problem = at.TrajectoryProblem(at.Robot.adept_one_xl(), scene, scene.start, scene.goal)
-    from adept_traj.analysis import obstacle_jump_intervals
+    from adept_traj.certification import obstacle_jump_intervals
 
     assert obstacle_jump_intervals(problem)[0] == pytest.approx(0.75)
     x = problem.trajectory.straight_line(2.2)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.cli import main
 from adept_traj.collision import CollisionChecker
 from adept_traj.collision.distance_gradient import distance_gradients

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import adept_traj as at
-from adept_traj.analysis import certify
+from adept_traj.certification import certify
 from adept_traj.collision import distance_gradients
 from tests.certification.test_verification import coal_min_distances
 

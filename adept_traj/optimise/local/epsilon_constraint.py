@@ -37,8 +37,9 @@ Details, each measured on paper fronts:
   solve stops after :data:`MAX_EVALUATIONS` constraint-and-Jacobian evaluations. The
   caller certifies the result.
 
-SLSQP runs with one BLAS thread (as :func:`~adept_traj.optimise.local.minimum_time.minimum_time`): the same
-start gives the same move.
+SLSQP runs with one BLAS thread (as
+:func:`~adept_traj.optimise.local.minimum_time.minimum_time`): the same start gives the same
+move.
 """
 
 from __future__ import annotations

@@ -10,7 +10,8 @@ and never takes one from the search), and the helper then waits.
 :meth:`Polisher.start` hands it the search's final population (its arrays and counts,
 pickled: about 0.1 MB for the paper run); the helper polishes it as
 :func:`~adept_traj.optimise.polish_run_with_certificates` does, on the problem it
-inherited, while the caller certifies the front (:mod:`adept_traj.optimise.parallel.early_certificates`), and
+inherited, while the caller certifies the front
+(:mod:`adept_traj.optimise.parallel.early_certificates`), and
 :meth:`Polisher.result` collects the polished population and the polish's certificates.
 The same code on the same numbers: the population is the one the caller would make, bit
 for bit (only the measured times differ).
@@ -31,7 +32,7 @@ import dataclasses
 from functools import partial
 from typing import Any
 
-from adept_traj.analysis import (
+from adept_traj.certification import (
     MemberCertificate,
     certifying_problem,
     problem_parts,
