@@ -51,7 +51,7 @@ import numpy as np
 
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.local.minimum_time import PolishOutcome
-from adept_traj.optimise.operators.repair import kinematic_time
+from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.problem import MAXIMISED, local_constraints, objective_gradients
 from adept_traj.robot import VELOCITY_AT_REST
 from adept_traj.validation import as_integer, as_vector
@@ -74,8 +74,6 @@ _TIGHTEN = 1e-7
 #: move can raise it, and a tightened row would make SLSQP's subproblem infeasible.
 _TIGHTENED = np.array([True, True, True, False, True, True])
 
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.local.multi_start`).
-_SLACK = 1e-9
 
 #: Half-width of the box around the start that the solve stays in, as a fraction of each
 #: decision variable's range (xu − xl): a local step (SLSQP's first iterates otherwise
@@ -299,7 +297,7 @@ def _solve(
         lowers the cost."""
         step = np.clip(y[:n], problem.xl, problem.xu) - best[0]
         x = best[0] + _FRACTIONS[:, None] * step
-        t_kin = kinematic_time(problem, x) * (1.0 + _SLACK)
+        t_kin = kinematic_time(problem, x) * (1.0 + KINEMATIC_SLACK)
         x[:, 0] = np.minimum(np.maximum(x[:, 0], t_kin), problem.xu[0])
         ev = problem.evaluate_batch(x)
         moves[0] += 1  # one batch

@@ -30,14 +30,12 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.operators.repair import kinematic_time
+from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
 from adept_traj.validation import as_integer, as_scalar, as_vector
 
 __all__ = ["PolishOutcome", "at_kinematic_minimum", "minimum_time"]
 
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.operators.repair`).
-_SLACK = 1e-9
 
 #: Index of the distance rows in :data:`~adept_traj.problem.CONSTRAINT_KINDS`.
 _DISTANCE = CONSTRAINT_KINDS.index("distance")
@@ -193,7 +191,7 @@ def at_kinematic_minimum(problem: Any, x: np.ndarray) -> np.ndarray:
     relative slack of 1e-9) where a solver's samples missed a peak, and kept ≤ the upper
     bound."""
     x = np.clip(x, problem.xl, problem.xu)
-    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + _SLACK)
+    t_kin = kinematic_time(problem, x[None])[0] * (1.0 + KINEMATIC_SLACK)
     x[0] = min(max(x[0], t_kin), problem.xu[0])
     return x
 

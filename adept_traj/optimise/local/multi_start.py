@@ -32,7 +32,7 @@ from adept_traj.optimise.local.refinement import (
 )
 from adept_traj.optimise.local.timed_starts import timed_roadmap_starts
 from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
-from adept_traj.optimise.operators.repair import kinematic_time
+from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.validation import as_integer
@@ -47,8 +47,6 @@ __all__ = [
     "time_optimal",
 ]
 
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.operators.repair`).
-_SLACK = 1e-9
 
 #: Ramps drawn per ramp start of :func:`time_optimal` (the fastest ones are used).
 _RAMPS_PER_START = 8
@@ -273,5 +271,5 @@ def _starts(problem: Any, seed: int, n_starts: int) -> np.ndarray:
     t_kin = kinematic_time(problem, x)
     order = np.concatenate([[0], 1 + np.argsort(t_kin[1:], kind="stable")])[:n_starts]
     x, t_kin = x[order], t_kin[order]
-    x[:, 0] = np.clip(t_kin * (1.0 + _SLACK), problem.xl[0], problem.xu[0])
+    x[:, 0] = np.clip(t_kin * (1.0 + KINEMATIC_SLACK), problem.xl[0], problem.xu[0])
     return x

@@ -29,10 +29,12 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.problem import derivative_abs_max
 from adept_traj.validation import as_scalar
 
-__all__ = ["KinematicTimeRepair", "kinematic_time"]
+__all__ = ["KINEMATIC_SLACK", "KinematicTimeRepair", "kinematic_time"]
 
-#: Relative slack so that the repaired T satisfies the limits despite rounding.
-_SLACK = 1e-9
+#: Relative slack on the kinematic minimum: a travel time set to ``kinematic_time(...) *
+#: (1 + KINEMATIC_SLACK)`` meets every velocity, acceleration and jerk limit despite
+#: rounding. The repair, the fast-end search and the local solvers all raise T by it.
+KINEMATIC_SLACK = 1e-9
 
 #: Candidates whose exact extrema are computed at once: the per-segment arrays of
 #: :meth:`~adept_traj.problem.BSplineTrajectory.bounds` stay a few MB whatever the
@@ -115,7 +117,7 @@ class KinematicTimeRepair(Repair):
         X = np.array(X, dtype=float)
         if X.size == 0:
             return X
-        t_kin = (kinematic_time(problem, X) if t_kin is None else t_kin) * (1.0 + _SLACK)
+        t_kin = (kinematic_time(problem, X) if t_kin is None else t_kin) * (1.0 + KINEMATIC_SLACK)
         T = np.where(snapped, t_kin, np.maximum(X[:, 0], t_kin))
         X[:, 0] = np.clip(T, problem.xl[0], problem.xu[0])
         return X

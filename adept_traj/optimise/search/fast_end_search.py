@@ -47,14 +47,15 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.operators.de_variant import ArrayVariant
 from adept_traj.optimise.operators.mating import ArrayMating
 from adept_traj.optimise.operators.population import population_values
-from adept_traj.optimise.operators.repair import KinematicTimeRepair, kinematic_time
+from adept_traj.optimise.operators.repair import (
+    KINEMATIC_SLACK,
+    KinematicTimeRepair,
+    kinematic_time,
+)
 from adept_traj.optimise.search.sampling import RampSampling
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["FastEndSearch"]
-
-#: Relative slack on the kinematic minimum (as in :mod:`adept_traj.optimise.operators.repair`).
-_SLACK = 1e-9
 
 
 class FastEndSearch:
@@ -155,10 +156,10 @@ class FastEndSearch:
         if deferred:  # one kinematic time call for the kept trial vectors and the children
             t_all = kinematic_time(problem, np.concatenate([off[keep], children]))
             kept = repair.repaired(problem, off[keep], snapped[keep], t_all[: len(keep)])
-            t_kin = t_all[len(keep) :] * (1.0 + _SLACK)
+            t_kin = t_all[len(keep) :] * (1.0 + KINEMATIC_SLACK)
         else:
             kept = off[keep]
-            t_kin = kinematic_time(problem, children) * (1.0 + _SLACK)
+            t_kin = kinematic_time(problem, children) * (1.0 + KINEMATIC_SLACK)
         children[:, 0] = np.clip(t_kin, problem.xl[0], problem.xu[0])
         if arrays:
             return Population.new(X=np.concatenate([kept, children]))
