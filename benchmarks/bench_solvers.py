@@ -4,9 +4,9 @@ The issue asks for a local solver from a well-kept package, chosen by certified 
 time. IPOPT (cyipopt) has no wheel for this platform, so the candidates are scipy's two
 constrained methods. Both solve the same problem as
 :func:`adept_traj.optimise.local.minimum_time.minimum_time` — minimise T subject to every
-smooth per-sample constraint of :func:`adept_traj.problem.local_constraints` (exact Jacobians), inside the
-decision bounds — from the same starts: the straight move and the two kinematically
-fastest of 16 seeded ramps, each at its kinematic minimum T (as
+smooth per-sample constraint of :func:`adept_traj.problem.local_constraints` (exact
+Jacobians), inside the decision bounds — from the same starts: the straight move and the two
+kinematically fastest of 16 seeded ramps, each at its kinematic minimum T (as
 :func:`adept_traj.optimise.time_optimal`). Printed per start and method: the T reached
 [s], T / T_lb, whether the evaluator finds it feasible and the 1 kHz continuous
 certificate certifies it, the iterations, the constraint evaluations and the process CPU

@@ -35,9 +35,10 @@ ratio 0). The certificate is feasible when every value is within its bound plus
 least the problem's safety margin (no tolerance).
 
 **Between the samples** (``continuous=True``, the default),
-:mod:`~adept_traj.certification.continuous` bounds the distance on every sample interval from the robot's and the obstacles' point
-speeds and bisects the intervals where the bound misses the margin; the refined samples join
-the distance check. :attr:`Certificate.guarantee` then says ``"continuous"`` (the distance is
+:mod:`~adept_traj.certification.continuous` bounds the distance on every sample interval
+from the robot's and the obstacles' point speeds and bisects the intervals where the bound
+misses the margin; the refined samples join the distance check.
+:attr:`Certificate.guarantee` then says ``"continuous"`` (the distance is
 at least the margin at every instant: :attr:`Certificate.distance_bound` ≥ margin) or
 ``"sampled at N Hz"`` (the finest rate reached); :attr:`Certificate.certified` is
 :attr:`~Certificate.feasible` with the continuous guarantee. The torque has no exact
