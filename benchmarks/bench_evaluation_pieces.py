@@ -47,7 +47,7 @@ BLOCK_SAMPLES = 4096
 def pieces(problem: TrajectoryProblem, x: np.ndarray) -> dict[str, float]:
     """CPU seconds per piece over the blocks of population ``x`` (pop, n_var)."""
     robot, traj, checker = problem.robot, problem.trajectory, problem.checker
-    broad = checker._broad  # the profile reads the checker's parts
+    broad = checker.broad_phase  # the profile reads the checker's parts
     spent: dict[str, float] = {}
 
     def timed(name: str, fn: Callable[[], object]) -> object:
@@ -71,7 +71,7 @@ def pieces(problem: TrajectoryProblem, x: np.ndarray) -> dict[str, float]:
                 broad.ball_centres(f), broad.ball_radius, len(b)
             ),
         )
-        poses = timed("obstacle poses", lambda smp=smp: checker._obstacle_poses(smp.t))
+        poses = timed("obstacle poses", lambda smp=smp: checker.obstacle_poses(smp.t))
         timed("broad phase", lambda f=frames, p=poses, q=q: broad.bounds(f, p, q))
         timed(
             "min_distances (all of it)",

@@ -76,7 +76,7 @@ def search_pairs(
     smallest = lower.argmin(axis=1)  # (n_motions, n_obs): where each smallest bound is
     best = np.take_along_axis(lower, smallest[:, None], axis=1)[:, 0]  # bound until improved
     where = np.full(best.shape, -1)
-    closed = checker._broad.closed_form.all(axis=0)  # (n_obs,): every close pair exact
+    closed = checker.broad_phase.closed_form.all(axis=0)  # (n_obs,): every close pair exact
     # Every pair within influence of such an obstacle is exact already: the argmin is
     # exact when at most influence; above, it may be a level-1 bound (then -1).
     is_exact = np.take_along_axis(known, smallest[:, None, :], axis=1)[:, 0]
@@ -127,11 +127,11 @@ def _narrow_many(
 ) -> np.ndarray:
     """Exact distances (R,) [m] by coal of solid ``solids[i]`` at flat sample
     ``samples[i]`` and obstacle ``obstacles[i]``, the solid poses formed in one batch."""
-    poses = checker._broad.solid_poses(frames, samples, solids)
+    poses = checker.broad_phase.solid_poses(frames, samples, solids)
     out = np.empty(len(samples))
     for i, (n, s, o) in enumerate(zip(samples.tolist(), solids.tolist(), obstacles.tolist())):
         pose_o = obstacle_poses[o]
-        out[i] = checker._narrow(poses[i], pose_o if pose_o.ndim == 2 else pose_o[n], s, o)
+        out[i] = checker.narrow_distance(poses[i], pose_o if pose_o.ndim == 2 else pose_o[n], s, o)
     return out
 
 
@@ -162,7 +162,7 @@ def _walk(
     exact = known[m, cand, o]
     samples, solids = m * n_t + cand // ns, cand % ns
     unknown = np.flatnonzero(~exact)
-    poses = checker._broad.solid_poses(frames, samples[unknown], solids[unknown])
+    poses = checker.broad_phase.solid_poses(frames, samples[unknown], solids[unknown])
     slot = np.cumsum(~exact) - 1  # index into poses of each unknown candidate
     ends = np.searchsorted(pair, np.arange(len(need)), side="right").tolist()
     bound_l, exact_l, cand_l = bound.tolist(), exact.tolist(), cand.tolist()
@@ -180,7 +180,7 @@ def _walk(
                 if pose_o.ndim == 3:
                     pose_o = pose_o[samples_l[c]]
                 # only a distance below v matters: a larger one may come as a bound ≥ v
-                d = checker._narrow(poses[slot_l[c]], pose_o, solids_l[c], o_l[c], v)
+                d = checker.narrow_distance(poses[slot_l[c]], pose_o, solids_l[c], o_l[c], v)
                 calls += 1
             if d < v:
                 v, w = d, cand_l[c]

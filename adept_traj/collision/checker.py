@@ -124,7 +124,9 @@ class CollisionChecker:
         objects = robot.collision_model.geometryObjects
         self.solid_names = tuple(g.name for g in objects)
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
-        self._broad = BroadPhase(robot, scene, self.influence)
+        #: The :class:`~adept_traj.collision.broad_phase.BroadPhase`: the solids' and
+        #: obstacles' conservative bounds (read by the branch and bound and the gradients).
+        self.broad_phase = BroadPhase(robot, scene, self.influence)
         # Allowed contacts (scene.allowed_contacts: link, obstacle): never checked.
         links = [robot.model.frames[g.parentFrame].name for g in objects]
         pairs = [
@@ -132,11 +134,12 @@ class CollisionChecker:
         ]
         self.allowed = np.array(pairs, dtype=bool).reshape(len(objects), len(self.obstacle_names))
         self._robot_geoms = [g.geometry for g in objects]
-        shapes = self._broad.obstacle_shape  # a closed mesh's functor tests the inside too
-        self._functors = [
+        shapes = self.broad_phase.obstacle_shape  # a closed mesh's functor tests the inside too
+        #: coal's distance functors, ``functors[s][o]`` for solid s and obstacle o.
+        self.functors = [
             [
                 distance_functor(g, o, sh, self.influence)
-                for o, sh in zip(self._broad.obstacle_geometry, shapes)
+                for o, sh in zip(self.broad_phase.obstacle_geometry, shapes)
             ]
             for g in self._robot_geoms
         ]
@@ -156,19 +159,19 @@ class CollisionChecker:
     def solid_shapes(self) -> tuple[object | None, ...]:
         """The robot solids as :mod:`adept_traj.scene.shapes` objects (``None``: not a
         primitive)."""
-        return tuple(self._broad.solid_shape)
+        return tuple(self.broad_phase.solid_shape)
 
     @property
     def closed_form(self) -> np.ndarray:
         """(n_solids, n_obstacles) bool: pairs whose distance is computed in closed form
         (a sphere obstacle and a primitive solid) instead of by coal."""
-        return self._broad.closed_form.copy()
+        return self.broad_phase.closed_form.copy()
 
     @property
     def static_pairs(self) -> np.ndarray:
         """(n_solids, n_obstacles) bool: pairs of a solid fixed to the base and a fixed
         obstacle, whose constant distance is computed once (at construction)."""
-        return self._broad.static.copy()
+        return self.broad_phase.static.copy()
 
     @property
     def n_solids(self) -> int:
@@ -187,10 +190,13 @@ class CollisionChecker:
         With ``exact=True`` every pair is computed exactly: by coal, in closed form for a
         sphere obstacle, once for a static pair (for verification).
         """
-        qa, ta = self._check(q, t)
+        qa, ta = self.checked_motion(q, t)
         return self._distances(qa, ta, exact)
 
-    def _check(self, q: Any, t: Any) -> tuple[np.ndarray, np.ndarray]:
+    def checked_motion(self, q: Any, t: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``q`` (..., n_t, nq) [rad | m] and ``t`` [s] as float arrays, ``t`` broadcast to
+        q's leading shape (..., n_t); :class:`~adept_traj.errors.InputShapeError` names a
+        shape that does not fit."""
         qa = as_finite_array(q, "q")
         ta = as_finite_array(t, "t")
         if qa.ndim < 2 or qa.shape[-1] != self.robot.nq:
@@ -217,7 +223,7 @@ class CollisionChecker:
         frames (:attr:`~adept_traj.robot.ForwardKinematics.joint_frames`) if already
         computed.
         """
-        qa, ta = self._check(q, t)
+        qa, ta = self.checked_motion(q, t)
         if joint_frames is None:
             joint_frames = self.robot.kinematics.joint_frames(qa)
         expected = (self.robot.model.njoints, 3, 4, ta.size)
@@ -234,8 +240,8 @@ class CollisionChecker:
         ta = np.asarray(t, dtype=float)
         return ta if self.start_time == 0.0 else ta + self.start_time
 
-    # ------------------------------------------------------------------ private hooks
-    def _obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
+    # ------------------------------ parts the branch and bound and the distance gradients use
+    def obstacle_poses(self, t: np.ndarray) -> list[np.ndarray]:
         """Obstacle poses in the robot base frame at the flattened motion times ``t`` (scene
         times :meth:`scene_time`): per obstacle one (4, 4) pose if it is fixed, else
         (N, 4, 4) with N = ``t.size``."""
@@ -255,10 +261,12 @@ class CollisionChecker:
         return poses
 
     @staticmethod
-    def _pose_at(poses: np.ndarray, n: int) -> np.ndarray:
+    def pose_at(poses: np.ndarray, n: int) -> np.ndarray:
+        """The (4, 4) pose at flat sample ``n`` of one obstacle's :meth:`obstacle_poses`
+        entry (a fixed obstacle's one pose, or row ``n`` of a moving one's)."""
         return poses if poses.ndim == 2 else poses[n]
 
-    def _narrow(
+    def narrow_distance(
         self,
         solid_pose: np.ndarray,
         obstacle_pose: np.ndarray,
@@ -273,7 +281,7 @@ class CollisionChecker:
         tf_solid.setTransform(solid_pose[:3, :3], solid_pose[:3, 3])  # one call, not two
         tf_obstacle.setTransform(obstacle_pose[:3, :3], obstacle_pose[:3, 3])
         self._result.clear()
-        functor = self._functors[s][o]
+        functor = self.functors[s][o]
         if below is not None and isinstance(functor, CloudDistance):
             return functor(tf_solid, tf_obstacle, self._request, self._result, below)
         return functor(tf_solid, tf_obstacle, self._request, self._result)
@@ -283,8 +291,8 @@ class CollisionChecker:
         (:mod:`adept_traj.collision.pruning`: their distance is reported as the bound that
         proves it), then search the others (:meth:`_search`)."""
         n_motions = int(np.prod(q.shape[:-2]))
-        centres = self._broad.ball_centres(frames)  # for the pruning and the broad phase
-        far = self._pruning.lower_bounds(centres, self._broad.ball_radius, n_motions)
+        centres = self.broad_phase.ball_centres(frames)  # for the pruning and the broad phase
+        far = self._pruning.lower_bounds(centres, self.broad_phase.ball_radius, n_motions)
         keep = self._pruning.kept(far)
         part = self._restricted(keep)._search(q, t, frames, centres)
         out = [far.copy(), np.full(far.shape, -1), np.full(far.shape, -1)]
@@ -312,9 +320,9 @@ class CollisionChecker:
         :meth:`BroadPhase.ball_centres` of ``frames``, or None); a :class:`MinDistances`."""
         batch, n_t = q.shape[:-2], q.shape[-2]
         n_motions = int(np.prod(batch))
-        obstacle_poses = self._obstacle_poses(t)
+        obstacle_poses = self.obstacle_poses(t)
         q_flat = q.reshape(-1, q.shape[-1])
-        bounds = self._broad.bounds(frames, obstacle_poses, q_flat, balls)
+        bounds = self.broad_phase.bounds(frames, obstacle_poses, q_flat, balls)
         lower, known = bounds.lower, bounds.exact
         if self.allowed.any():  # else no pass over the whole arrays
             lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed
@@ -333,8 +341,8 @@ class CollisionChecker:
 
     def _distances(self, q: np.ndarray, t: np.ndarray, exact: bool) -> PairDistances:
         frames = self.robot.kinematics.joint_frames(q)  # (njoints, 3, 4, N)
-        obstacle_poses = self._obstacle_poses(t)
-        broad = self._broad
+        obstacle_poses = self.obstacle_poses(t)
+        broad = self.broad_phase
         if exact:
             n = frames.shape[-1]
             flat_d = np.empty((n, self.n_solids, self.n_obstacles))
@@ -356,9 +364,11 @@ class CollisionChecker:
         samples, solids, obstacles = np.nonzero(todo)
         for c in range(0, len(samples), 8192):  # solid poses in batches (1 MB), not per call
             cut = [a[c : c + 8192] for a in (samples, solids, obstacles)]
-            poses = self._broad.solid_poses(frames, cut[0], cut[1])
+            poses = self.broad_phase.solid_poses(frames, cut[0], cut[1])
             for pose, n, s, o in zip(poses, *(a.tolist() for a in cut)):
-                flat_d[n, s, o] = self._narrow(pose, self._pose_at(obstacle_poses[o], n), s, o)
+                flat_d[n, s, o] = self.narrow_distance(
+                    pose, self.pose_at(obstacle_poses[o], n), s, o
+                )
         known |= todo
         shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)
         return PairDistances(

@@ -108,13 +108,13 @@ def distance_gradients(checker: CollisionChecker, q: Any, t: Any) -> DistanceGra
     q, t:
         Configurations and times, as for :meth:`CollisionChecker.distances`.
     """
-    qa, ta = checker._check(q, t)
+    qa, ta = checker.checked_motion(q, t)
     return _distance_gradients(checker, qa, ta)
 
 
 def _distance_gradients(checker: CollisionChecker, q: np.ndarray, t: np.ndarray):
     nq, n_obs = q.shape[-1], checker.n_obstacles
-    pairs = checker._distances(q, t, exact=False)
+    pairs = checker.distances(q, t)
     n_samples = int(np.prod(q.shape[:-1]))
     flat = pairs.distance.reshape(n_samples, checker.n_solids, n_obs)
     distance = flat.min(axis=1)  # (N, n_obs)
@@ -156,20 +156,20 @@ def _witnesses(
     [m] are ``distance`` (m,): the first of :data:`WITNESS_TOLERANCES` whose distance
     agrees with it to :data:`_AGREE` (all zero, a zero gradient, if none does: not met on
     the shipped scenes)."""
-    poses = checker._broad.solid_poses(frames, rows, solids)
-    obstacle_poses = checker._obstacle_poses(t)
+    poses = checker.broad_phase.solid_poses(frames, rows, solids)
+    obstacle_poses = checker.obstacle_poses(t)
     out = np.zeros((3, len(rows), 3))
     requests, result = _witness_requests(), coal.DistanceResult()
     tf_solid, tf_obstacle = coal.Transform3s(), coal.Transform3s()
     for i, (n, k, o) in enumerate(zip(rows.tolist(), solids.tolist(), obstacles.tolist())):
-        pose = checker._pose_at(obstacle_poses[o], n)
+        pose = checker.pose_at(obstacle_poses[o], n)
         tf_solid.setRotation(poses[i, :3, :3])
         tf_solid.setTranslation(poses[i, :3, 3])
         tf_obstacle.setRotation(pose[:3, :3])
         tf_obstacle.setTranslation(pose[:3, 3])
         for request in requests:  # GJK may fail at the tightest tolerance: loosen
             result.clear()
-            d = checker._functors[k][o](tf_solid, tf_obstacle, request, result)
+            d = checker.functors[k][o](tf_solid, tf_obstacle, request, result)
             if abs(d - distance[i]) <= _AGREE:
                 out[:, i] = result.getNearestPoint1(), result.getNearestPoint2(), result.normal
                 break
@@ -196,7 +196,7 @@ def _solid_term(
     normal: np.ndarray,
 ) -> np.ndarray:
     """(m, nq) :math:`-n^\\top J_{p_1}`, batched per joint carrying the solids."""
-    kinematics, parents = checker.robot.kinematics, checker._broad.parents
+    kinematics, parents = checker.robot.kinematics, checker.broad_phase.parents
     out = np.empty((len(rows), checker.robot.nq))
     joint = np.asarray(parents)[solids]
     for j in np.unique(joint).tolist():

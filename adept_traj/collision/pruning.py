@@ -130,8 +130,8 @@ def restrict_checker(checker: CollisionChecker, obstacles: np.ndarray) -> Collis
     restricted to them, nothing recomputed."""
     keep = [int(o) for o in obstacles]
     view = copy.copy(checker)
-    view._broad = restrict_broad_phase(checker._broad, np.asarray(keep))
-    view._functors = [[row[o] for o in keep] for row in checker._functors]
+    view.broad_phase = restrict_broad_phase(checker.broad_phase, np.asarray(keep))
+    view.functors = [[row[o] for o in keep] for row in checker.functors]
     view.obstacle_names = tuple(checker.obstacle_names[o] for o in keep)
     contacts = tuple(c for c in checker.scene.allowed_contacts if c[1] in view.obstacle_names)
     view.scene = Scene(

@@ -188,7 +188,7 @@ class BatchKinematics:
                 jac[:3, j.index] += z
         return jac
 
-    def _jacobian_rows(
+    def jacobian_rows(
         self, frames: np.ndarray, point_joint: int, point: np.ndarray, rows: list[int]
     ) -> np.ndarray:
         """The rows ``rows`` (indices into (v_x, v_y, v_z, ω_x, ω_y, ω_z)) of

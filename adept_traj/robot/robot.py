@@ -434,7 +434,7 @@ class Robot(FrozenAttributes):
         (3, 4, N), component-major (the determinant reads contiguous entries)."""
         rows = [TASK_ROWS.index(r) for r in self.task_rows]
         parent = self.model.frames[self._tool_id].parentJoint
-        jac = self.kinematics._jacobian_rows(frames, parent, tool[:, 3], rows)  # (m, nq, N)
+        jac = self.kinematics.jacobian_rows(frames, parent, tool[:, 3], rows)  # (m, nq, N)
         return manipulability_measure(np.moveaxis(jac, -1, 0))
 
 

@@ -112,8 +112,8 @@ def test_paper_scene_keeps_its_tables_and_a_far_box_gets_none(robot: Robot) -> N
     paper = Scene.paper()
     far = Obstacle("far", Box((0.2, 0.2, 0.2)), FixedPose.from_xyz_rpy([4.0, 0.4, 0.1]))
     cell = Scene((*paper.obstacles, far), robot_base=paper.robot_base)
-    tables = CollisionChecker(robot, cell)._broad.tables
-    assert sorted(tables) == sorted(CollisionChecker(robot, paper)._broad.tables)
+    tables = CollisionChecker(robot, cell).broad_phase.tables
+    assert sorted(tables) == sorted(CollisionChecker(robot, paper).broad_phase.tables)
     assert len(tables) == 4  # the inner arm's two solids against each cube
 
 

@@ -250,6 +250,103 @@ def test_the_private_name_check_finds_each_form(tmp_path: Path):
     assert private_names_used(pkg / "top.py", pkg) == ["1: from adept_traj.sub import _hidden"]
 
 
+#: Private names of pymoo's operator and algorithm protocol: adept_traj's subclasses
+#: override them and call them on pymoo's objects (checked to exist on pymoo's classes).
+PYMOO_PROTOCOL = {
+    "_do": "pymoo.core.operator.Operator",
+    "_initialize": "pymoo.core.algorithm.Algorithm",
+    "_set_optimum": "pymoo.core.algorithm.Algorithm",
+}
+
+
+def _defined_names(tree: ast.AST) -> set[str]:
+    """Names a module defines: functions, classes, assigned names and attributes (``x._a =
+    ...``, ``setattr(x, "_a", ...)``, ``object.__setattr__(x, "_a", ...)``)."""
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+            names.add(node.attr)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            names.add(node.id)
+        elif isinstance(node, ast.arg):
+            names.add(node.arg)
+        elif isinstance(node, ast.Call) and len(node.args) >= 2:
+            func = node.func
+            setter = (isinstance(func, ast.Name) and func.id == "setattr") or (
+                isinstance(func, ast.Attribute) and func.attr == "__setattr__"
+            )
+            name = node.args[1]
+            if setter and isinstance(name, ast.Constant) and isinstance(name.value, str):
+                names.add(name.value)
+    return names
+
+
+def private_attributes_used(paths: list[Path]) -> list[str]:
+    """Every ``obj._name`` (not on ``self`` or ``cls``) in one of ``paths`` where ``_name``
+    is not defined in that module but is defined in another one: a private method or
+    attribute used across modules. pymoo's protocol names (:data:`PYMOO_PROTOCOL`) aside."""
+    trees = {path: ast.parse(path.read_text(encoding="utf-8")) for path in paths}
+    defined = {path: _defined_names(tree) for path, tree in trees.items()}
+    found = []
+    for path, tree in trees.items():
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.Attribute) and _is_private(node.attr)):
+                continue
+            if isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"):
+                continue
+            if node.attr in defined[path] or node.attr in PYMOO_PROTOCOL:
+                continue
+            owners = sorted(p.name for p, names in defined.items() if node.attr in names)
+            if owners:
+                found.append(f"{path.name}:{node.lineno}: {ast.unparse(node)} ({owners})")
+    return found
+
+
+def test_no_private_method_or_attribute_is_used_from_another_module():
+    """``checker._narrow(...)`` in another module: what another module calls is public
+    (documented), or the caller moves into the module."""
+    found = private_attributes_used(_modules())
+    assert not found, found
+
+
+def test_pymoo_protocol_names_are_pymoo_s():
+    import importlib
+
+    for name, owner in PYMOO_PROTOCOL.items():
+        module, _, cls = owner.rpartition(".")
+        assert hasattr(getattr(importlib.import_module(module), cls), name), (name, owner)
+
+
+def test_the_private_attribute_check_finds_each_form(tmp_path: Path):
+    """The check above on made-up modules: another module's private method or attribute is
+    found, on any object but ``self``; a module's own, stdlib's and pymoo's are not."""
+    (tmp_path / "checker.py").write_text(
+        "class Checker:\n"
+        "    def __init__(self):\n        self._broad = 1\n"
+        "        object.__setattr__(self, '_rates', 2)\n"
+        "    def _narrow(self):\n        return self._broad\n",
+        encoding="utf-8",
+    )
+    (tmp_path / "user.py").write_text(
+        "import os\n"
+        "def f(checker, op):\n"
+        "    a = checker._narrow()\n"  # found
+        "    b = checker._broad + checker._rates\n"  # both found
+        "    op._do(None)\n"  # pymoo's protocol: allowed
+        "    os._exit(0)\n"  # not the package's: allowed
+        "    return a, b\n",
+        encoding="utf-8",
+    )
+    found = private_attributes_used([tmp_path / "checker.py", tmp_path / "user.py"])
+    assert [f.split(": ", 1)[1] for f in found] == [
+        "checker._narrow (['checker.py'])",
+        "checker._broad (['checker.py'])",
+        "checker._rates (['checker.py'])",
+    ]
+
+
 def test_every_exception_class_is_in_errors_py():
     elsewhere = []
     for path in _modules():

@@ -71,7 +71,7 @@ def test_jacobian_rows_match_pinocchio(chain: tuple, rows: list[int]) -> None:
     LOCAL_WORLD_ALIGNED joint Jacobian."""
     model, kin, q, frames = chain
     last = model.njoints - 1
-    jac = kin._jacobian_rows(frames, last, frames[last, :, 3], rows)  # (m, nq, N)
+    jac = kin.jacobian_rows(frames, last, frames[last, :, 3], rows)  # (m, nq, N)
     data = model.createData()
     for n, qn in enumerate(q):
         pin.computeJointJacobians(model, data, qn)
@@ -89,7 +89,7 @@ def test_manipulability_of_the_task_rows_is_that_of_frame_jacobian(
     model, kin, _, frames = chain
     last = model.njoints - 1
     point = frames[last, :, 3]
-    fast = kin._jacobian_rows(frames, last, point, rows)
+    fast = kin.jacobian_rows(frames, last, point, rows)
     full = kin.frame_jacobian(frames, last, point)[rows]
     np.testing.assert_array_equal(
         manipulability_measure(np.moveaxis(fast, -1, 0)),
@@ -138,7 +138,7 @@ def test_solid_poses_and_ball_centres_match_pinocchio_geometry_placements() -> N
     """Several solids' poses in one call, and the enclosing-ball centres written in place,
     against Pinocchio's own geometry placements."""
     robot, scene = at.Robot.adept_one_xl(), at.Scene.paper()
-    broad = CollisionChecker(robot, scene)._broad
+    broad = CollisionChecker(robot, scene).broad_phase
     rng = np.random.default_rng(11)
     q = rng.uniform(robot.limits.lower, robot.limits.upper, size=(30, robot.nq))
     frames = robot.kinematics.joint_frames(q)

@@ -211,7 +211,7 @@ def test_robot_solid_inside_a_closed_mesh_is_colliding(star):
     inside = []
     frames = robot.kinematics.joint_frames(q.reshape(-1, 4))
     for k, _g in enumerate(robot.collision_model.geometryObjects):
-        pose = checker._broad.solid_poses(frames, np.array([0]), k)[0]
+        pose = checker.broad_phase.solid_poses(frames, np.array([0]), k)[0]
         local = np.linalg.inv(scene.obstacles[0].pose(0.0)) @ pose[:, 3]
         inside.append(bool(star_inside(local[None, :3], r_out=0.8, r_in=0.6, height=0.6)[0]))
     assert any(inside)
@@ -233,7 +233,9 @@ def test_broad_phase_bounds_are_lower_bounds_for_meshes(star):
     q = rng.uniform(np.maximum(lo, -2.5), np.minimum(hi, 2.5), size=(1, 300, 4))
     t = np.zeros((1, 300))
     exact = checker.distances(q, t, exact=True).distance
-    bounds = checker._broad.bounds(robot.kinematics.joint_frames(q[0]), checker._obstacle_poses(t))
+    bounds = checker.broad_phase.bounds(
+        robot.kinematics.joint_frames(q[0]), checker.obstacle_poses(t)
+    )
     assert (bounds.lower.reshape(exact.shape) <= exact + 1e-9).all()
     assert (exact < 0).any()
     assert (exact > 0).any()

@@ -119,7 +119,7 @@ def test_distances_bracket_the_points(points):
     frames = robot.kinematics.joint_frames(q[0])
     to_cloud = np.linalg.inv(scene.base_from_world @ where.transform)
     for n, k in zip(*np.nonzero(exact[0, :, :, 0] < 0.3)):
-        pose = to_cloud @ checker._broad.solid_poses(frames, np.array([n]), int(k))[0]
+        pose = to_cloud @ checker.broad_phase.solid_poses(frames, np.array([n]), int(k))[0]
         geom = robot.collision_model.geometryObjects[int(k)].geometry
         tf = coal.Transform3s(pose[:3, :3], pose[:3, 3])
         request = coal.DistanceRequest()
