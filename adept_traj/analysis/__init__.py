@@ -3,10 +3,14 @@
 (:mod:`~adept_traj.analysis.paper_measures`), the weighted sum of a move and the
 plausibility warnings of a scene.
 
-The certificate moved to :mod:`adept_traj.certification` (issue #27); its names are still
-found here (``from adept_traj.analysis import certify``) for code written before."""
+The certificate moved to :mod:`adept_traj.certification` (issue #27); its public names are
+still found here (``from adept_traj.analysis import certify``), imported from there on first
+use, for code written before."""
 
 from __future__ import annotations
+
+import importlib as _importlib
+from typing import Any as _Any
 
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
@@ -34,79 +38,20 @@ from adept_traj.analysis.paper_measures import (
 )
 from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
-from adept_traj.certification import (
-    BATCH_SAMPLES,
-    BATCH_VALUES,
-    CONTINUOUS,
-    DEFAULT_MAX_DEPTH,
-    DEFAULT_RATE_HZ,
-    DEFAULT_TOLERANCE,
-    FRONT_INFLUENCE_ABOVE_MARGIN,
-    Certificate,
-    DenseStates,
-    DenseTrajectory,
-    DistanceGuarantee,
-    LimitCheck,
-    MemberCertificate,
-    SelfDistance,
-    batch_samples,
-    certificate_bytes,
-    certify,
-    certify_member,
-    certify_members,
-    certifying_problem,
-    check_certificate_memory,
-    check_rest_poses,
-    continuous_distance,
-    continuous_self_distance,
-    dense_samples,
-    obstacle_jump_intervals,
-    obstacle_speeds,
-    problem_parts,
-    rest_pose_contacts,
-    same_parts,
-    self_distance,
-    solid_lever_arms,
-)
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
-    "BATCH_SAMPLES",
-    "BATCH_VALUES",
-    "CONTINUOUS",
     "DEFAULT_HV_REFERENCE",
-    "DEFAULT_MAX_DEPTH",
-    "DEFAULT_RATE_HZ",
-    "DEFAULT_TOLERANCE",
-    "FRONT_INFLUENCE_ABOVE_MARGIN",
     "LIMIT_KINDS",
     "PAPER_WEIGHTS",
     "REACH_FACTOR",
     "WEIGHTED_SUM_REFERENCE",
     "BestTradeoff",
-    "Certificate",
-    "DenseStates",
-    "DenseTrajectory",
-    "DistanceGuarantee",
-    "LimitCheck",
-    "MemberCertificate",
-    "SelfDistance",
     "WeightedSum",
     "algorithm_effort",
     "average_fitness",
-    "batch_samples",
     "best_tradeoff",
-    "certificate_bytes",
-    "certify",
-    "certify_member",
-    "certify_members",
-    "certifying_problem",
-    "check_certificate_memory",
-    "check_rest_poses",
     "combined_objective",
-    "continuous_distance",
-    "continuous_self_distance",
-    "dense_samples",
     "hypervolume",
     "igd",
     "non_dominated",
@@ -114,18 +59,21 @@ __all__ = [
     "normalised_hypervolume",
     "objective_bounds",
     "objective_weights",
-    "obstacle_jump_intervals",
-    "obstacle_speeds",
     "optimizer_overhead",
-    "problem_parts",
     "ratio_non_dominated",
-    "rest_pose_contacts",
     "robot_reach",
-    "same_parts",
-    "self_distance",
-    "solid_lever_arms",
     "spread",
     "to_unit_minimisation",
     "unit_warnings",
     "weighted_sum",
 ]
+
+
+def __getattr__(name: str) -> _Any:
+    """A public name of :mod:`adept_traj.certification` (moved from here), on first use."""
+    certification = _importlib.import_module("adept_traj.certification")
+    if name in certification.__all__:
+        value = getattr(certification, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
