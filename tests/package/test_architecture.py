@@ -436,3 +436,14 @@ def test_modules_are_small():
         if n > 460 or (n > 400 and rel not in LONG_MODULES):
             long[rel] = n
     assert not long, long
+
+
+def test_tests_are_grouped_by_subsystem():
+    """Every test file sits in a folder of tests/ named after a subsystem (none at the top),
+    and every such folder is a package, so that two test files may share a name."""
+    tests = PACKAGE.parent / "tests"
+    assert sorted(p.name for p in tests.glob("test_*.py")) == []
+    folders = {p.parent for p in tests.rglob("test_*.py")}
+    assert all((folder / "__init__.py").is_file() for folder in folders | {tests}), sorted(
+        str(f.relative_to(tests)) for f in folders if not (f / "__init__.py").is_file()
+    )
