@@ -32,11 +32,7 @@ from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import as_finite_array
 
-__all__ = [
-    "CollisionChecker",
-    "MinDistances",
-    "PairDistances",
-]
+__all__ = ["CollisionChecker", "MinDistances", "PairDistances"]
 
 
 @dataclass(frozen=True)
@@ -262,8 +258,7 @@ class CollisionChecker:
 
     @staticmethod
     def pose_at(poses: np.ndarray, n: int) -> np.ndarray:
-        """The (4, 4) pose at flat sample ``n`` of one obstacle's :meth:`obstacle_poses`
-        entry (a fixed obstacle's one pose, or row ``n`` of a moving one's)."""
+        """The (4, 4) pose at flat sample ``n`` of an :meth:`obstacle_poses` entry."""
         return poses if poses.ndim == 2 else poses[n]
 
     def narrow_distance(
@@ -275,8 +270,8 @@ class CollisionChecker:
         below: float | None = None,
     ) -> float:
         """Exact signed distance [m] of solid ``s`` and obstacle ``o`` at the given poses;
-        with ``below`` [m], a distance not below it may come back as a lower bound of it
-        that is at least ``below`` (a point cloud's narrow phase then does less work)."""
+        with ``below`` [m], a distance not below it may come back as a lower bound ≥ it (a
+        point cloud's narrow phase then does less work)."""
         tf_solid, tf_obstacle = self._tf
         tf_solid.setTransform(solid_pose[:3, :3], solid_pose[:3, 3])  # one call, not two
         tf_obstacle.setTransform(obstacle_pose[:3, :3], obstacle_pose[:3, 3])
