@@ -163,7 +163,7 @@ def main() -> None:
                 f"over the best known ({best:.4f} s), seeds {args.seeds}", round(max(ratios), 3),
                 "×", target="≤ 1.01×", met=max(ratios) <= 1.01, runs=[round(r, 4) for r in ratios],
             )  # fmt: skip
-            target = TIME_OPTIMAL_TARGET[scene] if algorithm == "time-optimal" else None
+            target = TIME_OPTIMAL_TARGET.get(key) if algorithm == "time-optimal" else None
             figure(
                 f"{scene}_{algorithm}_wall", f"{scene}, {algorithm}: median wall time",
                 round(statistics.median(walls), 1), "s",
