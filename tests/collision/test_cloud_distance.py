@@ -157,7 +157,7 @@ def test_cloud_level_bounds_never_above_coal(fence):
     q = lo + (hi - lo) * rng.uniform(size=(60, robot.nq))
     frames = robot.kinematics.joint_frames(q)
     pose = scene.base_from_world @ ob.pose(0.0)
-    lower = checker._broad.bounds(frames, [pose], q).lower[..., 0]  # (60, n_solids)
+    lower = checker.broad_phase.bounds(frames, [pose], q).lower[..., 0]  # (60, n_solids)
     octree, request = fence.to_coal(), distance_request()
     tf_cloud = coal.Transform3s(pose[:3, :3], pose[:3, 3])
     model, gm = robot.model, robot.collision_model
@@ -203,7 +203,7 @@ def test_urdf_hull_links_against_a_cloud_match_coal():
     checker = CollisionChecker(robot, scene, influence=CAP)
     hulls = [g.geometry for g in robot.collision_model.geometryObjects]
     assert any(isinstance(h, coal.ConvexBase) for h in hulls)
-    octree = checker._broad.obstacle_geometry[0]
+    octree = checker.broad_phase.obstacle_geometry[0]
     for h in hulls:
         if isinstance(h, coal.ConvexBase):
             assert isinstance(distance_functor(h, octree, cloud, CAP), CloudDistance)
