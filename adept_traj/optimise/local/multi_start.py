@@ -72,11 +72,12 @@ def time_optimal(
     move and the ``n_starts − 1`` kinematically fastest of ``8 (n_starts − 1)`` seeded
     ramps (each at its kinematic minimum T; the evaluator-feasible ones first) and, unless
     one of them ends **certified** within :data:`~adept_traj.optimise.GLOBAL_GAP` of the
-    kinematic lower bound, from the global stage's starts
-    (:func:`~adept_traj.optimise.via_point_starts`: feasible via-point moves and ramps of
-    distinct basins, and the least infeasible): every start screened
-    (:func:`~adept_traj.optimise.screen_starts`, stopping at the first near the bound),
-    then the fastest screened moves refined to the end
+    kinematic lower bound, from the global stage's starts (:func:`global_stage`): the
+    relaxed problem's optimum, always screened once the stage runs, then — while none is
+    near the bound or the relaxed floor — the timed trees' starts, the other ramps and the
+    via points (:func:`~adept_traj.optimise.via_point_starts`). Every start screened
+    (:func:`~adept_traj.optimise.screen_starts`, ``processes`` at once), then, unless one
+    is near, the fastest screened moves refined to the end
     (:func:`~adept_traj.optimise.refine_starts`).
 
     Parameters
