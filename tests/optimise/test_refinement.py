@@ -32,6 +32,7 @@ from adept_traj.optimise import (
 )
 from adept_traj.optimise.local.refinement import DIP_STEP
 from adept_traj.problem import CONSTRAINT_KINDS, local_constraints
+from adept_traj.process_pool import children
 from adept_traj.testing.paper_moves import lift_then_lower
 from tests.certification.test_verification import coal_min_distances
 
@@ -284,6 +285,28 @@ def test_time_optimal_on_the_detour_scene(detour) -> None:
     assert best <= 1.01 * BEST_MOVES["fastest_time_optimal_seed1"][0]
     assert best < 0.75 * DRAKE_DETOUR_T
     assert not outcomes[0].start_certified  # the first start: through the post
+
+
+def test_the_relaxed_worker_is_stopped_when_the_first_start_is_near(problem) -> None:
+    """Paper scene (a pendulum: the relaxed problem's worker starts beside the first
+    screening), processes=2: the straight move ends near the bound, the worker is stopped
+    and reaped, and the outcome is the one-process one."""
+    two = time_optimal(problem, seed=1, n_starts=2, processes=2)
+    assert children() == []
+    assert len(two) == 1
+    assert near_lower_bound(problem, two)
+    assert two[0].x.tolist() == time_optimal(problem, seed=1, n_starts=2, processes=1)[0].x.tolist()
+
+
+@pytest.mark.slow  # ~20–40 s: the time-optimal mode twice on the detour scene
+def test_time_optimal_on_two_processes_is_time_optimal_on_one(detour) -> None:
+    """processes=2 (the relaxed problem's optimum computed in a worker beside the first
+    start's screening, screenings two at a time): the same outcomes, bit for bit, as one
+    process."""
+    one = time_optimal(detour, seed=1, n_starts=3, processes=1)
+    two = time_optimal(detour, seed=1, n_starts=3, processes=2)
+    assert [o.x.tolist() for o in one] == [o.x.tolist() for o in two]
+    assert [o.certified for o in one] == [o.certified for o in two]
 
 
 @pytest.mark.slow  # ~10–20 s: the global stage (relaxed problem, screenings)

@@ -35,6 +35,7 @@ from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, 
 from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
 from adept_traj.problem import TrajectoryProblem
+from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_integer
 
 __all__ = [
@@ -44,6 +45,7 @@ __all__ = [
     "fastest_of_basins",
     "global_stage",
     "global_starts",
+    "relaxed_optimum",
     "time_optimal",
 ]
 
@@ -101,9 +103,17 @@ def time_optimal(
     near = functools.partial(near_lower_bound, problem)
     starts = _feasible_first(problem, _starts(problem, seed, n_starts))
     options = {"rate_hz": rate_hz, "processes": processes, **options}
-    screened = screen_starts(problem, starts[:1], stop=near, **options)
+    ahead = _relaxed_ahead(problem, n_starts, rate_hz, processes)  # beside the first start
+    try:
+        screened = screen_starts(problem, starts[:1], stop=near, **options)
+        known = None if ahead is None or near(screened) else ahead.recv()
+    finally:
+        if ahead is not None:
+            ahead.close()  # not needed when the first start is near the bound
     if not near(screened):  # the relaxed problem's optimum before the other starts
-        stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes)
+        stage = global_stage(
+            problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes, known=known
+        )
         near = functools.partial(near_lower_bound, problem, floor=stage.floor)
         # the relaxed optimum always (a start near the floor may be a worse basin's; the
         # stop sees the relaxed outcomes only), then the others while none is near
@@ -164,7 +174,12 @@ def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -
 
 
 def global_stage(
-    problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0, processes: int | None = None
+    problem: Any,
+    *,
+    n_starts: int = 3,
+    rate_hz: float = 1000.0,
+    processes: int | None = None,
+    known: tuple[np.ndarray, float] | None = None,
 ) -> GlobalStage:
     """The global stage's starts and the floor [s] of
     :func:`~adept_traj.optimise.near_lower_bound`. Where obstacles move: the fastest
@@ -176,12 +191,29 @@ def global_stage(
     :data:`~adept_traj.optimise.GLOBAL_SEED` (a function of the problem alone). Without
     moving obstacles, or when the relaxed problem has no certified move, the floor is 0.
     The relaxed problem's refinements run ``processes`` at once (default: the problem's
-    ``workers``); the via points are drawn when first asked for.
+    ``workers``; ``known``: :func:`relaxed_optimum`'s answer, already computed); the via
+    points are drawn when first asked for.
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
     via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts)
-    relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
+    relaxed, floor = relaxed_optimum(problem, n_starts=n_starts, rate_hz=rate_hz,
+                                     processes=processes) if known is None else known  # fmt: skip
     timed = functools.partial(np.empty, (0, problem.n_var))
+    if problem.scene.moving:
+        guide = relaxed[:1] if len(relaxed) else None
+        timed = functools.partial(
+            timed_roadmap_starts, problem, GLOBAL_SEED, guides=guide, n_starts=n_starts
+        )
+    return GlobalStage(relaxed=relaxed, floor=floor, make_timed=timed, make_via=via)
+
+
+def relaxed_optimum(
+    problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0, processes: int | None = None
+) -> tuple[np.ndarray, float]:
+    """The relaxed part of :func:`global_stage`: (k, n_var) the fastest certified move of
+    the problem without its moving obstacles at :data:`STRETCHES` × its T, and that T [s]
+    (the floor); (0, n_var) and 0 without moving obstacles or without a certified move."""
+    relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
     if scene.moving:
         still = dataclasses.replace(scene, obstacles=scene.fixed)
         fixed = TrajectoryProblem(
@@ -195,11 +227,26 @@ def global_stage(
             stretched = np.repeat(best[None], len(STRETCHES), axis=0)
             stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
             relaxed, floor = stretched, float(best[0])
-        guide = relaxed[:1] if len(relaxed) else None
-        timed = functools.partial(
-            timed_roadmap_starts, problem, GLOBAL_SEED, guides=guide, n_starts=n_starts
-        )
-    return GlobalStage(relaxed=relaxed, floor=floor, make_timed=timed, make_via=via)
+    return relaxed, floor
+
+
+def _relaxed_ahead(
+    problem: Any, n_starts: int, rate_hz: float, processes: int | None
+) -> Worker | None:
+    """A worker computing :func:`relaxed_optimum` while the caller screens its first start
+    (``None`` without moving obstacles, with one process, or without ``fork``)."""
+    n_proc = problem.settings.workers if processes is None else processes
+    if not problem.scene.moving or n_proc <= 1 or not can_fork():
+        return None
+    return Worker(_send_relaxed, problem, n_starts, rate_hz, processes,
+                  note="raised in the relaxed problem's worker")  # fmt: skip
+
+
+def _send_relaxed(
+    channel: Channel, problem: Any, n_starts: int, rate_hz: float, processes: int | None
+) -> None:
+    """The worker of :func:`_relaxed_ahead`."""
+    channel.send(relaxed_optimum(problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes))
 
 
 def fastest_of_basins(
