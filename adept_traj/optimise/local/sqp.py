@@ -29,13 +29,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from adept_traj.errors import ConfigurationError, InputShapeError
 from adept_traj.validation import as_finite_array, as_integer, as_scalar
 
-__all__ = ["SqpResult", "sqp"]
+__all__ = ["Rows", "SqpResult", "sqp"]
+
+#: ``y ↦ (h (m,), J (m, n))``: the rows at a point and their Jacobian.
+Rows = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 #: Armijo factor of the line search, its most trials per iteration and the smallest
 #: step fraction it takes (Kraft's values).
@@ -77,7 +81,7 @@ def sqp(
     y0: np.ndarray,
     lower: np.ndarray,
     upper: np.ndarray,
-    rows: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+    rows: Rows,
     *,
     max_iter: int,
     tol: float = 1e-10,
@@ -127,21 +131,12 @@ def sqp(
     from threadpoolctl import threadpool_limits  # lazy, as the solver
 
     with threadpool_limits(limits=1, user_api="blas"):
-        return _sqp(cost, y0, lower, upper, rows, max_iter, tol)
+        return _sqp(c, y0, (lower, upper), rows, max_iter, tol)
 
 
-def _sqp(
-    cost: np.ndarray,
-    y0: np.ndarray,
-    lower: np.ndarray,
-    upper: np.ndarray,
-    rows: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
-    max_iter: int,
-    tol: float,
-) -> SqpResult:
-    c = np.asarray(cost, dtype=float)
-    lo = np.where(np.isfinite(lower), lower, -_INF)
-    hi = np.where(np.isfinite(upper), upper, _INF)
+def _sqp(c: np.ndarray, y0: Any, bounds: tuple, rows: Rows, max_iter: int, tol: float) -> SqpResult:
+    lo = np.where(np.isfinite(bounds[0]), bounds[0], -_INF)
+    hi = np.where(np.isfinite(bounds[1]), bounds[1], _INF)
     y = np.clip(np.asarray(y0, dtype=float), lo, hi)
     h, J = rows(y)
     n, m = len(y), len(h)
