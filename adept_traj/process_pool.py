@@ -164,19 +164,25 @@ def serve(channel: Channel, function: Callable[..., Any]) -> None:
         channel.send(function(*channel.recv()))
 
 
-def map_forked(function: Callable[[Any], Any], items: Sequence[Any], processes: int) -> list:
+def map_forked(
+    function: Callable[[Any], Any],
+    items: Sequence[Any],
+    processes: int,
+    note: str = "raised in map_forked",
+) -> list:
     """``[function(item) for item in items]`` on up to ``processes`` processes at once:
     the first item of every group of ``processes`` in this one, the others each in a
     :class:`Worker` forked for it (it inherits ``function``; its value comes back
-    pickled, its error is raised here). In order; the same values as the loop when
-    ``function`` is deterministic. One process (or no ``fork``): the loop itself."""
+    pickled, its error is raised here with ``note``). In order; the same values as the
+    loop when ``function`` is deterministic. One process (or no ``fork``): the loop
+    itself."""
     out: list = []
     step = max(1, int(processes)) if can_fork() else 1
     for i in range(0, len(items), step):
         forked: list[Worker] = []
         try:
             for item in items[i + 1 : i + step]:
-                forked.append(Worker(_call, function, item, note="raised in map_forked"))
+                forked.append(Worker(_call, function, item, note=note))
             out.append(function(items[i]))
             out.extend(worker.recv() for worker in forked)
         finally:  # Ctrl-C or an error included: the workers are stopped at once

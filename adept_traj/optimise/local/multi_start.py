@@ -110,18 +110,13 @@ def time_optimal(
     finally:
         if ahead is not None:
             ahead.close()  # not needed when the first start is near the bound
+    stage = None
     if not near(screened):  # the relaxed problem's optimum before the other starts
         stage = global_stage(
             problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes, known=known
         )
-        near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        # the relaxed optimum always (a start near the floor may be a worse basin's; the
-        # stop sees the relaxed outcomes only), then the others while none is near
-        screened += screen_starts(problem, stage.relaxed, stop=near, **options)
-        for more in (lambda: stage.timed, lambda: starts[1:], lambda: stage.via):
-            if not near(screened):  # the timed and via-point starts made only if needed
-                screened += screen_starts(problem, more(), stop=near, **options)
-    if near(screened):
+        screened += _screen_stage(problem, stage, screened, starts[1:], **options)
+    if near_lower_bound(problem, screened, floor=stage.floor if stage else 0.0):
         return screened
     return screened + refine_starts(problem, screened, rate_hz=rate_hz, processes=processes)
 
@@ -284,19 +279,34 @@ def fastest_of_basins(
         screened = screen_starts(
             problem, xs[np.sort(first)[:max_basins]], rate_hz=rate_hz, stop=near
         )
+    stage = None
     if not near(screened):
         stage = global_stage(problem, n_starts=max_basins, rate_hz=rate_hz)
-        near = functools.partial(near_lower_bound, problem, floor=stage.floor)
-        # the relaxed optimum always: a member within GLOBAL_GAP of the floor may be a
-        # worse basin's (measured on detour, NSGA-II seed 2: 1.1110 s, a local optimum,
-        # where the stretched relaxed optimum refines to 1.0991 s)
-        screened += screen_starts(problem, stage.relaxed, rate_hz=rate_hz, stop=near)
-        for more in (lambda: stage.timed, lambda: stage.via):
-            if not near(screened):  # the timed and via-point starts made only if needed
-                screened += screen_starts(problem, more(), rate_hz=rate_hz, stop=near)
-    if near(screened):
+        screened += _screen_stage(problem, stage, screened, xs[:0], rate_hz=rate_hz)
+    if near_lower_bound(problem, screened, floor=stage.floor if stage else 0.0):
         return screened  # no other basin can be faster by more than GLOBAL_GAP
     return screened + refine_starts(problem, screened, rate_hz=rate_hz)
+
+
+def _screen_stage(
+    problem: Any,
+    stage: GlobalStage,
+    screened: list[Refinement],
+    others: np.ndarray,
+    **options: Any,
+) -> list[Refinement]:
+    """The screenings of the global stage's starts after ``screened``: the relaxed
+    optimum always — a move within GLOBAL_GAP of the floor may be a worse basin's local
+    optimum (measured on detour, NSGA-II seed 2: 1.1110 s, where the stretched relaxed
+    optimum screens to 1.0991 s); its stop sees the relaxed outcomes only —, then, while
+    no move is near the bound or the floor, the timed trees', ``others`` (n, n_var) and
+    the via points, each made only when reached."""
+    near = functools.partial(near_lower_bound, problem, floor=stage.floor)
+    more = screen_starts(problem, stage.relaxed, stop=near, **options)
+    for starts in (lambda: stage.timed, lambda: others, lambda: stage.via):
+        if not near(screened + more):
+            more += screen_starts(problem, starts(), stop=near, **options)
+    return more
 
 
 def _feasible_first(problem: Any, starts: np.ndarray) -> np.ndarray:

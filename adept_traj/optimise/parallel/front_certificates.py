@@ -3,7 +3,7 @@
 :func:`~adept_traj.analysis.certify_members` certifies one batch of members after the
 other (its cost per member: docs/performance.md).
 :func:`certify_front_members` gives each of ``workers`` processes (this one and
-``workers - 1`` worker processes, :class:`~adept_traj.process_pool.Worker`) every
+``workers - 1`` worker processes, :func:`~adept_traj.process_pool.map_forked`) every
 ``workers``-th member (the trade-off order interleaved, so that each gets as many of the
 costly and the cheap ones), each process calls
 :func:`~adept_traj.analysis.certify_members` once on its share, and the summaries come
@@ -26,7 +26,7 @@ from adept_traj.certification.member_certificate import (
 )
 from adept_traj.errors import InputShapeError
 from adept_traj.problem import TrajectoryProblem
-from adept_traj.process_pool import Channel, Worker, can_fork
+from adept_traj.process_pool import can_fork, map_forked
 from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
 
 __all__ = ["certify_front_members", "checked_members"]
@@ -64,17 +64,13 @@ def certify_front_members(
         return certify_members(problem, xs, rows, rate_hz=rate)
     certifying_problem(problem)  # made once here: the workers inherit it
     shares = [rows[i::n_proc] for i in range(n_proc)]
-    forked: list[Worker] = []
-    try:
-        for share in shares[:-1]:
-            note = "raised while certifying front members in a worker process"
-            forked.append(Worker(_certify_share, problem, xs, share, rate, note=note))
-        last = certify_members(problem, xs, shares[-1], rate_hz=rate)  # this process' share
-        parts = [worker.recv() for worker in forked]
-        parts.append([last[k] for k in shares[-1]])
-    finally:  # Ctrl-C or an error included: the workers are stopped at once
-        for worker in forked:
-            worker.close()
+
+    def certify_share(share: list[int]) -> list[MemberCertificate | None]:
+        out = certify_members(problem, xs, share, rate_hz=rate)
+        return [out[k] for k in share]
+
+    note = "raised while certifying front members in a worker process"
+    parts = map_forked(certify_share, shares, n_proc, note=note)
     out: list[MemberCertificate | None] = [None] * len(xs)
     for share, part in zip(shares, parts):
         for k, certificate in zip(share, part):
@@ -107,11 +103,3 @@ def checked_members(
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
     return xs, rows, rate
-
-
-def _certify_share(
-    channel: Channel, problem: TrajectoryProblem, x: np.ndarray, rows: list[int], rate_hz: float
-) -> None:
-    """A worker: send the summaries of ``rows``, in that order."""
-    out = certify_members(problem, x, rows, rate_hz=rate_hz)
-    channel.send([out[k] for k in rows])
