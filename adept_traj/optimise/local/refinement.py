@@ -195,8 +195,7 @@ def refine_minimum_time(
     rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
     rounds = as_integer(max_rounds, "max_rounds", minimum=1, error=ConfigurationError)
     boxes = as_integer(max_boxes, "max_boxes", minimum=1, error=ConfigurationError)
-    import scipy.optimize  # noqa: F401  (lazy; loaded first: its BLAS is limited too)
-    from threadpoolctl import threadpool_limits  # lazy, as scipy.optimize
+    from threadpoolctl import threadpool_limits  # lazy: only the local solver needs it
 
     extra = np.empty(0) if extra_samples is None else np.asarray(extra_samples, dtype=float)
     if extra.ndim != 1 or np.any(~np.isfinite(extra)) or np.any((extra < 0) | (extra > 1)):
