@@ -34,7 +34,6 @@ from adept_traj.optimise.local.timed_starts import timed_roadmap_starts
 from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
 from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
-from adept_traj.problem import TrajectoryProblem
 from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_integer
 
@@ -211,9 +210,7 @@ def relaxed_optimum(
     relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
     if scene.moving:
         still = dataclasses.replace(scene, obstacles=scene.fixed)
-        fixed = TrajectoryProblem(
-            problem.robot, still, problem.start, problem.goal, problem.settings, workers=1
-        )
+        fixed = problem.replace(scene=still, workers=1)
         processes = problem.settings.workers if processes is None else processes
         outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
         done = [o for o in outcomes if o.certified]
