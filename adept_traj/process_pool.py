@@ -40,9 +40,8 @@ Every worker, the same way:
 - **May prepare at the lowest priority**: with ``prepare`` (e.g. heavy imports), the
   worker first runs it in a thread at nice :data:`LOWEST_PRIORITY` (Linux niceness is
   per thread: it runs while a core idles and never takes one from the caller), then says
-  it is ready (:meth:`Worker.ready`) and runs ``target`` at the caller's priority. A
-  caller that has to wait for the preparation raises it to its own priority first
-  (:meth:`Worker.hurry`), where the system allows.
+  it is ready (:meth:`Worker.ready`) and runs ``target`` at the caller's priority
+  (:meth:`Worker.hurry` raises a preparation the caller waits for).
 """
 
 from __future__ import annotations
@@ -89,8 +88,6 @@ _PROTOCOL = pickle.HIGHEST_PROTOCOL
 _HELD: set[Connection] = set()
 #: The workers this process forked and has not reaped: pid → Worker (weakly).
 _LIVE: weakref.WeakValueDictionary[int, Worker] = weakref.WeakValueDictionary()
-
-
 #: Workers killed by a finalizer but not reaped yet (they had not ended at once).
 _UNREAPED: set[int] = set()
 
@@ -119,8 +116,7 @@ if hasattr(os, "register_at_fork"):
 
 
 def can_fork() -> bool:
-    """Whether this platform forks processes (Linux, macOS): without it no worker starts
-    and the callers do their work themselves."""
+    """Whether this platform forks (Linux, macOS); else no worker starts: callers work."""
     return hasattr(os, "fork")
 
 
@@ -321,20 +317,16 @@ class Worker:
         return self._ready and self.pid is not None
 
     def hurry(self) -> bool:
-        """Raise every thread of a worker still preparing at nice :data:`LOWEST_PRIORITY`
-        to the calling thread's niceness, so that a caller about to wait for it does not
-        wait behind every other process of the machine; return whether it was raised
-        (``False`` where the system refuses: lowering a niceness needs ``CAP_SYS_NICE``
-        or a high enough ``RLIMIT_NICE``; not Linux; the worker stopped)."""
+        """Raise the threads of a worker still preparing to the calling thread's niceness
+        (a caller about to wait for it); whether it was done (not where the system refuses:
+        that needs ``CAP_SYS_NICE`` or ``RLIMIT_NICE``; nor for a stopped worker)."""
         if self.pid is None or os.getpid() != self._creator:
             return False
-        mine = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+        who, mine = os.PRIO_PROCESS, os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
         try:
-            threads = [int(t) for t in os.listdir(f"/proc/{self.pid}/task")]
-            for tid in threads:
+            for tid in map(int, os.listdir(f"/proc/{self.pid}/task")):
                 with contextlib.suppress(ProcessLookupError):  # that thread has ended
-                    if os.getpriority(os.PRIO_PROCESS, tid) > mine:
-                        os.setpriority(os.PRIO_PROCESS, tid, mine)
+                    os.setpriority(who, tid, min(mine, os.getpriority(who, tid)))
         except (PermissionError, FileNotFoundError):  # not allowed; no /proc; ended
             return False
         return True

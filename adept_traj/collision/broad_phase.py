@@ -17,7 +17,9 @@ Levels, each on the rows the previous one left within ``influence``:
    range bounds the distance to within about 0.6 mm (when the configurations ``q`` are
    given); level 1 is then skipped for the pair, except at samples outside the table's
    grid. (Not for joints with an infinite or very long range, nor for sphere shapes, nor
-   for obstacles farther than ``influence`` + :data:`TABLE_REACH` from the solid's sweep.)
+   for obstacles farther than ``influence`` +
+   :data:`~adept_traj.collision.joint_tables.TABLE_REACH` from the solid's sweep:
+   :mod:`adept_traj.collision.joint_tables`.)
 1. **Enclosing ball** of each solid (centre ``c``, radius ``R``), from the joint poses
    directly (no solid pose is formed for far samples):
 
@@ -59,6 +61,7 @@ import numpy as np
 
 from adept_traj.collision.cloud_bounds import cloud_bound, cloud_samples
 from adept_traj.collision.distance_table import DistanceTable, table_bounds
+from adept_traj.collision.joint_tables import joint_tables
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.point_distance import (
     obstacle_signed_distance,
@@ -73,7 +76,6 @@ from adept_traj.collision.primitives import (
     half_extent,
     shape_of,
 )
-from adept_traj.collision.pruning import sweep_clearance
 from adept_traj.errors import InvalidInputError
 from adept_traj.robot.kinematics import compose, stack_times
 from adept_traj.robot.robot import Robot, solid_frames
@@ -81,15 +83,6 @@ from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Sphere
 
 __all__ = ["Bounds", "BroadPhase"]
-
-#: Grid step [rad | m] of the single-joint distance tables (level 0).
-TABLE_STEP = 1e-3
-#: A solid that stays farther than ``influence`` + this [m] from an obstacle over a full turn
-#: of its joint gets no table against it: its level-1 bound exceeds that distance anyway
-#: (the paper's cube 2, 0.37 m from the inner arm's sweep, keeps its tables).
-TABLE_REACH = 0.4
-#: Joints with a longer range (e.g. unlimited) get no table.
-_TABLE_MAX_POINTS = 20_000
 
 #: Subtracted from the separating-axis bound, which can equal the exact distance: keeps it
 #: a lower bound under rounding (coal's own results are exact to about 1e-15 m here).
@@ -125,9 +118,9 @@ class BroadPhase:
         Distance [m] above which a bound needs no refinement (≥ 0).
     tables:
         Single-joint distance tables already made for this robot and these obstacles, by
-        (solid, obstacle) index (e.g. :meth:`CollisionChecker.tables_for
-        <adept_traj.collision.CollisionChecker.tables_for>` of another checker): each is
-        taken instead of computed where this broad phase tabulates the pair over the same
+        (solid, obstacle) index (e.g. another checker's,
+        :func:`~adept_traj.collision.joint_tables.kept_tables`): each is taken instead of
+        computed where this broad phase tabulates the pair over the same
         joint (their values depend on the solid, the obstacle and the base pose alone).
     """
 
@@ -188,21 +181,20 @@ class BroadPhase:
                 self.local[k], pose_o, int(k), int(o), objects[int(k)].geometry
             )
         #: Single-joint distance tables by (solid, obstacle) (level 0).
-        self.tables: dict[tuple[int, int], DistanceTable] = {}
-        known = {} if tables is None else tables
-        for k in range(self.n_solids):
-            for o in range(self.n_obstacles):
-                j = self._table_joint(robot, k, o)
-                if j is not None and self._sweep_reaches(robot, scene, k, o):
-                    given = known.get((k, o))
-                    if given is None or given.joint != j:
-                        given = self._table(robot, scene, k, o, j, objects[k].geometry)
-                    self.tables[k, o] = given
+        self.tables: dict[tuple[int, int], DistanceTable] = joint_tables(
+            self, robot, scene, [g.geometry for g in objects], tables or {}
+        )
 
     @property
     def ball_radius(self) -> np.ndarray:
         """(n_solids,) radii [m] of the solids' enclosing balls."""
         return self._ball_radius
+
+    @property
+    def ball_in_joint(self) -> np.ndarray:
+        """(n_solids, 3) centres [m] of the solids' enclosing balls in their parent joint's
+        frame."""
+        return self._ball_in_joint
 
     def ball_centres(self, frames: np.ndarray) -> np.ndarray:
         """(3, n_solids, N) centres [m] of the solids' enclosing balls in the base frame,
@@ -257,85 +249,6 @@ class BroadPhase:
             top = compose(frames[self.parents[s]][..., rows[sel]], self.local[s])
             pose[sel, :3] = top.transpose(2, 0, 1)
         return pose
-
-    def _table_joint(self, robot: Robot, k: int, o: int) -> int | None:
-        """The joint (index in q) to tabulate solid ``k`` and obstacle ``o`` over, or None:
-        a table needs a primitive solid moved by one joint hanging from the base (with a
-        finite range), a fixed obstacle, and no other exact level for the pair."""
-        p = int(self.parents[k])
-        if p == 0 or robot.kinematics.parents[p - 1] != 0:
-            return None
-        j = int(np.flatnonzero(robot.kinematics.support[p])[0])  # the only joint moving p
-        span = robot.limits.upper[j] - robot.limits.lower[j]
-        kinds = (self.solid_kind[k], self.obstacle_kind[o])
-        tabulable = (
-            bool(np.isfinite(span))
-            and span / TABLE_STEP <= _TABLE_MAX_POINTS
-            and not self.moving[o]
-            and not self.closed_form[k, o]
-            and None not in kinds
-            and all(kind[0] != "sphere" for kind in kinds)  # coal's sphere depths: see _refine
-        )
-        return j if tabulable else None
-
-    def _sweep_reaches(self, robot: Robot, scene: Scene, k: int, o: int) -> bool:
-        """Whether solid ``k``, turned through a full revolution of its parent joint (from
-        :meth:`_table_joint`), may come within ``influence`` + :data:`TABLE_REACH` of
-        fixed obstacle ``o``
-        (:func:`~adept_traj.collision.pruning.sweep_clearance`); a prismatic joint: yes."""
-        p, kin = int(self.parents[k]), robot.kinematics
-        if not kin.revolute[p - 1]:
-            return True
-        frames = kin.joint_frames(np.zeros((1, robot.nq)))
-        origin, rot = frames[p, :, 3, 0], frames[p, :, :3, 0]
-        centre = rot @ self._ball_in_joint[k] + origin
-        obstacle = scene.obstacles[o]
-        where = (scene.base_from_world @ obstacle.pose(0.0))[:3, 3]
-        clearance = sweep_clearance(
-            origin, rot @ kin.axes[p - 1], centre, self._ball_radius[k],
-            where, obstacle.shape.bounding_radius,
-        )  # fmt: skip
-        return clearance <= self.influence + TABLE_REACH
-
-    def _table(
-        self,
-        robot: Robot,
-        scene: Scene,
-        k: int,
-        o: int,
-        j: int,
-        geometry: coal.CollisionGeometry,
-    ) -> DistanceTable:
-        """Exact distances of solid ``k`` and obstacle ``o`` over the range of joint ``j``
-        (from :meth:`_table_joint`; its limits, one step beyond each end)."""
-        p = int(self.parents[k])
-        kin = robot.kinematics
-        lo = robot.limits.lower[j] - TABLE_STEP
-        count = int(np.ceil((robot.limits.upper[j] - robot.limits.lower[j]) / TABLE_STEP)) + 3
-        q = np.zeros((count, robot.nq))
-        q[:, j] = lo + TABLE_STEP * np.arange(count)
-        frames = kin.joint_frames(q)
-        poses = self.solid_poses(frames, np.arange(count), k)
-        pose_o = scene.base_from_world @ scene.obstacles[o].pose(0.0)
-        functor = coal.ComputeDistance(geometry, self.obstacle_geometry[o])
-        request, result = distance_request(), coal.DistanceResult()
-        tf_o = coal.Transform3s(pose_o[:3, :3], pose_o[:3, 3])
-        tf_s = coal.Transform3s()
-        values = np.empty(count)
-        for i, ps in enumerate(poses):
-            tf_s.setRotation(ps[:3, :3])
-            tf_s.setTranslation(ps[:3, 3])
-            result.clear()
-            values[i] = functor(tf_s, tf_o, request, result)
-        if kin.revolute[p - 1]:
-            origin, rot = frames[p, :, 3, 0], frames[p, :, :3, 0]
-            axis = rot @ kin.axes[p - 1]
-            centre = rot @ self._ball_in_joint[k] + origin
-            rho = np.linalg.norm(np.cross(centre - origin, axis))
-            lipschitz = float(rho + self._ball_radius[k])
-        else:
-            lipschitz = 1.0
-        return DistanceTable(j, float(lo), TABLE_STEP, values, lipschitz)
 
     # ------------------------------------------------------------------ bounds
     def bounds(

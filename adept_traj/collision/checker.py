@@ -106,9 +106,8 @@ class CollisionChecker:
         Scene time t0 [s] of the motion's time 0 (default 0): the obstacles are placed at
         scene time :math:`t_0 + t` for the times ``t`` the methods are given (finite, ≥ 0).
     tables:
-        The broad phase's single-joint distance tables already made for this robot and
-        scene (:meth:`tables_for` of another checker), taken instead of computed
-        (:class:`~adept_traj.collision.broad_phase.BroadPhase`).
+        Single-joint distance tables already made for this robot and scene, taken instead
+        of computed (:func:`~adept_traj.collision.joint_tables.kept_tables`).
     """
 
     def __init__(
@@ -161,25 +160,6 @@ class CollisionChecker:
         ]
         self._law_of = shared_motion_laws(scene)
         self._views: dict[tuple[int, ...], CollisionChecker] = {}  # by obstacles kept
-
-    def tables_for(self, robot: Robot, scene: Scene) -> dict[tuple[int, int], DistanceTable]:
-        """This checker's single-joint distance tables that hold for ``robot`` and
-        ``scene``, by (solid, obstacle index in ``scene``), to give a new checker
-        (``tables=``): those of the obstacles of ``scene`` that are this checker's
-        obstacles (the same objects) with the same robot base pose, for this checker's
-        robot (the same object); ``{}`` otherwise."""
-        same_base = np.array_equal(scene.base_from_world, self._to_base)
-        if robot is not self.robot or not same_base:
-            return {}
-        mine = self.scene.obstacles
-        index = {o: next((i for i, m in enumerate(mine) if m is ob), -1)
-                 for o, ob in enumerate(scene.obstacles)}  # fmt: skip
-        return {
-            (k, o): table
-            for o, old in index.items()
-            for (k, kept), table in self.broad_phase.tables.items()
-            if kept == old
-        }
 
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:

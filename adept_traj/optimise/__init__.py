@@ -16,6 +16,8 @@ from adept_traj.optimise.local.multi_start import (
     fastest_of_basins,
     global_stage,
     global_starts,
+    initial_starts,
+    relaxed_optimum,
     time_optimal,
 )
 from adept_traj.optimise.local.polish_modes import (
@@ -138,6 +140,7 @@ from adept_traj.optimise.search.loop import (
 )
 from adept_traj.optimise.search.sampling import (
     RampSampling,
+    SeededInitialization,
     check_population_memory,
     population_bytes,
 )
@@ -181,6 +184,7 @@ __all__ = [
     "RankAndCrowdingSurvival",
     "Refinement",
     "RunState",
+    "SeededInitialization",
     "TimedPaths",
     "TournamentArrays",
     "ViaPointSampling",
@@ -201,6 +205,7 @@ __all__ = [
     "global_stage",
     "global_starts",
     "has_checkpoint",
+    "initial_starts",
     "kinematic_time",
     "load_checkpoint",
     "make_algorithm",
@@ -221,6 +226,7 @@ __all__ = [
     "ranked_optimum",
     "refine_minimum_time",
     "refine_starts",
+    "relaxed_optimum",
     "restore_algorithm",
     "save_checkpoint",
     "sbx_children",

@@ -60,6 +60,7 @@ from adept_traj.analysis.weighted_sum import WeightedSum
 from adept_traj.certification.certificate import Certificate, certify
 from adept_traj.certification.member_certificate import MemberCertificate
 from adept_traj.errors import ConfigurationError
+from adept_traj.optimise.local.multi_start import initial_starts
 from adept_traj.optimise.local.polish_modes import TIME_OPTIMAL, polish_mode, time_optimal_run
 from adept_traj.optimise.local.weighted_move import weighted_run
 from adept_traj.optimise.parallel.early_certificates import feasible_front, start_early_certificates
@@ -190,8 +191,7 @@ def _certified_choice(
     """(certificate, front index) of the reported solution: the first certified member in
     the trade-off ``order`` (n,), or the best trade-off ``order[0]`` with its failing
     certificate when none is; the certificate computes every distance exactly."""
-    passed = [int(k) for k in order if front.feasible[k]]
-    index = passed[0] if passed else int(order[0])
+    index = next((int(k) for k in order if front.feasible[k]), int(order[0]))
     return certify(problem, front.x[index], rate_hz=rate_hz), index
 
 
@@ -297,6 +297,9 @@ def plan(
     else:
         alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
         check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
+        if not {"sampling", "starts"} & params.keys():  # the global stage's starts (#24),
+            params = {**params, "starts": initial_starts(problem, rate_hz=rate_hz)}  # resumed too
+            alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
         state = optimise(
             problem,
             alg,

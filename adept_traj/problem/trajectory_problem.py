@@ -51,6 +51,7 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from adept_traj.collision import CollisionChecker, self_collision_check
+from adept_traj.collision.joint_tables import kept_tables
 from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelError
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, concatenate_evaluations, timed_evaluation
@@ -132,7 +133,7 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         tables: Any,
     ) -> None:
         """The constructor's work; ``tables``: the checker's distance tables already made
-        (:meth:`~adept_traj.collision.CollisionChecker.tables_for`, from :meth:`replace`),
+        (:func:`~adept_traj.collision.joint_tables.kept_tables`, from :meth:`replace`),
         or ``None``."""
         settings = settings or ProblemSettings()
         if overrides:
@@ -223,7 +224,7 @@ class TrajectoryProblem(FrozenAttributes, Problem):
                 f"replace() takes {', '.join(_PARTS)} or ProblemSettings fields; got {unknown}"
             )
         new = TrajectoryProblem.__new__(TrajectoryProblem)
-        tables = self.checker.tables_for(parts["robot"], parts["scene"])
+        tables = kept_tables(self.checker, parts["robot"], parts["scene"])
         new._build(*(parts[k] for k in _PARTS), changes, tables)
         return new
 
@@ -249,6 +250,12 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         except KeyError:
             value = self._derived[key] = make(self)
             return value
+
+    def derived_made(self, prefix: str) -> dict[str, Any]:
+        """The data :meth:`derived` has made so far whose key starts with ``prefix``, by
+        key (e.g. to hand it to a process forked before it was made, which keeps it with
+        ``derived(key, lambda _: value)``)."""
+        return {k: v for k, v in self._derived.items() if k.startswith(prefix)}
 
     # ------------------------------------------------------------------ public
     @property

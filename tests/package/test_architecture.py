@@ -407,6 +407,10 @@ LONG_MODULES = {
     "problem/bspline.py": "BSplineTrajectory's public methods, half of it docstrings and math",
     "schema.py": "the one reader of three file formats (Node and its typed accessors)",
     "collision/broad_phase.py": "the conservative bounds of every shape pair, one algorithm",
+    "collision/checker.py": "CollisionChecker, the one face of the distances over every "
+    "obstacle kind (broad phase, views, clouds, coal), half of it docstrings",
+    "optimise/planner.py": "plan(): the one pipeline from the search to the certified result "
+    "(its checkpoint fingerprint, history and front), half of it docstrings",
     "scene/scene_file.py": "the reader and writer of every scene-file table (its mesh, cloud, "
     "motion and robot entries are in machine_entries)",
     "scene/motion_laws.py": "the MotionLaw contract (pose, speed bound, jumps) and the paper's "

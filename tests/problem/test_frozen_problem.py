@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from adept_traj.collision.checker import shared_motion_laws
+from adept_traj.collision.joint_tables import kept_tables
 from adept_traj.errors import AdeptTrajError, ConfigurationError, FrozenObjectError
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
 from adept_traj.robot import Robot
@@ -199,12 +200,12 @@ def test_a_copy_takes_over_the_distance_tables_of_the_obstacles_it_keeps(robot):
         np.testing.assert_array_equal(a.objectives, b.objectives)
     # another robot object, or a moved base: nothing taken over
     other = Robot.adept_one_xl()
-    assert problem.checker.tables_for(other, detour) == {}
+    assert kept_tables(problem.checker, other, detour) == {}
     base = np.array(detour.robot_base, dtype=float)
     base[0, 3] += 0.01
     moved = dataclasses.replace(detour, robot_base=base)
-    assert problem.checker.tables_for(robot, moved) == {}
+    assert kept_tables(problem.checker, robot, moved) == {}
     assert (
-        problem.checker.tables_for(robot, detour).keys()
+        kept_tables(problem.checker, robot, detour).keys()
         == problem.checker.broad_phase.tables.keys()
     )

@@ -31,7 +31,12 @@ from adept_traj.optimise.local.refinement import (
     screen_starts,
 )
 from adept_traj.optimise.local.timed_starts import timed_roadmap_starts
-from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
+from adept_traj.optimise.local.via_points import (
+    GLOBAL_GAP,
+    GLOBAL_SEED,
+    near_lower_bound,
+    via_point_starts,
+)
 from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
 from adept_traj.process_pool import Channel, Worker, can_fork
@@ -39,12 +44,16 @@ from adept_traj.validation import as_integer
 
 __all__ = [
     "MAX_BASINS",
+    "RELAXED_KEY",
     "STRETCHES",
     "GlobalStage",
     "fastest_of_basins",
     "global_stage",
     "global_starts",
+    "initial_starts",
+    "made_relaxed_optima",
     "relaxed_optimum",
+    "relaxed_problem",
     "time_optimal",
 ]
 
@@ -58,6 +67,10 @@ MAX_BASINS = 3
 
 #: Factors of the fixed-obstacle optimum's T at which :func:`global_starts` offers it.
 STRETCHES = (1.0, 1.1, 1.25)
+
+#: The key under which a problem keeps its relaxed problem and optima
+#: (:meth:`~adept_traj.problem.TrajectoryProblem.derived`).
+RELAXED_KEY = "optimise.local.relaxed"
 
 
 def time_optimal(
@@ -209,11 +222,23 @@ def relaxed_optimum(
 ) -> tuple[np.ndarray, float]:
     """The relaxed part of :func:`global_stage`: (k, n_var) the fastest certified move of
     the problem without its moving obstacles at :data:`STRETCHES` × its T, and that T [s]
-    (the floor); (0, n_var) and 0 without moving obstacles or without a certified move."""
+    (the floor); (0, n_var) and 0 without moving obstacles or without a certified move.
+    Made once per problem, ``n_starts`` and ``rate_hz`` and kept on the problem
+    (:meth:`~adept_traj.problem.TrajectoryProblem.derived`; ``processes`` changes only
+    how fast: the same moves)."""
+    key = f"{RELAXED_KEY}:{n_starts}:{float(rate_hz)!r}"
+    make = functools.partial(_relaxed_optimum, n_starts=n_starts, rate_hz=rate_hz,
+                             processes=processes)  # fmt: skip
+    return problem.derived(key, make)
+
+
+def _relaxed_optimum(
+    problem: Any, *, n_starts: int, rate_hz: float, processes: int | None
+) -> tuple[np.ndarray, float]:
+    """:func:`relaxed_optimum`, made."""
     relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
     if scene.moving:
-        still = dataclasses.replace(scene, obstacles=scene.fixed)
-        fixed = problem.replace(scene=still, workers=1)
+        fixed = relaxed_problem(problem)
         processes = problem.settings.workers if processes is None else processes
         outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
         done = [o for o in outcomes if o.certified]
@@ -223,6 +248,43 @@ def relaxed_optimum(
             stretched[:, 0] = np.minimum(best[0] * np.asarray(STRETCHES), problem.xu[0])
             relaxed, floor = stretched, float(best[0])
     return relaxed, floor
+
+
+def made_relaxed_optima(problem: Any) -> dict[str, tuple[np.ndarray, float]]:
+    """The relaxed optima :func:`relaxed_optimum` has made and kept on ``problem``, by
+    their key, to hand to a process forked before they were made (it keeps them with
+    :meth:`~adept_traj.problem.TrajectoryProblem.derived`)."""
+    return problem.derived_made(f"{RELAXED_KEY}:")
+
+
+def relaxed_problem(problem: Any) -> Any:
+    """The problem without its moving obstacles, evaluating in one process (made once and
+    kept on the problem; its feasible set contains the problem's)."""
+    scene = problem.scene
+    still = dataclasses.replace(scene, obstacles=scene.fixed)
+    return problem.derived(f"{RELAXED_KEY}.problem", lambda p: p.replace(scene=still, workers=1))
+
+
+def initial_starts(
+    problem: Any, *, rate_hz: float = 1000.0, processes: int | None = None
+) -> np.ndarray:
+    """(k, n_var) the global stage's starts for the evolutionary search's initial
+    population: where obstacles move, the relaxed problem's fastest certified move at
+    :data:`STRETCHES` × its T (:func:`relaxed_optimum` with :data:`MAX_BASINS` starts,
+    as the polish asks for it: made once for both) when its T lies more than
+    :data:`~adept_traj.optimise.GLOBAL_GAP` above the kinematic lower bound; (0, n_var)
+    otherwise. A relaxed optimum within that gap of the bound takes the way of the
+    straight move, which the sampling's straight move and ramps already cover (measured on
+    the paper scene: every seed finds that basin), and the search is left as it was."""
+    none = np.empty((0, problem.n_var))
+    if not problem.scene.moving:
+        return none
+    relaxed, floor = relaxed_optimum(
+        problem, n_starts=MAX_BASINS, rate_hz=rate_hz, processes=processes
+    )
+    if floor <= problem.lower_bound.T_min * (1.0 + GLOBAL_GAP):
+        return none
+    return relaxed
 
 
 def _relaxed_ahead(

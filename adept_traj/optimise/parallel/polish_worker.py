@@ -39,6 +39,7 @@ from adept_traj.certification import (
     same_parts,
 )
 from adept_traj.errors import ConfigurationError, WorkerDiedError
+from adept_traj.optimise.local.multi_start import made_relaxed_optima
 from adept_traj.optimise.local.polish_modes import polish_mode, polish_run_with_certificates
 from adept_traj.optimise.parallel.early_certificates import EarlyCertificates, feasible_front
 from adept_traj.optimise.search.loop import RunState
@@ -225,7 +226,9 @@ class Polisher:
             return False
         arrays = dataclasses.replace(state, history=[], fronts=[])  # what the polish reads
         try:
-            self._worker.send(arrays, rate, mode, weights)
+            # what the caller made since the fork and the polish reuses: the relaxed optima
+            made = made_relaxed_optima(self.problem)
+            self._worker.send(arrays, rate, mode, weights, made)
         except WorkerDiedError:  # died meanwhile: the caller polishes
             self.cancel()
             return False
@@ -269,5 +272,7 @@ def _prepare(problem: TrajectoryProblem) -> None:
 
 def _helper(channel: Channel, problem: TrajectoryProblem) -> None:
     """The helper process, once prepared: wait for the order, polish, send the result."""
-    state, rate_hz, mode, weights = channel.recv()
+    state, rate_hz, mode, weights, made = channel.recv()
+    for key, value in made.items():  # kept on the helper's copy of the problem, as made
+        problem.derived(key, lambda _problem, value=value: value)
     channel.send(polish_run_with_certificates(problem, state, rate_hz, mode, weights))

@@ -57,7 +57,7 @@ from adept_traj.optimise.operators.repair import KinematicTimeRepair
 from adept_traj.optimise.operators.survival import RankAndCrowdingSurvival
 from adept_traj.optimise.operators.tournament import binary_tournament
 from adept_traj.optimise.search.fast_end_search import FastEndSearch
-from adept_traj.optimise.search.sampling import RampSampling
+from adept_traj.optimise.search.sampling import RampSampling, SeededInitialization
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
@@ -101,6 +101,7 @@ def make_algorithm(
     sampling: Any = None,
     repair: bool = True,
     fast_end: float = 0.3,
+    starts: Any = None,
     **params: Any,
 ) -> tuple[Algorithm, AlgorithmSettings]:
     """A configured pymoo algorithm and its settings.
@@ -126,6 +127,11 @@ def make_algorithm(
         :class:`~adept_traj.optimise.FastEndSearch` (local perturbations of the fastest
         feasible members and fresh ramps at their kinematic minimum time; default 0.3,
         ``0`` runs the algorithm's own mating only). The number of evaluations is unchanged.
+    starts:
+        (k, n_var) moves put, as given, into the initial population after the sampling's
+        first member (:class:`~adept_traj.optimise.SeededInitialization`; e.g. the global
+        stage's, :func:`~adept_traj.optimise.initial_starts`); their number is recorded as
+        the setting ``initial_starts`` (default: none, and no such setting).
     params:
         Operator parameters overriding the paper's: NSGA-II ``crossover_prob``,
         ``crossover_eta``, ``mutation_prob_var``, ``mutation_eta``; MODE ``CR``, ``F``.
@@ -160,6 +166,9 @@ def make_algorithm(
     if fast_end > 1.0:
         raise ConfigurationError(f"fast_end must be a number in [0, 1]; got {fast_end!r}")
     algorithm = _build(key, pop, sampling, settings, fix)
+    if starts is not None and len(starts):
+        algorithm.initialization = SeededInitialization(algorithm.initialization, starts)
+        settings["initial_starts"] = len(starts)
     if key == "nsga2":  # the same offspring, its rounds on arrays
         algorithm.mating = ArrayMating.of(algorithm.mating)
     if fast_end > 0 and hasattr(algorithm, "mating"):

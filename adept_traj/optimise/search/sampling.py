@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pymoo.core.initialization import Initialization
 from pymoo.core.sampling import Sampling
 
 from adept_traj.errors import ConfigurationError
@@ -37,7 +38,12 @@ from adept_traj.memory import check_memory
 from adept_traj.optimise.operators.repair import kinematic_time
 from adept_traj.validation import as_integer, as_scalar
 
-__all__ = ["RampSampling", "check_population_memory", "population_bytes"]
+__all__ = [
+    "RampSampling",
+    "SeededInitialization",
+    "check_population_memory",
+    "population_bytes",
+]
 
 
 _GRID = np.linspace(0.0, 1.0, 2001)
@@ -232,3 +238,43 @@ class RampSampling(Sampling):
         if fast_times:
             x[fast, 0] = kinematic_time(problem, x[fast]) * above
         return np.clip(x, problem.xl, problem.xu)
+
+
+class SeededInitialization(Initialization):
+    """pymoo's initialization (sampling, repair, duplicate elimination), then given moves
+    put, as they are, in place of the population's rows 1 … k (row 0, the sampling's
+    straight move, kept): the global stage's starts
+    (:func:`~adept_traj.optimise.initial_starts`). They are not repaired: the
+    kinematic-time repair would snap some of them to the kinematic minimum T of their
+    path (a random share of every candidate), where the relaxed problem's optimum passes
+    the moving obstacles at other phases.
+
+    Parameters
+    ----------
+    initialization:
+        The algorithm's own :class:`pymoo.core.initialization.Initialization`.
+    starts:
+        (k, n_var) moves inside the decision bounds, each at or above its kinematic
+        minimum T; at most ``n_samples − 1`` are used.
+    """
+
+    def __init__(self, initialization: Initialization, starts: Any) -> None:
+        super().__init__(
+            initialization.sampling,
+            repair=initialization.repair,
+            eliminate_duplicates=initialization.eliminate_duplicates,
+        )
+        self.starts = np.array(starts, dtype=float, ndmin=2)
+
+    def do(self, problem: Any, n_samples: int, random_state: Any = None, **kwargs: Any):
+        pop = super().do(problem, n_samples, random_state=random_state, **kwargs)
+        if self.starts.shape[1] != problem.n_var:
+            raise ConfigurationError(
+                f"starts must have n_var = {problem.n_var} columns; got {self.starts.shape}"
+            )
+        m = min(len(self.starts), len(pop) - 1)
+        if m > 0:
+            x = pop.get("X")
+            x[1 : 1 + m] = np.clip(self.starts[:m], problem.xl, problem.xu)
+            pop.set("X", x)
+        return pop
