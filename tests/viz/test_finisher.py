@@ -13,6 +13,7 @@ import argparse
 import multiprocessing
 import os
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -207,13 +208,11 @@ def test_a_helper_not_ready_when_the_run_ends_is_stopped_and_the_caller_writes(
     monkeypatch.setattr(finisher, "_preload", _marking_preload(marker, seconds=60.0))
     monkeypatch.setattr(finisher, "HURRIED_TIMEOUT", 0.2)  # hurried, still not done
 
-    def run_ends_while_importing(*_args, **_kwargs):
-        while not marker.is_file() or not marker.read_text():
-            time.sleep(0.01)
-        return stored
-
     out = tmp_path / "run"
-    assert _plan(monkeypatch, stored, out, "--no-html", plan=run_ends_while_importing) == 1
+    assert (
+        _plan(monkeypatch, stored, out, "--no-html", plan=_ends_while_importing(marker, stored))
+        == 1
+    )
     helper = int(marker.read_text().split()[0])
     assert _gone(helper, within=0.0)
     writers = {int(p.read_text().split()[1]) for p in (out / "figures").iterdir()}
@@ -235,17 +234,13 @@ def test_a_helper_still_importing_when_the_run_ends_is_hurried_and_used(
 
     monkeypatch.setattr(finisher, "_preload", imports_until_hurried)
 
-    def run_ends_while_importing(*_args, **_kwargs):
-        while not marker.is_file() or not marker.read_text():
-            time.sleep(0.01)
-        return stored
-
     out = tmp_path / "run"
-    assert _plan(monkeypatch, stored, out, "--no-html", plan=run_ends_while_importing) == 1
+    assert (
+        _plan(monkeypatch, stored, out, "--no-html", plan=_ends_while_importing(marker, stored))
+        == 1
+    )
     helper = int(marker.read_text().split()[0])
     writers = {int(p.read_text().split()[1]) for p in (out / "figures").iterdir()}
-    import resource
-
     allowed = os.geteuid() == 0 or resource.getrlimit(resource.RLIMIT_NICE)[0] >= 20 - _nice()
     if allowed:  # hurried: the helper (and its fork) drew, not the caller
         assert helper in writers
@@ -254,6 +249,17 @@ def test_a_helper_still_importing_when_the_run_ends_is_hurried_and_used(
         assert helper not in writers
     assert _gone(helper, within=10.0)
     assert not (out / "run.json").exists()
+
+
+def _ends_while_importing(marker: Path, result: PlanningResult):
+    """An optimiser that returns ``result`` once the helper's imports have begun."""
+
+    def run(*_args, **_kwargs):
+        while not marker.is_file() or not marker.read_text():
+            time.sleep(0.01)
+        return result
+
+    return run
 
 
 def _caller(marker: Path, ready: bool) -> None:
