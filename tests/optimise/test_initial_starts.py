@@ -19,10 +19,12 @@ from adept_traj.optimise import (
     GLOBAL_GAP,
     MAX_BASINS,
     KinematicTimeRepair,
+    PlanningInterrupted,
     initial_starts,
     kinematic_time,
     make_algorithm,
     optimise,
+    plan,
     relaxed_optimum,
 )
 from adept_traj.optimise.local import multi_start
@@ -132,3 +134,25 @@ def test_detour_seeds_the_relaxed_optimum_made_once_and_handed_over(detour, monk
 
 def _never(*_args, **_kwargs):
     raise AssertionError("the relaxed optimum was made again")
+
+
+@pytest.mark.slow  # ~10–20 s: the relaxed optimum once, then three short runs on detour
+def test_a_seeded_run_interrupted_and_resumed_is_the_uninterrupted_one(detour, tmp_path) -> None:
+    """plan() seeds the initial population on detour; killed after generation 2 (its
+    checkpoint) and resumed, it gives the front of the run never interrupted, the same
+    settings (the resumed run computes the same starts: its fingerprint matches)."""
+    budget = {"pop_size": 12, "n_gen": 4, "polish": "off", "max_certify": 2}
+    full = plan(detour, "nsga2", seed=4, **budget)
+    assert full.algorithm_settings["initial_starts"] == 3
+
+    def interrupt(info) -> None:
+        if info.generation == 2:
+            raise KeyboardInterrupt
+
+    folder = tmp_path / "checkpoint"
+    with pytest.raises(PlanningInterrupted):
+        plan(detour, "nsga2", seed=4, checkpoint=folder, progress=interrupt, **budget)
+    resumed = plan(detour, "nsga2", seed=4, checkpoint=folder, resume=True, **budget)
+    np.testing.assert_array_equal(resumed.front.x, full.front.x)
+    np.testing.assert_array_equal(resumed.front.objectives, full.front.objectives)
+    assert resumed.algorithm_settings == full.algorithm_settings
