@@ -61,7 +61,8 @@ import numpy as np
 from adept_traj.certification.continuous import (
     CONTINUOUS,
     DEFAULT_MAX_DEPTH,
-    continuous_distance_with_acceleration,
+    SampledMove,
+    continuous_distance,
 )
 from adept_traj.certification.dense_trajectory import (
     DenseStates,
@@ -78,7 +79,7 @@ from adept_traj.certification.limit_check import (
 from adept_traj.certification.self_distance import (
     SelfDistance,
     normalise_distance_fields,
-    self_distance_with_acceleration,
+    self_distance,
 )
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
@@ -355,25 +356,21 @@ def certify_states(
     Certificate
         As :func:`certify`.
     """
-    T = float(xa[0])
     smp, tau, pairs = states
     n = len(smp.t)
     t, q, qd, qdd, qddd = smp.t, smp.q, smp.qd, smp.qdd, smp.qddd
     bounds = problem.trajectory.bounds(xa)
-    acc = bounds.qdd_abs_max  # (nq,) the exact largest |q̈|, for the continuous bounds
+    move = SampledMove(xa, t, q, qd, bounds.qdd_abs_max)  # the exact largest |q̈|
 
     checker = problem.checker
     if pairs is not None:  # (n, ns, no)
         per_sample = pairs.min(axis=(1, 2))
-        grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance_with_acceleration(
-                problem, xa, t, qd, pairs, grid_hz, depth, exact, acc
-            )
+            found = continuous_distance(problem, move, pairs, depth, exact)
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
-            guarantee, bound = f"sampled at {grid_hz:g} Hz", None
+            guarantee, bound = f"sampled at {move.rate_hz:g} Hz", None
             k, solid, obstacle = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
             min_d, t_min_d = float(pairs[k, solid, obstacle]), float(t[k])
         pair: tuple[str, str] | None = (
@@ -394,9 +391,7 @@ def certify_states(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and self_distance_with_acceleration(
-        problem, xa, t, q, qd, continuous, depth, acc
-    )
+    own = problem.self_check and self_distance(problem, move, continuous, depth)
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

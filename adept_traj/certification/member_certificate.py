@@ -273,21 +273,6 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
     return batches
 
 
-def problem_parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """The objects ``problem`` is made from — its settings, robot, scene, start and goal —
-    to be compared by identity (:func:`same_parts`). The problem is frozen, so they never
-    change for one problem; kept for the polisher's check that it was started for the
-    problem it is given."""
-    return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
-
-
-def same_parts(parts: tuple[Any, ...], problem: TrajectoryProblem) -> bool:
-    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts, object for
-    object."""
-    now = problem_parts(problem)
-    return len(parts) == len(now) and all(a is b for a, b in zip(parts, now))
-
-
 def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:
     """The problem :func:`certify_members` certifies on, and its influence distance [m]:
     ``problem`` with the influence lowered to ``margin +`` :data:`FRONT_INFLUENCE_ABOVE_MARGIN`

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError, WorkerDiedError
+from adept_traj.process_helper import Helper
 from adept_traj.process_pool import LOWEST_PRIORITY, Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
@@ -76,7 +77,7 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     return Finisher(robot, scene, figures=bool(figures), html=bool(html))
 
 
-class Finisher:
+class Finisher(Helper):
     """The helper process forked by :func:`start_finisher`; a context manager that stops
     it when the block is left.
 
@@ -99,25 +100,6 @@ class Finisher:
                 prepare=partial(_preload, figures, html),
                 note="raised while writing the figures and page in a worker process",
             )
-
-    @property
-    def pid(self) -> int | None:
-        return None if self._worker is None else self._worker.pid
-
-    def ready(self, timeout: float = 0.0) -> bool:
-        """Whether the helper has done its imports (waiting up to ``timeout`` [s])."""
-        return self._worker is not None and self._worker.ready(timeout)
-
-    def cancel(self) -> None:
-        """Stop the helper (a no-op once it is reaped): killed, then reaped."""
-        if self._worker is not None:
-            self._worker.close()
-
-    def __enter__(self) -> Finisher:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
     def start(
         self,
