@@ -424,10 +424,8 @@ def exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
 
     Parameters
     ----------
-    T:
-        (...) travel times [s].
-    P:
-        (..., S + 3, nq) control points [rad | m].
+    T, P:
+        As :func:`exact_bounds`: travel times (...) [s] and control points.
 
     Returns
     -------

@@ -93,10 +93,8 @@ def check_front_csv(r: PlanningResult, path: Path) -> None:
 
     Parameters
     ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
+    r, path:
+        As :func:`write_front_csv`.
 
     Raises
     ------
@@ -146,10 +144,8 @@ def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
 
     Parameters
     ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
+    r, path:
+        As :func:`write_front_csv`.
 
     Returns
     -------
@@ -169,10 +165,8 @@ def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
 
     Parameters
     ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
+    r, path:
+        As :func:`write_front_csv`.
 
     Raises
     ------

@@ -71,20 +71,10 @@ _JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=
 
 
 def write_json(r: PlanningResult, path: Path) -> Path:
-    """Write ``result.json`` of a result (atomically).
-
-    Parameters
-    ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-    """
+    """Write result ``r`` (a :class:`~adept_traj.results.PlanningResult`) as JSON to
+    ``path`` (atomically: a reader sees the old file or the whole new one); return
+    ``path``. The layout is the module's (schema version :data:`VERSION`, or 1 for a
+    result read from a version-1 file)."""
     return write_text_atomic(path, _dumps(_encode(r)) + "\n")
 
 
