@@ -86,12 +86,12 @@ from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
 from adept_traj.validation import (
+    DeepEqual,
     as_finite_array,
     as_integer,
     as_scalar,
     as_vector,
     check_type,
-    deep_equal,
     readonly_copy,
 )
 
@@ -109,7 +109,7 @@ DEFAULT_RATE_HZ = 1000.0
 
 
 @dataclass(frozen=True, eq=False)
-class Certificate:
+class Certificate(DeepEqual):
     """The dense verification of one trajectory (see the module docstring).
 
     Attributes
@@ -216,11 +216,6 @@ class Certificate:
         """:attr:`feasible` with the ``"continuous"`` distance (and self-distance) guarantee."""
         own_ok = self.self_distance is None or self.self_distance.guarantee == CONTINUOUS
         return self.feasible and self.guarantee == CONTINUOUS and own_ok
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
 

@@ -60,6 +60,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from adept_traj.collision import SelfCollision
 from adept_traj.collision import solid_lever_arms as lever_arms
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -74,6 +75,7 @@ __all__ = [
     "obstacle_jump_intervals",
     "obstacle_speeds",
     "sampled_move",
+    "self_check_of",
     "solid_lever_arms",
 ]
 
@@ -252,6 +254,21 @@ def continuous_distance(
     )  # fmt: skip
 
 
+def self_check_of(problem: TrajectoryProblem) -> SelfCollision:
+    """The problem's :attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which the
+    self-distance bounds need.
+
+    Raises
+    ------
+    InvalidInputError
+        The problem's self-collision check is off.
+    """
+    check = problem.self_check
+    if check is None:
+        raise InvalidInputError("the problem's self-collision check is off")
+    return check
+
+
 def continuous_self_distance(
     problem: TrajectoryProblem,
     move: SampledMove,
@@ -269,11 +286,9 @@ def continuous_self_distance(
     Raises
     ------
     InvalidInputError
-        The problem's self-collision check is off.
+        The problem's self-collision check is off (:func:`self_check_of`).
     """
-    check = problem.self_check
-    if check is None:
-        raise InvalidInputError("the problem's self-collision check is off")
+    check = self_check_of(problem)
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
         return check.distances(q, exact_below=problem.settings.margin)[..., None]

@@ -23,7 +23,7 @@ import numpy as np
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMITS
-from adept_traj.validation import as_finite_array, as_scalar, deep_equal, readonly_copy
+from adept_traj.validation import DeepEqual, as_finite_array, as_scalar, readonly_copy
 
 __all__ = [
     "BATCH_SAMPLES",
@@ -64,7 +64,7 @@ DenseStates = tuple[Any, np.ndarray, np.ndarray | None]
 
 
 @dataclass(frozen=True, eq=False)
-class DenseTrajectory:
+class DenseTrajectory(DeepEqual):
     """A trajectory sampled on a uniform grid (both ends included).
 
     Attributes
@@ -117,11 +117,6 @@ class DenseTrajectory:
     def nq(self) -> int:
         """Number of joints."""
         return int(self.q.shape[1])
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
 

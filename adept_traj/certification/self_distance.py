@@ -33,6 +33,7 @@ from adept_traj.certification.continuous import (
     CONTINUOUS,
     SampledMove,
     continuous_self_distance,
+    self_check_of,
 )
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -146,11 +147,9 @@ def self_distance(
     Raises
     ------
     InvalidInputError
-        The problem's self-collision check is off.
+        As :func:`~adept_traj.certification.continuous.continuous_self_distance`.
     """
-    check = problem.self_check
-    if check is None:
-        raise InvalidInputError("the problem's self-collision check is off")
+    check = self_check_of(problem)
     t, q, grid_hz = move.t, move.q, move.rate_hz
     if not check.n_pairs:
         return SelfDistance(math.inf, True, None, None, CONTINUOUS, math.inf)

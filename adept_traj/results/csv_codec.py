@@ -171,7 +171,7 @@ def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
     Raises
     ------
     ResultFormatError
-        Another header, row count or value (naming the row and column).
+        As :func:`check_front_csv`.
     """
     legacy = trajectory_header(r.robot.joint_names)
     text = read_text(path)
