@@ -161,17 +161,7 @@ def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
     """Check that ``best_trajectory.csv`` agrees with a result read from ``result.json``:
     the fixed-step file with the best trade-off's spline (to :data:`_SAMPLE_RTOL`); a file
     of an earlier version (the certificate's grid) with ``result.json``'s dense samples,
-    exactly.
-
-    Parameters
-    ----------
-    r, path:
-        As :func:`write_front_csv`.
-
-    Raises
-    ------
-    ResultFormatError
-        As :func:`check_front_csv`.
+    exactly. Its arguments and errors are those of :func:`check_front_csv`.
     """
     legacy = trajectory_header(r.robot.joint_names)
     text = read_text(path)

@@ -19,21 +19,16 @@ import html
 import json
 import math
 import uuid
-import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat
-    import umsgpack
-
 from adept_traj.errors import MeshcatServerError
 from adept_traj.files import write_text_atomic
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.viz.meshcat_geometry import translation
+from adept_traj.viz.meshcat_modules import meshcat, umsgpack
 from adept_traj.viz.playback import (
     CLOSEST_COLOR,
     FIXED_OBSTACLE_COLOR,
