@@ -39,8 +39,8 @@ __all__ = [
 #: :func:`~adept_traj.analysis.certify_members` (a move with more is formed alone): the
 #: per-call work of the inverse dynamics and the distances is shared, and the batch's
 #: arrays stay in the CPU cache. Measured on the paper front (42 solid–obstacle pairs):
-#: about 6 000 samples (3–4 moves at 1 kHz) were the fastest, 6 % faster than one move at
-#: a time; 12 000 were 1.7× slower.
+#: about 6 000 samples (3–4 moves at 1 kHz) were the fastest, faster than one move at a
+#: time and than 12 000 samples.
 BATCH_SAMPLES = 6144
 
 #: Most solid–obstacle distances (samples × pairs, 2 MiB of them) of one batch: a scene

@@ -77,11 +77,11 @@ __all__ = ["TrajectoryProblem"]
 _MIN_CHUNK = 8
 #: Samples (individuals × samples per trajectory) evaluated together: the working arrays of
 #: one block stay in the CPU cache (a whole population of 500 × 116 samples would stream
-#: every intermediate array through main memory: ≈ 1.3× slower, measured). A population is
+#: every intermediate array through main memory, measured slower). A population is
 #: cut into equal blocks of 2/3 to 3/2 of this (``round(pop / (4096 // n_s))`` blocks): a
-#: block has a fixed cost (≈ 2.6 ms on the paper problem, the broad phase's numpy calls per
-#: solid–obstacle pair), so 50 trajectories are one block, not 35 + 15 (blocks of 8 000
-#: samples and more are ≈ 2× slower per sample here: their arrays leave the 2 MB L2 cache).
+#: block has a fixed cost (the broad phase's numpy calls per solid–obstacle pair), so 50
+#: trajectories are one block, not 35 + 15 (blocks of 8 000 samples and more were slower
+#: per sample here: their arrays leave the 2 MB L2 cache).
 _BLOCK_SAMPLES = 4096
 
 #: The parts a problem is made from, as :meth:`TrajectoryProblem.replace` takes them.

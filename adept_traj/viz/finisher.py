@@ -48,7 +48,8 @@ IMPORT_NICENESS = LOWEST_PRIORITY
 #: How long :meth:`Finisher.start` waits for the helper's imports to end [s] (0: the
 #: helper is used only if it is ready when the run ends).
 READY_TIMEOUT = 0.0
-#: Cost weight of ``playback.html`` on the scale of the figures' weights [0.1 s CPU].
+#: Cost weight of ``playback.html`` on the scale of the figures' weights (their relative
+#: CPU costs, :func:`~adept_traj.viz.plots.all_figures.figure_jobs`).
 _HTML_WEIGHT = 0.3
 
 
