@@ -40,7 +40,9 @@ Every worker, the same way:
 - **May prepare at the lowest priority**: with ``prepare`` (e.g. heavy imports), the
   worker first runs it in a thread at nice :data:`LOWEST_PRIORITY` (Linux niceness is
   per thread: it runs while a core idles and never takes one from the caller), then says
-  it is ready (:meth:`Worker.ready`) and runs ``target`` at the caller's priority.
+  it is ready (:meth:`Worker.ready`) and runs ``target`` at the caller's priority. A
+  caller that has to wait for the preparation raises it to its own priority first
+  (:meth:`Worker.hurry`), where the system allows.
 """
 
 from __future__ import annotations
@@ -317,6 +319,25 @@ class Worker:
             if not self._ready:  # its preparation failed, or it died
                 self.close()
         return self._ready and self.pid is not None
+
+    def hurry(self) -> bool:
+        """Raise every thread of a worker still preparing at nice :data:`LOWEST_PRIORITY`
+        to the calling thread's niceness, so that a caller about to wait for it does not
+        wait behind every other process of the machine; return whether it was raised
+        (``False`` where the system refuses: lowering a niceness needs ``CAP_SYS_NICE``
+        or a high enough ``RLIMIT_NICE``; not Linux; the worker stopped)."""
+        if self.pid is None or os.getpid() != self._creator:
+            return False
+        mine = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+        try:
+            threads = [int(t) for t in os.listdir(f"/proc/{self.pid}/task")]
+            for tid in threads:
+                with contextlib.suppress(ProcessLookupError):  # that thread has ended
+                    if os.getpriority(os.PRIO_PROCESS, tid) > mine:
+                        os.setpriority(os.PRIO_PROCESS, tid, mine)
+        except (PermissionError, FileNotFoundError):  # not allowed; no /proc; ended
+            return False
+        return True
 
     def _message(self) -> tuple:
         """The worker's next message; a :class:`WorkerDiedError` at the pipe's end.

@@ -292,14 +292,6 @@ def _certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem |
     influence = min(st.influence, st.margin + FRONT_INFLUENCE_ABOVE_MARGIN)
     if influence == st.influence:
         return None, influence
-    fast = TrajectoryProblem(
-        problem.robot,
-        problem.scene,
-        problem.start,
-        problem.goal,
-        st,
-        influence=influence,
-        search_buffer=0.0,  # the certificate checks the true margin; the buffer is unused
-        workers=1,
-    )
+    # the certificate checks the true margin: the search buffer is unused
+    fast = problem.replace(influence=influence, search_buffer=0.0, workers=1)
     return fast, influence

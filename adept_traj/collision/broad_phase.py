@@ -51,6 +51,7 @@ primitives' kinds, balls and projections in :mod:`adept_traj.collision.primitive
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import coal
@@ -122,9 +123,21 @@ class BroadPhase:
         The robot's collision solids and the obstacles.
     influence:
         Distance [m] above which a bound needs no refinement (≥ 0).
+    tables:
+        Single-joint distance tables already made for this robot and these obstacles, by
+        (solid, obstacle) index (e.g. :meth:`CollisionChecker.tables_for
+        <adept_traj.collision.CollisionChecker.tables_for>` of another checker): each is
+        taken instead of computed where this broad phase tabulates the pair over the same
+        joint (their values depend on the solid, the obstacle and the base pose alone).
     """
 
-    def __init__(self, robot: Robot, scene: Scene, influence: float) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        scene: Scene,
+        influence: float,
+        tables: Mapping[tuple[int, int], DistanceTable] | None = None,
+    ) -> None:
         self.influence = float(influence)
         objects = robot.collision_model.geometryObjects
         self.n_solids, self.n_obstacles = len(objects), len(scene.obstacles)
@@ -176,11 +189,15 @@ class BroadPhase:
             )
         #: Single-joint distance tables by (solid, obstacle) (level 0).
         self.tables: dict[tuple[int, int], DistanceTable] = {}
+        known = {} if tables is None else tables
         for k in range(self.n_solids):
             for o in range(self.n_obstacles):
                 j = self._table_joint(robot, k, o)
                 if j is not None and self._sweep_reaches(robot, scene, k, o):
-                    self.tables[k, o] = self._table(robot, scene, k, o, j, objects[k].geometry)
+                    given = known.get((k, o))
+                    if given is None or given.joint != j:
+                        given = self._table(robot, scene, k, o, j, objects[k].geometry)
+                    self.tables[k, o] = given
 
     @property
     def ball_radius(self) -> np.ndarray:

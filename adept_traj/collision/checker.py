@@ -14,6 +14,7 @@ constraint, the clearance penalty) is therefore exact.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,6 +24,7 @@ import numpy as np
 from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.cloud_distance import CloudDistance
+from adept_traj.collision.distance_table import DistanceTable
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
@@ -103,10 +105,19 @@ class CollisionChecker:
     start_time:
         Scene time t0 [s] of the motion's time 0 (default 0): the obstacles are placed at
         scene time :math:`t_0 + t` for the times ``t`` the methods are given (finite, ≥ 0).
+    tables:
+        The broad phase's single-joint distance tables already made for this robot and
+        scene (:meth:`tables_for` of another checker), taken instead of computed
+        (:class:`~adept_traj.collision.broad_phase.BroadPhase`).
     """
 
     def __init__(
-        self, robot: Robot, scene: Scene, influence: float = 0.05, start_time: float = 0.0
+        self,
+        robot: Robot,
+        scene: Scene,
+        influence: float = 0.05,
+        start_time: float = 0.0,
+        tables: Mapping[tuple[int, int], DistanceTable] | None = None,
     ) -> None:
         if not (np.isfinite(influence) and influence >= 0):
             raise InvalidInputError(f"influence must be a finite distance ≥ 0 [m]; got {influence}")
@@ -122,7 +133,7 @@ class CollisionChecker:
         self.obstacle_names = tuple(ob.name for ob in scene.obstacles)
         #: The :class:`~adept_traj.collision.broad_phase.BroadPhase`: the solids' and
         #: obstacles' conservative bounds (read by the branch and bound and the gradients).
-        self.broad_phase = BroadPhase(robot, scene, self.influence)
+        self.broad_phase = BroadPhase(robot, scene, self.influence, tables)
         # Allowed contacts (scene.allowed_contacts: link, obstacle): never checked.
         links = [robot.model.frames[g.parentFrame].name for g in objects]
         pairs = [
@@ -150,6 +161,25 @@ class CollisionChecker:
         ]
         self._law_of = shared_motion_laws(scene)
         self._views: dict[tuple[int, ...], CollisionChecker] = {}  # by obstacles kept
+
+    def tables_for(self, robot: Robot, scene: Scene) -> dict[tuple[int, int], DistanceTable]:
+        """This checker's single-joint distance tables that hold for ``robot`` and
+        ``scene``, by (solid, obstacle index in ``scene``), to give a new checker
+        (``tables=``): those of the obstacles of ``scene`` that are this checker's
+        obstacles (the same objects) with the same robot base pose, for this checker's
+        robot (the same object); ``{}`` otherwise."""
+        same_base = np.array_equal(scene.base_from_world, self._to_base)
+        if robot is not self.robot or not same_base:
+            return {}
+        mine = self.scene.obstacles
+        index = {o: next((i for i, m in enumerate(mine) if m is ob), -1)
+                 for o, ob in enumerate(scene.obstacles)}  # fmt: skip
+        return {
+            (k, o): table
+            for o, old in index.items()
+            for (k, kept), table in self.broad_phase.tables.items()
+            if kept == old
+        }
 
     @property
     def solid_shapes(self) -> tuple[object | None, ...]:

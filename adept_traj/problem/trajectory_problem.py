@@ -118,6 +118,21 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         settings: ProblemSettings | None = None,
         **overrides: Any,
     ) -> None:
+        self._build(robot, scene, start, goal, settings, overrides, None)
+
+    def _build(
+        self,
+        robot: Robot,
+        scene: Scene,
+        start: Any,
+        goal: Any,
+        settings: ProblemSettings | None,
+        overrides: dict[str, Any],
+        tables: Any,
+    ) -> None:
+        """The constructor's work; ``tables``: the checker's distance tables already made
+        (:meth:`~adept_traj.collision.CollisionChecker.tables_for`, from :meth:`replace`),
+        or ``None``."""
         settings = settings or ProblemSettings()
         if overrides:
             values = {**settings.__dict__, **overrides}
@@ -155,7 +170,9 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         s, w = self.trajectory.quadrature(settings.nodes_per_segment)
         self.s = readonly_copy(np.concatenate([[0.0], s, [1.0]]))  # both ends too (weight 0)
         self.weights = readonly_copy(np.concatenate([[0.0], w, [0.0]]))
-        self.checker = CollisionChecker(robot, scene, settings.influence, settings.start_time)
+        self.checker = CollisionChecker(
+            robot, scene, settings.influence, settings.start_time, tables=tables
+        )
         super().__init__(
             n_var=self.trajectory.n_var,
             n_obj=len(OBJECTIVES),
@@ -188,8 +205,10 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         Returns
         -------
         TrajectoryProblem
-            Built anew from the changed parts (nothing derived is shared; no worker
-            pool).
+            Built anew from the changed parts (no worker pool), except the collision
+            checker's single-joint distance tables of an unchanged robot and of the
+            obstacles both scenes hold (the same objects, the same base pose), which are
+            taken over: their values depend on nothing else.
 
         Raises
         ------
@@ -202,7 +221,10 @@ class TrajectoryProblem(FrozenAttributes, Problem):
             raise ConfigurationError(
                 f"replace() takes {', '.join(_PARTS)} or ProblemSettings fields; got {unknown}"
             )
-        return TrajectoryProblem(**parts, **changes)
+        new = TrajectoryProblem.__new__(TrajectoryProblem)
+        tables = self.checker.tables_for(parts["robot"], parts["scene"])
+        new._build(*(parts[k] for k in _PARTS), changes, tables)
+        return new
 
     def derived(self, key: str, make: Callable[[TrajectoryProblem], _Derived]) -> _Derived:
         """Data derived from this problem alone, made once by ``make(self)`` and kept on

@@ -19,9 +19,11 @@ The helper never outlives the caller (:mod:`adept_traj.process_pool`): it ignore
 reaps it, and it ends with the caller however the caller ends. An error of the helper is
 raised by :meth:`Finisher.wait` in the caller (the same exception, with the helper's
 traceback as a note); a helper that dies without a word has its work done again by the
-caller. A helper that has not finished its imports when the
-run ends (a machine too busy to lend it a core) is not used: :meth:`Finisher.start`
-stops it and returns ``False``, and the caller writes the files itself.
+caller. A helper that has not finished its imports when the run ends (a machine too
+busy to lend it a core) has them raised to the caller's priority and is waited for, a
+bounded time; where the system does not allow that, or the bound passes, it is not used:
+:meth:`Finisher.start` stops it and returns ``False``, and the caller writes the files
+itself.
 """
 
 from __future__ import annotations
@@ -45,9 +47,14 @@ __all__ = ["Finisher", "start_finisher"]
 
 #: Niceness of the helper's importing thread (the lowest priority).
 IMPORT_NICENESS = LOWEST_PRIORITY
-#: How long :meth:`Finisher.start` waits for the helper's imports to end [s] (0: the
-#: helper is used only if it is ready when the run ends).
+#: How long :meth:`Finisher.start` waits for the helper's imports to end [s] at their
+#: lowest priority (0: not at all).
 READY_TIMEOUT = 0.0
+#: How long :meth:`Finisher.start` waits for imports still under way once they are raised
+#: to the caller's priority (:meth:`~adept_traj.process_pool.Worker.hurry`) [s]: a bound;
+#: the rest of the imports takes a fraction of it on a free core, and redoing them in
+#: the caller would take as long.
+HURRIED_TIMEOUT = 3.0
 #: Cost weight of ``playback.html`` on the scale of the figures' weights (their relative
 #: CPU costs, :func:`~adept_traj.viz.plots.all_figures.figure_jobs`).
 _HTML_WEIGHT = 0.3
@@ -102,6 +109,14 @@ class Finisher(Helper):
                 note="raised while writing the figures and page in a worker process",
             )
 
+    def _ready_now(self) -> bool:
+        """Whether the helper is ready: at once, or within :data:`READY_TIMEOUT`, or, with
+        its imports raised to this process's priority, within :data:`HURRIED_TIMEOUT`."""
+        if self.ready(READY_TIMEOUT):
+            return True
+        worker = self._worker
+        return worker is not None and worker.hurry() and self.ready(HURRIED_TIMEOUT)
+
     def start(
         self,
         results: Mapping[str, PlanningResult],
@@ -121,13 +136,14 @@ class Finisher(Helper):
         Returns
         -------
         ``True`` if the helper writes them (collect with :meth:`wait`); ``False`` if it was
-        not ready (its imports not done within :data:`READY_TIMEOUT`) or cannot do them:
-        it is then stopped, and the caller writes the files itself.
+        not ready (its imports not done within :data:`READY_TIMEOUT`, nor, raised to the
+        caller's priority where the system allows, within :data:`HURRIED_TIMEOUT`) or
+        cannot do them: it is then stopped, and the caller writes the files itself.
         """
         order = _order(results, figures, html)
         if (order[1] is not None and not self._figures) or (order[2] and not self._html):
             raise InvalidInputError("the helper was started without the output asked for")
-        if self._worker is None or not self.ready(READY_TIMEOUT):
+        if self._worker is None or not self._ready_now():
             if self._worker is not None:
                 self._worker.kill()  # reaped by cancel: a helper at nice 19 may end slowly
             return False

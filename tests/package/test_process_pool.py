@@ -119,6 +119,38 @@ def test_prepare_runs_at_nice_19_before_the_target_at_the_callers_priority() -> 
         assert worker.recv() == ([LOWEST_PRIORITY], own)
 
 
+def _may_lower_niceness() -> bool:
+    """Whether this process may lower a niceness back from 19 (root, or RLIMIT_NICE)."""
+    import resource
+
+    soft, _ = resource.getrlimit(resource.RLIMIT_NICE)
+    own = os.getpriority(os.PRIO_PROCESS, 0)
+    return os.geteuid() == 0 or soft == resource.RLIM_INFINITY or 20 - soft <= own
+
+
+def _until_hurried() -> None:
+    """A preparation that lasts until its thread is raised above nice 19 (at most 60 s)."""
+    deadline = time.monotonic() + 60.0
+    while os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == LOWEST_PRIORITY:
+        if time.monotonic() > deadline:
+            raise TimeoutError("never hurried")
+        time.sleep(0.01)
+
+
+def test_hurry_raises_a_preparing_worker_to_the_callers_priority() -> None:
+    seen: list[int] = []
+    with Worker(_niceness, seen, prepare=_until_hurried) as worker:
+        time.sleep(0.2)
+        assert not worker.ready()  # still preparing at nice 19
+        if not _may_lower_niceness():
+            assert worker.hurry() is False  # refused by the system, said so
+            return
+        assert worker.hurry() is True
+        assert worker.ready(30.0)
+        assert worker.recv() == ([], os.getpriority(os.PRIO_PROCESS, 0))
+    assert worker.hurry() is False  # stopped
+
+
 def test_a_failing_preparation_is_not_ready_and_reaped() -> None:
     def fails() -> None:
         raise ImportError("no such module")

@@ -161,3 +161,50 @@ def test_a_pendulums_rod_and_bob_share_their_motion_law(scene):
     fixed = [i for i, ob in enumerate(scene.obstacles) if not ob.is_moving]
     assert fixed
     assert all(laws[i] == i for i in fixed)
+
+
+def test_a_copy_takes_over_the_distance_tables_of_the_obstacles_it_keeps(robot):
+    detour = Scene.shipped("detour")
+    problem = TrajectoryProblem(robot, detour, detour.start, detour.goal)
+    assert problem.checker.broad_phase.tables  # the post and the table are tabulated
+    still = dataclasses.replace(detour, obstacles=detour.fixed)
+    copies = {
+        "relaxed": problem.replace(scene=still, workers=1),
+        "certifying": problem.replace(influence=0.015, search_buffer=0.0),
+    }
+    directs = {
+        "relaxed": TrajectoryProblem(robot, still, detour.start, detour.goal, problem.settings),
+        "certifying": TrajectoryProblem(
+            robot, detour, detour.start, detour.goal, problem.settings, influence=0.015,
+            search_buffer=0.0,
+        ),
+    }  # fmt: skip
+    x = np.stack([problem.trajectory.straight_line(t) for t in (1.2, 1.6, 2.4)])
+    for name, copy in copies.items():
+        direct = directs[name]
+        mine, theirs = copy.checker.broad_phase.tables, direct.checker.broad_phase.tables
+        assert mine, name
+        assert mine.keys() == theirs.keys(), name
+        for key, table in mine.items():
+            k, o = key
+            kept = copy.scene.obstacles[o]
+            old = next(i for i, ob in enumerate(detour.obstacles) if ob is kept)
+            assert table is problem.checker.broad_phase.tables[k, old], name  # taken over
+            np.testing.assert_array_equal(table.values, theirs[key].values)
+            assert (table.joint, table.start, table.step, table.lipschitz) == (
+                theirs[key].joint, theirs[key].start, theirs[key].step, theirs[key].lipschitz
+            )  # fmt: skip
+        a, b = copy.evaluate_batch(x), direct.evaluate_batch(x)
+        np.testing.assert_array_equal(a.constraints, b.constraints)
+        np.testing.assert_array_equal(a.objectives, b.objectives)
+    # another robot object, or a moved base: nothing taken over
+    other = Robot.adept_one_xl()
+    assert problem.checker.tables_for(other, detour) == {}
+    base = np.array(detour.robot_base, dtype=float)
+    base[0, 3] += 0.01
+    moved = dataclasses.replace(detour, robot_base=base)
+    assert problem.checker.tables_for(robot, moved) == {}
+    assert (
+        problem.checker.tables_for(robot, detour).keys()
+        == problem.checker.broad_phase.tables.keys()
+    )

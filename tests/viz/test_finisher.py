@@ -205,6 +205,7 @@ def test_a_helper_not_ready_when_the_run_ends_is_stopped_and_the_caller_writes(
 ) -> None:
     marker = tmp_path / "preload"
     monkeypatch.setattr(finisher, "_preload", _marking_preload(marker, seconds=60.0))
+    monkeypatch.setattr(finisher, "HURRIED_TIMEOUT", 0.2)  # hurried, still not done
 
     def run_ends_while_importing(*_args, **_kwargs):
         while not marker.is_file() or not marker.read_text():
@@ -218,6 +219,40 @@ def test_a_helper_not_ready_when_the_run_ends_is_stopped_and_the_caller_writes(
     writers = {int(p.read_text().split()[1]) for p in (out / "figures").iterdir()}
     assert len(writers) >= 1
     assert helper not in writers
+    assert not (out / "run.json").exists()
+
+
+def test_a_helper_still_importing_when_the_run_ends_is_hurried_and_used(
+    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    marker = tmp_path / "preload"
+
+    def imports_until_hurried(_figures: bool, _html: bool) -> None:
+        marker.write_text(f"{os.getpid()} {_nice()}")
+        deadline = time.monotonic() + 60.0
+        while _nice() == finisher.IMPORT_NICENESS and time.monotonic() < deadline:
+            time.sleep(0.01)
+
+    monkeypatch.setattr(finisher, "_preload", imports_until_hurried)
+
+    def run_ends_while_importing(*_args, **_kwargs):
+        while not marker.is_file() or not marker.read_text():
+            time.sleep(0.01)
+        return stored
+
+    out = tmp_path / "run"
+    assert _plan(monkeypatch, stored, out, "--no-html", plan=run_ends_while_importing) == 1
+    helper = int(marker.read_text().split()[0])
+    writers = {int(p.read_text().split()[1]) for p in (out / "figures").iterdir()}
+    import resource
+
+    allowed = os.geteuid() == 0 or resource.getrlimit(resource.RLIMIT_NICE)[0] >= 20 - _nice()
+    if allowed:  # hurried: the helper (and its fork) drew, not the caller
+        assert helper in writers
+        assert os.getpid() not in writers
+    else:  # refused: the caller drew
+        assert helper not in writers
+    assert _gone(helper, within=10.0)
     assert not (out / "run.json").exists()
 
 

@@ -34,7 +34,6 @@ from adept_traj.optimise.local.timed_starts import timed_roadmap_starts
 from adept_traj.optimise.local.via_points import GLOBAL_SEED, near_lower_bound, via_point_starts
 from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
-from adept_traj.problem import TrajectoryProblem
 from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_integer
 
@@ -104,8 +103,11 @@ def time_optimal(
     starts = _feasible_first(problem, _starts(problem, seed, n_starts))
     options = {"rate_hz": rate_hz, "processes": processes, **options}
     ahead = _relaxed_ahead(problem, n_starts, rate_hz, processes)  # beside the first start
+    # Without moving obstacles the global stage has no relaxed or timed starts: the ramps
+    # come next whatever the first outcome, and are screened beside it (the same outcomes).
+    first = 1 if problem.scene.moving else _first_group(problem, processes)
     try:
-        screened = screen_starts(problem, starts[:1], stop=near, **options)
+        screened = screen_starts(problem, starts[:first], stop=near, **options)
         known = None if ahead is None or near(screened) else ahead.recv()
     finally:
         if ahead is not None:
@@ -115,7 +117,7 @@ def time_optimal(
         stage = global_stage(
             problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes, known=known
         )
-        screened += _screen_stage(problem, stage, screened, starts[1:], **options)
+        screened += _screen_stage(problem, stage, screened, starts[first:], **options)
     if near_lower_bound(problem, screened, floor=stage.floor if stage else 0.0):
         return screened
     return screened + refine_starts(problem, screened, rate_hz=rate_hz, processes=processes)
@@ -211,9 +213,7 @@ def relaxed_optimum(
     relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
     if scene.moving:
         still = dataclasses.replace(scene, obstacles=scene.fixed)
-        fixed = TrajectoryProblem(
-            problem.robot, still, problem.start, problem.goal, problem.settings, workers=1
-        )
+        fixed = problem.replace(scene=still, workers=1)
         processes = problem.settings.workers if processes is None else processes
         outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
         done = [o for o in outcomes if o.certified]
@@ -307,6 +307,11 @@ def _screen_stage(
         if not near(screened + more):
             more += screen_starts(problem, starts(), stop=near, **options)
     return more
+
+
+def _first_group(problem: Any, processes: int | None) -> int:
+    """Starts screened at once (the first group of :func:`screen_starts`)."""
+    return max(1, problem.settings.workers if processes is None else int(processes))
 
 
 def _feasible_first(problem: Any, starts: np.ndarray) -> np.ndarray:
