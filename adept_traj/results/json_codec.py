@@ -339,7 +339,7 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
     ``gap``, ``certificate.n_samples``, each check's ``worst`` and ``within``, …) disagree
     with what the rest of the file gives: the file re-encoded from the decoded result must be
     the file read. The walk is iterative (the nesting is already bounded)."""
-    # json.dumps (C) gives the same data as the file's own layout (_dumps), 4× faster
+    # json.dumps (C) gives the same data as the file's own layout (_dumps), faster
     stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(json.dumps(_encode(result))), "")]
     while stack:
         stored, derived, path = stack.pop()
