@@ -19,6 +19,7 @@ import numpy as np
 from adept_traj.errors import FrozenObjectError, InputShapeError, InvalidInputError
 
 __all__ = [
+    "DeepEqual",
     "FrozenAttributes",
     "as_batch",
     "as_finite_array",
@@ -192,6 +193,17 @@ def deep_equal(a: Any, b: Any) -> bool:
             and all(deep_equal(x, y) for x, y in zip(a, b))
         )
     return bool(a == b)
+
+
+class DeepEqual:
+    """Equality by :func:`deep_equal` for the package's frozen dataclasses with array
+    fields (declared ``eq=False``: a generated ``__eq__`` fails on arrays); a record of
+    another type is not equal. Unhashable, as a dataclass with ``eq`` would be."""
+
+    def __eq__(self, other: object) -> bool:
+        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 class FrozenAttributes:

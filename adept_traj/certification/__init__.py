@@ -26,10 +26,12 @@ from adept_traj.certification.continuous import (
     CONTINUOUS,
     DEFAULT_MAX_DEPTH,
     DistanceGuarantee,
+    SampledMove,
     continuous_distance,
     continuous_self_distance,
     obstacle_jump_intervals,
     obstacle_speeds,
+    sampled_move,
     solid_lever_arms,
 )
 from adept_traj.certification.dense_trajectory import (
@@ -47,8 +49,6 @@ from adept_traj.certification.member_certificate import (
     certify_member,
     certify_members,
     certifying_problem,
-    problem_parts,
-    same_parts,
 )
 from adept_traj.certification.mismatches import AUDIT_RTOL, Mismatch
 from adept_traj.certification.rest_poses import check_rest_poses, rest_pose_contacts
@@ -70,6 +70,7 @@ __all__ = [
     "LimitCheck",
     "MemberCertificate",
     "Mismatch",
+    "SampledMove",
     "SelfDistance",
     "batch_samples",
     "certificate_bytes",
@@ -84,9 +85,8 @@ __all__ = [
     "dense_samples",
     "obstacle_jump_intervals",
     "obstacle_speeds",
-    "problem_parts",
     "rest_pose_contacts",
-    "same_parts",
+    "sampled_move",
     "self_distance",
     "solid_lever_arms",
 ]

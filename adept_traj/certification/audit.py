@@ -270,21 +270,13 @@ class _Auditor(MismatchLog):
 
     def member_certificate(self, path: str, stored: Any, now: Any) -> None:
         """Compare two :class:`~adept_traj.analysis.MemberCertificate` field by field."""
-        for field in (
-            "feasible",
-            "guarantee",
-            "torque_guarantee",
-            "worst_joint",
-            "min_distance_exact",
-            "closest_pair",
-            "violations",
-        ):
-            self.value(f"{path}.{field}", getattr(stored, field), getattr(now, field))
-        self.numbers(f"{path}.worst", stored.worst, now.worst)
-        self.numbers(f"{path}.t_worst", stored.t_worst, now.t_worst)
-        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
-        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
-        self.optional(f"{path}.distance_bound", stored.distance_bound, now.distance_bound)
+        self.fields(
+            path, stored, now,
+            ("value", "feasible", "guarantee", "torque_guarantee", "worst_joint",
+             "min_distance_exact", "closest_pair", "violations"),
+            ("numbers", "worst", "t_worst", "min_distance"),
+            ("optional", "t_min_distance", "distance_bound"),
+        )  # fmt: skip
         self.self_distance(f"{path}.self_distance", stored.self_distance, now.self_distance)
 
     def self_distance(self, path: str, stored: Any, now: Any) -> None:
@@ -292,19 +284,17 @@ class _Auditor(MismatchLog):
         if stored is None or now is None:
             self.value(path, stored, now)
             return
-        for field in ("exact", "pair", "guarantee"):
-            self.value(f"{path}.{field}", getattr(stored, field), getattr(now, field))
-        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
-        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
-        self.optional(f"{path}.distance_bound", stored.distance_bound, now.distance_bound)
+        self.fields(
+            path, stored, now, ("value", "exact", "pair", "guarantee"),
+            ("numbers", "min_distance"), ("optional", "t_min_distance", "distance_bound"),
+        )  # fmt: skip
 
     def certificate(self, path: str, stored: Certificate, now: Certificate) -> None:
-        self.value(f"{path}.feasible", stored.feasible, now.feasible)
-        self.value(f"{path}.n_samples", stored.n_samples, now.n_samples)
-        self.numbers(f"{path}.margin", stored.margin, now.margin)
-        self.numbers(f"{path}.min_distance", stored.min_distance, now.min_distance)
-        self.optional(f"{path}.t_min_distance", stored.t_min_distance, now.t_min_distance)
-        self.value(f"{path}.closest_pair", stored.closest_pair, now.closest_pair)
+        self.fields(
+            path, stored, now, ("value", "feasible", "n_samples"),
+            ("numbers", "margin", "min_distance"), ("optional", "t_min_distance"),
+            ("value", "closest_pair"),
+        )  # fmt: skip
         self.value(f"{path}.violations", list(stored.violations), list(now.violations))
         self.self_distance(f"{path}.self_distance", stored.self_distance, now.self_distance)
         for old, new in zip(stored.checks, now.checks, strict=True):

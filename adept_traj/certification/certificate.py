@@ -61,7 +61,8 @@ import numpy as np
 from adept_traj.certification.continuous import (
     CONTINUOUS,
     DEFAULT_MAX_DEPTH,
-    continuous_distance_with_acceleration,
+    SampledMove,
+    continuous_distance,
 )
 from adept_traj.certification.dense_trajectory import (
     DenseStates,
@@ -78,19 +79,19 @@ from adept_traj.certification.limit_check import (
 from adept_traj.certification.self_distance import (
     SelfDistance,
     normalise_distance_fields,
-    self_distance_with_acceleration,
+    self_distance,
 )
 from adept_traj.errors import InvalidInputError
 from adept_traj.memory import check_memory
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
 from adept_traj.validation import (
+    DeepEqual,
     as_finite_array,
     as_integer,
     as_scalar,
     as_vector,
     check_type,
-    deep_equal,
     readonly_copy,
 )
 
@@ -108,7 +109,7 @@ DEFAULT_RATE_HZ = 1000.0
 
 
 @dataclass(frozen=True, eq=False)
-class Certificate:
+class Certificate(DeepEqual):
     """The dense verification of one trajectory (see the module docstring).
 
     Attributes
@@ -215,11 +216,6 @@ class Certificate:
         """:attr:`feasible` with the ``"continuous"`` distance (and self-distance) guarantee."""
         own_ok = self.self_distance is None or self.self_distance.guarantee == CONTINUOUS
         return self.feasible and self.guarantee == CONTINUOUS and own_ok
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -355,25 +351,21 @@ def certify_states(
     Certificate
         As :func:`certify`.
     """
-    T = float(xa[0])
     smp, tau, pairs = states
     n = len(smp.t)
     t, q, qd, qdd, qddd = smp.t, smp.q, smp.qd, smp.qdd, smp.qddd
     bounds = problem.trajectory.bounds(xa)
-    acc = bounds.qdd_abs_max  # (nq,) the exact largest |q̈|, for the continuous bounds
+    move = SampledMove(xa, t, q, qd, bounds.qdd_abs_max)  # the exact largest |q̈|
 
     checker = problem.checker
     if pairs is not None:  # (n, ns, no)
         per_sample = pairs.min(axis=(1, 2))
-        grid_hz = (n - 1) / T
         if continuous:
-            found = continuous_distance_with_acceleration(
-                problem, xa, t, qd, pairs, grid_hz, depth, exact, acc
-            )
+            found = continuous_distance(problem, move, pairs, depth, exact)
             guarantee, bound = found.guarantee, found.lower_bound
             min_d, t_min_d, (solid, obstacle) = found.min_distance, found.t_min_distance, found.pair
         else:
-            guarantee, bound = f"sampled at {grid_hz:g} Hz", None
+            guarantee, bound = f"sampled at {move.rate_hz:g} Hz", None
             k, solid, obstacle = np.unravel_index(int(np.argmin(pairs)), pairs.shape)
             min_d, t_min_d = float(pairs[k, solid, obstacle]), float(t[k])
         pair: tuple[str, str] | None = (
@@ -394,9 +386,7 @@ def certify_states(
             f"distance: {min_d:.4g} m < margin {margin:.4g} m at t = {t_min_d:.3f} s "
             f"({pair[0]} – {pair[1]})"
         )
-    own = problem.self_check and self_distance_with_acceleration(
-        problem, xa, t, q, qd, continuous, depth, acc
-    )
+    own = problem.self_check and self_distance(problem, move, continuous, depth)
     violations.extend(own.violations(margin) if own else ())
     dense = DenseTrajectory(t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, tau=tau, min_distance=per_sample)
     return Certificate(

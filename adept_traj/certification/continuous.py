@@ -60,6 +60,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from adept_traj.collision import SelfCollision
 from adept_traj.collision import solid_lever_arms as lever_arms
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -68,12 +69,13 @@ __all__ = [
     "CONTINUOUS",
     "DEFAULT_MAX_DEPTH",
     "DistanceGuarantee",
+    "SampledMove",
     "continuous_distance",
-    "continuous_distance_with_acceleration",
     "continuous_self_distance",
-    "continuous_self_distance_with_acceleration",
     "obstacle_jump_intervals",
     "obstacle_speeds",
+    "sampled_move",
+    "self_check_of",
     "solid_lever_arms",
 ]
 
@@ -178,26 +180,58 @@ def _interval_bounds(
     return low
 
 
+@dataclass(frozen=True, eq=False)
+class SampledMove:
+    r"""A move and its samples, as the continuous bounds take them (made by
+    :func:`sampled_move`, or by :func:`~adept_traj.certification.certify`, which has the
+    spline's bounds already).
+
+    Attributes
+    ----------
+    x: (n_var,) checked decision vector ``[T [s], free control points [rad | m]]``.
+    t: (n,) sample times [s], increasing, ``t[0] = 0``, ``t[-1] = T``.
+    q: (n, nq) configurations at ``t`` [rad | m].
+    qd: (n, nq) joint speeds at ``t`` [rad/s | m/s].
+    acc: (nq,) the spline's exact largest :math:`|\ddot q_i|` over the move [rad/s² | m/s²]
+        (:meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``(x).qdd_abs_max``). A
+        smaller value voids every guarantee made from the move: give only that value.
+    """
+
+    x: np.ndarray
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    acc: np.ndarray
+
+    @property
+    def rate_hz(self) -> float:
+        """The uniform grid's rate [Hz], ``(n − 1) / T``."""
+        return (len(self.t) - 1) / float(self.x[0])
+
+
+def sampled_move(
+    problem: TrajectoryProblem, x: np.ndarray, t: np.ndarray, q: np.ndarray, qd: np.ndarray
+) -> SampledMove:
+    """The :class:`SampledMove` of ``x`` (n_var,) sampled at ``t`` (n,) [s] with
+    configurations ``q`` and speeds ``qd`` (n, nq), its acceleration bound computed from
+    ``problem``'s spline (so never below the true one)."""
+    return SampledMove(x, t, q, qd, problem.trajectory.bounds(x).qdd_abs_max)
+
+
 def continuous_distance(
     problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    qd: np.ndarray,
+    move: SampledMove,
     pairs: np.ndarray,
-    rate_hz: float,
     max_depth: int = DEFAULT_MAX_DEPTH,
     exact: bool = True,
 ) -> DistanceGuarantee:
-    """Lower-bound the distance between the samples and refine where needed.
+    """Lower-bound the robot–obstacle distance between the samples and refine where needed.
 
     Parameters
     ----------
     problem: the problem (robot, scene, margin).
-    x: (n_var,) checked decision vector.
-    t: (n,) sample times [s], increasing, ``t[0] = 0``, ``t[-1] = T``.
-    qd: (n, nq) joint speeds at ``t`` [rad/s | m/s].
-    pairs: (n, ns, no) exact distances at ``t`` [m], or lower bounds of them.
-    rate_hz: the uniform grid's rate [Hz], ``(n − 1) / T`` (for the guarantee's name).
+    move: the move and its samples (:func:`sampled_move`).
+    pairs: (n, ns, no) exact distances at ``move.t`` [m], or lower bounds of them.
     max_depth: most bisections (≥ 0).
     exact: distances at the midpoints exact for every pair (``False``: lower bounds
         above the checker's influence distance, as
@@ -207,43 +241,6 @@ def continuous_distance(
     -------
     :class:`DistanceGuarantee`.
     """
-    acc = problem.trajectory.bounds(x).qdd_abs_max
-    return continuous_distance_with_acceleration(
-        problem, x, t, qd, pairs, rate_hz, max_depth, exact, acc
-    )
-
-
-def continuous_distance_with_acceleration(
-    problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    qd: np.ndarray,
-    pairs: np.ndarray,
-    rate_hz: float,
-    max_depth: int,
-    exact: bool,
-    acc: np.ndarray,
-) -> DistanceGuarantee:
-    r""":func:`continuous_distance` with the spline's largest :math:`|\ddot q_i|` already
-    computed by the caller (:func:`~adept_traj.analysis.certify`, which has the spline's
-    bounds of ``x``).
-
-    Parameters
-    ----------
-    problem, x, t, qd, pairs, rate_hz, max_depth, exact:
-        As :func:`continuous_distance`: the problem, the move (n_var,), the sample times
-        (n,) [s], the joint speeds (n, nq) [rad/s | m/s] and the distances (n, n_solids,
-        n_obstacles) [m] there, the grid rate [Hz], the most bisections, exact distances.
-    acc:
-        (nq,) [rad/s² | m/s²] the spline's exact largest :math:`|\ddot q_i|` over the move:
-        :meth:`~adept_traj.problem.BSplineTrajectory.bounds` ``(x).qdd_abs_max``. A smaller
-        value voids the guarantee; pass only that value.
-
-    Returns
-    -------
-    DistanceGuarantee
-        As :func:`continuous_distance`.
-    """
     checker = problem.checker
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
@@ -252,89 +249,68 @@ def continuous_distance_with_acceleration(
     arms, speeds = _rates(problem)
     jumps = obstacle_jump_intervals(problem)
     return _bisect(
-        problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc,
+        problem, move, pairs, max_depth, arms, speeds, distances,
         jumps if np.isfinite(jumps).any() else None,
     )  # fmt: skip
 
 
-def continuous_self_distance(
-    problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    qd: np.ndarray,
-    pairs: np.ndarray,
-    rate_hz: float,
-    max_depth: int = DEFAULT_MAX_DEPTH,
-) -> DistanceGuarantee:
-    """:func:`continuous_distance` for the robot's own solid pairs
-    (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
-    (n, n_pairs) [m] are the self-distances at ``t`` (or lower bounds of them); the
-    Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
-    solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
-    obstacle speed). The midpoints' distances are exact below the margin, lower bounds
-    above it. The returned ``pair`` is ``(pair index, 0)``."""
-    acc = problem.trajectory.bounds(x).qdd_abs_max
-    return continuous_self_distance_with_acceleration(
-        problem, x, t, qd, pairs, rate_hz, max_depth, acc
-    )
+def self_check_of(problem: TrajectoryProblem) -> SelfCollision:
+    """The problem's :attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which the
+    self-distance bounds need.
 
-
-def continuous_self_distance_with_acceleration(
-    problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    qd: np.ndarray,
-    pairs: np.ndarray,
-    rate_hz: float,
-    max_depth: int,
-    acc: np.ndarray,
-) -> DistanceGuarantee:
-    r""":func:`continuous_self_distance` with the spline's largest :math:`|\ddot q_i|`
-    already computed by the caller (as :func:`continuous_distance_with_acceleration`).
-
-    Parameters
-    ----------
-    problem, x, t, qd, pairs, rate_hz, max_depth:
-        As :func:`continuous_self_distance`; ``pairs`` (n, n_pairs) [m].
-    acc:
-        (nq,) [rad/s² | m/s²] :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
-        ``(x).qdd_abs_max``: a smaller value voids the guarantee.
-
-    Returns
-    -------
-    DistanceGuarantee
-        As :func:`continuous_self_distance`.
+    Raises
+    ------
+    InvalidInputError
+        The problem's self-collision check is off.
     """
     check = problem.self_check
     if check is None:
         raise InvalidInputError("the problem's self-collision check is off")
+    return check
+
+
+def continuous_self_distance(
+    problem: TrajectoryProblem,
+    move: SampledMove,
+    pairs: np.ndarray,
+    max_depth: int = DEFAULT_MAX_DEPTH,
+) -> DistanceGuarantee:
+    """:func:`continuous_distance` for the robot's own solid pairs
+    (:attr:`~adept_traj.problem.TrajectoryProblem.self_check`, which must be on): ``pairs``
+    (n, n_pairs) [m] are the self-distances at ``move.t`` (or lower bounds of them); the
+    Lipschitz constant of pair :math:`(a, b)` counts only the joints that move one of its
+    solids (:attr:`~adept_traj.collision.SelfCollision.lever_arms`), nothing moves otherwise (no
+    obstacle speed). The midpoints' distances are exact below the margin, lower bounds
+    above it. The returned ``pair`` is ``(pair index, 0)``.
+
+    Raises
+    ------
+    InvalidInputError
+        The problem's self-collision check is off (:func:`self_check_of`).
+    """
+    check = self_check_of(problem)
 
     def distances(q: np.ndarray, t_m: np.ndarray) -> np.ndarray:
         return check.distances(q, exact_below=problem.settings.margin)[..., None]
 
     arms, speeds = check.lever_arms, np.zeros(1)
-    pairs = pairs[..., None]
-    return _bisect(problem, x, t, qd, pairs, rate_hz, max_depth, arms, speeds, distances, acc)
+    return _bisect(problem, move, pairs[..., None], max_depth, arms, speeds, distances)
 
 
 def _bisect(
     problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    qd: np.ndarray,
+    move: SampledMove,
     pairs: np.ndarray,
-    rate_hz: float,
     max_depth: int,
     arms: np.ndarray,
     speeds: np.ndarray,
     distances: Callable[[np.ndarray, np.ndarray], np.ndarray],
-    acc: np.ndarray,
     jumps: np.ndarray | None = None,
 ) -> DistanceGuarantee:
     """The refinement of :func:`continuous_distance` for distances ``pairs`` (n, ns, no) at
-    ``t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,), the exact acceleration
-    bound ``acc`` (nq,); ``distances(q, t)`` gives them (m, ns, no) at configurations
-    (m, nq) and times (m,) [s]."""
+    ``move.t``, rate factors ``arms`` (ns, nq) and ``speeds`` (no,); ``distances(q, t)``
+    gives them (m, ns, no) at configurations (m, nq) and times (m,) [s]."""
+    x, t, qd, acc, rate_hz = move.x, move.t, move.qd, move.acc, move.rate_hz
     margin = float(problem.settings.margin)
     T = float(x[0])
     k, s, o = np.unravel_index(int(np.argmin(pairs)), pairs.shape)

@@ -30,7 +30,13 @@ import numpy as np
 
 from adept_traj.errors import ConfigurationError, InvalidInputError
 from adept_traj.robot.limits import LIMIT_KINDS, LIMITS
-from adept_traj.validation import as_finite_array, as_scalar, as_vector, deep_equal, readonly_copy
+from adept_traj.validation import (
+    DeepEqual,
+    as_finite_array,
+    as_scalar,
+    as_vector,
+    readonly_copy,
+)
 
 __all__ = [
     "DEFAULT_TOLERANCE",
@@ -58,7 +64,7 @@ TORQUE_MAX_LEVELS = 3
 
 
 @dataclass(frozen=True, eq=False)
-class LimitCheck:
+class LimitCheck(DeepEqual):
     """The worst use of one kind of limit over the trajectory, per joint.
 
     Attributes
@@ -117,11 +123,6 @@ class LimitCheck:
     def ok(self) -> bool:
         """Every joint within the limit."""
         return bool(self.within.all())
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
 

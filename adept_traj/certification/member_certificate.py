@@ -50,7 +50,7 @@ from adept_traj.certification.self_distance import SelfDistance
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.robot.limits import LIMIT_KINDS
-from adept_traj.validation import as_batch, as_integer, as_scalar, check_type, deep_equal
+from adept_traj.validation import DeepEqual, as_batch, as_integer, as_scalar, check_type
 
 __all__ = [
     "FRONT_INFLUENCE_ABOVE_MARGIN",
@@ -66,7 +66,7 @@ FRONT_INFLUENCE_ABOVE_MARGIN = 0.01
 
 
 @dataclass(frozen=True, eq=False)
-class MemberCertificate:
+class MemberCertificate(DeepEqual):
     """The summary of one front member's certificate (module docstring).
 
     Attributes
@@ -153,11 +153,6 @@ class MemberCertificate:
         if kind not in LIMIT_KINDS:
             raise InvalidInputError(f"kind must be one of {LIMIT_KINDS}; got {kind!r}")
         return self.worst[LIMIT_KINDS.index(kind)]
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -271,21 +266,6 @@ def _batches(xs: np.ndarray, rows: list[int], rate_hz: float, most: int) -> list
         batches[-1].append(k)
         total += n
     return batches
-
-
-def problem_parts(problem: TrajectoryProblem) -> tuple[Any, ...]:
-    """The objects ``problem`` is made from — its settings, robot, scene, start and goal —
-    to be compared by identity (:func:`same_parts`). The problem is frozen, so they never
-    change for one problem; kept for the polisher's check that it was started for the
-    problem it is given."""
-    return (problem.settings, problem.robot, problem.scene, problem.start, problem.goal)
-
-
-def same_parts(parts: tuple[Any, ...], problem: TrajectoryProblem) -> bool:
-    """Whether ``parts`` (from :func:`problem_parts`) are ``problem``'s parts, object for
-    object."""
-    now = problem_parts(problem)
-    return len(parts) == len(now) and all(a is b for a, b in zip(parts, now))
 
 
 def certifying_problem(problem: TrajectoryProblem) -> tuple[TrajectoryProblem, float]:

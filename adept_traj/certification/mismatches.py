@@ -89,6 +89,15 @@ class MismatchLog:
         else:
             self.numbers(path, stored, recomputed)
 
+    def fields(self, path: str, stored: Any, recomputed: Any, *groups: tuple[str, ...]) -> None:
+        """Compare attributes of two records, in the order given: each group is a kind —
+        ``"value"``, ``"numbers"`` or ``"optional"``, the method that compares — then the
+        attribute names it compares, each field named ``path.name``."""
+        for kind, *names in groups:
+            compare = getattr(self, kind)
+            for name in names:
+                compare(f"{path}.{name}", getattr(stored, name), getattr(recomputed, name))
+
     def tree(self, path: str, stored: Any, recomputed: Any) -> None:
         """Compare two parsed documents (dicts, lists, leaves) leaf by leaf."""
         if isinstance(stored, dict) and isinstance(recomputed, dict):

@@ -31,7 +31,9 @@ import numpy as np
 
 from adept_traj.certification.continuous import (
     CONTINUOUS,
-    continuous_self_distance_with_acceleration,
+    SampledMove,
+    continuous_self_distance,
+    self_check_of,
 )
 from adept_traj.errors import InvalidInputError
 from adept_traj.problem.trajectory_problem import TrajectoryProblem
@@ -41,7 +43,6 @@ __all__ = [
     "SelfDistance",
     "normalise_distance_fields",
     "self_distance",
-    "self_distance_with_acceleration",
 ]
 
 #: Most exact distances computed to make the smallest self-distance of a certificate exact.
@@ -127,17 +128,12 @@ def normalise_distance_fields(record: object, value: str, when: str, pair: str, 
 
 
 def self_distance(
-    problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    q: np.ndarray,
-    qd: np.ndarray,
-    continuous: bool,
-    max_depth: int,
+    problem: TrajectoryProblem, move: SampledMove, continuous: bool, max_depth: int
 ) -> SelfDistance:
-    """The :class:`SelfDistance` of ``x`` (n_var,) sampled at ``t`` (n,) [s] with
-    configurations ``q`` and speeds ``qd`` (n, nq), for :func:`~adept_traj.analysis.certify`
-    (its ``continuous`` and ``max_depth``; the problem's self-collision check must be on).
+    """The :class:`SelfDistance` of a move
+    (:func:`~adept_traj.certification.continuous.sampled_move`), for
+    :func:`~adept_traj.analysis.certify` (its ``continuous`` and ``max_depth``; the
+    problem's self-collision check must be on).
 
     The distances at the samples are exact where below the margin and lower bounds
     above it (:meth:`~adept_traj.collision.SelfCollision.distances` with ``exact_below``:
@@ -147,41 +143,14 @@ def self_distance(
     bounds by the joint-space Lipschitz bound, until the smallest value is exact or above
     the check's influence distance, at most :data:`MIN_SEARCH` times (else it is reported
     as a bound, ``exact=False``), whatever ``certify``'s ``exact``.
+
+    Raises
+    ------
+    InvalidInputError
+        As :func:`~adept_traj.certification.continuous.continuous_self_distance`.
     """
-    acc = problem.trajectory.bounds(x).qdd_abs_max
-    return self_distance_with_acceleration(problem, x, t, q, qd, continuous, max_depth, acc)
-
-
-def self_distance_with_acceleration(
-    problem: TrajectoryProblem,
-    x: np.ndarray,
-    t: np.ndarray,
-    q: np.ndarray,
-    qd: np.ndarray,
-    continuous: bool,
-    max_depth: int,
-    acc: np.ndarray,
-) -> SelfDistance:
-    r""":func:`self_distance` with the spline's largest :math:`|\ddot q_i|` already computed
-    by the caller (:func:`~adept_traj.analysis.certify`).
-
-    Parameters
-    ----------
-    problem, x, t, q, qd, continuous, max_depth:
-        As :func:`self_distance`: ``t`` (n,) [s], ``q`` and ``qd`` (n, nq).
-    acc:
-        (nq,) [rad/s² | m/s²] :meth:`~adept_traj.problem.BSplineTrajectory.bounds`
-        ``(x).qdd_abs_max``: a smaller value voids the continuous bound.
-
-    Returns
-    -------
-    SelfDistance
-        As :func:`self_distance`.
-    """
-    check = problem.self_check
-    if check is None:
-        raise InvalidInputError("the problem's self-collision check is off")
-    grid_hz = (len(t) - 1) / float(x[0])
+    check = self_check_of(problem)
+    t, q, grid_hz = move.t, move.q, move.rate_hz
     if not check.n_pairs:
         return SelfDistance(math.inf, True, None, None, CONTINUOUS, math.inf)
     margin = float(problem.settings.margin)
@@ -199,9 +168,7 @@ def self_distance_with_acceleration(
     best, t_best, exact = float(d[k, p]), float(t[k]), bool(known[k, p])
     guarantee, bound = f"sampled at {grid_hz:g} Hz", None
     if continuous:
-        between = continuous_self_distance_with_acceleration(
-            problem, x, t, qd, d, grid_hz, max_depth, acc
-        )
+        between = continuous_self_distance(problem, move, d, max_depth)
         guarantee, bound = between.guarantee, between.lower_bound
         if between.min_distance < best:  # (exact: below the margin) between the samples
             best, t_best, p = between.min_distance, between.t_min_distance, between.pair[0]

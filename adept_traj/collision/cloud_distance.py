@@ -42,14 +42,13 @@ leaves (level 5 of :mod:`adept_traj.collision.broad_phase`).
 
 from __future__ import annotations
 
-import weakref
 from functools import cached_property
 from typing import Any
 
 import coal
 import numpy as np
 
-from adept_traj.scene.point_clouds import cube_field_step
+from adept_traj.scene.point_clouds import PointCloud, cube_field_step
 
 __all__ = [
     "BUCKET_EDGE",
@@ -61,6 +60,7 @@ __all__ = [
     "hull_planes",
     "solid_distance_bound",
     "solid_half_sides",
+    "supports_distance_bound",
 ]
 
 #: Margin [m] beyond the cap of the leaves not gathered (their distance exceeds cap + it).
@@ -71,10 +71,6 @@ TIE = 1e-9
 
 #: Edge of a bucket [edges of the largest leaf].
 BUCKET_EDGE = 8.0
-
-#: The leaves of each cloud, by the id of the cloud (a shape hashes by its contents, slow
-#: for 10⁶ points), with a weak reference that drops the entry with the cloud.
-_CELLS: dict[int, tuple[weakref.ref, CloudCells]] = {}
 
 
 class CloudCells:
@@ -169,28 +165,30 @@ class CloudCells:
         return origin, h, distance
 
 
-def cloud_cells(octree: coal.OcTree, key: object) -> CloudCells:
-    """The :class:`CloudCells` of ``octree``, made once per ``key`` (the cloud)."""
-    entry = _CELLS.get(id(key))
-    if entry is None or entry[0]() is not key:
-        ident = id(key)
-        entry = _CELLS[ident] = (
-            weakref.ref(key, lambda _, ident=ident: _CELLS.pop(ident, None)),
-            CloudCells(octree),
-        )
-    return entry[1]
+def cloud_cells(octree: coal.OcTree, cloud: PointCloud) -> CloudCells:
+    """The :class:`CloudCells` of ``octree`` (``cloud``'s), made once per cloud and kept on
+    it (:meth:`~adept_traj.scene.PointCloud.derived`)."""
+    return cloud.derived("collision.cloud_distance.cells", lambda _: CloudCells(octree))
 
 
-def solid_distance_bound(solid: coal.CollisionGeometry, p: np.ndarray) -> tuple[Any, Any] | None:
+def supports_distance_bound(solid: coal.CollisionGeometry) -> bool:
+    """Whether :func:`solid_distance_bound` bounds the distance to ``solid``."""
+    return isinstance(solid, (coal.ConvexBase, coal.Sphere, coal.Capsule, coal.Box, coal.Cylinder))
+
+
+def solid_distance_bound(
+    solid: coal.CollisionGeometry, p: np.ndarray, planes: np.ndarray | None = None
+) -> tuple[Any, Any] | None:
     r"""Signed distance (n,) [m] of points ``p`` (n, 3) in the frame of a coal ``Box``,
     ``Cylinder`` (axis z), ``Capsule`` (axis z) or ``Sphere``, and a subgradient (n, 3)
     of it (unit where the distance is positive); for a convex polytope (``ConvexBase``:
     a URDF link's hull) a convex function never above its signed distance,
     :math:`\max_i (n_i \cdot x - b_i)` over its face planes (exact inside; outside, the
     distance to the farthest supporting half-space), with the unit normal of that face
-    as subgradient; None for another geometry."""
+    as subgradient (``planes``: its :func:`hull_planes`, computed here if ``None``); None
+    for another geometry."""
     if isinstance(solid, coal.ConvexBase):
-        planes = hull_planes(solid)
+        planes = hull_planes(solid) if planes is None else planes
         side = p @ planes[:, :3].T + planes[:, 3]  # (n, faces)
         face = side.argmax(axis=1)
         return side[np.arange(len(p)), face], planes[face, :3]
@@ -235,21 +233,13 @@ def solid_half_sides(solid: coal.CollisionGeometry) -> np.ndarray | None:
     return np.array([solid.radius, solid.radius, tip])
 
 
-#: The face planes of each convex solid, by its id, with the solid (kept alive with them).
-_PLANES: dict[int, tuple[coal.ConvexBase, np.ndarray]] = {}
-
-
 def hull_planes(solid: coal.ConvexBase) -> np.ndarray:
     """The face planes (f, 4) of a convex polytope, ``(n, -b)`` with unit outward normals
-    ``n`` (f, 3) and offsets ``b`` [m] (``n · x ≤ b`` inside; qhull through scipy, once a
-    solid)."""
-    entry = _PLANES.get(id(solid))
-    if entry is None or entry[0] is not solid:
-        from scipy.spatial import ConvexHull
+    ``n`` (f, 3) and offsets ``b`` [m] (``n · x ≤ b`` inside; qhull through scipy)."""
+    from scipy.spatial import ConvexHull
 
-        equations = ConvexHull(np.asarray(solid.points(), dtype=float)).equations
-        entry = _PLANES[id(solid)] = (solid, np.ascontiguousarray(equations))
-    return entry[1]
+    equations = ConvexHull(np.asarray(solid.points(), dtype=float)).equations
+    return np.ascontiguousarray(equations)
 
 
 def _box_sdf(p: np.ndarray, h: np.ndarray, signed_axes: tuple[int, ...] | None = None):
@@ -277,7 +267,7 @@ class CloudDistance:
     then holds coal's witness points and normal of the nearest leaf (not above ``cap``)."""
 
     def __init__(
-        self, solid: coal.CollisionGeometry, octree: coal.OcTree, key: object, cap: float
+        self, solid: coal.CollisionGeometry, octree: coal.OcTree, key: PointCloud, cap: float
     ) -> None:
         self._solid = solid
         #: Distances above this [m] are returned as a lower bound above it.
@@ -290,8 +280,9 @@ class CloudDistance:
         self._half_local = solid_half_sides(solid)
         #: a convex polytope's box (centre (3,), half sides (3,)) [m], its frame: a cheap
         #: first bound of the leaves before the one over its faces
-        self._hull_box = None
+        self._hull_box = self._planes = None
         if isinstance(solid, coal.ConvexBase):
+            self._planes = hull_planes(solid)
             v = np.asarray(solid.points(), dtype=float)
             self._hull_box = (0.5 * (v.min(0) + v.max(0)), 0.5 * (v.max(0) - v.min(0)))
         self._scratch = coal.DistanceResult()
@@ -318,7 +309,7 @@ class CloudDistance:
 
         def bound(centre: np.ndarray, half: np.ndarray) -> np.ndarray:
             """ℓ (n,) of boxes of centres (n, 3) and half sides (n, 3) or half edges (n,)."""
-            d, g = solid_distance_bound(self._solid, (centre - pos) @ rot)  # type: ignore[misc]
+            d, g = solid_distance_bound(self._solid, (centre - pos) @ rot, self._planes)  # type: ignore[misc]
             g = np.abs(g @ rot.T)  # the subgradient in the cloud frame
             return d - (np.einsum("ij,ij->i", g, half) if half.ndim == 2 else g.sum(1) * half)
 

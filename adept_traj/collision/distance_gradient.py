@@ -58,7 +58,7 @@ __all__ = ["WITNESS_TOLERANCES", "DistanceGradients", "distance_gradients"]
 #: witness points off by about :math:`\\sqrt{\\varepsilon r}` and the normal by
 #: :math:`\\sqrt{\\varepsilon / r}`: with the distances' 1e-9 m the gradient of the
 #: AdeptOne's outer arm against the pendulum rod (r = 1 cm) was 1e-4 off (relative), with
-#: 1e-14 m 2e-6, for ≈ 1 µs more per call. At 1e-14 GJK fails now and then (coal 3.0.3
+#: 1e-14 m 2e-6, for a little more time per call. At 1e-14 GJK fails now and then (coal 3.0.3
 #: returned −1.8e308 and NaN points for a cylinder 3 cm from a box): the next one is used.
 WITNESS_TOLERANCES: tuple[float, ...] = (1e-14, 1e-12, DISTANCE_TOLERANCE)
 

@@ -26,7 +26,7 @@ from typing import Any
 import coal
 import numpy as np
 
-from adept_traj.collision.cloud_distance import CloudDistance, solid_distance_bound
+from adept_traj.collision.cloud_distance import CloudDistance, supports_distance_bound
 from adept_traj.scene.meshes import Mesh
 from adept_traj.scene.point_clouds import PointCloud
 
@@ -75,6 +75,6 @@ def distance_functor(
     it), else coal's own ``ComputeDistance``."""
     if isinstance(shape, Mesh) and shape.closed:
         return MeshDistance(solid, obstacle_geometry, shape)
-    if isinstance(shape, PointCloud) and solid_distance_bound(solid, np.zeros((1, 3))):
+    if isinstance(shape, PointCloud) and supports_distance_bound(solid):
         return CloudDistance(solid, obstacle_geometry, shape, cap)
     return coal.ComputeDistance(solid, obstacle_geometry)

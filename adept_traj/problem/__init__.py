@@ -29,6 +29,7 @@ from adept_traj.problem.objectives import (
     Objective,
     from_pymoo,
     paper_penalty,
+    paper_semi_axes,
     to_pymoo,
 )
 from adept_traj.problem.problem_settings import ProblemSettings
@@ -67,5 +68,6 @@ __all__ = [
     "local_constraints",
     "objective_gradients",
     "paper_penalty",
+    "paper_semi_axes",
     "to_pymoo",
 ]

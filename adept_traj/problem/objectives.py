@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import InputShapeError, InvalidInputError
+from adept_traj.scene.shapes import Box
 from adept_traj.validation import as_finite_array
 
 __all__ = [
@@ -49,6 +50,7 @@ __all__ = [
     "Objective",
     "from_pymoo",
     "paper_penalty",
+    "paper_semi_axes",
     "to_pymoo",
 ]
 
@@ -151,6 +153,21 @@ def _flip_maximised(values: Any, name: str) -> np.ndarray:
         )
     arr[..., _NEGATED] = -arr[..., _NEGATED]
     return arr
+
+
+def paper_semi_axes(obstacles: Any, z3: str) -> np.ndarray:
+    """Semi-axes (n_obs, 3) [m] of the paper's circumscribing volumes (eqs. 13, 15) of
+    ``obstacles`` (a scene's :class:`~adept_traj.scene.Obstacle` tuple): a sphere of the
+    shape's bounding radius, or, with ``z3 == "paper-ellipsoid"``, for a box the smallest
+    ellipsoid with the box's axes containing it, √3 × its half sides (axis-aligned in the
+    obstacle frame; the paper's cubes are axis-aligned)."""
+    axes = []
+    for ob in obstacles:
+        if z3 == "paper-ellipsoid" and isinstance(ob.shape, Box):
+            axes.append(np.sqrt(3.0) * 0.5 * np.asarray(ob.shape.size))
+        else:
+            axes.append(np.full(3, ob.shape.bounding_radius))
+    return np.array(axes).reshape(-1, 3)
 
 
 def paper_penalty(

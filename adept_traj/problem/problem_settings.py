@@ -4,12 +4,12 @@ its valid range)."""
 
 from __future__ import annotations
 
-import multiprocessing
 from dataclasses import dataclass
 
 import numpy as np
 
 from adept_traj.errors import ConfigurationError
+from adept_traj.process_pool import can_fork
 from adept_traj.validation import as_integer, as_scalar
 
 __all__ = ["ProblemSettings"]
@@ -111,7 +111,7 @@ class ProblemSettings:
         for name, minimum in (("workers", 1), ("nodes_per_segment", 1), ("n_knots", 4)):
             value = as_integer(getattr(self, name), name, minimum=minimum, error=ConfigurationError)
             object.__setattr__(self, name, value)
-        if self.workers > 1 and "fork" not in multiprocessing.get_all_start_methods():
+        if self.workers > 1 and not can_fork():
             raise ConfigurationError("workers > 1 needs the 'fork' start method (Linux)")
         if self.t_bounds is not None:
             try:

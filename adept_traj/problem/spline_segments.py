@@ -71,6 +71,18 @@ class TrajectorySamples:
     qddd: np.ndarray | None
 
 
+def _abs_max(order: str, doc: str) -> property:
+    """A read-only property of :class:`TrajectoryBounds`: the largest absolute value of
+    derivative ``order`` (``"q"``, ``"qd"``, …) from its ``<order>_min`` and
+    ``<order>_max`` fields, documented by ``doc``."""
+    low, high = f"{order}_min", f"{order}_max"
+
+    def largest(self: TrajectoryBounds) -> np.ndarray:
+        return np.maximum(np.abs(getattr(self, low)), np.abs(getattr(self, high)))
+
+    return property(largest, doc=doc)
+
+
 @dataclass(frozen=True, eq=False)
 class TrajectoryBounds:
     r"""Exact per-joint extrema over :math:`t \in [0, T]`, each of shape ``(..., nq)``.
@@ -93,25 +105,16 @@ class TrajectoryBounds:
     qddd_min: np.ndarray
     qddd_max: np.ndarray
 
-    @property
-    def q_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |q_i(t)|` [rad] or [m], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.q_min), np.abs(self.q_max))
-
-    @property
-    def qd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\dot q_i(t)|` [rad/s] or [m/s], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qd_min), np.abs(self.qd_max))
-
-    @property
-    def qdd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\ddot q_i(t)|` [rad/s²] or [m/s²], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qdd_min), np.abs(self.qdd_max))
-
-    @property
-    def qddd_abs_max(self) -> np.ndarray:
-        r""":math:`\max_t |\dddot q_i(t)|` [rad/s³] or [m/s³], shape ``(..., nq)``."""
-        return np.maximum(np.abs(self.qddd_min), np.abs(self.qddd_max))
+    q_abs_max = _abs_max("q", r":math:`\max_t |q_i(t)|` [rad] or [m], shape ``(..., nq)``.")
+    qd_abs_max = _abs_max(
+        "qd", r":math:`\max_t |\dot q_i(t)|` [rad/s] or [m/s], shape ``(..., nq)``."
+    )
+    qdd_abs_max = _abs_max(
+        "qdd", r":math:`\max_t |\ddot q_i(t)|` [rad/s²] or [m/s²], shape ``(..., nq)``."
+    )
+    qddd_abs_max = _abs_max(
+        "qddd", r":math:`\max_t |\dddot q_i(t)|` [rad/s³] or [m/s³], shape ``(..., nq)``."
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -424,10 +427,8 @@ def exact_integrals(T: np.ndarray, P: np.ndarray) -> TrajectoryIntegrals:
 
     Parameters
     ----------
-    T:
-        (...) travel times [s].
-    P:
-        (..., S + 3, nq) control points [rad | m].
+    T, P:
+        As :func:`exact_bounds`: travel times (...) [s] and control points.
 
     Returns
     -------

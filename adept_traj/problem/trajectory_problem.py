@@ -56,13 +56,12 @@ from adept_traj.errors import ConfigurationError, InputShapeError, RobotModelErr
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation, concatenate_evaluations, timed_evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator
-from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, to_pymoo
+from adept_traj.problem.objectives import OBJECTIVES, paper_penalty, paper_semi_axes, to_pymoo
 from adept_traj.problem.problem_settings import ProblemSettings
 from adept_traj.problem.time_bound import kinematic_lower_bound
 from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
-from adept_traj.scene.shapes import Box
 from adept_traj.validation import (
     FrozenAttributes,
     as_batch,
@@ -79,11 +78,11 @@ __all__ = ["TrajectoryProblem"]
 _MIN_CHUNK = 8
 #: Samples (individuals × samples per trajectory) evaluated together: the working arrays of
 #: one block stay in the CPU cache (a whole population of 500 × 116 samples would stream
-#: every intermediate array through main memory: ≈ 1.3× slower, measured). A population is
+#: every intermediate array through main memory, measured slower). A population is
 #: cut into equal blocks of 2/3 to 3/2 of this (``round(pop / (4096 // n_s))`` blocks): a
-#: block has a fixed cost (≈ 2.6 ms on the paper problem, the broad phase's numpy calls per
-#: solid–obstacle pair), so 50 trajectories are one block, not 35 + 15 (blocks of 8 000
-#: samples and more are ≈ 2× slower per sample here: their arrays leave the 2 MB L2 cache).
+#: block has a fixed cost (the broad phase's numpy calls per solid–obstacle pair), so 50
+#: trajectories are one block, not 35 + 15 (blocks of 8 000 samples and more were slower
+#: per sample here: their arrays leave the 2 MB L2 cache).
 _BLOCK_SAMPLES = 4096
 
 #: The parts a problem is made from, as :meth:`TrajectoryProblem.replace` takes them.
@@ -362,22 +361,19 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         """Eq. 14 (``"paper-sphere"``) or eq. 16 with the obstacles' axes
         (``"paper-ellipsoid"``) on the tool points (..., n_s, 3)."""
         if self.settings.z3 == "paper-sphere":
-            return paper_penalty(tool, poses[..., :3, 3], self._semi_axes(), equation=14)
+            return paper_penalty(
+                tool,
+                poses[..., :3, 3],
+                paper_semi_axes(self.scene.obstacles, self.settings.z3),
+                equation=14,
+            )
         return paper_penalty(
-            tool, poses[..., :3, 3], self._semi_axes(), rotations=poses[..., :3, :3], equation=16
+            tool,
+            poses[..., :3, 3],
+            paper_semi_axes(self.scene.obstacles, self.settings.z3),
+            rotations=poses[..., :3, :3],
+            equation=16,
         )
-
-    def _semi_axes(self) -> np.ndarray:
-        """Semi-axes (n_obs, 3) [m] of the circumscribing spheres/ellipsoids (eqs. 13, 15)."""
-        axes = []
-        for ob in self.scene.obstacles:
-            if self.settings.z3 == "paper-ellipsoid" and isinstance(ob.shape, Box):
-                # The smallest ellipsoid with the box's axes containing it: √3 × half sides
-                # (axis-aligned in the obstacle frame; the paper's cubes are axis-aligned).
-                axes.append(np.sqrt(3.0) * 0.5 * np.asarray(ob.shape.size))
-            else:
-                axes.append(np.full(3, ob.shape.bounding_radius))
-        return np.array(axes).reshape(-1, 3)
 
     def _constraints(
         self,

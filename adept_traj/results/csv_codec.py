@@ -93,10 +93,8 @@ def check_front_csv(r: PlanningResult, path: Path) -> None:
 
     Parameters
     ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
+    r, path:
+        As :func:`write_front_csv`.
 
     Raises
     ------
@@ -146,10 +144,8 @@ def write_trajectory_csv(r: PlanningResult, path: Path) -> Path:
 
     Parameters
     ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
+    r, path:
+        As :func:`write_front_csv`.
 
     Returns
     -------
@@ -165,19 +161,7 @@ def check_trajectory_csv(r: PlanningResult, path: Path) -> None:
     """Check that ``best_trajectory.csv`` agrees with a result read from ``result.json``:
     the fixed-step file with the best trade-off's spline (to :data:`_SAMPLE_RTOL`); a file
     of an earlier version (the certificate's grid) with ``result.json``'s dense samples,
-    exactly.
-
-    Parameters
-    ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
-
-    Raises
-    ------
-    ResultFormatError
-        Another header, row count or value (naming the row and column).
+    exactly. Its arguments and errors are those of :func:`check_front_csv`.
     """
     legacy = trajectory_header(r.robot.joint_names)
     text = read_text(path)

@@ -71,20 +71,10 @@ _JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=
 
 
 def write_json(r: PlanningResult, path: Path) -> Path:
-    """Write ``result.json`` of a result (atomically).
-
-    Parameters
-    ----------
-    r:
-        The :class:`~adept_traj.results.PlanningResult`.
-    path:
-        The file.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-    """
+    """Write result ``r`` (a :class:`~adept_traj.results.PlanningResult`) as JSON to
+    ``path`` (atomically: a reader sees the old file or the whole new one); return
+    ``path``. The layout is the module's (schema version :data:`VERSION`, or 1 for a
+    result read from a version-1 file)."""
     return write_text_atomic(path, _dumps(_encode(r)) + "\n")
 
 
@@ -349,7 +339,7 @@ def _check_derived(top: Node, result: PlanningResult) -> None:
     ``gap``, ``certificate.n_samples``, each check's ``worst`` and ``within``, …) disagree
     with what the rest of the file gives: the file re-encoded from the decoded result must be
     the file read. The walk is iterative (the nesting is already bounded)."""
-    # json.dumps (C) gives the same data as the file's own layout (_dumps), 4× faster
+    # json.dumps (C) gives the same data as the file's own layout (_dumps), faster
     stack: list[tuple[Any, Any, str]] = [(top.value, json.loads(json.dumps(_encode(result))), "")]
     while stack:
         stored, derived, path = stack.pop()

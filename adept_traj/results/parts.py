@@ -25,7 +25,13 @@ from adept_traj.errors import AdeptTrajError, InputShapeError, InvalidInputError
 from adept_traj.problem import OBJECTIVE_NAMES, Evaluation
 from adept_traj.robot import RobotSource
 from adept_traj.robot.robot import Robot, shipped_file
-from adept_traj.validation import as_finite_array, as_integer, as_scalar, deep_equal, readonly_copy
+from adept_traj.validation import (
+    DeepEqual,
+    as_finite_array,
+    as_integer,
+    as_scalar,
+    readonly_copy,
+)
 
 __all__ = [
     "SHIPPED_ROBOT",
@@ -153,7 +159,7 @@ def _is_shipped(robot: Robot) -> bool:
 
 # ============================================================================ front
 @dataclass(frozen=True, eq=False)
-class Front:
+class Front(DeepEqual):
     """A set of solutions: the final non-dominated set of a run.
 
     Attributes
@@ -262,11 +268,6 @@ class Front:
             certificates,
         )
 
-    def __eq__(self, other: object) -> bool:
-        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
-
-    __hash__ = None  # type: ignore[assignment]
-
 
 @dataclass(frozen=True)
 class BestSolution:
@@ -291,7 +292,7 @@ class BestSolution:
 
 # ============================================================================ run
 @dataclass(frozen=True, eq=False)
-class Metrics:
+class Metrics(DeepEqual):
     """Quality metrics of the front (``None``: not computed; NaN is stored as ``None``).
 
     Attributes
@@ -325,11 +326,6 @@ class Metrics:
             if ref.ndim != 1:
                 raise InputShapeError(f"hv_reference_point must be 1-D; got {ref.shape}")
             object.__setattr__(self, "hv_reference_point", ref)
-
-    def __eq__(self, other: object) -> bool:
-        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
-
-    __hash__ = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True)

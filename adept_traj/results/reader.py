@@ -41,17 +41,8 @@ def open_json(path: Path) -> Node:
 
 
 def read_text(path: Path) -> str:
-    """The UTF-8 text of a file of the result folder, at most
-    :data:`~adept_traj.files.MAX_FILE_BYTES`.
-
-    Parameters
-    ----------
-    path:
-        The file.
-
-    Returns
-    -------
-    str
+    """The UTF-8 text of the file ``path`` of the result folder, at most
+    :data:`~adept_traj.files.MAX_FILE_BYTES` (:func:`open_json` parses a JSON one).
 
     Raises
     ------

@@ -64,6 +64,7 @@ from adept_traj.robot import Robot
 from adept_traj.robot.limits import JointLimits
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import (
+    DeepEqual,
     as_finite_array,
     as_integer,
     check_type,
@@ -92,7 +93,7 @@ NO_FEASIBLE_WARNING = "no feasible solution found: the front holds the least-inf
 
 # ============================================================================ the result
 @dataclass(frozen=True, eq=False)
-class PlanningResult:
+class PlanningResult(DeepEqual):
     """Everything a planning run produces (see ``docs/results.md`` for the file schema).
 
     Build one with :meth:`from_problem` (fills the problem-derived fields) or directly.
@@ -331,11 +332,6 @@ class PlanningResult:
         ``z1 / metrics.t_best`` (≥ 1); ``None`` when T_best was not computed."""
         t_best = self.metrics.t_best
         return float(self.best_objectives[0]) / t_best if t_best else None
-
-    def __eq__(self, other: object) -> bool:
-        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
-
-    __hash__ = None  # type: ignore[assignment]
 
     # ------------------------------------------------------------------ files
     def save(self, folder: str | os.PathLike[str]) -> Path:

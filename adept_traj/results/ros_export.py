@@ -105,7 +105,8 @@ def to_csv(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the CSV of the member's dense samples.
 
     Raises
     ------

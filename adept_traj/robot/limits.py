@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import InvalidInputError, JointLimitError
-from adept_traj.validation import as_batch, deep_equal, readonly_copy
+from adept_traj.validation import DeepEqual, as_batch, readonly_copy
 
 __all__ = ["LIMITS", "LIMIT_KINDS", "JointLimits", "LimitKind"]
 
@@ -60,7 +60,7 @@ LIMIT_KINDS: tuple[str, ...] = tuple(kind.name for kind in LIMITS)
 
 
 @dataclass(frozen=True, init=False, eq=False)
-class JointLimits:
+class JointLimits(DeepEqual):
     """Per-joint limits, each an array of shape ``(nq,)`` in SI units.
 
     Attributes
@@ -115,11 +115,6 @@ class JointLimits:
             ("lower", "upper", "velocity", "acceleration", "jerk", "torque"), values
         ):
             object.__setattr__(self, field, readonly_copy(value))
-
-    def __eq__(self, other: object) -> bool:
-        return deep_equal(self, other) if type(other) is type(self) else NotImplemented
-
-    __hash__ = None  # type: ignore[assignment]
 
     @property
     def effort(self) -> np.ndarray:

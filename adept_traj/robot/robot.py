@@ -407,7 +407,7 @@ class Robot(FrozenAttributes):
             tau = tau.reshape(n, self.nq)
         else:
             # A fresh pool each call: it copies the model, so later edits of
-            # model.armature etc. are always seen (≈ 40 µs, negligible for a batch).
+            # model.armature etc. are always seen (negligible for a batch).
             pool = pin.ModelPool(self.model, 1)
             qf_, vf_, af_ = (np.asfortranarray(x.T) for x in (qf, vf, af))
             tau = pin.rneaInParallel(1, pool, qf_, vf_, af_).reshape(self.nq, n).T  # (n,): 1 joint

@@ -5,7 +5,13 @@ from __future__ import annotations
 
 from adept_traj.errors import SceneFileNotFoundError
 from adept_traj.scene.machine_motions import LinearMotion, RotationMotion, rotation_about
-from adept_traj.scene.meshes import MAX_MESH_TRIANGLES, MESH_SUFFIXES, Mesh, read_mesh_arrays
+from adept_traj.scene.meshes import (
+    MAX_MESH_TRIANGLES,
+    MESH_SUFFIXES,
+    Mesh,
+    merge_meshes,
+    read_mesh_arrays,
+)
 from adept_traj.scene.motion_laws import (
     FixedPose,
     MotionLaw,
@@ -70,6 +76,7 @@ __all__ = [
     "check_obstacle_count",
     "cloud_bytes",
     "coal_transform",
+    "merge_meshes",
     "pendulum_obstacles",
     "read_cloud_points",
     "read_mesh_arrays",

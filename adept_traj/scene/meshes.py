@@ -40,7 +40,7 @@ from adept_traj.errors import InvalidInputError, MeshFileError, OpenMeshWarning
 from adept_traj.scene.shapes import Shape
 from adept_traj.validation import as_finite_array, readonly_copy
 
-__all__ = ["MAX_MESH_TRIANGLES", "MESH_SUFFIXES", "Mesh", "read_mesh_arrays"]
+__all__ = ["MAX_MESH_TRIANGLES", "MESH_SUFFIXES", "Mesh", "merge_meshes", "read_mesh_arrays"]
 
 #: Most triangles one mesh may have (8 million: about 0.6 GB of vertices, triangles and
 #: coal's bounding-volume tree); a larger mesh is refused before it is built.
@@ -269,3 +269,15 @@ def read_mesh_arrays(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarr
     if not np.isfinite(vertices).all():
         raise MeshFileError(f"mesh file {str(p)!r} holds a non-finite vertex coordinate")
     return vertices, triangles
+
+
+def merge_meshes(*meshes: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """One triangle mesh of several ``(vertices (v, 3), triangles (f, 3))``: the vertices
+    stacked and each mesh's triangle indices shifted by the vertices before it (not a
+    boolean union: overlapping parts stay separate shells)."""
+    vs, ts, offset = [], [], 0
+    for v, t in meshes:
+        vs.append(v)
+        ts.append(t + offset)
+        offset += len(v)
+    return np.vstack(vs), np.vstack(ts)

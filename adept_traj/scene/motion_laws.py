@@ -124,8 +124,7 @@ class MotionLaw(ValueObject, ABC):
 
         Parameters
         ----------
-        point: (3,) centre of the attached ball in the moving frame [m].
-        radius: radius of the attached ball [m], ≥ 0.
+        point, radius: the attached ball, as for :meth:`swept_ball`.
 
         Returns
         -------

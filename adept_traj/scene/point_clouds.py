@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -208,6 +209,29 @@ class PointCloud(Shape):
     def to_coal(self) -> coal.OcTree:
         """A new ``coal.OcTree`` of the points at the resolution (``coal.makeOctree``)."""
         return coal.makeOctree(np.array(self.points), self.resolution)
+
+    def derived(self, key: str, make: Callable[[PointCloud], Any]) -> Any:
+        """Data derived from this cloud alone (e.g. the collision checker's leaves), made
+        once by ``make(self)`` and kept on the cloud (it is frozen: nothing it is made from
+        can change), the same object on every call for ``key``. Not pickled: a copy in
+        another process makes its own.
+
+        Parameters
+        ----------
+        key:
+            Names the data (by convention the module making it).
+        make:
+            Makes it from the cloud; called on the first request for ``key`` only.
+        """
+        cache = self.__dict__.setdefault("_derived", {})
+        if key not in cache:
+            cache[key] = make(self)
+        return cache[key]
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state.pop("_derived", None)  # coal objects, made again where needed
+        return state
 
 
 def _coarse_field(points: np.ndarray, r: float, lo: np.ndarray, hi: np.ndarray) -> Any:

@@ -22,10 +22,10 @@ import numpy as np
 
 from adept_traj.errors import InputShapeError, InvalidInputError
 from adept_traj.validation import (
+    DeepEqual,
     as_finite_array,
     as_scalar,
     as_vector,
-    deep_equal,
     describe_bad_values,
     readonly_copy,
 )
@@ -41,11 +41,12 @@ __all__ = [
 ]
 
 
-class ValueObject:
+class ValueObject(DeepEqual):
     """Equality and hashing by field values, numpy arrays compared element-wise.
 
     A dataclass's generated ``__eq__`` fails on array fields (``bool(array == array)`` is
-    ambiguous); frozen dataclasses of this package declare ``eq=False`` and inherit these.
+    ambiguous); frozen dataclasses of this package declare ``eq=False`` and inherit these
+    (the equality of :class:`~adept_traj.validation.DeepEqual`, with a hash).
     """
 
     def _key(self) -> tuple[Any, ...]:
@@ -56,11 +57,6 @@ class ValueObject:
                 value = (value.shape, (value + 0.0).tobytes())  # + 0.0: -0.0 hashes as 0.0
             values.append(value)
         return tuple(values)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return deep_equal(self, other)
 
     def __hash__(self) -> int:
         return hash((type(self).__name__, self._key()))

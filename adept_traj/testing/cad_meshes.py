@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from adept_traj.scene.meshes import merge_meshes
+
 __all__ = ["box_mesh", "merge_meshes", "table_mesh", "write_stl"]
 
 
@@ -47,17 +49,6 @@ def box_mesh(size, subdivisions: int = 1, centre=(0.0, 0.0, 0.0)):
                     tris += [(c0, c1, c2), (c0, c2, c3)]
     vertices = np.array(list(verts)) * h + np.asarray(centre, dtype=float)
     return vertices, np.array(tris, dtype=np.int64)
-
-
-def merge_meshes(*meshes):
-    """One mesh (vertices, triangles) of several, indices shifted (not a boolean union:
-    overlapping parts stay separate shells)."""
-    vs, ts, offset = [], [], 0
-    for v, t in meshes:
-        vs.append(v)
-        ts.append(t + offset)
-        offset += len(v)
-    return np.vstack(vs), np.vstack(ts)
 
 
 def table_mesh(top=(0.6, 0.4), height=0.4, thickness=0.04, leg=0.05, subdivisions=2):

@@ -5,8 +5,10 @@
 per-segment, per-sample loops: Pinocchio (RNEA, frame Jacobians) and coal are called once per
 sample and per (solid, obstacle) pair, with no broad phase; the spline is evaluated segment
 by segment with scalar formulas (``_ReferenceSpline``), not with
-:mod:`~adept_traj.problem.spline_segments`; the constraints (paper (7)–(12)) and the
-circumscribing volumes of the paper's penalty (eqs. 13, 15) are written out here again. It
+:mod:`~adept_traj.problem.spline_segments`; the constraints (paper (7)–(12)) are written
+out here again (the circumscribing volumes of the paper's penalty, eqs. 13 and 15, are the
+problem's definition, :func:`~adept_traj.problem.paper_semi_axes`, which the tests check
+against the closed form). It
 shares no evaluation code with the batched problem — the Coulomb sign, the manipulability
 measure, the closed-form point distances of sphere obstacles and the paper's penalty are
 written out here too, scalar, one sample at a time — which makes it the oracle of the tests
@@ -26,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from adept_traj.collision import distance_request
-from adept_traj.problem import Evaluation, TrajectoryProblem
+from adept_traj.problem import Evaluation, TrajectoryProblem, paper_semi_axes
 from adept_traj.robot import LIMITS, TASK_ROWS, VELOCITY_AT_REST
 from adept_traj.scene import Box, Capsule, Cylinder, Sphere
 from adept_traj.validation import as_batch, check_type
@@ -55,19 +57,6 @@ def evaluate_reference(problem: TrajectoryProblem, x: Any) -> Evaluation:
     if xa.ndim == 1:
         return Evaluation(ev.objectives[0], ev.constraints[0], ev.min_distance[0], 0, seconds)
     return Evaluation(ev.objectives, ev.constraints, ev.min_distance, 0, seconds)
-
-
-def _semi_axes(problem: TrajectoryProblem) -> np.ndarray:
-    """Semi-axes (n_obs, 3) [m] of the paper's circumscribing volumes: a sphere of the
-    shape's bounding radius (eq. 13), or for a box with ``"paper-ellipsoid"`` the smallest
-    ellipsoid with the box's axes, √3 × the half sides (eq. 15)."""
-    axes = []
-    for ob in problem.scene.obstacles:
-        if problem.settings.z3 == "paper-ellipsoid" and isinstance(ob.shape, Box):
-            axes.append(np.sqrt(3.0) * 0.5 * np.asarray(ob.shape.size))
-        else:
-            axes.append(np.full(3, ob.shape.bounding_radius))
-    return np.array(axes).reshape(-1, 3)
 
 
 def _coulomb_sign(v: float) -> float:
@@ -205,7 +194,10 @@ def _evaluate(problem: TrajectoryProblem, x: np.ndarray) -> Evaluation:
             poses = np.array(obs_poses).transpose(1, 0, 2, 3)  # (n_obs, n_s, 4, 4)
             rotations = None if st.z3 == "paper-sphere" else poses[..., :3, :3]
             z3 = _paper_penalty(
-                np.array(tool_points), poses[..., :3, 3], _semi_axes(problem), rotations
+                np.array(tool_points),
+                poses[..., :3, 3],
+                paper_semi_axes(problem.scene.obstacles, problem.settings.z3),
+                rotations,
             )
         objectives.append([T, z2, z3, z4, z5, z6])
         constraints.append(_constraints(problem, extrema, tau_max, d_obs.min(initial=np.inf)))

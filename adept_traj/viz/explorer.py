@@ -58,6 +58,7 @@ from adept_traj.scene import (
     PointCloud,
     Scene,
     Sphere,
+    merge_meshes,
 )
 from adept_traj.validation import as_path, check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
@@ -133,12 +134,7 @@ def _mesh(shape: Any) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(shape, Capsule):
         parts = [_cylinder(shape.radius, shape.length)]
         parts += [_sphere(shape.radius, z) for z in (-0.5 * shape.length, 0.5 * shape.length)]
-        verts, faces, offset = [], [], 0
-        for v, f in parts:
-            verts.append(v)
-            faces.append(f + offset)
-            offset += len(v)
-        return np.vstack(verts), np.vstack(faces)
+        return merge_meshes(*parts)
     if isinstance(shape, Mesh):  # its own triangles
         return np.asarray(shape.vertices, dtype=float), np.asarray(shape.triangles)
     if isinstance(shape, PointCloud):  # drawn as the box of its points (the page stays small)

@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError, WorkerDiedError
+from adept_traj.process_helper import Helper
 from adept_traj.process_pool import LOWEST_PRIORITY, Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
@@ -54,7 +55,8 @@ READY_TIMEOUT = 0.0
 #: the rest of the imports takes a fraction of it on a free core, and redoing them in
 #: the caller would take as long.
 HURRIED_TIMEOUT = 3.0
-#: Cost weight of ``playback.html`` on the scale of the figures' weights [0.1 s CPU].
+#: Cost weight of ``playback.html`` on the scale of the figures' weights (their relative
+#: CPU costs, :func:`~adept_traj.viz.plots.all_figures.figure_jobs`).
 _HTML_WEIGHT = 0.3
 
 
@@ -83,7 +85,7 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     return Finisher(robot, scene, figures=bool(figures), html=bool(html))
 
 
-class Finisher:
+class Finisher(Helper):
     """The helper process forked by :func:`start_finisher`; a context manager that stops
     it when the block is left.
 
@@ -107,14 +109,6 @@ class Finisher:
                 note="raised while writing the figures and page in a worker process",
             )
 
-    @property
-    def pid(self) -> int | None:
-        return None if self._worker is None else self._worker.pid
-
-    def ready(self, timeout: float = 0.0) -> bool:
-        """Whether the helper has done its imports (waiting up to ``timeout`` [s])."""
-        return self._worker is not None and self._worker.ready(timeout)
-
     def _ready_now(self) -> bool:
         """Whether the helper is ready: at once, or within :data:`READY_TIMEOUT`, or, with
         its imports raised to this process's priority, within :data:`HURRIED_TIMEOUT`."""
@@ -122,17 +116,6 @@ class Finisher:
             return True
         worker = self._worker
         return worker is not None and worker.hurry() and self.ready(HURRIED_TIMEOUT)
-
-    def cancel(self) -> None:
-        """Stop the helper (a no-op once it is reaped): killed, then reaped."""
-        if self._worker is not None:
-            self._worker.close()
-
-    def __enter__(self) -> Finisher:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
     def start(
         self,

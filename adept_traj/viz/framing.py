@@ -8,16 +8,12 @@ sets the camera.
 from __future__ import annotations
 
 import math
-import warnings
 from typing import Any
 
 import numpy as np
 
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat.geometry as mg
-
 from adept_traj.viz.meshcat_geometry import Part, translation
+from adept_traj.viz.meshcat_modules import mg
 
 __all__ = ["FLOOR_COLOR", "GRID_COLOR", "camera", "floor"]
 

@@ -8,17 +8,12 @@ a capsule is a cylinder and two spheres.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import coal
 import numpy as np
-
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat.geometry as mg
 
 from adept_traj.errors import InvalidInputError
 from adept_traj.scene import (
@@ -32,6 +27,7 @@ from adept_traj.scene import (
     Shape,
     Sphere,
 )
+from adept_traj.viz.meshcat_modules import mg
 
 __all__ = [
     "MAX_DRAWN_POINTS",

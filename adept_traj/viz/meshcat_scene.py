@@ -19,21 +19,16 @@ import html
 import json
 import math
 import uuid
-import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat
-    import umsgpack
-
 from adept_traj.errors import MeshcatServerError
 from adept_traj.files import write_text_atomic
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.viz.meshcat_geometry import translation
+from adept_traj.viz.meshcat_modules import meshcat, umsgpack
 from adept_traj.viz.playback import (
     CLOSEST_COLOR,
     FIXED_OBSTACLE_COLOR,
@@ -315,44 +310,11 @@ def _page(playback: Playback, *, title: str, label: str | None, viewer: str) -> 
     )
 
 
-def static_html(
-    result: PlanningResult,
-    path: str | Path,
-    *,
-    speed: float = 1.0,
-    fps: float = 30.0,
-    loop: bool = True,
-    show_closest: bool = False,
-    replay: Replay | None = None,
-    member: int | None = None,
-) -> Path:
-    """Write a self-contained HTML page playing a member of ``result``'s front (default:
-    the best trade-off), labelled with the member, its T and whether it is certified.
-
-    The page inlines meshcat's viewer and the scene (no server, no network access); the
-    animation starts on opening and loops (``loop=False``: plays once). About 0.9 MB,
-    written atomically (a temporary file renamed).
-
-    Parameters
-    ----------
-    result: the planning result.
-    path: the file to write (its folder is created if needed).
-    speed, fps, show_closest, replay, member: see
-        :func:`~adept_traj.viz.playback.build_animation`.
-    loop: loop the animation forever.
-
-    Returns
-    -------
-    pathlib.Path
-        The written file.
-    """
-    return write_text_atomic(
-        Path(path),
-        result_page(
-            result, speed=speed, fps=fps, loop=loop, show_closest=show_closest,
-            replay=replay, member=member,
-        ),
-    )  # fmt: skip
+def static_html(result: PlanningResult, path: str | Path, **options: Any) -> Path:
+    """Write :func:`result_page`'s page of ``result`` to ``path`` (its folder created if
+    needed), atomically (a temporary file renamed); ``options`` are
+    :func:`result_page`'s keywords. Returns ``path`` as a :class:`pathlib.Path`."""
+    return write_text_atomic(Path(path), result_page(result, **options))
 
 
 def result_page(
@@ -365,7 +327,24 @@ def result_page(
     replay: Replay | None = None,
     member: int | None = None,
 ) -> str:
-    """The text of :func:`static_html`'s page (same parameters but ``path``)."""
+    """A self-contained HTML page playing a member of ``result``'s front (default: the best
+    trade-off), labelled with the member, its T and whether it is certified.
+
+    The page inlines meshcat's viewer and the scene (no server, no network access); the
+    animation starts on opening and loops (``loop=False``: plays once). About 0.9 MB.
+
+    Parameters
+    ----------
+    result: the planning result.
+    speed, fps, show_closest, replay, member: see
+        :func:`~adept_traj.viz.playback.build_animation`.
+    loop: loop the animation forever.
+
+    Returns
+    -------
+    str
+        The page (``playback.html``, written by :func:`static_html`).
+    """
     playback = build_animation(
         result, speed=speed, fps=fps, show_closest=show_closest, replay=replay, member=member
     )

@@ -27,18 +27,11 @@ Timing: frame ``k`` is shown at playback time ``k / fps`` [s] and shows the phys
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat.geometry as mg
-    from meshcat.animation import Animation, AnimationFrameVisualizer
-    from meshcat.path import Path as MeshcatPath
 
 from adept_traj.certification import dense_samples
 from adept_traj.errors import InvalidInputError
@@ -61,6 +54,12 @@ from adept_traj.viz.meshcat_geometry import (
     shape_parts,
     solid_parts,
     translation,
+)
+from adept_traj.viz.meshcat_modules import (
+    Animation,
+    AnimationFrameVisualizer,
+    MeshcatPath,
+    mg,
 )
 
 __all__ = [

@@ -16,19 +16,14 @@ import queue
 import subprocess
 import sys
 import threading
-import warnings
 import webbrowser
 from typing import Any
 
 import zmq
 
-with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
-    warnings.filterwarnings("ignore", "zmq.eventloop.ioloop is deprecated", DeprecationWarning)
-    import meshcat
-    from meshcat.visualizer import ViewerWindow
-
 from adept_traj.errors import MeshcatServerError
 from adept_traj.results import PlanningResult, Replay
+from adept_traj.viz.meshcat_modules import ViewerWindow, meshcat
 from adept_traj.viz.meshcat_scene import draw, member_page
 from adept_traj.viz.playback import build_animation
 

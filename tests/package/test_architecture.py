@@ -17,6 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "adept_traj"
 RANK = {
     "errors": 0, "data": 0, "urdf": 0,
     "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
+    "process_helper": 1.5,
     "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,

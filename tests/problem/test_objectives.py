@@ -225,3 +225,20 @@ def test_paper_penalty_equation_14_and_rotated_ellipsoids() -> None:
     assert float(paper_penalty(point, centre, axes)) == 0.0  # axis-aligned: outside
     inside = float(paper_penalty(point, centre, axes, rotations=turn))
     assert inside == pytest.approx(1.0 / 0.25**2)  # r_e = 0.5² / 1²
+
+
+def test_paper_semi_axes_closed_form() -> None:
+    """Eq. 13: a sphere of the shape's bounding radius; eq. 15 (``paper-ellipsoid``): a box's
+    semi-axes √3 × its half sides, other shapes still spheres."""
+    from adept_traj.problem import paper_semi_axes
+    from adept_traj.scene import Box, Obstacle, Sphere
+
+    obstacles = (Obstacle("box", Box((0.2, 0.4, 0.6))), Obstacle("ball", Sphere(0.1)))
+    sphere = paper_semi_axes(obstacles, "paper-sphere")
+    ellipsoid = paper_semi_axes(obstacles, "paper-ellipsoid")
+    half_diagonal = 0.5 * np.sqrt(0.2**2 + 0.4**2 + 0.6**2)
+    np.testing.assert_allclose(sphere, [[half_diagonal] * 3, [0.1] * 3], rtol=1e-15)
+    np.testing.assert_allclose(
+        ellipsoid, [[0.1 * 3**0.5, 0.2 * 3**0.5, 0.3 * 3**0.5], [0.1] * 3], rtol=1e-15
+    )
+    assert paper_semi_axes((), "paper-sphere").shape == (0, 3)

@@ -76,8 +76,8 @@ POLISH_MODES: tuple[str, ...] = ("off", "fastest", "front", "all")
 SPREAD_MEMBERS = 2
 
 #: Cost of one gradient evaluation of the polish (constraints, objectives and their
-#: Jacobians of one move, ≈ 40 ms) in evaluations of one move by the search's evaluator
-#: (≈ 0.6 ms within a paper population), measured on the paper scene.
+#: Jacobians of one move) in evaluations of one move by the search's evaluator (within a
+#: paper population): the ratio of the two times, measured on the paper scene.
 GRADIENT_COST = 40
 
 #: Share of the search's evaluations (in evaluator units, :data:`GRADIENT_COST`) that

@@ -72,8 +72,7 @@ FRACTIONS = 0.5 ** np.arange(6)
 #: bound its answer (a box that found one goes on: the next box keeps those rows).
 _WORKING_SET_ROUNDS = 3
 
-#: A box whose best point lowers T by less than this fraction ends the solve (0.15 ms
-#: of a 1.5 s move).
+#: A box whose best point lowers T by less than this fraction of T ends the solve.
 _PROGRESS = 1e-4
 
 

@@ -96,10 +96,8 @@ def weighted_descent(
 
     Parameters
     ----------
-    problem:
-        The :class:`~adept_traj.problem.TrajectoryProblem` (``z3="clearance"``).
-    x0:
-        (n_var,) start ``[T [s], free control points [rad | m]]``, inside the bounds.
+    problem, x0:
+        As :func:`~adept_traj.optimise.local.epsilon_constraint.epsilon_step`.
     weighted:
         The :class:`~adept_traj.analysis.WeightedSum` to minimise.
     max_evaluations:

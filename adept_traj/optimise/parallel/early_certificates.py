@@ -44,6 +44,7 @@ from adept_traj.certification.member_certificate import MemberCertificate, certi
 from adept_traj.errors import WorkerDiedError
 from adept_traj.optimise.parallel.front_certificates import checked_members
 from adept_traj.problem import TrajectoryProblem, from_pymoo
+from adept_traj.process_helper import Helper
 from adept_traj.process_pool import Channel, Worker, can_fork
 
 __all__ = ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"]
@@ -103,7 +104,7 @@ def feasible_front(F: Any, G: Any, weights: Any) -> np.ndarray:
     return rows[best_tradeoff(objectives[rows], weights).order]
 
 
-class EarlyCertificates:
+class EarlyCertificates(Helper):
     """The certificates started by :func:`start_early_certificates`; a context manager
     that stops its worker when the block is left.
 
@@ -127,21 +128,6 @@ class EarlyCertificates:
         self._worker: Worker | None = None
         if fork and self._shares and can_fork():
             self._worker = Worker(_work, self, note="raised in the early certificates' worker")
-
-    @property
-    def pid(self) -> int | None:
-        return None if self._worker is None else self._worker.pid
-
-    def cancel(self) -> None:
-        """Stop the worker (a no-op once it is reaped): killed, then reaped."""
-        if self._worker is not None:
-            self._worker.close()
-
-    def __enter__(self) -> EarlyCertificates:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
     def finish(
         self, wanted: Collection[bytes] | None = None, *, failed: list[int] | None = None

@@ -32,18 +32,14 @@ import dataclasses
 from functools import partial
 from typing import Any
 
-from adept_traj.certification import (
-    MemberCertificate,
-    certifying_problem,
-    problem_parts,
-    same_parts,
-)
+from adept_traj.certification import MemberCertificate, certifying_problem
 from adept_traj.errors import ConfigurationError, WorkerDiedError
 from adept_traj.optimise.local.multi_start import made_relaxed_optima
 from adept_traj.optimise.local.polish_modes import polish_mode, polish_run_with_certificates
 from adept_traj.optimise.parallel.early_certificates import EarlyCertificates, feasible_front
 from adept_traj.optimise.search.loop import RunState
 from adept_traj.problem import TrajectoryProblem
+from adept_traj.process_helper import Helper
 from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.validation import as_scalar, check_type
 
@@ -72,18 +68,16 @@ def start_polisher(problem: TrajectoryProblem) -> Polisher:
 
 def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
     """Refuse a ``polisher`` that is neither ``None`` nor a :class:`Polisher` started for
-    ``problem`` (the same object, with the same settings, robot, scene, start and goal as
-    when the polisher was forked: its helper polishes the copy it inherited then). A
-    polisher already used, or stopped, is accepted: it is not ready, and the caller
-    polishes itself (a helper serves one search).
+    ``problem`` (the same object: the problem is frozen, so its helper polishes the problem
+    as it is). A polisher already used, or stopped, is accepted: it is not ready, and the
+    caller polishes itself (a helper serves one search).
 
     Raises
     ------
     InvalidInputError
         ``polisher`` of another type.
     ConfigurationError
-        A polisher started for another problem, or for this problem before one of its
-        parts was replaced.
+        A polisher started for another problem.
     """
     if polisher is None:
         return
@@ -92,12 +86,6 @@ def check_polisher(polisher: Any, problem: TrajectoryProblem) -> None:
         raise ConfigurationError(
             "the polisher was started for another problem (start_polisher(problem) with "
             "the problem given to plan)"
-        )
-    if not same_parts(polisher.made_from, problem):
-        raise ConfigurationError(
-            "the problem's settings, robot, scene, start or goal were replaced after the "
-            "polisher was started (its process polishes the problem as it was then): "
-            "start_polisher(problem) again"
         )
 
 
@@ -157,7 +145,7 @@ def polish_with_certificates(
     return polished, {**early.finish(keys), **certified}
 
 
-class Polisher:
+class Polisher(Helper):
     """The helper process forked by :func:`start_polisher`; a context manager that stops
     it when the block is left.
 
@@ -165,15 +153,12 @@ class Polisher:
     ----------
     problem : TrajectoryProblem
         The problem it polishes for (the caller's object).
-    made_from : tuple
-        ``problem``'s settings, robot, scene, start and goal when it was forked.
     pid : int or None
         The helper's process id (``None`` without one, or once it is reaped).
     """
 
     def __init__(self, problem: TrajectoryProblem) -> None:
         self.problem = problem
-        self.made_from = problem_parts(problem)
         self._order: dict[str, Any] | None = None
         self._worker: Worker | None = None
         if can_fork():
@@ -183,26 +168,6 @@ class Polisher:
                 prepare=partial(_prepare, problem),
                 note="raised while polishing in the polisher's worker process",
             )
-
-    @property
-    def pid(self) -> int | None:
-        return None if self._worker is None else self._worker.pid
-
-    def ready(self, timeout: float = 0.0) -> bool:
-        """Whether the helper is prepared (waiting up to ``timeout`` [s]); ``False`` once
-        it is stopped or used (a helper serves one search)."""
-        return self._worker is not None and self._worker.ready(timeout)
-
-    def cancel(self) -> None:
-        """Stop the helper (a no-op once it is reaped): killed, then reaped."""
-        if self._worker is not None:
-            self._worker.close()
-
-    def __enter__(self) -> Polisher:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
 
     def start(self, state: RunState, rate_hz: float, mode: str, weights: Any) -> bool:
         """Hand the search's final ``state`` to the helper, if it is ready, and return at

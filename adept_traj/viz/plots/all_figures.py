@@ -24,6 +24,7 @@ from typing import Any
 
 from adept_traj.errors import InvalidInputError, WorkerDiedError
 from adept_traj.problem import available_cores
+from adept_traj.process_helper import Helper
 from adept_traj.process_pool import Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.validation import as_integer, check_type
@@ -196,7 +197,7 @@ def start_save_all(
     return BackgroundFigures(jobs, paths, n_proc)
 
 
-class BackgroundFigures:
+class BackgroundFigures(Helper):
     """The figures being drawn in a worker process (made by :func:`start_save_all`).
 
     Attributes
@@ -236,15 +237,8 @@ class BackgroundFigures:
     def cancel(self) -> None:
         """Stop the drawing (a no-op once :meth:`wait` has returned): the worker is killed
         and reaped; files it has finished stay (each is written atomically)."""
-        if self._worker is not None:
-            self._worker.close()
-            self._worker = None
-
-    def __enter__(self) -> BackgroundFigures:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.cancel()
+        super().cancel()
+        self._worker = None
 
 
 def _draw_all(channel: Channel, jobs: list[Job], processes: int) -> None:

@@ -57,7 +57,8 @@ def pareto_matrix(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the matrix of the fronts' pairwise scatter plots.
     """
     res = as_results(results)
     out = png_path(path)

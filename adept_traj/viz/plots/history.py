@@ -56,7 +56,8 @@ def hypervolume_history(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the hypervolume (or feasible count) per generation.
 
     Raises
     ------

@@ -87,7 +87,8 @@ def joint_motion(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the member's joint profiles against their limits.
 
     Raises
     ------

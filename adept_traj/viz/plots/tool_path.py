@@ -81,7 +81,8 @@ def tool_path_3d(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the tool path in the scene and its two projections.
     """
     r = as_result(result)
     out = png_path(path)

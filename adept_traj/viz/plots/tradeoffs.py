@@ -45,7 +45,8 @@ def best_tradeoffs(
 
     Returns
     -------
-    The path written.
+    pathlib.Path
+        ``path``, the bar chart of the best trade-offs' scores.
     """
     res = as_results(results)
     out = png_path(path)
