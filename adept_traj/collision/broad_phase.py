@@ -327,12 +327,16 @@ class BroadPhase:
         obstacle_poses: list[np.ndarray],
         q: np.ndarray | None = None,
         centres: np.ndarray | None = None,
+        cloud_level: bool | np.ndarray = True,
     ) -> Bounds:
         """Lower bounds for joint frames (njoints, 3, 4, N) (component-major) and obstacle
         poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
         configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too.
         ``centres`` (3, n_solids, N) [m] may pass the enclosing-ball centres if already
-        computed (:meth:`ball_centres` of the same ``frames``)."""
+        computed (:meth:`ball_centres` of the same ``frames``). ``cloud_level``
+        (n_obstacles,) bool leaves level 5 out for the point clouds not marked (the branch
+        and bound's cloud search bounds their leaves itself:
+        :mod:`~adept_traj.collision.cloud_search`)."""
         n = frames.shape[-1]
         for name, value, shape in (
             ("q", q, (n, self.nq)),
@@ -344,6 +348,7 @@ class BroadPhase:
         # work; ``exact`` (few entries) is written in the layout of the result directly.
         lower = np.empty((self.n_solids, self.n_obstacles, n))
         exact = np.zeros((n, self.n_solids, self.n_obstacles), dtype=bool)
+        level5 = np.broadcast_to(cloud_level, (self.n_obstacles,))
         if self.n_obstacles and n:
             rows = {p: frames[p].reshape(12, n) for p, _ in self._by_parent}
             # Level 0 first; level 1 only for the pairs (and samples) it leaves open.
@@ -369,7 +374,9 @@ class BroadPhase:
                     exact[idx, k, o] = True
                 else:
                     sub = rows[self.parents[k]][:, idx]
-                    lower[k, o, idx] = self._refine(lower[k, o, idx], sub, frames, idx, po, k, o)
+                    lower[k, o, idx] = self._refine(
+                        lower[k, o, idx], sub, frames, idx, po, k, o, bool(level5[o])
+                    )
         # (n_solids · n_obstacles, N) → (N, n_solids, n_obstacles): a 2-D transpose copies
         # about twice as fast as the 3-D one with few obstacles (as fast with many)
         flat = lower.reshape(self.n_solids * self.n_obstacles, n)
@@ -414,8 +421,9 @@ class BroadPhase:
         po: np.ndarray,
         k: int,
         o: int,
+        cloud_level: bool = True,
     ) -> np.ndarray:
-        """Levels 3 and 4 for solid ``k`` at the samples ``idx`` (its parent joint's frame
+        """Levels 3 and 4 (or 5) for solid ``k`` at the samples ``idx`` (its parent joint's frame
         as ``rows`` (12, R); all joint ``frames`` (njoints, 3, 4, N)) and obstacle ``o``
         (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
         centres = self._cover_in_joint[k]
@@ -427,7 +435,7 @@ class BroadPhase:
         kind_s, kind_o = self.solid_kind[k], self.obstacle_kind[o]
         still = np.flatnonzero(bound <= self.influence)
         if still.size and kind_o is None:  # a point cloud: level 5 (a mesh: as it is)
-            return cloud_bound(self, bound, still, frames, idx, po, k, o)
+            return cloud_bound(self, bound, still, frames, idx, po, k, o) if cloud_level else bound
         if still.size == 0 or kind_s is None or kind_o is None:
             return bound
         ps = self.solid_poses(frames, idx[still], k)
