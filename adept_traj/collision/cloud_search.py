@@ -37,7 +37,10 @@ from adept_traj.collision.primitives import distance_request
 if TYPE_CHECKING:
     from adept_traj.collision.checker import CollisionChecker
 
-__all__ = ["cloud_obstacles", "search_clouds"]
+__all__ = ["ROUNDS", "cloud_obstacles", "search_clouds"]
+
+#: The first rank (by bound, in its pair) of each round of candidates.
+ROUNDS = (0, 2, 8)
 
 
 def cloud_obstacles(checker: CollisionChecker) -> np.ndarray:
@@ -101,15 +104,19 @@ def search_clouds(
         sel = np.flatnonzero(solid == s)
         poses[sel] = checker.broad_phase.solid_poses(frames, sample[sel], s)
     candidates = (pair, cand, sample, solid, obstacle, poses)
-    # round 1: each pair's candidate of the smallest bound; round 2: the others whose
-    # bound is at most the pair's upper bound then known
+    # in rounds of each pair's candidates by increasing bound (ROUNDS), each round's only
+    # where the bound is at most the pair's upper bound then known
     bound = rows[pair, cand]
     order = np.lexsort((bound, pair))
-    first = np.zeros(len(pair), dtype=bool)
-    first[order[np.flatnonzero(np.diff(pair[order], prepend=-1))]] = True
-    parts = [_descend(checker, obstacle_poses, candidates, np.flatnonzero(first), cap, state)]
-    rest = np.flatnonzero(~first & (bound <= np.minimum(cap, state["upper"])[pair] + TIE))
-    parts.append(_descend(checker, obstacle_poses, candidates, rest, cap, state))
+    rank = np.empty(len(pair), dtype=int)
+    starts = np.flatnonzero(np.diff(pair[order], prepend=-1))
+    rank[order] = np.arange(len(pair)) - np.repeat(starts, np.diff(np.append(starts, len(pair))))
+    parts = []
+    for lo, hi in zip(ROUNDS, (*ROUNDS[1:], np.inf)):
+        todo = (rank >= lo) & (rank < hi) & (bound <= np.minimum(cap, state["upper"])[pair] + TIE)
+        parts.append(
+            _descend(checker, obstacle_poses, candidates, np.flatnonzero(todo), cap, state)
+        )
     upper, floor = state["upper"], state["floor"]
     entry, leaf, bound = (np.concatenate([p[i] for p in parts]) for i in range(3))
     keep = bound <= np.minimum(cap, upper)[pair[entry]] + TIE  # caps lowered by later solids

@@ -27,18 +27,28 @@ centimetres away).
 
 from __future__ import annotations
 
+import functools
 import weakref
 from dataclasses import dataclass
 
 import coal
 import numpy as np
 
-from adept_traj.collision.cloud_distance import TIE, CloudCells, solid_distance_bound
+from adept_traj.collision.cloud_distance import (
+    TIE,
+    CloudCells,
+    solid_distance_bound,
+    solid_half_sides,
+)
 
 __all__ = ["TOP_NODES", "CloudTree", "Descent", "cloud_tree", "descend", "exact_signed_distance"]
 
 #: Most nodes of the coarsest level (every query is bounded against each of them).
 TOP_NODES = 16
+
+#: Nodes of cubes larger than this [m] are bounded by the gaps between their box and the
+#: solid's box (on the cloud's axes) and their slab only: a cheap first cut of far nodes.
+FINE_EDGE = 0.08
 
 #: Subtracted from a slab gap, which can equal the distance: a lower bound under rounding.
 ROUNDING = 1e-9
@@ -54,7 +64,8 @@ class Level:
     (n,) int, ``first`` (n + 1,) int: the children of node i are the nodes
     ``first[i]:first[i + 1]`` of the next (finer) level (unused at the leaves); and the
     slab holding each node's leaves, ``low ≤ normal · x ≤ high`` (normal (n, 3) unit,
-    low, high (n,) [m]; None at the leaves)."""
+    low, high (n,) [m]; None at the leaves); ``coarse``: cubes of an edge above
+    :data:`FINE_EDGE`."""
 
     centre: np.ndarray
     half: np.ndarray
@@ -63,6 +74,7 @@ class Level:
     normal: np.ndarray | None = None
     low: np.ndarray | None = None
     high: np.ndarray | None = None
+    coarse: bool = False
 
 
 class CloudTree:
@@ -110,7 +122,8 @@ class CloudTree:
             nxt = starts[j + 1] if j + 1 < len(starts) else start
             first = np.searchsorted(nxt, start)
             slab = _slabs(self.leaf_centre, self.leaf_half, start) if j < len(keys) else ()
-            levels.append(Level(mid, spread, rep, first, *slab))
+            coarse = j < len(keys) and leaf * 2.0 ** (len(keys) - j) > FINE_EDGE
+            levels.append(Level(mid, spread, rep, first, *slab, coarse=coarse))
         self.levels = tuple(levels)
 
 
@@ -210,12 +223,17 @@ def descend(
     n = np.tile(np.arange(len(tree.levels[0].rep)), len(rot))
     bound = np.empty(0)
     last = len(tree.levels) - 1
+    reach = np.abs(rot) @ solid_half_sides(solid)  # (R, 3) half sides of the solids' boxes
     for j, level in enumerate(tree.levels):
         r, p, gq = rot[q], pos[q], group[q]
-        local = np.einsum("mji,mj->mi", r, level.centre[n] - p)  # solid frame
-        d, g = solid_distance_bound(solid, local)  # type: ignore[misc]
-        g = np.einsum("mij,mj->mi", r, g)  # the subgradient, cloud frame
-        bound = d - np.einsum("mi,mi->m", np.abs(g), level.half[n])
+        if level.coarse:  # the gap between the boxes on the cloud's axes
+            off = np.abs(p - level.centre[n]) - reach[q] - level.half[n]
+            bound = functools.reduce(np.maximum, off.T) - ROUNDING
+        else:  # ℓ
+            local = np.einsum("mji,mj->mi", r, level.centre[n] - p)  # solid frame
+            d, g = solid_distance_bound(solid, local)  # type: ignore[misc]
+            g = np.einsum("mij,mj->mi", r, g)  # the subgradient, cloud frame
+            bound = d - np.einsum("mi,mi->m", np.abs(g), level.half[n])
         if level.normal is not None and slab:  # the gap to the node's slab, where positive
             nrm = level.normal[n]
             h = solid_support(solid, np.einsum("mji,mj->mi", r, nrm))
@@ -223,8 +241,11 @@ def descend(
             gap = np.maximum(level.low[n] - at - h, at - h - level.high[n]) - ROUNDING
             np.maximum(bound, gap, out=bound, where=gap > 0.0)
         keep = bound <= np.minimum(cap, upper)[gq] + TIE  # (an upper bound may equal ℓ)
-        if exact:  # the representative leaf's corner facing the solid: an upper bound
-            k = np.flatnonzero(keep)  # (of the nodes kept: the others' are above the cap)
+        if exact and not level.coarse:  # the representative leaf's corner facing the
+            # solid: an upper bound
+            least = np.full(n_groups, np.inf)  # (of the nodes of each group's least bound)
+            np.minimum.at(least, gq, bound)
+            k = np.flatnonzero(keep & (bound <= least[gq]))
             rep = level.rep[n[k]]
             corner = tree.leaf_centre[rep] - np.copysign(tree.leaf_half[rep][:, None], g[k])
             u, _ = solid_distance_bound(solid, np.einsum("mji,mj->mi", r[k], corner - p[k]))  # type: ignore[misc]
