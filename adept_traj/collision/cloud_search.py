@@ -19,8 +19,8 @@ one candidate at a time). :func:`search_clouds` finds it for all pairs together:
 Every (candidate, leaf) left out has a bound above the pair's cap, so :math:`v` is the
 pair's smallest distance where it is at most ``influence``; above it, the smallest of
 :math:`v` and the bounds left out is returned, a lower bound above ``influence``. Pairs
-whose cloud meets a robot solid that :func:`~adept_traj.collision.cloud_distance.
-solid_distance_bound` does not handle keep the one-candidate-at-a-time search.
+whose robot has a solid other than a box, cylinder, capsule or sphere keep the
+one-candidate-at-a-time search (:func:`cloud_obstacles`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import coal
 import numpy as np
 
 from adept_traj.collision.cloud_distance import TIE, CloudDistance
-from adept_traj.collision.cloud_tree import cloud_tree, descend
+from adept_traj.collision.cloud_tree import cloud_tree, descend, exact_signed_distance
 from adept_traj.collision.primitives import distance_request
 
 if TYPE_CHECKING:
@@ -44,13 +44,17 @@ ROUNDS = (0, 2, 8)
 
 
 def cloud_obstacles(checker: CollisionChecker) -> np.ndarray:
-    """(n_obstacles,) bool: the point clouds whose every robot solid's functor is a
-    :class:`~adept_traj.collision.cloud_distance.CloudDistance` (the batched search)."""
+    """(n_obstacles,) bool: the point clouds searched here, those whose every robot solid's
+    functor is a :class:`~adept_traj.collision.cloud_distance.CloudDistance` of a solid
+    with an exact signed distance (a box, cylinder, capsule or sphere: its upper bounds
+    prune the search; a URDF link's hull keeps the search one candidate at a time, where
+    the broad phase's cloud level bounds it more cheaply)."""
     rows = checker.functors
     clouds = [
-        all(isinstance(row[o], CloudDistance) for row in rows) for o in range(checker.n_obstacles)
+        all(isinstance(f, CloudDistance) and exact_signed_distance(f.solid) for f in column)
+        for column in zip(*rows)
     ]
-    return np.array(clouds, dtype=bool) & (checker.n_solids > 0)
+    return np.array(clouds, dtype=bool).reshape(checker.n_obstacles) & (checker.n_solids > 0)
 
 
 def search_clouds(
