@@ -38,7 +38,8 @@ Levels, each on the rows the previous one left within ``influence``:
    over all directions, so it is at most the overlap on any one axis,
    :math:`d \\ge \\max_u \\text{gap}_u` (this bounds deep candidates tightly, and the
    branch and bound computes few of them).
-5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds`.
+5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds` (left out by the
+   branch and bound for the clouds it searches itself: :mod:`~adept_traj.collision.cloud_search`).
 
 Everything is numpy on whole arrays; the Python loops run over solids and obstacles
 (7 × 4 for the AdeptOne XL scene), never over samples. That is why it is kept rather than

@@ -9,7 +9,11 @@ one candidate at a time). :func:`search_clouds` finds it for all pairs together:
 1. :func:`~adept_traj.collision.cloud_tree.descend`, per robot solid, over the candidates
    of every pair: the (candidate, leaf) pairs whose lower bound :math:`\ell` is at most the
    pair's cap (the influence, or the best upper bound of the pair's distance found on the
-   way), each pair's upper bound carried from one solid to the next;
+   way), each pair's upper bound carried from one solid to the next. The candidates go in
+   rounds by increasing broad-phase bound (:data:`ROUNDS`: each pair's first 2, the next
+   6, the rest), a round's only where that bound is at most the pair's upper bound left by
+   the rounds before: the later, larger rounds descend with a cap near the pair's
+   distance;
 2. per pair, coal's distance of these (candidate, leaf) pairs in increasing order of
    :math:`\ell` until the next bound is at least the best value :math:`v` (less
    :data:`~adept_traj.collision.cloud_distance.TIE`), or :math:`v` is negative (a

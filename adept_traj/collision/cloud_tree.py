@@ -1,28 +1,35 @@
 r"""A hierarchy of a point cloud's octree leaves and its batched descent for many solid poses.
 
-:class:`CloudTree` groups the occupied leaves of :class:`~adept_traj.collision.
-cloud_distance.CloudCells` in nested nodes: the cubes of edge :math:`2^L` leaf edges
-(:math:`L = 1, 2, \dots`) of a grid aligned with the leaves' box, up to the first level of
-at most :data:`TOP_NODES` nodes. Each node keeps the smallest axis-aligned box holding its
-leaves (tighter than its cube for a thin scan) and a representative leaf (the one nearest
-that box's centre).
+:class:`CloudTree` groups the occupied leaves of
+:class:`~adept_traj.collision.cloud_distance.CloudCells` in nested nodes: the cubes of
+edge :math:`2^L` leaf edges (:math:`L = 1, 2, \dots`) of a grid aligned with the leaves'
+box, up to the first level of at most :data:`TOP_NODES` nodes. Each node keeps the
+smallest axis-aligned box holding its leaves (tighter than its cube for a thin scan), a
+representative leaf (the one nearest that box's centre) and a *slab* holding its leaf
+cubes, :math:`a \le n \cdot x \le b` along the direction :math:`n` of their centres' least
+spread (a thin one for a piece of a scanned surface, whatever its orientation, where the
+box of a tilted piece is thick).
 
 :func:`descend` takes R poses of one robot solid (queries, each in a *group*: the pairs of
 the branch and bound) and walks the levels breadth-first, every (query, node) of a level in
-one batch. For each it forms the lower bound :math:`\ell` of
-:mod:`~adept_traj.collision.cloud_distance` (the solid's signed distance at the box centre
-less its subgradient's reach over the box: never above the distance of the solid to any
-leaf in the node) and, for a solid whose signed distance is exact (a box, cylinder, capsule
-or sphere), an **upper bound** of the group's smallest distance: the signed distance
-:math:`\varphi(x)` of the solid at the representative leaf's corner :math:`x` facing the
-solid (a point of that leaf, so the leaf is at most :math:`\max(\varphi(x), 0)` away; a
-leaf meeting the solid has a distance ≤ 0). Only the (query, node) whose :math:`\ell` is at
-most the group's cap — the smaller of ``cap`` and the best upper bound so far — are
-refined into their children: a node above it holds no leaf nearer than the group's
-smallest distance (or than ``cap``). What is left at the leaves are the (query, leaf)
-candidates of the exact step (:mod:`~adept_traj.collision.cloud_search`), with their
-:math:`\ell` (within a fraction of a millimetre of coal's distance for a leaf a few
-centimetres away).
+one batch. For each it forms a lower bound of the solid's distance to every leaf in the
+node: the larger of the gap between the solid's and the slab's projections on :math:`n`
+(where positive: the support function of the solid, closed form) and, for nodes of at most
+:data:`FINE_EDGE`, the bound :math:`\ell` of :mod:`~adept_traj.collision.cloud_distance`
+(the solid's signed distance at the box centre less its subgradient's reach over the box),
+for larger ones the gap between the node's box and the box holding the solid on the
+cloud's axes (cheaper, as useful there); and, at the nodes of at most :data:`FINE_EDGE`
+with the least bound of their group, for a solid whose signed distance is exact (a box,
+cylinder, capsule or sphere), an **upper bound** of the group's smallest distance: the
+signed distance :math:`\varphi(x)` of the solid at the representative leaf's corner
+:math:`x` facing the solid (a point of that leaf, so the leaf is at most
+:math:`\max(\varphi(x), 0)` away; a leaf meeting the solid has a distance ≤ 0). Only the
+(query, node) whose bound is at most the group's cap — the smaller of ``cap`` and the
+best upper bound so far — are refined into their children: a node above it holds no leaf
+nearer than the group's smallest distance (or than ``cap``). What is left at the leaves
+are the (query, leaf) candidates of the exact step
+(:mod:`~adept_traj.collision.cloud_search`), with their :math:`\ell` (within a fraction of
+a millimetre of coal's distance for a leaf a few centimetres away).
 """
 
 from __future__ import annotations
