@@ -38,8 +38,7 @@ Levels, each on the rows the previous one left within ``influence``:
    over all directions, so it is at most the overlap on any one axis,
    :math:`d \\ge \\max_u \\text{gap}_u` (this bounds deep candidates tightly, and the
    branch and bound computes few of them).
-5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds` (left out by the
-   branch and bound for the clouds it searches itself: :mod:`~adept_traj.collision.cloud_search`).
+5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds` (or not: ``cloud_level``).
 
 Everything is numpy on whole arrays; the Python loops run over solids and obstacles
 (7 × 4 for the AdeptOne XL scene), never over samples. That is why it is kept rather than
@@ -307,18 +306,16 @@ class BroadPhase:
         tf_s = coal.Transform3s()
         values = np.empty(count)
         for i, ps in enumerate(poses):
-            tf_s.setRotation(ps[:3, :3])
-            tf_s.setTranslation(ps[:3, 3])
+            tf_s.setTransform(ps[:3, :3], ps[:3, 3])
             result.clear()
             values[i] = functor(tf_s, tf_o, request, result)
+        lipschitz = 1.0  # a prismatic joint
         if kin.revolute[p - 1]:
             origin, rot = frames[p, :, 3, 0], frames[p, :, :3, 0]
             axis = rot @ kin.axes[p - 1]
             centre = rot @ self._ball_in_joint[k] + origin
             rho = np.linalg.norm(np.cross(centre - origin, axis))
             lipschitz = float(rho + self._ball_radius[k])
-        else:
-            lipschitz = 1.0
         return DistanceTable(j, float(lo), TABLE_STEP, values, lipschitz)
 
     # ------------------------------------------------------------------ bounds
@@ -334,10 +331,8 @@ class BroadPhase:
         poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
         configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too.
         ``centres`` (3, n_solids, N) [m] may pass the enclosing-ball centres if already
-        computed (:meth:`ball_centres` of the same ``frames``). ``cloud_level``
-        (n_obstacles,) bool leaves level 5 out for the point clouds not marked (the branch
-        and bound's cloud search bounds their leaves itself:
-        :mod:`~adept_traj.collision.cloud_search`)."""
+        computed (:meth:`ball_centres` of the same ``frames``). ``cloud_level`` (n_obstacles,)
+        bool: the clouds given level 5 (the others: :mod:`~adept_traj.collision.cloud_search`)."""
         n = frames.shape[-1]
         for name, value, shape in (
             ("q", q, (n, self.nq)),
@@ -374,10 +369,8 @@ class BroadPhase:
                     lower[k, o, idx] = self.closed_form_distance(ps, po, k, o)
                     exact[idx, k, o] = True
                 else:
-                    sub = rows[self.parents[k]][:, idx]
-                    lower[k, o, idx] = self._refine(
-                        lower[k, o, idx], sub, frames, idx, po, k, o, bool(level5[o])
-                    )
+                    sub, low = rows[self.parents[k]][:, idx], lower[k, o]
+                    low[idx] = self._refine(low[idx], sub, frames, idx, po, k, o, level5[o])
         # (n_solids · n_obstacles, N) → (N, n_solids, n_obstacles): a 2-D transpose copies
         # about twice as fast as the 3-D one with few obstacles (as fast with many)
         flat = lower.reshape(self.n_solids * self.n_obstacles, n)

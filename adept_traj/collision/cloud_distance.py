@@ -42,9 +42,8 @@ leaves (level 5 of :mod:`adept_traj.collision.broad_phase`).
 
 from __future__ import annotations
 
-import functools
 import weakref
-from functools import cached_property
+from functools import cached_property, reduce
 from typing import Any
 
 import coal
@@ -259,7 +258,7 @@ def _box_sdf(p: np.ndarray, h: np.ndarray, signed_axes: tuple[int, ...] | None =
     q = np.abs(p) - h
     out = np.maximum(q, 0.0)
     n = np.sqrt(np.einsum("ij,ij->i", out, out))
-    inner = functools.reduce(np.maximum, q.T)  # column by column (faster than q.max(1))
+    inner = reduce(np.maximum, q.T)  # column by column (faster than q.max(1))
     d = n + np.minimum(inner, 0.0)
     g = out / np.where(n > 0, n, 1.0)[:, None]  # (0 inside)
     inside = n == 0
@@ -303,12 +302,10 @@ class CloudDistance:
         """The robot solid."""
         return self._solid
 
-    def leaf_distance(
-        self, half: float, tf_solid: Any, tf_leaf: Any, request: Any, out: Any
-    ) -> float:
+    def leaf_distance(self, half: float, tf_solid: Any, tf_leaf: Any, req: Any, out: Any) -> float:
         """coal's distance [m] of the solid and one leaf of half edge ``half`` [m] (a cube
         of the cloud's axes) at the poses ``tf_solid`` and ``tf_leaf`` (its centre)."""
-        return self._functors[half](tf_solid, tf_leaf, request, out)
+        return self._functors[half](tf_solid, tf_leaf, req, out)
 
     def __call__(
         self,
