@@ -31,6 +31,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from adept_traj.collision.cloud_search import cloud_obstacles, search_clouds
+
 if TYPE_CHECKING:
     from adept_traj.collision.checker import CollisionChecker
 
@@ -82,14 +84,22 @@ def search_pairs(
     is_exact = np.take_along_axis(known, smallest[:, None, :], axis=1)[:, 0]
     where[:, closed] = np.where(is_exact, smallest, -1)[:, closed]
     pm, po = np.nonzero((best <= influence) & ~closed)
+    calls = 0
+    cloudy = cloud_obstacles(checker)[po]  # the point clouds: all their pairs at once
+    if cloudy.any():
+        cm, co = pm[cloudy], po[cloudy]
+        rows = lower[cm, :, co]
+        value, found, calls = search_clouds(checker, frames, rows, cm, co, obstacle_poses, n_t)
+        best[cm, co], where[cm, co] = _floor(value, found, rows, influence)
+        pm, po = pm[~cloudy], po[~cloudy]
     if len(pm) == 0:
-        return best, where, 0
+        return best, where, calls
     rows = lower[pm, :, po]  # (n_pairs, n_t · n_solids)
     first = smallest[pm, po]  # = rows.argmin(axis=1)
     # 1. The first candidates, their poses (solid and obstacle) formed together.
     value = rows[np.arange(len(pm)), first]  # exact already where known
     todo = np.flatnonzero(~known[pm, first, po])
-    calls = len(todo)
+    calls += len(todo)
     value[todo] = _narrow_many(
         checker, frames, obstacle_poses, pm[todo] * n_t + first[todo] // ns,
         first[todo] % ns, po[todo],
@@ -104,17 +114,23 @@ def search_pairs(
         calls += _walk(
             checker, frames, obstacle_poses, known, rows, mask, pm, po, need, value, found
         )
-    where[pm, po] = found
-    # 3. Not exact: candidates with a bound in (influence, value) were not computed; the
-    # smallest of value and those bounds is a lower bound above influence.
+    best[pm, po], where[pm, po] = _floor(value, found, rows, influence)
+    return best, where, calls
+
+
+def _floor(
+    value: np.ndarray, found: np.ndarray, rows: np.ndarray, influence: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Step 3 of the module doc: where ``value`` (P,) is above ``influence``, the smallest
+    of it and the bounds of ``rows`` (P, n_candidates) above ``influence`` (those were not
+    computed), with ``found`` (P,) set to -1 there; both returned (modified in place)."""
     over = np.flatnonzero(value > influence)
     if len(over):
         sub = rows[over]
         floor = np.where(sub > influence, sub, np.inf).min(axis=1)
         value[over] = np.minimum(value[over], floor)
-        where[pm[over], po[over]] = -1
-    best[pm, po] = value
-    return best, where, calls
+        found[over] = -1
+    return value, found
 
 
 def _narrow_many(

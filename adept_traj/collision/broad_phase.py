@@ -40,7 +40,7 @@ Levels, each on the rows the previous one left within ``influence``:
    over all directions, so it is at most the overlap on any one axis,
    :math:`d \\ge \\max_u \\text{gap}_u` (this bounds deep candidates tightly, and the
    branch and bound computes few of them).
-5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds`.
+5. **Point clouds** (not 4): :mod:`adept_traj.collision.cloud_bounds` (or not: ``cloud_level``).
 
 Everything is numpy on whole arrays; the Python loops run over solids and obstacles
 (7 × 4 for the AdeptOne XL scene), never over samples. That is why it is kept rather than
@@ -257,12 +257,14 @@ class BroadPhase:
         obstacle_poses: list[np.ndarray],
         q: np.ndarray | None = None,
         centres: np.ndarray | None = None,
+        cloud_level: bool | np.ndarray = True,
     ) -> Bounds:
         """Lower bounds for joint frames (njoints, 3, 4, N) (component-major) and obstacle
         poses in the base frame (per obstacle (4, 4) if fixed, else (N, 4, 4)); with the
         configurations ``q`` (N, nq) [rad | m], the single-joint tables are used too.
         ``centres`` (3, n_solids, N) [m] may pass the enclosing-ball centres if already
-        computed (:meth:`ball_centres` of the same ``frames``)."""
+        computed (:meth:`ball_centres` of the same ``frames``). ``cloud_level`` (n_obstacles,)
+        bool: the clouds given level 5 (the others: :mod:`~adept_traj.collision.cloud_search`)."""
         n = frames.shape[-1]
         for name, value, shape in (
             ("q", q, (n, self.nq)),
@@ -274,6 +276,7 @@ class BroadPhase:
         # work; ``exact`` (few entries) is written in the layout of the result directly.
         lower = np.empty((self.n_solids, self.n_obstacles, n))
         exact = np.zeros((n, self.n_solids, self.n_obstacles), dtype=bool)
+        level5 = np.broadcast_to(cloud_level, (self.n_obstacles,))
         if self.n_obstacles and n:
             rows = {p: frames[p].reshape(12, n) for p, _ in self._by_parent}
             # Level 0 first; level 1 only for the pairs (and samples) it leaves open.
@@ -298,8 +301,8 @@ class BroadPhase:
                     lower[k, o, idx] = self.closed_form_distance(ps, po, k, o)
                     exact[idx, k, o] = True
                 else:
-                    sub = rows[self.parents[k]][:, idx]
-                    lower[k, o, idx] = self._refine(lower[k, o, idx], sub, frames, idx, po, k, o)
+                    sub, low = rows[self.parents[k]][:, idx], lower[k, o]
+                    low[idx] = self._refine(low[idx], sub, frames, idx, po, k, o, level5[o])
         # (n_solids · n_obstacles, N) → (N, n_solids, n_obstacles): a 2-D transpose copies
         # about twice as fast as the 3-D one with few obstacles (as fast with many)
         flat = lower.reshape(self.n_solids * self.n_obstacles, n)
@@ -344,8 +347,9 @@ class BroadPhase:
         po: np.ndarray,
         k: int,
         o: int,
+        cloud_level: bool = True,
     ) -> np.ndarray:
-        """Levels 3 and 4 for solid ``k`` at the samples ``idx`` (its parent joint's frame
+        """Levels 3 and 4 (or 5) for solid ``k`` at the samples ``idx`` (its parent joint's frame
         as ``rows`` (12, R); all joint ``frames`` (njoints, 3, 4, N)) and obstacle ``o``
         (``po`` (4, 4) or (R, 4, 4)), from ``bound`` (R,)."""
         centres = self._cover_in_joint[k]
@@ -357,7 +361,7 @@ class BroadPhase:
         kind_s, kind_o = self.solid_kind[k], self.obstacle_kind[o]
         still = np.flatnonzero(bound <= self.influence)
         if still.size and kind_o is None:  # a point cloud: level 5 (a mesh: as it is)
-            return cloud_bound(self, bound, still, frames, idx, po, k, o)
+            return cloud_bound(self, bound, still, frames, idx, po, k, o) if cloud_level else bound
         if still.size == 0 or kind_s is None or kind_o is None:
             return bound
         ps = self.solid_poses(frames, idx[still], k)

@@ -24,6 +24,7 @@ import numpy as np
 from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.cloud_distance import CloudDistance
+from adept_traj.collision.cloud_search import cloud_obstacles
 from adept_traj.collision.distance_table import DistanceTable
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
@@ -327,7 +328,8 @@ class CollisionChecker:
         n_motions = int(np.prod(batch))
         obstacle_poses = self.obstacle_poses(t)
         q_flat = q.reshape(-1, q.shape[-1])
-        bounds = self.broad_phase.bounds(frames, obstacle_poses, q_flat, balls)
+        searched = cloud_obstacles(self)  # their leaves bounded by the search, not level 5
+        bounds = self.broad_phase.bounds(frames, obstacle_poses, q_flat, balls, ~searched)
         lower, known = bounds.lower, bounds.exact
         if self.allowed.any():  # else no pass over the whole arrays
             lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed

@@ -125,8 +125,7 @@ def tabulate(
     tf_s = coal.Transform3s()
     values = np.empty(count)
     for i, ps in enumerate(poses):
-        tf_s.setRotation(ps[:3, :3])
-        tf_s.setTranslation(ps[:3, 3])
+        tf_s.setTransform(ps[:3, :3], ps[:3, 3])
         result.clear()
         values[i] = functor(tf_s, tf_o, request, result)
     if kin.revolute[p - 1]:

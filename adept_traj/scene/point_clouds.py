@@ -56,10 +56,13 @@ CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".npy")
 
 #: Bytes per point of a cloud: its (n, 3) float64 array twice (read, then kept), coal's
 #: octree (at most 480 B per point measured, for points each in a cell of its own), the
-#: coarse field's passes over the points (≈ 100 B) and the checker's leaf arrays
+#: coarse field's passes over the points (≈ 100 B), the checker's leaf arrays
 #: (:class:`~adept_traj.collision.cloud_distance.CloudCells`: ≤ 600 B per leaf, a leaf
-#: per point at most; ``tracemalloc`` peaks, ``benchmarks/bench_memory.py``).
-_BYTES_PER_POINT = 48 + 480 + 100 + 600
+#: per point at most) and their hierarchy
+#: (:class:`~adept_traj.collision.cloud_tree.CloudTree`: 195 B per leaf kept, 459 B at the
+#: peak of its making, for leaves filling a volume); ``tracemalloc`` peaks,
+#: ``benchmarks/bench_memory.py`` and ``tests/scene/test_point_clouds.py``.
+_BYTES_PER_POINT = 48 + 480 + 100 + 600 + 460
 
 #: Most cells of a cloud's coarse distance field (4 MB of float32).
 _FIELD_CELLS = 1_000_000

@@ -213,12 +213,14 @@ def test_cube_field_counted_and_refused_before_any_field(tmp_path, monkeypatch):
 
 
 def test_cloud_estimate_bounds_the_measured_peak():
-    """tracemalloc's peak while a cloud, its leaf arrays and its cube-distance field are
-    made (numpy and scipy; coal's octree is C++, counted separately in the estimate) stays
-    below :func:`cloud_bytes` of its points and field cells."""
+    """tracemalloc's peak while a cloud, its leaf arrays, their hierarchy and its
+    cube-distance field are made (numpy and scipy; coal's octree is C++, counted
+    separately in the estimate) stays below :func:`cloud_bytes` of its points and field
+    cells."""
     import tracemalloc
 
     from adept_traj.collision.cloud_distance import CloudCells
+    from adept_traj.collision.cloud_tree import CloudTree
     from adept_traj.scene.point_clouds import cloud_bytes, cube_field_step
 
     rng = np.random.default_rng(8)
@@ -230,11 +232,13 @@ def test_cloud_estimate_bounds_the_measured_peak():
         cloud = PointCloud(p, 0.01)
         cells = CloudCells(octree)
         field = cells.field[2]
+        tree = CloudTree(cells)
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
     _, n_cells = cube_field_step(p.min(axis=0) - 0.01, p.max(axis=0) + 0.01, 0.01)
     assert field.size <= n_cells
     assert cloud.n_points == len(p)
+    assert len(tree.leaf_half) == len(cells.half)
     assert field.size > 500_000  # the field is the large part here
     assert peak <= cloud_bytes(len(p), n_cells), (peak, cloud_bytes(len(p), n_cells))
