@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import tempfile
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -45,12 +46,15 @@ __all__ = [
     "MOVE_FILE",
     "RETRIES",
     "MoveTask",
+    "SavedMove",
     "cycle_tasks",
     "dask_client",
+    "plan_and_encode",
     "plan_move",
     "run_cycle",
     "run_planning_tasks",
     "run_tasks",
+    "worker_robot",
 ]
 
 #: Sub-folder of the output folder holding one result folder per move.
@@ -126,7 +130,7 @@ def cycle_tasks(cycle: Cycle) -> list[MoveTask]:
 
 
 @lru_cache(maxsize=4)
-def _robot(source: RobotSource) -> Robot:
+def worker_robot(source: RobotSource) -> Robot:
     """The robot of ``source``, loaded once per worker process."""
     return source.load()
 
@@ -134,7 +138,7 @@ def _robot(source: RobotSource) -> Robot:
 def plan_move(task: MoveTask) -> PlanningResult:
     """Plan one move (the body of a Dask task; also callable directly)."""
     m = task.move
-    robot, t0 = _robot(task.robot), task.start_time
+    robot, t0 = worker_robot(task.robot), task.start_time
     problem = TrajectoryProblem(robot, task.scene, task.start, task.goal, workers=1, start_time=t0)
     try:
         return plan(
@@ -150,6 +154,31 @@ def plan_move(task: MoveTask) -> PlanningResult:
         problem.close()
 
 
+@dataclass(frozen=True)
+class SavedMove:
+    """A planned move and the bytes of its result folder's files (what a task returns).
+
+    Attributes
+    ----------
+    result: the planning result.
+    files: file name -> content of every file :meth:`~adept_traj.results.PlanningResult.save`
+        writes (``result.json``, ``front.csv``, ``best_trajectory.csv``).
+    """
+
+    result: PlanningResult
+    files: dict[str, bytes]
+
+
+def plan_and_encode(task: MoveTask) -> SavedMove:
+    """Plan one move and encode its result files in the worker (the body of a cycle's
+    Dask task): the command only writes the bytes, so the encoding runs in parallel."""
+    result = plan_move(task)
+    with tempfile.TemporaryDirectory(prefix="adept-traj-move-") as tmp:
+        folder = result.save(Path(tmp) / "result")
+        files = {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+    return SavedMove(result, files)
+
+
 def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
     """The saved result of ``task`` in ``folder`` when it is complete and planned for the
     same task; ``None`` otherwise (then it is planned again)."""
@@ -162,13 +191,15 @@ def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
         return None
 
 
-def _save(folder: Path, task: MoveTask, result: PlanningResult) -> Path:
-    """Save ``result`` into ``folder/NAME`` at once and atomically (a temporary folder
-    renamed), with ``move.json``."""
+def _save(folder: Path, task: MoveTask, saved: SavedMove) -> Path:
+    """Write the files of ``saved`` into ``folder/NAME`` at once and atomically (a
+    temporary folder renamed), with ``move.json``."""
     final = folder / task.move.name
     tmp = final.with_name(f".{task.move.name}.partial")
     shutil.rmtree(tmp, ignore_errors=True)
-    result.save(tmp)
+    tmp.mkdir(parents=True)
+    for name, content in saved.files.items():
+        (tmp / name).write_bytes(content)
     write_text_atomic(tmp / MOVE_FILE, json.dumps(task.description(), indent=1))
     shutil.rmtree(final, ignore_errors=True)
     os.replace(tmp, final)
@@ -296,10 +327,10 @@ def run_planning_tasks(
             if progress is not None:
                 progress(task.move.name)
 
-    def saved(j: int, result: PlanningResult) -> None:
+    def saved(j: int, move: SavedMove) -> None:
         i = pending[j]
-        _save(where, tasks[i], result)
-        results[i] = result
+        _save(where, tasks[i], move)
+        results[i] = move.result
         if progress is not None:
             progress(tasks[i].move.name)
 
@@ -307,7 +338,7 @@ def run_planning_tasks(
         where.mkdir(parents=True, exist_ok=True)
         run_tasks(
             [tasks[i] for i in pending],
-            plan_move,
+            plan_and_encode,
             workers=workers,
             scheduler=scheduler,
             on_result=saved,
