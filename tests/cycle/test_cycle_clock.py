@@ -437,6 +437,105 @@ def test_back_to_back_waits_only_where_it_must(seed: int) -> None:
     assert s + options[-1][i].T == pytest.approx(repeat * fastest, rel=1e-12)
 
 
+def _preferred_chain(options, P, repeat, move_ok, rest_ok):
+    """The back-to-back schedule written out again, as a search over every sequence: each
+    move's step is (plan, start) with start = the previous end (no dwell) or the first time
+    after it in the plan's phase (a dwell); a sequence is valid where every plan is
+    certified at its phase, ``move_ok`` at its start and ``rest_ok`` for its dwell; the
+    preferred valid sequence is the least by its steps' keys, (0, T, plan) without a
+    dwell and (1, start, T, plan) with one, compared move by move."""
+    import itertools
+
+    K = len(options)
+    best = None
+    for seq in itertools.product(*[range(2 * len(options[n % K])) for n in range(repeat * K)]):
+        end, keys, steps = 0.0, [], []
+        for n, c in enumerate(seq):
+            k = n % K
+            i, wait = c % len(options[k]), c >= len(options[k])
+            o = options[k][i]
+            start = end
+            if wait:
+                start = o.phase
+                while start <= end + 1e-12:
+                    start += P
+                while start - P > end + 1e-12:
+                    start -= P
+            if not (o.certified and move_ok(k, i, start) and rest_ok(k, end, start - end)):
+                break
+            keys.append((1, start, o.T, i) if wait else (0, o.T, i))
+            steps.append((i, start))
+            end = start + o.T
+        else:
+            if best is None or keys < best[0]:
+                best = (keys, steps)
+    return None if best is None else [tuple(best[1][p * K : (p + 1) * K]) for p in range(repeat)]
+
+
+def test_back_to_back_backtracks_to_a_certified_chain() -> None:
+    """Where the fastest step leaves the next move with no certified step (no plan
+    certified at that instant, the robot not allowed to wait there), back_to_back goes
+    back and takes the next step: its schedule is the preferred one of a search over every
+    sequence of steps (no schedule where that search finds none), on seeds where the
+    first steps alone fail too; the prefetch is asked first about the first query."""
+    from adept_traj.cycle import PhaseOption, back_to_back
+
+    P, repeat, K = 2.0, 2, 2
+    backtracked = 0
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        options = [
+            [PhaseOption(float(f), float(T), True)
+             for f, T in zip(rng.uniform(0, P, 2), rng.uniform(0.4, 1.3, 2))]
+            for _ in range(K)
+        ]  # fmt: skip
+
+        def move_ok(k, i, s, options=options, seed=seed):  # at its phase; elsewhere at random
+            o = options[k][i]
+            at_phase = abs((s - o.phase) / P - round((s - o.phase) / P)) < 1e-9
+            return at_phase or math.cos(5.3 * s + 2.1 * i + 3 * k + seed) > 0.3
+
+        def rest_ok(k, start, duration):  # the robot may wait at move 0's start only
+            return duration <= 1e-12 or k == 0
+
+        asked, prefetched = [], set()
+
+        def counted(k, i, s, asked=asked, move_ok=move_ok):
+            asked.append((k, i, s))
+            return move_ok(k, i, s)
+
+        runs = back_to_back(options, P, repeat, counted, rest_ok, prefetch=prefetched.update)
+        expected = _preferred_chain(options, P, repeat, move_ok, rest_ok)
+        assert asked[0] in prefetched
+        if expected is None:
+            assert runs is None
+            continue
+        assert [list(p) for p in runs] == [list(p) for p in expected], seed
+        try:  # the first steps alone (no step undone)
+            back_to_back(options, P, repeat, move_ok, rest_ok, max_undone=0)
+        except CycleError:
+            backtracked += 1
+    assert backtracked >= 2  # the seeds exercise the backtracking
+
+
+def test_back_to_back_backtracking_is_bounded() -> None:
+    """A chain with no certified schedule undoes at most max_undone steps and then says so,
+    naming the limit; within the limit it reports that no schedule exists."""
+    from adept_traj.cycle import PhaseOption, back_to_back
+
+    options = [[PhaseOption(0.0, 0.5, True), PhaseOption(1.0, 0.7, True)]] * 2
+
+    def never_last(k, i, s):  # the last move of the cycle is never certified
+        return not (k == 1 and s > 2.0)
+
+    def rest_ok(k, start, duration):
+        return duration <= 1e-12
+
+    with pytest.raises(CycleError, match="MAX_UNDONE = 3"):
+        back_to_back(options, 2.0, 3, never_last, rest_ok, max_undone=3)
+    assert back_to_back(options, 2.0, 3, never_last, rest_ok) is None
+
+
 def test_rest_profile_is_conservative() -> None:
     """A dwell the rest profile allows is certified by certify_rest at its real scene
     times (several periods later too); the profile refuses the dwells certify_rest
