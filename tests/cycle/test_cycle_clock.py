@@ -93,45 +93,54 @@ def _dense(folder: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _clear_by_hand(out: Path, scene: dict, period: float) -> int:
-    """Re-check the cycle saved in ``out`` with the oracle (module doc): the pass time
-    re-derived from the dwells and the stored trajectories, then every move of every pass
-    and every dwell (the robot at rest at the move's start) and final dwell clear of the
-    obstacles of the scene file's mapping ``scene`` at its real scene times. Returns the
-    moves checked."""
+    """Re-check the cycle saved in ``out`` with the oracle (module doc): the start times
+    re-derived from the dwells and the stored trajectories (periodic: the pass time a
+    multiple of P, later passes shifted by it; back to back: every pass recorded, no
+    final dwell), then every move of every pass and every dwell (the robot at rest at the
+    move's start) and final dwell clear of the obstacles of the scene file's mapping
+    ``scene`` at its real scene times. Returns the moves checked."""
     summary = json.loads((out / "cycle.json").read_text())
     robot, clock = Robot.adept_one_xl(), summary["clock"]
-    assert clock["scene_clock"] == "periodic"
-    assert clock["period"] == pytest.approx(period, rel=1e-12)
-    moves = clock["passes"][0]
-    # the pass time by hand: dwells + travel times + the final dwell, a multiple of P
-    ends, t = [], 0.0
-    for m in moves:
-        dense_t, _ = _dense(out / m["folder"])
-        t += m["dwell"]
-        assert m["start_time"] == pytest.approx(t, abs=1e-12)
-        t += dense_t[-1]
-        ends.append(t)
-    pass_time = t + clock["final_dwell"]
-    assert pass_time / period == pytest.approx(round(pass_time / period), abs=1e-9)
-    assert summary["cycle_time"] == pytest.approx(summary["repeat"] * pass_time, rel=1e-12)
-    checked = 0
-    for p in range(summary["repeat"]):
+    periodic = clock["scene_clock"] == "periodic"
+    if periodic:
+        assert clock["period"] == pytest.approx(period, rel=1e-12)
+    else:
+        assert clock["mode"] == "dwell grid (back to back)"
+        assert clock["final_dwell"] == 0.0
+        assert len(clock["passes"]) == summary["repeat"]
+    # the start times by hand: dwells + travel times (+ the final dwell, a multiple of P)
+    runs, t = [], 0.0
+    for moves in clock["passes"]:
         for m in moves:
-            dense_t, dense_q = _dense(out / m["folder"])
-            start = m["start_time"] + p * pass_time
-            rows = np.r_[np.arange(0, len(dense_t), 12), len(dense_t) - 1]
-            hand, _ = clearance_by_hand(robot, scene, dense_q[rows], start + dense_t[rows])
-            assert hand.min() >= MARGIN - 1e-6, (p, m["name"], hand.min())
-            # the dwell before it: the robot at rest at its start while the bob moves
-            rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
-            still = np.repeat(dense_q[:1], len(rest), axis=0)
-            hand, _ = clearance_by_hand(robot, scene, still, rest)
-            assert hand.min() >= MARGIN - 1e-6, (p, m["name"], "dwell", hand.min())
-            checked += 1
-        final = ends[-1] + p * pass_time + np.linspace(0.0, clock["final_dwell"], 40)
-        still = np.repeat(_dense(out / moves[-1]["folder"])[1][-1:], len(final), axis=0)
-        assert clearance_by_hand(robot, scene, still, final)[0].min() >= MARGIN - 1e-6
-    assert checked == summary["repeat"] * len(moves)
+            dense_t, _ = _dense(out / m["folder"])
+            t += m["dwell"]
+            assert m["start_time"] == pytest.approx(t, abs=1e-9)
+            runs.append((m, t))
+            t += dense_t[-1]
+    if periodic:
+        pass_time = t + clock["final_dwell"]
+        assert pass_time / period == pytest.approx(round(pass_time / period), abs=1e-9)
+        assert summary["cycle_time"] == pytest.approx(summary["repeat"] * pass_time, rel=1e-12)
+        runs = [(m, s + p * pass_time) for p in range(summary["repeat"]) for m, s in runs]
+    else:
+        assert summary["cycle_time"] == pytest.approx(t, rel=1e-12)
+    checked = 0
+    for n, (m, start) in enumerate(runs):
+        dense_t, dense_q = _dense(out / m["folder"])
+        rows = np.r_[np.arange(0, len(dense_t), 12), len(dense_t) - 1]
+        hand, _ = clearance_by_hand(robot, scene, dense_q[rows], start + dense_t[rows])
+        assert hand.min() >= MARGIN - 1e-6, (n, m["name"], hand.min())
+        # the dwell before it: the robot at rest at its start while the bob moves
+        rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
+        still = np.repeat(dense_q[:1], len(rest), axis=0)
+        hand, _ = clearance_by_hand(robot, scene, still, rest)
+        assert hand.min() >= MARGIN - 1e-6, (n, m["name"], "dwell", hand.min())
+        checked += 1
+        if periodic and m is clock["passes"][0][-1]:
+            final = start + dense_t[-1] + np.linspace(0.0, clock["final_dwell"], 40)
+            still = np.repeat(dense_q[-1:], len(final), axis=0)
+            assert clearance_by_hand(robot, scene, still, final)[0].min() >= MARGIN - 1e-6
+    assert checked == summary["repeat"] * len(clock["passes"][0])
     return checked
 
 
@@ -143,6 +152,24 @@ def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path)
 
 
 @pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
+def test_the_default_schedule_is_never_longer_than_back_to_back(planned: Path) -> None:
+    """The periodic schedule (one pass rounded up to whole periods) and every pass back to
+    back are both made; the kept one is the shorter (cycle.json's choice, cycle.md), here
+    back to back: without the rounding the passes need no final dwell."""
+    summary = json.loads((planned / "cycle.json").read_text())
+    choice = summary["clock"]["choice"]
+    times = {
+        name: float(t)
+        for name, t in re.findall(r"(periodic|every pass back to back)[^:]*: ([0-9.]+) s", choice)
+    }
+    assert set(times) == {"periodic", "every pass back to back"}, choice
+    assert summary["cycle_time"] == pytest.approx(min(times.values()), abs=1e-3)
+    assert summary["cycle_time"] < times["periodic"]  # this cycle: back to back is shorter
+    assert choice.startswith("every pass back to back")
+    assert f"Schedule kept: {choice}." in (planned / "cycle.md").read_text()
+
+
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
 def test_the_clock_decides_the_dwells(planned: Path) -> None:
     """The chosen moves are certified for their own start times, not for any: started a
     quarter, half or three quarters of a period later, a move hits the pendulum (by hand;
@@ -151,7 +178,8 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
     candidates = [c for m in summary["clock"]["passes"][0] for c in m["candidates"]]
     assert len(candidates) == 8
     scene = Scene.from_file(planned.parent / "swing.toml").to_dict()
-    period, robot = summary["clock"]["period"], Robot.adept_one_xl()
+    period = 2 * math.pi / scene["pendulum"][0]["omega"]  # by hand, from the file
+    robot = Robot.adept_one_xl()
     hits = []
     for m in summary["clock"]["passes"][0]:
         t, q = _dense(planned / m["folder"])
@@ -162,12 +190,17 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
         ]
         hits.append(min(d.min() for d in shifted) < 0.0)
     assert any(hits), hits
+    periodic = summary["clock"]["scene_clock"] == "periodic"
     for m in summary["clock"]["passes"][0]:
         result = PlanningResult.load(planned / m["folder"])
-        assert result.problem_settings.start_time == m["start_time"]
         assert result.feasible
-        best = min(c["dwell"] + c["T"] for c in m["candidates"] if c["certified"])
-        assert m["dwell"] + m["T"] == best  # the earliest certified end
+        if periodic:  # pass 0 as planned: the earliest certified end of the dwell grid
+            assert result.problem_settings.start_time == m["start_time"]
+            best = min(c["dwell"] + c["T"] for c in m["candidates"] if c["certified"])
+            assert m["dwell"] + m["T"] == best
+        else:  # back to back: a plan of the dwell grid of pass 0, run at its real start
+            assert re.fullmatch(re.escape(m["name"]) + r"\.p0\.w\d", m["folder"].split("/")[-1])
+            assert m["T"] in [c["T"] for c in m["candidates"] if c["certified"]]
     assert (planned / "cycle_gantt.png").stat().st_size > 0
     text = (planned / "cycle.md").read_text()
     assert "## Scene clock" in text
@@ -197,11 +230,13 @@ def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path) ->
 def test_playback_runs_on_one_continuous_clock(planned: Path, cluster) -> None:
     cycle = read_cycle_file(planned.parent / "c.toml")
     summary = json.loads((planned / "cycle.json").read_text())
-    results = [[PlanningResult.load(planned / m["folder"]) for m in summary["clock"]["passes"][0]]]
+    passes = summary["clock"]["passes"]
+    results = [[PlanningResult.load(planned / m["folder"]) for m in ms] for ms in passes]
     from adept_traj.cycle.clock import CycleClock
 
-    clock, _ = plan_on_clock(cycle, planned, resume=True, scheduler=cluster.scheduler_address)
+    clock, again = plan_on_clock(cycle, planned, resume=True, scheduler=cluster.scheduler_address)
     assert isinstance(clock, CycleClock)
+    assert len(again) == len(passes)
     play = clock_playback(clock, results, robot=Robot.adept_one_xl(), scene=cycle.scene, fps=20)
     assert np.all(np.diff(play.times) > 0)
     assert play.times[0] == 0.0
