@@ -42,6 +42,7 @@ from adept_traj.validation import as_integer
 
 __all__ = [
     "CLOSE_TIMEOUT",
+    "LOCAL_DASK_CONFIG",
     "MOVES_FOLDER",
     "MOVE_FILE",
     "RETRIES",
@@ -67,6 +68,18 @@ RETRIES = 2
 #: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
+#: Dask settings of the local cluster (its scheduler runs in this process, its workers
+#: inherit them): no statistical profiler in the workers (a stack sample every 10 ms), no
+#: GIL monitor (every 1 ms), the system monitor every 2 s and the event-loop watchdog
+#: every 0.5 s instead of 0.5 s and 20 ms. Their sampling is CPU time the command spends
+#: serially and the workers on top of the tasks, for the length of the run; they feed only
+#: the dashboard.
+LOCAL_DASK_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.tick.interval": "500ms",
+}
 
 
 @dataclass(frozen=True)
@@ -231,27 +244,30 @@ def dask_client(workers: int | None, scheduler: str | None, n_tasks: int) -> Ite
     """A ``distributed.Client``: of a new local cluster of ``min(workers, n_tasks)``
     single-threaded worker processes (default: one per core), or of the scheduler at
     address ``scheduler``; closed (and the cluster stopped, each worker process given
-    :data:`CLOSE_TIMEOUT` to exit) on leaving."""
+    :data:`CLOSE_TIMEOUT` to exit) on leaving. A local cluster runs with
+    :data:`LOCAL_DASK_CONFIG`."""
+    import dask
     from distributed import Client, LocalCluster
 
-    if scheduler is None:
-        n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
-        cluster = LocalCluster(
-            n_workers=min(n, max(n_tasks, 1)),
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # any free port: 8787 may be taken
-        )
-        client = Client(cluster)
-    else:
-        cluster, client = None, Client(scheduler)
-    try:
-        yield client
-    finally:
-        client.close()
-        if cluster is not None:
-            _stop_workers(cluster, CLOSE_TIMEOUT)
-            cluster.close()
+    with dask.config.set(LOCAL_DASK_CONFIG if scheduler is None else {}):
+        if scheduler is None:
+            n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
+            cluster = LocalCluster(
+                n_workers=min(n, max(n_tasks, 1)),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: 8787 may be taken
+            )
+            client = Client(cluster)
+        else:
+            cluster, client = None, Client(scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+            if cluster is not None:
+                _stop_workers(cluster, CLOSE_TIMEOUT)
+                cluster.close()
 
 
 def _stop_workers(cluster: Any, timeout: float) -> None:
