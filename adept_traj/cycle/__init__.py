@@ -46,6 +46,7 @@ from adept_traj.cycle.recertify import (
 from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
     CLOSE_TIMEOUT,
+    LOCAL_DASK_CONFIG,
     MOVE_FILE,
     MOVES_FOLDER,
     RETRIES,
@@ -109,6 +110,7 @@ __all__ = [
     "CYCLE_REPORT",
     "DEFAULT_PHASES",
     "GANTT_FIGURE",
+    "LOCAL_DASK_CONFIG",
     "MAX_BACK_TO_BACK_MOVES",
     "MAX_CLOCKED_MOVES",
     "MAX_DWELL_CANDIDATES",

@@ -738,3 +738,60 @@ def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Pa
     first = json.loads((detour_planned / "cycle.json").read_text())
     second = json.loads((out / "cycle.json").read_text())
     assert first == second
+
+
+def test_move_certifier_answers_as_certify_at_the_real_start(cluster) -> None:
+    """A plan asked about at the very time it was planned takes its own certificate (no
+    new one); at other scene times the answer is certify's, called directly on a problem
+    started there, the same in this process and in Dask tasks (batches)."""
+    from distributed import Client
+
+    from adept_traj.certification import certify
+    from adept_traj.cycle import MoveCertifier, PlannedMove
+    from adept_traj.problem import TrajectoryProblem
+    from adept_traj.robot import RobotSource
+    from adept_traj.testing.paper_moves import lift_then_lower
+
+    robot, scene = Robot.adept_one_xl(), Scene.shipped("paper")
+    start, goal = np.array(HOME), np.array(PLACE)
+    x = lift_then_lower(TrajectoryProblem(robot, scene, start, goal, workers=1))
+    starts = [0.0, 0.35, 0.8, 1.4]
+    expected = []
+    for s in starts:
+        problem = TrajectoryProblem(robot, scene, start, goal, workers=1, start_time=s)
+        expected.append(bool(certify(problem, x, rate_hz=1000.0).certified))
+        problem.close()
+    assert len(set(expected)) == 2  # the pendulum: certified at some starts only
+    own = not expected[0]  # the plan's own answer at 0, deliberately not certify's
+    plans = [[PlannedMove(start, goal, x, 0.0, own)]]
+    source = RobotSource()  # the shipped AdeptOne XL
+    here = MoveCertifier(source, scene, 1000.0, plans)
+    assert [here(0, 0, s) for s in starts] == [own, *expected[1:]]
+    assert here.computed == len(starts) - 1
+    with Client(cluster.scheduler_address) as client:
+        there = MoveCertifier(source, scene, 1000.0, plans, client=client)
+        there.prefetch([(0, 0, s) for s in starts])
+        assert there.computed == len(starts) - 1
+        assert [there(0, 0, s) for s in starts] == [own, *expected[1:]]
+
+
+def test_back_to_back_beyond_its_limit_names_it() -> None:
+    """More than MAX_BACK_TO_BACK_MOVES moves to chain: not tried (no certificate asked),
+    and the reason names the limit; within it, the chain of every plan certified
+    everywhere is repeat × the fastest plan's T."""
+    from adept_traj.cycle import MAX_BACK_TO_BACK_MOVES, PhaseOption, chain_passes
+
+    options = [[PhaseOption(0.0, 0.5, True), PhaseOption(1.0, 0.7, True)]]
+    asked = []
+
+    def move_ok(k, i, s):
+        asked.append(s)
+        return True
+
+    runs, why = chain_passes(options, 2.0, MAX_BACK_TO_BACK_MOVES + 1, move_ok, lambda *a: True)
+    assert runs is None
+    assert not asked
+    assert f"MAX_BACK_TO_BACK_MOVES = {MAX_BACK_TO_BACK_MOVES}" in why
+    runs, why = chain_passes(options, 2.0, 7, move_ok, lambda *a: True)
+    assert why is None
+    assert [p[0] for p in runs] == [(0, 0.5 * p) for p in range(7)]
