@@ -19,7 +19,11 @@ when none is certified: the move is reported not certified).
 Passes: when every moving obstacle's law is periodic with a common period P
 (:func:`scene_period`), a final dwell at the end of the first pass makes the pass time a
 multiple of P, so that every pass sees the obstacles in the same phases: one pass planned
-and certified covers all ``repeat`` of them. Otherwise every pass is planned, at most
+and certified covers all ``repeat`` of them. That rounding is a choice: with ``repeat`` > 1
+every pass is also chained back to back from the first pass's plans
+(:func:`~adept_traj.cycle.chained_clock`, each move re-certified at its real start time),
+and the shorter certified of the two schedules is kept (the periodic one on a tie; the
+clock's ``choice`` says which and why). Otherwise every pass is planned, at most
 :data:`MAX_CLOCKED_MOVES` moves in all (a larger cycle is refused before any planning).
 """
 
@@ -142,8 +146,9 @@ def plan_on_clock(
 
     Every dwell candidate of every move is a Dask task, saved as it finishes into
     ``out/moves/NAME.pP.wJ/`` (pass P, dwell J of the grid); ``resume`` loads those
-    already saved for the same task. Returns the clock and, per planned pass, the chosen
-    results in order. ``progress`` is called with each move's name when it is chosen.
+    already saved for the same task. Returns the clock (periodic, or every pass back to
+    back where that is shorter: module doc) and, per pass of the clock, the chosen results
+    in order. ``progress`` is called with each move's name when it is chosen.
 
     Raises
     ------
