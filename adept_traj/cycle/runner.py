@@ -68,12 +68,10 @@ RETRIES = 2
 #: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
-#: Dask settings of the local cluster (its scheduler runs in this process, its workers
-#: inherit them): no statistical profiler in the workers (a stack sample every 10 ms), no
-#: GIL monitor (every 1 ms), the system monitor every 2 s and the event-loop watchdog
-#: every 0.5 s instead of 0.5 s and 20 ms. Their sampling is CPU time the command spends
-#: serially and the workers on top of the tasks, for the length of the run; they feed only
-#: the dashboard.
+#: Dask settings of the local cluster (its scheduler runs in this process; the workers
+#: inherit them): no worker profiler (a sample every 10 ms), no GIL monitor (every 1 ms),
+#: system monitor and watchdog every 2 s and 0.5 s (not 0.5 s, 20 ms): CPU time for as
+#: long as the run lasts, serial in the command, for the dashboard only.
 LOCAL_DASK_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.gil.enabled": False,
@@ -169,14 +167,8 @@ def plan_move(task: MoveTask) -> PlanningResult:
 
 @dataclass(frozen=True)
 class SavedMove:
-    """A planned move and the bytes of its result folder's files (what a task returns).
-
-    Attributes
-    ----------
-    result: the planning result.
-    files: file name -> content of every file :meth:`~adept_traj.results.PlanningResult.save`
-        writes (``result.json``, ``front.csv``, ``best_trajectory.csv``).
-    """
+    """What a cycle's task returns: the planning ``result`` and ``files``, file name ->
+    bytes of every file :meth:`~adept_traj.results.PlanningResult.save` writes."""
 
     result: PlanningResult
     files: dict[str, bytes]
