@@ -124,11 +124,14 @@ def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
             f"{best:.3f} s ({how}), naive back-to-back {_seconds(naive)} s{gain}; periodic "
             f"{_seconds(report['periodic'])} s"
             f"{'' if report['periodic_certified'] else ' (not re-certified)'}, back to back "
-            f"{_seconds(report['back_to_back'])} s",
+            f"{_seconds(report['back_to_back'])} s"
+            + ("" if report["back_to_back_note"] is None else f" ({report['back_to_back_note']})"),
             file=sys.stderr,
         )
         return _report_on_clock(args, cycle, out, clock, passes)
     clock, passes = _with_bar(args, cycle, out, plan_on_clock)
+    if clock.choice:
+        print(f"schedule: {clock.choice}", file=sys.stderr)
     return _report_on_clock(args, cycle, out, clock, passes)
 
 

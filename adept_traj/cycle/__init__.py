@@ -10,11 +10,10 @@ Dask (``distributed``) is imported only when a cycle runs."""
 
 from __future__ import annotations
 
+from adept_traj.cycle.chained import ChainPlan, chained_clock
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
     MAX_CLOCKED_MOVES,
-    ClockedMove,
-    CycleClock,
     check_chained,
     dwell_grid,
     plan_on_clock,
@@ -31,26 +30,46 @@ from adept_traj.cycle.cycle_file import (
 )
 from adept_traj.cycle.cycle_playback import (
     PLAYBACK_FILE,
+    PLAYBACK_PASSES,
     clock_playback,
     cycle_html,
     cycle_playback,
 )
 from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
+from adept_traj.cycle.recertify import (
+    CertifyBatch,
+    MoveCertifier,
+    PlannedMove,
+    RestCertifier,
+    certify_batch,
+)
 from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
     CLOSE_TIMEOUT,
+    LOCAL_DASK_CONFIG,
     MOVE_FILE,
     MOVES_FOLDER,
     RETRIES,
     MoveTask,
+    SavedMove,
     cycle_tasks,
     dask_client,
+    plan_and_encode,
     plan_move,
     run_cycle,
     run_planning_tasks,
     run_tasks,
+    worker_robot,
 )
-from adept_traj.cycle.schedules import PhaseOption, back_to_back, phase_frontier, phase_schedules
+from adept_traj.cycle.schedules import (
+    MAX_BACK_TO_BACK_MOVES,
+    MAX_UNDONE,
+    PhaseOption,
+    back_to_back,
+    chain_passes,
+    phase_frontier,
+    phase_schedules,
+)
 from adept_traj.cycle.study import (
     ALGORITHM_PAIR,
     METRICS,
@@ -80,6 +99,7 @@ from adept_traj.cycle.summary import (
     save_gantt,
     write_cycle_report,
 )
+from adept_traj.cycle.timeline import ClockedMove, CycleClock
 
 __all__ = [
     "ALGORITHM_PAIR",
@@ -90,30 +110,43 @@ __all__ = [
     "CYCLE_REPORT",
     "DEFAULT_PHASES",
     "GANTT_FIGURE",
+    "LOCAL_DASK_CONFIG",
+    "MAX_BACK_TO_BACK_MOVES",
     "MAX_CLOCKED_MOVES",
     "MAX_DWELL_CANDIDATES",
     "MAX_MOVES",
+    "MAX_UNDONE",
     "METRICS",
     "MOVES_FOLDER",
     "MOVE_FILE",
     "PLAYBACK_FILE",
+    "PLAYBACK_PASSES",
     "RECERTIFIED_PASSES",
     "RETRIES",
     "RUNS_FOLDER",
     "STUDY_FILE",
     "STUDY_REPORT",
+    "CertifyBatch",
+    "ChainPlan",
     "ClockedMove",
     "Cycle",
     "CycleClock",
     "Location",
     "Metric",
+    "MoveCertifier",
     "MoveSpec",
     "MoveTask",
     "PhaseOption",
+    "PlannedMove",
+    "RestCertifier",
     "RestCheck",
     "RestProfile",
+    "SavedMove",
     "back_to_back",
+    "certify_batch",
     "certify_rest",
+    "chain_passes",
+    "chained_clock",
     "check_chained",
     "chosen_member",
     "clock_playback",
@@ -129,6 +162,7 @@ __all__ = [
     "parse_seeds",
     "phase_frontier",
     "phase_schedules",
+    "plan_and_encode",
     "plan_move",
     "plan_on_clock",
     "plan_phase_grid",
@@ -143,6 +177,7 @@ __all__ = [
     "scene_period",
     "study_markdown",
     "study_statistics",
+    "worker_robot",
     "write_cycle_report",
     "write_study_report",
 ]

@@ -19,7 +19,11 @@ when none is certified: the move is reported not certified).
 Passes: when every moving obstacle's law is periodic with a common period P
 (:func:`scene_period`), a final dwell at the end of the first pass makes the pass time a
 multiple of P, so that every pass sees the obstacles in the same phases: one pass planned
-and certified covers all ``repeat`` of them. Otherwise every pass is planned, at most
+and certified covers all ``repeat`` of them. That rounding is a choice: with ``repeat`` > 1
+every pass is also chained back to back from the first pass's plans
+(:func:`~adept_traj.cycle.chained_clock`, each move re-certified at its real start time),
+and the shorter certified of the two schedules is kept (the periodic one on a tie; the
+clock's ``choice`` says which and why). Otherwise every pass is planned, at most
 :data:`MAX_CLOCKED_MOVES` moves in all (a larger cycle is refused before any planning).
 """
 
@@ -28,21 +32,25 @@ from __future__ import annotations
 import itertools
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from adept_traj.cycle.chained import ChainPlan, chained_clock
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
-from adept_traj.cycle.rest import RestCheck, certify_rest
+from adept_traj.cycle.recertify import RestCertifier
+from adept_traj.cycle.rest import certify_rest
 from adept_traj.cycle.runner import (
     MOVES_FOLDER,
     cycle_tasks,
     dask_client,
     run_planning_tasks,
 )
+from adept_traj.cycle.schedules import SAME_TIME
+from adept_traj.cycle.timeline import ClockedMove, CycleClock
 from adept_traj.errors import CycleError
 from adept_traj.problem import ProblemSettings
 from adept_traj.results import PlanningResult
@@ -125,97 +133,6 @@ def check_chained(cycle: Cycle) -> None:
         )
 
 
-@dataclass(frozen=True)
-class ClockedMove:
-    """One move of one pass on the scene clock.
-
-    Attributes
-    ----------
-    pass_index, index, name: the pass (0-based), the move's place in the sequence, its name.
-    folder: its result folder, relative to the cycle's output folder; member: the row of
-        its front the cycle runs (:func:`~adept_traj.cycle.chosen_member`).
-    start_time, dwell, T: scene time [s] the move starts, the dwell [s] before it, its
-        travel time [s] (the reported solution's).
-    move_certified: the reported solution is certified at ``start_time``.
-    rest: the certificate of the dwell before it.
-    candidates: per dwell of the grid, ``(dwell [s], T [s], certified)``.
-    """
-
-    pass_index: int
-    index: int
-    name: str
-    folder: str
-    member: int
-    start_time: float
-    dwell: float
-    T: float
-    move_certified: bool
-    rest: RestCheck
-    candidates: tuple[tuple[float, float, bool], ...]
-
-    @property
-    def end_time(self) -> float:
-        """Scene time [s] the move ends, ``start_time + T``."""
-        return self.start_time + self.T
-
-    @property
-    def certified(self) -> bool:
-        """The move and the dwell before it are certified."""
-        return self.move_certified and self.rest.certified
-
-
-@dataclass(frozen=True)
-class CycleClock:
-    """A cycle planned on the scene clock (:func:`plan_on_clock`).
-
-    Attributes
-    ----------
-    period: the scene's common period P [s], or ``None`` (every pass planned).
-    passes: the planned passes (one for a periodic scene), each its moves in order.
-    final_dwell, final_rest: the dwell [s] after the first pass that makes the pass time a
-        multiple of P and its certificate (periodic scene with ``repeat`` > 1; else 0 and
-        ``None``).
-    repeat: passes per cycle; dwells: the dwell grid [s] (the start phases [s] of a phase
-        grid, :mod:`adept_traj.cycle.phase_grid`).
-    mode: ``"dwell grid"`` (:func:`plan_on_clock`) or ``"phase grid (optimised)"`` /
-        ``"phase grid (naive)"`` (:func:`~adept_traj.cycle.plan_phase_grid`).
-    """
-
-    period: float | None
-    passes: tuple[tuple[ClockedMove, ...], ...]
-    final_dwell: float
-    final_rest: RestCheck | None
-    repeat: int
-    dwells: tuple[float, ...]
-    mode: str = "dwell grid"
-
-    @property
-    def pass_time(self) -> float:
-        """Scene time [s] of one pass, dwells and the final dwell included (periodic
-        scene); the end of the last planned pass otherwise."""
-        return self.passes[-1][-1].end_time + self.final_dwell
-
-    @property
-    def cycle_time(self) -> float:
-        """The whole cycle [s]: ``repeat`` × the pass time (periodic), else the end of the
-        last pass."""
-        return self.repeat * self.pass_time if self.period is not None else self.pass_time
-
-    @property
-    def certified(self) -> bool:
-        """Every move and every dwell of every pass is certified."""
-        rest = self.final_rest is None or self.final_rest.certified
-        return rest and all(m.certified for moves in self.passes for m in moves)
-
-    def start_times(self) -> list[list[float]]:
-        """Per pass of the ``repeat`` passes, each move's scene start time [s] (a periodic
-        cycle's passes p > 0 shifted by p × the pass time)."""
-        if self.period is None:
-            return [[m.start_time for m in moves] for moves in self.passes]
-        shift = self.pass_time
-        return [[m.start_time + p * shift for m in self.passes[0]] for p in range(self.repeat)]
-
-
 def plan_on_clock(
     cycle: Cycle,
     out: str | os.PathLike[str],
@@ -229,8 +146,9 @@ def plan_on_clock(
 
     Every dwell candidate of every move is a Dask task, saved as it finishes into
     ``out/moves/NAME.pP.wJ/`` (pass P, dwell J of the grid); ``resume`` loads those
-    already saved for the same task. Returns the clock and, per planned pass, the chosen
-    results in order. ``progress`` is called with each move's name when it is chosen.
+    already saved for the same task. Returns the clock (periodic, or every pass back to
+    back where that is shorter: module doc) and, per pass of the clock, the chosen results
+    in order. ``progress`` is called with each move's name when it is chosen.
 
     Raises
     ------
@@ -256,6 +174,7 @@ def plan_on_clock(
     tasks = cycle_tasks(cycle)
     passes, chosen_results = [], []
     t = 0.0
+    chain: list[list[ChainPlan]] = []  # the plans of pass 0, for every pass back to back
     with dask_client(workers, scheduler, len(grid)) as client:
         for p in range(planned):
             row, row_results = [], []
@@ -290,22 +209,70 @@ def plan_on_clock(
                     )
                 )
                 row_results.append(r)
+                chain.append(
+                    [
+                        ChainPlan(f"{MOVES_FOLDER}/{c.move.name}", r, k, c.start_time, T, g)
+                        for c, r, k, T, g in zip(candidates, results, rows, times, good)
+                    ]
+                )
                 t = row[-1].end_time
                 if progress is not None:
                     progress(m.name)
             passes.append(tuple(row))
             chosen_results.append(row_results)
-    final, final_rest = 0.0, None
-    if period is not None and cycle.repeat > 1:
-        final = math.ceil(t / period - 1e-9) * period - t
-        goal = tasks[-1].goal
-        final_rest = certify_rest(robot, cycle.scene, goal, t, max(final, 0.0), **rest)
-    clock = CycleClock(
-        period=period,
-        passes=tuple(passes),
-        final_dwell=max(final, 0.0),
-        final_rest=final_rest,
-        repeat=cycle.repeat,
-        dwells=tuple(float(d) for d in grid),
-    )
-    return clock, chosen_results
+        final, final_rest = 0.0, None
+        if period is not None and cycle.repeat > 1:
+            final = math.ceil(t / period - 1e-9) * period - t
+            goal = tasks[-1].goal
+            final_rest = certify_rest(robot, cycle.scene, goal, t, max(final, 0.0), **rest)
+        clock = CycleClock(
+            period=period,
+            passes=tuple(passes),
+            final_dwell=max(final, 0.0),
+            final_rest=final_rest,
+            repeat=cycle.repeat,
+            dwells=tuple(float(d) for d in grid),
+        )
+        if period is None or cycle.repeat == 1:
+            return clock, chosen_results
+        sites = [task.start for task in tasks]
+        back, back_results, why = chained_clock(
+            cycle,
+            tasks,
+            period,
+            chain,
+            rest=RestCertifier(robot, cycle.scene, sites, **rest),
+            candidates=[m.candidates for m in passes[0]],
+            client=client,
+            dwells=clock.dwells,
+        )
+    return _shorter(clock, chosen_results, back, back_results, why)
+
+
+def _shorter(
+    periodic: CycleClock,
+    periodic_results: list[list[PlanningResult]],
+    back: CycleClock | None,
+    back_results: list[list[PlanningResult]],
+    why: str | None,
+) -> tuple[CycleClock, list[list[PlanningResult]]]:
+    """The shorter certified of the periodic clock and every pass back to back (``back``,
+    ``None`` when there is none: ``why``), the periodic one on a tie; its ``choice`` says
+    which and why."""
+    rounded = f"one pass rounded up to a multiple of P, × {periodic.repeat}"
+    p_time = f"{periodic.cycle_time:.3f} s"
+    p_state = "certified" if periodic.certified else "NOT certified"
+    if back is None:
+        text = f"periodic ({rounded}): {p_time}, {p_state}; every pass back to back: {why}"
+        return replace(periodic, choice=text), periodic_results
+    b_time = f"{back.cycle_time:.3f} s"
+    shorter = back.cycle_time < periodic.cycle_time - SAME_TIME
+    if back.certified and (shorter or not periodic.certified):
+        reason = "shorter" if shorter else f"the periodic schedule is {p_state}"
+        text = (
+            f"every pass back to back: {b_time} ({reason}; periodic, {rounded}: {p_time}, "
+            f"{p_state})"
+        )
+        return replace(back, choice=text), back_results
+    text = f"periodic ({rounded}): {p_time}, {p_state}; every pass back to back: {b_time}"
+    return replace(periodic, choice=text), periodic_results

@@ -10,8 +10,9 @@ moves). :func:`clock_playback` plays a cycle planned on the scene clock
 (:mod:`adept_traj.cycle.clock`) on one continuous clock: every frame at its scene time,
 the dwells included (the robot at rest, the obstacles moving on), so the obstacles never
 jump; a periodic cycle plays its one pass and the final dwell, so that the page's loop is
-continuous too. :func:`cycle_html` writes either as a self-contained page
-(``playback.html``). meshcat is imported only when they are called.
+continuous too; every pass back to back plays the first :data:`PLAYBACK_PASSES` passes.
+:func:`cycle_html` writes either as a self-contained page (``playback.html``). meshcat is
+imported only when they are called.
 """
 
 from __future__ import annotations
@@ -30,9 +31,12 @@ from adept_traj.results import PlanningResult, Replay
 from adept_traj.robot import Robot
 from adept_traj.scene import Scene
 
-__all__ = ["PLAYBACK_FILE", "clock_playback", "cycle_html", "cycle_playback"]
+__all__ = ["PLAYBACK_FILE", "PLAYBACK_PASSES", "clock_playback", "cycle_html", "cycle_playback"]
 
 PLAYBACK_FILE = "playback.html"
+#: Passes a clock's playback plays at most (the first ones; the page's size grows with
+#: every move).
+PLAYBACK_PASSES = 10
 
 
 def cycle_playback(
@@ -122,14 +126,16 @@ def clock_playback(
     """The :class:`~adept_traj.viz.playback.Playback` of a cycle planned on the scene
     clock: its planned passes (``results``: per pass the chosen results, in order) with
     every frame at its scene time [s] (keyframe = scene time × ``fps``), the dwells as
-    frames of the robot at rest while the obstacles move."""
+    frames of the robot at rest while the obstacles move; at most the first
+    :data:`PLAYBACK_PASSES` passes."""
     from adept_traj.viz.playback import SceneObject, build_animation
 
     segments: list[tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]] = []
     fixed: dict[str, Any] = {}
     tools = []
     certified = clock.certified
-    entries = [(m, r) for moves, rs in zip(clock.passes, results) for m, r in zip(moves, rs)]
+    shown = zip(clock.passes[:PLAYBACK_PASSES], results[:PLAYBACK_PASSES])
+    entries = [(m, r) for moves, rs in shown for m, r in zip(moves, rs)]
     for n, (m, r) in enumerate(entries):
         if r.problem_settings.start_time != m.start_time:  # run at another time than planned
             r = replace(r, problem_settings=replace(r.problem_settings, start_time=m.start_time))

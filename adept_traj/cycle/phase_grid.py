@@ -44,10 +44,12 @@ schedule chosen again, until a schedule passes every check or none is left. So o
 moves and dwells certified at the times they run are reported.
 
 With ``repeat`` > 1 the final dwell that makes a pass a multiple of P is a choice, not a
-need: where ``repeat`` × K ≤ :data:`~adept_traj.cycle.MAX_CLOCKED_MOVES`, every pass is
-also scheduled **back to back** (:func:`~adept_traj.cycle.back_to_back`: each move at the
-previous end with the fastest plan certified there, whatever phase it was planned at, a
-dwell only where none is; no final dwell), each move re-certified at its real start time.
+need: where ``repeat`` × K ≤ :data:`~adept_traj.cycle.MAX_BACK_TO_BACK_MOVES`, every pass
+is also scheduled **back to back** (:func:`~adept_traj.cycle.back_to_back`: each move at
+the previous end with the fastest plan certified there, whatever phase it was planned at,
+a dwell only where none is, backtracking where a move has no certified step; no final
+dwell), each move re-certified at its real start time in batches of Dask tasks
+(:class:`~adept_traj.cycle.MoveCertifier`).
 That is the **naive** schedule then (it waits only where it must), and the optimised one
 when its cycle time is shorter than ``repeat`` × the periodic schedule's pass time: the
 clock then holds every pass (``period`` ``None``, mode ``"phase grid (optimised, back to
@@ -65,17 +67,16 @@ from typing import Any
 
 import numpy as np
 
-from adept_traj.certification import certify
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
-    MAX_CLOCKED_MOVES,
     ClockedMove,
     CycleClock,
     check_chained,
     scene_period,
 )
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
-from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
+from adept_traj.cycle.recertify import MoveCertifier, PlannedMove, RestCertifier
+from adept_traj.cycle.rest import RestProfile
 from adept_traj.cycle.runner import (
     MOVES_FOLDER,
     MoveTask,
@@ -87,7 +88,7 @@ from adept_traj.cycle.schedules import (
     SAME_TIME,
     PhaseOption,
     Step,
-    back_to_back,
+    chain_passes,
     congruent,
     naive_schedule,
     pass_end,
@@ -95,7 +96,7 @@ from adept_traj.cycle.schedules import (
     phase_schedules,
 )
 from adept_traj.errors import CycleError
-from adept_traj.problem import ProblemSettings, TrajectoryProblem
+from adept_traj.problem import ProblemSettings
 from adept_traj.results import PlanningResult
 from adept_traj.validation import as_integer
 
@@ -129,6 +130,12 @@ def _plans(tasks: Sequence[MoveTask], results: Sequence[PlanningResult]) -> list
     return out
 
 
+def _planned(task: MoveTask, plan: _Plan) -> PlannedMove:
+    """``plan`` of ``task``'s move, planned at the scene time ``plan.option.phase`` [s]."""
+    x = plan.result.front.x[plan.member]
+    return PlannedMove(task.start, task.goal, x, plan.option.phase, plan.option.certified)
+
+
 def plan_phase_grid(
     cycle: Cycle,
     out: str | os.PathLike[str],
@@ -146,7 +153,8 @@ def plan_phase_grid(
     None, "naive": …, "periodic": the periodic schedule's cycle time [s] | None,
     "periodic_certified": whether it was re-certified (not when the back-to-back schedule
     is no longer: then "periodic" is its uncertified cycle time), "back_to_back": the
-    back-to-back schedule's | None, "plans": plans per move, "phases": (N,) grid [s]}``.
+    back-to-back schedule's | None, "back_to_back_note": why there is none | None, "plans":
+    plans per move, "phases": (N,) grid [s]}``.
     Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase J) and ``out/moves/NAME.xI/``
     (arrival I).
 
@@ -216,159 +224,141 @@ def plan_phase_grid(
                 done = run_planning_tasks(extra, where, resume=True, client=client)
                 plans[k] = plans[k] + _plans(extra, done)
 
-    options = [[p.option for p in row] for row in plans]
-    moves_ok: dict[tuple[int, int, float], bool] = {}
-    rests: dict[tuple[int, float, float], RestCheck] = {}
-
-    def move_ok(k: int, i: int, start: float) -> bool:
-        key = (k, i, start)
-        if key not in moves_ok:
-            p = plans[k][i]
-            problem = TrajectoryProblem(
-                robot, cycle.scene, base[k].start, base[k].goal, workers=1, start_time=start
-            )
-            try:  # the real start time, not the phase it was planned at
-                moves_ok[key] = bool(
-                    certify(problem, p.result.front.x[p.member], rate_hz=cycle.rate_hz).certified
-                )
-            finally:
-                problem.close()
-        return moves_ok[key]
-
-    def rest(k: int, start: float, duration: float) -> RestCheck:
-        key = (k, start, duration)
-        if key not in rests:
-            rests[key] = certify_rest(
-                robot,
-                cycle.scene,
-                sites[k],
-                start,
-                duration,
-                settings=settings,
-                rate_hz=cycle.rate_hz,
-            )
-        return rests[key]
-
-    def failures(path: tuple[Step, ...]) -> set[tuple[int, int, float]]:
-        """The steps of ``path`` not certified at their real scene times, every pass."""
-        end = path[-1][1] + options[-1][path[-1][0]].T
-        span = pass_end(end, P, cycle.repeat)
-        bad = set()
-        for p in range(min(cycle.repeat, RECERTIFIED_PASSES)):
-            shift, e = p * span, 0.0
-            for k, (i, s) in enumerate(path):
-                if not (move_ok(k, i, s + shift) and rest(k, e + shift, s - e).certified):
-                    bad.add((k, i, s))
-                e = s + options[k][i].T
-            if cycle.repeat > 1 and not rest(K, e + shift, span - e).certified:
-                bad.add((K - 1, *path[-1]))
-        return bad
-
-    runs = None  # every pass back to back, no final dwell (module doc)
-    if cycle.repeat > 1 and cycle.repeat * K <= MAX_CLOCKED_MOVES:
-        runs = back_to_back(
-            options,
-            P,
-            cycle.repeat,
-            move_ok,
-            lambda k, s, d: allowed(k, s, d) and rest(k, s, d).certified,
+        options = [[p.option for p in row] for row in plans]
+        move_ok = MoveCertifier(
+            cycle.robot,
+            cycle.scene,
+            cycle.rate_hz,
+            [[_planned(base[k], p) for p in row] for k, row in enumerate(plans)],
+            client=client,
         )
-    runs_time = None
-    if runs is not None:
-        i, s = runs[-1][-1]
-        runs_time = s + options[-1][i].T
-    chosen: dict[str, tuple[Step, ...] | None] = {"optimised": None, "naive": None}
-    bound = None  # a periodic schedule no shorter than the back-to-back one, not re-certified
-    for name in ("optimised",) if runs is not None else ("optimised", "naive"):
-        banned: frozenset[tuple[int, int, float]] = frozenset()
-        while True:
-            path = phase_schedules(
-                options, P, allowed, beam=width, repeat=cycle.repeat, banned=banned
-            )[name]
-            if path is not None and runs_time is not None:
-                span = cycle.repeat * _span(path, options, P, cycle.repeat)
-                if span >= runs_time - SAME_TIME:
-                    bound = span
+        rest = RestCertifier(robot, cycle.scene, sites, settings=settings, rate_hz=cycle.rate_hz)
+
+        def failures(path: tuple[Step, ...]) -> set[tuple[int, int, float]]:
+            """The steps of ``path`` not certified at their real scene times, every pass."""
+            end = path[-1][1] + options[-1][path[-1][0]].T
+            span = pass_end(end, P, cycle.repeat)
+            passes = range(min(cycle.repeat, RECERTIFIED_PASSES))
+            move_ok.prefetch(
+                [(k, i, s + p * span) for p in passes for k, (i, s) in enumerate(path)]
+            )
+            bad = set()
+            for p in passes:
+                shift, e = p * span, 0.0
+                for k, (i, s) in enumerate(path):
+                    if not (move_ok(k, i, s + shift) and rest(k, e + shift, s - e).certified):
+                        bad.add((k, i, s))
+                    e = s + options[k][i].T
+                if cycle.repeat > 1 and not rest(K, e + shift, span - e).certified:
+                    bad.add((K - 1, *path[-1]))
+            return bad
+
+        runs, why = None, None  # every pass back to back, no final dwell (module doc)
+        if cycle.repeat > 1:
+            runs, why = chain_passes(
+                options,
+                P,
+                cycle.repeat,
+                move_ok,
+                lambda k, s, d: allowed(k, s, d) and rest(k, s, d).certified,
+            )
+        runs_time = None
+        if runs is not None:
+            i, s = runs[-1][-1]
+            runs_time = s + options[-1][i].T
+        chosen: dict[str, tuple[Step, ...] | None] = {"optimised": None, "naive": None}
+        bound = None  # a periodic schedule no shorter than the back-to-back one, not re-certified
+        for name in ("optimised",) if runs is not None else ("optimised", "naive"):
+            banned: frozenset[tuple[int, int, float]] = frozenset()
+            while True:
+                path = phase_schedules(
+                    options, P, allowed, beam=width, repeat=cycle.repeat, banned=banned
+                )[name]
+                if path is not None and runs_time is not None:
+                    span = cycle.repeat * _span(path, options, P, cycle.repeat)
+                    if span >= runs_time - SAME_TIME:
+                        bound = span
+                        break
+                bad = set() if path is None else failures(path)
+                if not bad:
+                    chosen[name] = path
                     break
-            bad = set() if path is None else failures(path)
-            if not bad:
-                chosen[name] = path
-                break
-            banned = banned | bad
-    if chosen["optimised"] is not None and chosen["naive"] is not None:
-        span = {k: _span(v, options, P, cycle.repeat) for k, v in chosen.items()}
-        if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
-            chosen["optimised"] = chosen["naive"]
-    times = {
-        name: None if v is None else cycle.repeat * _span(v, options, P, cycle.repeat)
-        for name, v in chosen.items()
-    }
-    report: dict[str, Any] = {
-        "periodic": times["optimised"] if bound is None else bound,
-        "periodic_certified": times["optimised"] is not None,
-        "back_to_back": runs_time,
-    }
-    back = False
-    if runs_time is not None:  # the naive schedule is the back-to-back one
-        times["naive"] = runs_time
-        periodic = times["optimised"]
-        if periodic is None or runs_time < periodic - SAME_TIME:
-            times["optimised"] = runs_time
-            back = True  # and so is the optimised one
-        back = back or schedule == "naive"
-    if chosen[schedule] is None and not back:
-        counts = ", ".join(
-            f"{t.move.name} {sum(p.option.certified for p in row)}/{len(row)}"
-            for t, row in zip(base, plans)
-        )
-        raise CycleError(
-            f"{cycle.source}: no {schedule} schedule certified at its real start times on "
-            f"a grid of {n} phases and the arrivals (plans certified at their phase: "
-            f"{counts}); plan the cycle without --phase-grid"
-        )
-    if back and runs is not None:
-        chosen_passes = runs
-    else:  # not None: refused above otherwise
-        chosen_passes = [path for path in (chosen[schedule],) if path is not None]
-    rows, results = [], []
-    end = 0.0
-    for q, path in enumerate(chosen_passes):
-        row, row_results = [], []
-        for k, (i, start) in enumerate(path):
-            p = plans[k][i]
-            row.append(
-                ClockedMove(
-                    pass_index=q,
-                    index=k,
-                    name=base[k].move.name,
-                    folder=f"{MOVES_FOLDER}/{p.name}",
-                    member=p.member,
-                    start_time=start,
-                    dwell=start - end,
-                    T=p.option.T,
-                    move_certified=move_ok(k, i, start),
-                    rest=rest(k, end, start - end),
-                    candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
-                )
+                banned = banned | bad
+        if chosen["optimised"] is not None and chosen["naive"] is not None:
+            span = {k: _span(v, options, P, cycle.repeat) for k, v in chosen.items()}
+            if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
+                chosen["optimised"] = chosen["naive"]
+        times = {
+            name: None if v is None else cycle.repeat * _span(v, options, P, cycle.repeat)
+            for name, v in chosen.items()
+        }
+        report: dict[str, Any] = {
+            "periodic": times["optimised"] if bound is None else bound,
+            "periodic_certified": times["optimised"] is not None,
+            "back_to_back": runs_time,
+            "back_to_back_note": why,
+        }
+        back = False
+        if runs_time is not None:  # the naive schedule is the back-to-back one
+            times["naive"] = runs_time
+            periodic = times["optimised"]
+            if periodic is None or runs_time < periodic - SAME_TIME:
+                times["optimised"] = runs_time
+                back = True  # and so is the optimised one
+            back = back or schedule == "naive"
+        if chosen[schedule] is None and not back:
+            counts = ", ".join(
+                f"{t.move.name} {sum(p.option.certified for p in row)}/{len(row)}"
+                for t, row in zip(base, plans)
             )
-            row_results.append(p.result)
-            end = start + p.option.T
-        rows.append(tuple(row))
-        results.append(row_results)
-    final = 0.0 if back else pass_end(end, P, cycle.repeat) - end
-    clock = CycleClock(
-        period=None if back else P,
-        passes=tuple(rows),
-        final_dwell=max(final, 0.0),
-        final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 and not back else None,
-        repeat=cycle.repeat,
-        dwells=tuple(grid.tolist()),
-        mode=f"phase grid ({schedule}{', back to back' if back else ''})",
-    )
-    report.update({"optimised": times["optimised"], "naive": times["naive"]})
-    report["plans"] = [len(r) for r in plans]
-    report["phases"] = grid
-    return clock, results, report
+            raise CycleError(
+                f"{cycle.source}: no {schedule} schedule certified at its real start times on "
+                f"a grid of {n} phases and the arrivals (plans certified at their phase: "
+                f"{counts}); plan the cycle without --phase-grid"
+            )
+        if back and runs is not None:
+            chosen_passes = runs
+        else:  # not None: refused above otherwise
+            chosen_passes = [path for path in (chosen[schedule],) if path is not None]
+        rows, results = [], []
+        end = 0.0
+        for q, path in enumerate(chosen_passes):
+            row, row_results = [], []
+            for k, (i, start) in enumerate(path):
+                p = plans[k][i]
+                row.append(
+                    ClockedMove(
+                        pass_index=q,
+                        index=k,
+                        name=base[k].move.name,
+                        folder=f"{MOVES_FOLDER}/{p.name}",
+                        member=p.member,
+                        start_time=start,
+                        dwell=start - end,
+                        T=p.option.T,
+                        move_certified=move_ok(k, i, start),
+                        rest=rest(k, end, start - end),
+                        candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
+                    )
+                )
+                row_results.append(p.result)
+                end = start + p.option.T
+            rows.append(tuple(row))
+            results.append(row_results)
+        final = 0.0 if back else pass_end(end, P, cycle.repeat) - end
+        clock = CycleClock(
+            period=None if back else P,
+            passes=tuple(rows),
+            final_dwell=max(final, 0.0),
+            final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 and not back else None,
+            repeat=cycle.repeat,
+            dwells=tuple(grid.tolist()),
+            mode=f"phase grid ({schedule}{', back to back' if back else ''})",
+        )
+        report.update({"optimised": times["optimised"], "naive": times["naive"]})
+        report["plans"] = [len(r) for r in plans]
+        report["phases"] = grid
+        return clock, results, report
 
 
 def _span(

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import tempfile
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -41,16 +42,20 @@ from adept_traj.validation import as_integer
 
 __all__ = [
     "CLOSE_TIMEOUT",
+    "LOCAL_DASK_CONFIG",
     "MOVES_FOLDER",
     "MOVE_FILE",
     "RETRIES",
     "MoveTask",
+    "SavedMove",
     "cycle_tasks",
     "dask_client",
+    "plan_and_encode",
     "plan_move",
     "run_cycle",
     "run_planning_tasks",
     "run_tasks",
+    "worker_robot",
 ]
 
 #: Sub-folder of the output folder holding one result folder per move.
@@ -63,6 +68,16 @@ RETRIES = 2
 #: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
+#: Dask settings of the local cluster (its scheduler runs in this process; the workers
+#: inherit them): no worker profiler (a sample every 10 ms), no GIL monitor (every 1 ms),
+#: system monitor and watchdog every 2 s and 0.5 s (not 0.5 s, 20 ms): CPU time for as
+#: long as the run lasts, serial in the command, for the dashboard only.
+LOCAL_DASK_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.tick.interval": "500ms",
+}
 
 
 @dataclass(frozen=True)
@@ -126,7 +141,7 @@ def cycle_tasks(cycle: Cycle) -> list[MoveTask]:
 
 
 @lru_cache(maxsize=4)
-def _robot(source: RobotSource) -> Robot:
+def worker_robot(source: RobotSource) -> Robot:
     """The robot of ``source``, loaded once per worker process."""
     return source.load()
 
@@ -134,7 +149,7 @@ def _robot(source: RobotSource) -> Robot:
 def plan_move(task: MoveTask) -> PlanningResult:
     """Plan one move (the body of a Dask task; also callable directly)."""
     m = task.move
-    robot, t0 = _robot(task.robot), task.start_time
+    robot, t0 = worker_robot(task.robot), task.start_time
     problem = TrajectoryProblem(robot, task.scene, task.start, task.goal, workers=1, start_time=t0)
     try:
         return plan(
@@ -150,6 +165,25 @@ def plan_move(task: MoveTask) -> PlanningResult:
         problem.close()
 
 
+@dataclass(frozen=True)
+class SavedMove:
+    """What a cycle's task returns: the planning ``result`` and ``files``, file name ->
+    bytes of every file :meth:`~adept_traj.results.PlanningResult.save` writes."""
+
+    result: PlanningResult
+    files: dict[str, bytes]
+
+
+def plan_and_encode(task: MoveTask) -> SavedMove:
+    """Plan one move and encode its result files in the worker (the body of a cycle's
+    Dask task): the command only writes the bytes, so the encoding runs in parallel."""
+    result = plan_move(task)
+    with tempfile.TemporaryDirectory(prefix="adept-traj-move-") as tmp:
+        folder = result.save(Path(tmp) / "result")
+        files = {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+    return SavedMove(result, files)
+
+
 def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
     """The saved result of ``task`` in ``folder`` when it is complete and planned for the
     same task; ``None`` otherwise (then it is planned again)."""
@@ -162,13 +196,15 @@ def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
         return None
 
 
-def _save(folder: Path, task: MoveTask, result: PlanningResult) -> Path:
-    """Save ``result`` into ``folder/NAME`` at once and atomically (a temporary folder
-    renamed), with ``move.json``."""
+def _save(folder: Path, task: MoveTask, saved: SavedMove) -> Path:
+    """Write the files of ``saved`` into ``folder/NAME`` at once and atomically (a
+    temporary folder renamed), with ``move.json``."""
     final = folder / task.move.name
     tmp = final.with_name(f".{task.move.name}.partial")
     shutil.rmtree(tmp, ignore_errors=True)
-    result.save(tmp)
+    tmp.mkdir(parents=True)
+    for name, content in saved.files.items():
+        (tmp / name).write_bytes(content)
     write_text_atomic(tmp / MOVE_FILE, json.dumps(task.description(), indent=1))
     shutil.rmtree(final, ignore_errors=True)
     os.replace(tmp, final)
@@ -200,27 +236,30 @@ def dask_client(workers: int | None, scheduler: str | None, n_tasks: int) -> Ite
     """A ``distributed.Client``: of a new local cluster of ``min(workers, n_tasks)``
     single-threaded worker processes (default: one per core), or of the scheduler at
     address ``scheduler``; closed (and the cluster stopped, each worker process given
-    :data:`CLOSE_TIMEOUT` to exit) on leaving."""
+    :data:`CLOSE_TIMEOUT` to exit) on leaving. A local cluster runs with
+    :data:`LOCAL_DASK_CONFIG`."""
+    import dask
     from distributed import Client, LocalCluster
 
-    if scheduler is None:
-        n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
-        cluster = LocalCluster(
-            n_workers=min(n, max(n_tasks, 1)),
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # any free port: 8787 may be taken
-        )
-        client = Client(cluster)
-    else:
-        cluster, client = None, Client(scheduler)
-    try:
-        yield client
-    finally:
-        client.close()
-        if cluster is not None:
-            _stop_workers(cluster, CLOSE_TIMEOUT)
-            cluster.close()
+    with dask.config.set(LOCAL_DASK_CONFIG if scheduler is None else {}):
+        if scheduler is None:
+            n = as_integer(workers or os.cpu_count() or 1, "workers", minimum=1, maximum=1024)
+            cluster = LocalCluster(
+                n_workers=min(n, max(n_tasks, 1)),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: 8787 may be taken
+            )
+            client = Client(cluster)
+        else:
+            cluster, client = None, Client(scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+            if cluster is not None:
+                _stop_workers(cluster, CLOSE_TIMEOUT)
+                cluster.close()
 
 
 def _stop_workers(cluster: Any, timeout: float) -> None:
@@ -296,10 +335,10 @@ def run_planning_tasks(
             if progress is not None:
                 progress(task.move.name)
 
-    def saved(j: int, result: PlanningResult) -> None:
+    def saved(j: int, move: SavedMove) -> None:
         i = pending[j]
-        _save(where, tasks[i], result)
-        results[i] = result
+        _save(where, tasks[i], move)
+        results[i] = move.result
         if progress is not None:
             progress(tasks[i].move.name)
 
@@ -307,7 +346,7 @@ def run_planning_tasks(
         where.mkdir(parents=True, exist_ok=True)
         run_tasks(
             [tasks[i] for i in pending],
-            plan_move,
+            plan_and_encode,
             workers=workers,
             scheduler=scheduler,
             on_result=saved,

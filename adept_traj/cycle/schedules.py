@@ -2,24 +2,31 @@ r"""Schedules of a periodic cycle over the plans of its moves: dynamic programmi
 end times (:func:`phase_frontier`, :func:`phase_schedules`) and the naive back-to-back
 schedule (:func:`naive_schedule`); the arithmetic of the scene clock modulo the period
 (:func:`next_start`, :func:`congruent`, :func:`pass_end`); every pass back to back without
-a final dwell (:func:`back_to_back`). Pure functions of the plans' phases, travel times and
-certificates and of rest and certificate predicates: what they mean and how the plans are
-made is :mod:`adept_traj.cycle.phase_grid`'s.
+a final dwell, backtracking where a move has no certified step (:func:`back_to_back`).
+Pure functions of the plans' phases, travel times and certificates and of rest and
+certificate predicates: what they mean and how the plans are made is
+:mod:`adept_traj.cycle.phase_grid`'s and :mod:`adept_traj.cycle.clock`'s.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
+from adept_traj.errors import CycleError
+
 __all__ = [
+    "MAX_BACK_TO_BACK_MOVES",
+    "MAX_UNDONE",
+    "PREFETCH",
     "SAME_TIME",
     "MoveOk",
     "PhaseOption",
     "RestOk",
     "Step",
     "back_to_back",
+    "chain_passes",
     "congruent",
     "naive_schedule",
     "next_start",
@@ -30,6 +37,14 @@ __all__ = [
 
 #: Two scene times closer than this [s] are the same start (no dwell).
 SAME_TIME = 1e-9
+
+#: Most moves scheduled back to back (``repeat`` × the moves of a pass): each is certified
+#: at its own start time, so the cost grows with the cycle; beyond it the periodic schedule.
+MAX_BACK_TO_BACK_MOVES = 10_000
+#: Steps :func:`back_to_back` may undo (backtracking) before it gives up with an error.
+MAX_UNDONE = 10_000
+#: Moves ahead :func:`back_to_back` hands to its ``prefetch`` at once.
+PREFETCH = 256
 
 #: One step of a schedule: (plan index in the move's options, start time [s]).
 Step = tuple[int, float]
@@ -177,42 +192,119 @@ def back_to_back(
     repeat: int,
     move_ok: MoveOk,
     rest_ok: RestOk,
+    *,
+    prefetch: Callable[[list[tuple[int, int, float]]], None] | None = None,
+    max_undone: int | None = None,
 ) -> list[tuple[Step, ...]] | None:
     """Every one of the ``repeat`` passes planned back to back, with no final dwell: each
     move starts at the previous end with the plan of least T that ``move_ok`` certifies
     started there (any phase: it is re-certified at that scene time), and only where none
     is, at the earliest start ≥ the previous end in a plan's phase whose dwell ``rest_ok``
     allows and whose plan ``move_ok`` certifies (the robot waits only where it must).
-    Returns per pass its steps ``(plan, start [s])``, or ``None`` when a move has no
-    certified step."""
-    end, passes = 0.0, []
-    for _ in range(repeat):
-        path: tuple[Step, ...] = ()
-        for k, opts in enumerate(options):
-            step = _first_step(opts, k, end, period, move_ok, rest_ok)
-            if step is None:
+
+    Where a move has no such step at all (e.g. no plan certified at the previous end and
+    the robot may not wait at its start), the schedule **backtracks**: the move before it
+    takes its next step in the same order (the next plan certified at its start, then its
+    later starts), and so on back (depth first). ``max_undone`` bounds the steps undone
+    (default :data:`MAX_UNDONE`; :class:`~adept_traj.errors.CycleError` naming it beyond).
+
+    ``prefetch(queries)``, when given, is called with the ``(k, plan, start)`` of the next
+    :data:`PREFETCH` moves as they would run with each move's fastest plan and no dwell,
+    before ``move_ok`` is asked about them (so that a caller can certify them all at once,
+    in parallel), and again wherever the schedule leaves that prediction.
+
+    Returns per pass its steps ``(plan, start [s])``, or ``None`` when no schedule of
+    certified steps exists over the plans."""
+    K, limit = len(options), MAX_UNDONE if max_undone is None else max_undone
+    total = repeat * K
+    fastest = [
+        min(
+            (i for i, o in enumerate(opts) if o.certified),
+            key=lambda i: (opts[i].T, i),
+            default=None,
+        )
+        for opts in options
+    ]
+    predicted: dict[int, float] = {}
+
+    def candidates(n: int, end: float) -> Iterator[Step]:
+        k = n % K
+        if prefetch is not None and predicted.get(n) != end:
+            predicted.clear()
+            queries, e = [], end
+            for m in range(n, min(total, n + PREFETCH)):
+                i = fastest[m % K]
+                if i is None:
+                    break
+                predicted[m] = e
+                queries.append((m % K, i, e))
+                e = e + options[m % K][i].T
+            prefetch(queries)
+        return _candidates(options[k], k, end, period, move_ok, rest_ok)
+
+    path: list[Step] = []
+    stack = [candidates(0, 0.0)]
+    undone = 0
+    while len(path) < total:
+        step = next(stack[-1], None)
+        if step is None:  # no step left here: undo the move before
+            stack.pop()
+            if not path:
                 return None
-            path = (*path, step)
-            end = step[1] + opts[step[0]].T
-        passes.append(path)
-    return passes
+            path.pop()
+            undone += 1
+            if undone > limit:
+                raise CycleError(
+                    f"back to back: {undone} steps undone without a certified schedule, more "
+                    f"than MAX_UNDONE = {limit}"
+                )
+            continue
+        path.append(step)
+        if len(path) < total:
+            k = (len(path) - 1) % K
+            stack.append(candidates(len(path), step[1] + options[k][step[0]].T))
+    return [tuple(path[p * K : (p + 1) * K]) for p in range(repeat)]
 
 
-def _first_step(
+def _candidates(
     opts: Sequence[PhaseOption],
     k: int,
     end: float,
     period: float,
     move_ok: MoveOk,
     rest_ok: RestOk,
-) -> Step | None:
-    """:func:`back_to_back`'s step of move k after ``end`` [s]."""
+) -> Iterator[Step]:
+    """:func:`back_to_back`'s steps of move k after ``end`` [s], in the order tried."""
     good = [i for i, o in enumerate(opts) if o.certified]
     for i in sorted(good, key=lambda i: (opts[i].T, i)):  # no dwell
         if move_ok(k, i, end):
-            return i, end
+            yield i, end
     later = sorted((next_start(end, opts[i].phase, period), opts[i].T, i) for i in good)
     for s, _, i in later:
         if s > end and rest_ok(k, end, s - end) and move_ok(k, i, s):
-            return i, s
-    return None
+            yield i, s
+
+
+def chain_passes(
+    options: Sequence[Sequence[PhaseOption]],
+    period: float,
+    repeat: int,
+    move_ok: MoveOk,
+    rest_ok: RestOk,
+) -> tuple[list[tuple[Step, ...]] | None, str | None]:
+    """:func:`back_to_back` within :data:`MAX_BACK_TO_BACK_MOVES` (``move_ok.prefetch`` its
+    prefetch, when ``move_ok`` has one): ``(passes, None)``, or ``(None, why)`` saying why
+    there is no back-to-back schedule (the limit named)."""
+    moves = repeat * len(options)
+    if moves > MAX_BACK_TO_BACK_MOVES:
+        return None, (
+            f"not tried: repeat × moves = {moves}, more than MAX_BACK_TO_BACK_MOVES = "
+            f"{MAX_BACK_TO_BACK_MOVES}"
+        )
+    try:
+        runs = back_to_back(
+            options, period, repeat, move_ok, rest_ok, prefetch=getattr(move_ok, "prefetch", None)
+        )
+    except CycleError as exc:
+        return None, str(exc)
+    return runs, None if runs is not None else "no schedule of certified moves and dwells"

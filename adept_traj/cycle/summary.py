@@ -176,6 +176,7 @@ def clock_summary(clock: CycleClock) -> dict[str, Any]:
             for moves in clock.passes
         ],
         "start_times": clock.start_times(),
+        **({"choice": clock.choice} if clock.choice else {}),
     }
 
 
@@ -240,6 +241,7 @@ def _clock_markdown(summary: dict[str, Any]) -> list[str]:
         "",
         how + " Every move is planned and certified at its start time on the scene clock; "
         "a dwell is the robot at rest at the move's start (certified too).",
+        *(["", f"Schedule kept: {c['choice']}."] if c.get("choice") else []),
         "",
         "| pass | move | dwell [s] | start [s] | T [s] | end [s] | certified |",
         "|---|---|---|---|---|---|---|",

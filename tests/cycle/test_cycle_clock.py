@@ -93,45 +93,54 @@ def _dense(folder: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _clear_by_hand(out: Path, scene: dict, period: float) -> int:
-    """Re-check the cycle saved in ``out`` with the oracle (module doc): the pass time
-    re-derived from the dwells and the stored trajectories, then every move of every pass
-    and every dwell (the robot at rest at the move's start) and final dwell clear of the
-    obstacles of the scene file's mapping ``scene`` at its real scene times. Returns the
-    moves checked."""
+    """Re-check the cycle saved in ``out`` with the oracle (module doc): the start times
+    re-derived from the dwells and the stored trajectories (periodic: the pass time a
+    multiple of P, later passes shifted by it; back to back: every pass recorded, no
+    final dwell), then every move of every pass and every dwell (the robot at rest at the
+    move's start) and final dwell clear of the obstacles of the scene file's mapping
+    ``scene`` at its real scene times. Returns the moves checked."""
     summary = json.loads((out / "cycle.json").read_text())
     robot, clock = Robot.adept_one_xl(), summary["clock"]
-    assert clock["scene_clock"] == "periodic"
-    assert clock["period"] == pytest.approx(period, rel=1e-12)
-    moves = clock["passes"][0]
-    # the pass time by hand: dwells + travel times + the final dwell, a multiple of P
-    ends, t = [], 0.0
-    for m in moves:
-        dense_t, _ = _dense(out / m["folder"])
-        t += m["dwell"]
-        assert m["start_time"] == pytest.approx(t, abs=1e-12)
-        t += dense_t[-1]
-        ends.append(t)
-    pass_time = t + clock["final_dwell"]
-    assert pass_time / period == pytest.approx(round(pass_time / period), abs=1e-9)
-    assert summary["cycle_time"] == pytest.approx(summary["repeat"] * pass_time, rel=1e-12)
-    checked = 0
-    for p in range(summary["repeat"]):
+    periodic = clock["scene_clock"] == "periodic"
+    if periodic:
+        assert clock["period"] == pytest.approx(period, rel=1e-12)
+    else:
+        assert clock["mode"].endswith("back to back)")
+        assert clock["final_dwell"] == 0.0
+        assert len(clock["passes"]) == summary["repeat"]
+    # the start times by hand: dwells + travel times (+ the final dwell, a multiple of P)
+    runs, t = [], 0.0
+    for moves in clock["passes"]:
         for m in moves:
-            dense_t, dense_q = _dense(out / m["folder"])
-            start = m["start_time"] + p * pass_time
-            rows = np.r_[np.arange(0, len(dense_t), 12), len(dense_t) - 1]
-            hand, _ = clearance_by_hand(robot, scene, dense_q[rows], start + dense_t[rows])
-            assert hand.min() >= MARGIN - 1e-6, (p, m["name"], hand.min())
-            # the dwell before it: the robot at rest at its start while the bob moves
-            rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
-            still = np.repeat(dense_q[:1], len(rest), axis=0)
-            hand, _ = clearance_by_hand(robot, scene, still, rest)
-            assert hand.min() >= MARGIN - 1e-6, (p, m["name"], "dwell", hand.min())
-            checked += 1
-        final = ends[-1] + p * pass_time + np.linspace(0.0, clock["final_dwell"], 40)
-        still = np.repeat(_dense(out / moves[-1]["folder"])[1][-1:], len(final), axis=0)
-        assert clearance_by_hand(robot, scene, still, final)[0].min() >= MARGIN - 1e-6
-    assert checked == summary["repeat"] * len(moves)
+            dense_t, _ = _dense(out / m["folder"])
+            t += m["dwell"]
+            assert m["start_time"] == pytest.approx(t, abs=1e-9)
+            runs.append((m, t))
+            t += dense_t[-1]
+    if periodic:
+        pass_time = t + clock["final_dwell"]
+        assert pass_time / period == pytest.approx(round(pass_time / period), abs=1e-9)
+        assert summary["cycle_time"] == pytest.approx(summary["repeat"] * pass_time, rel=1e-12)
+        runs = [(m, s + p * pass_time) for p in range(summary["repeat"]) for m, s in runs]
+    else:
+        assert summary["cycle_time"] == pytest.approx(t, rel=1e-12)
+    checked = 0
+    for n, (m, start) in enumerate(runs):
+        dense_t, dense_q = _dense(out / m["folder"])
+        rows = np.r_[np.arange(0, len(dense_t), 12), len(dense_t) - 1]
+        hand, _ = clearance_by_hand(robot, scene, dense_q[rows], start + dense_t[rows])
+        assert hand.min() >= MARGIN - 1e-6, (n, m["name"], hand.min())
+        # the dwell before it: the robot at rest at its start while the bob moves
+        rest = start - m["dwell"] + np.linspace(0.0, m["dwell"], 40)
+        still = np.repeat(dense_q[:1], len(rest), axis=0)
+        hand, _ = clearance_by_hand(robot, scene, still, rest)
+        assert hand.min() >= MARGIN - 1e-6, (n, m["name"], "dwell", hand.min())
+        checked += 1
+        if periodic and m is clock["passes"][0][-1]:
+            final = start + dense_t[-1] + np.linspace(0.0, clock["final_dwell"], 40)
+            still = np.repeat(dense_q[-1:], len(final), axis=0)
+            assert clearance_by_hand(robot, scene, still, final)[0].min() >= MARGIN - 1e-6
+    assert checked == summary["repeat"] * len(clock["passes"][0])
     return checked
 
 
@@ -143,6 +152,24 @@ def test_every_move_of_every_pass_is_clear_at_its_real_start_time(planned: Path)
 
 
 @pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
+def test_the_default_schedule_is_never_longer_than_back_to_back(planned: Path) -> None:
+    """The periodic schedule (one pass rounded up to whole periods) and every pass back to
+    back are both made; the kept one is the shorter (cycle.json's choice, cycle.md), here
+    back to back: without the rounding the passes need no final dwell."""
+    summary = json.loads((planned / "cycle.json").read_text())
+    choice = summary["clock"]["choice"]
+    times = {
+        name: float(t)
+        for name, t in re.findall(r"(periodic|every pass back to back)[^:]*: ([0-9.]+) s", choice)
+    }
+    assert set(times) == {"periodic", "every pass back to back"}, choice
+    assert summary["cycle_time"] == pytest.approx(min(times.values()), abs=1e-3)
+    assert summary["cycle_time"] < times["periodic"]  # this cycle: back to back is shorter
+    assert choice.startswith("every pass back to back")
+    assert f"Schedule kept: {choice}." in (planned / "cycle.md").read_text()
+
+
+@pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
 def test_the_clock_decides_the_dwells(planned: Path) -> None:
     """The chosen moves are certified for their own start times, not for any: started a
     quarter, half or three quarters of a period later, a move hits the pendulum (by hand;
@@ -151,7 +178,8 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
     candidates = [c for m in summary["clock"]["passes"][0] for c in m["candidates"]]
     assert len(candidates) == 8
     scene = Scene.from_file(planned.parent / "swing.toml").to_dict()
-    period, robot = summary["clock"]["period"], Robot.adept_one_xl()
+    period = 2 * math.pi / scene["pendulum"][0]["omega"]  # by hand, from the file
+    robot = Robot.adept_one_xl()
     hits = []
     for m in summary["clock"]["passes"][0]:
         t, q = _dense(planned / m["folder"])
@@ -162,12 +190,17 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
         ]
         hits.append(min(d.min() for d in shifted) < 0.0)
     assert any(hits), hits
+    periodic = summary["clock"]["scene_clock"] == "periodic"
     for m in summary["clock"]["passes"][0]:
         result = PlanningResult.load(planned / m["folder"])
-        assert result.problem_settings.start_time == m["start_time"]
         assert result.feasible
-        best = min(c["dwell"] + c["T"] for c in m["candidates"] if c["certified"])
-        assert m["dwell"] + m["T"] == best  # the earliest certified end
+        if periodic:  # pass 0 as planned: the earliest certified end of the dwell grid
+            assert result.problem_settings.start_time == m["start_time"]
+            best = min(c["dwell"] + c["T"] for c in m["candidates"] if c["certified"])
+            assert m["dwell"] + m["T"] == best
+        else:  # back to back: a plan of the dwell grid of pass 0, run at its real start
+            assert re.fullmatch(re.escape(m["name"]) + r"\.p0\.w\d", m["folder"].split("/")[-1])
+            assert m["T"] in [c["T"] for c in m["candidates"] if c["certified"]]
     assert (planned / "cycle_gantt.png").stat().st_size > 0
     text = (planned / "cycle.md").read_text()
     assert "## Scene clock" in text
@@ -197,11 +230,13 @@ def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path) ->
 def test_playback_runs_on_one_continuous_clock(planned: Path, cluster) -> None:
     cycle = read_cycle_file(planned.parent / "c.toml")
     summary = json.loads((planned / "cycle.json").read_text())
-    results = [[PlanningResult.load(planned / m["folder"]) for m in summary["clock"]["passes"][0]]]
+    passes = summary["clock"]["passes"]
+    results = [[PlanningResult.load(planned / m["folder"]) for m in ms] for ms in passes]
     from adept_traj.cycle.clock import CycleClock
 
-    clock, _ = plan_on_clock(cycle, planned, resume=True, scheduler=cluster.scheduler_address)
+    clock, again = plan_on_clock(cycle, planned, resume=True, scheduler=cluster.scheduler_address)
     assert isinstance(clock, CycleClock)
+    assert len(again) == len(passes)
     play = clock_playback(clock, results, robot=Robot.adept_one_xl(), scene=cycle.scene, fps=20)
     assert np.all(np.diff(play.times) > 0)
     assert play.times[0] == 0.0
@@ -437,6 +472,105 @@ def test_back_to_back_waits_only_where_it_must(seed: int) -> None:
     assert s + options[-1][i].T == pytest.approx(repeat * fastest, rel=1e-12)
 
 
+def _preferred_chain(options, P, repeat, move_ok, rest_ok):
+    """The back-to-back schedule written out again, as a search over every sequence: each
+    move's step is (plan, start) with start = the previous end (no dwell) or the first time
+    after it in the plan's phase (a dwell); a sequence is valid where every plan is
+    certified at its phase, ``move_ok`` at its start and ``rest_ok`` for its dwell; the
+    preferred valid sequence is the least by its steps' keys, (0, T, plan) without a
+    dwell and (1, start, T, plan) with one, compared move by move."""
+    import itertools
+
+    K = len(options)
+    best = None
+    for seq in itertools.product(*[range(2 * len(options[n % K])) for n in range(repeat * K)]):
+        end, keys, steps = 0.0, [], []
+        for n, c in enumerate(seq):
+            k = n % K
+            i, wait = c % len(options[k]), c >= len(options[k])
+            o = options[k][i]
+            start = end
+            if wait:
+                start = o.phase
+                while start <= end + 1e-12:
+                    start += P
+                while start - P > end + 1e-12:
+                    start -= P
+            if not (o.certified and move_ok(k, i, start) and rest_ok(k, end, start - end)):
+                break
+            keys.append((1, start, o.T, i) if wait else (0, o.T, i))
+            steps.append((i, start))
+            end = start + o.T
+        else:
+            if best is None or keys < best[0]:
+                best = (keys, steps)
+    return None if best is None else [tuple(best[1][p * K : (p + 1) * K]) for p in range(repeat)]
+
+
+def test_back_to_back_backtracks_to_a_certified_chain() -> None:
+    """Where the fastest step leaves the next move with no certified step (no plan
+    certified at that instant, the robot not allowed to wait there), back_to_back goes
+    back and takes the next step: its schedule is the preferred one of a search over every
+    sequence of steps (no schedule where that search finds none), on seeds where the
+    first steps alone fail too; the prefetch is asked first about the first query."""
+    from adept_traj.cycle import PhaseOption, back_to_back
+
+    P, repeat, K = 2.0, 2, 2
+    backtracked = 0
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        options = [
+            [PhaseOption(float(f), float(T), True)
+             for f, T in zip(rng.uniform(0, P, 2), rng.uniform(0.4, 1.3, 2))]
+            for _ in range(K)
+        ]  # fmt: skip
+
+        def move_ok(k, i, s, options=options, seed=seed):  # at its phase; elsewhere at random
+            o = options[k][i]
+            at_phase = abs((s - o.phase) / P - round((s - o.phase) / P)) < 1e-9
+            return at_phase or math.cos(5.3 * s + 2.1 * i + 3 * k + seed) > 0.3
+
+        def rest_ok(k, start, duration):  # the robot may wait at move 0's start only
+            return duration <= 1e-12 or k == 0
+
+        asked, prefetched = [], set()
+
+        def counted(k, i, s, asked=asked, move_ok=move_ok):
+            asked.append((k, i, s))
+            return move_ok(k, i, s)
+
+        runs = back_to_back(options, P, repeat, counted, rest_ok, prefetch=prefetched.update)
+        expected = _preferred_chain(options, P, repeat, move_ok, rest_ok)
+        assert asked[0] in prefetched
+        if expected is None:
+            assert runs is None
+            continue
+        assert [list(p) for p in runs] == [list(p) for p in expected], seed
+        try:  # the first steps alone (no step undone)
+            back_to_back(options, P, repeat, move_ok, rest_ok, max_undone=0)
+        except CycleError:
+            backtracked += 1
+    assert backtracked >= 2  # the seeds exercise the backtracking
+
+
+def test_back_to_back_backtracking_is_bounded() -> None:
+    """A chain with no certified schedule undoes at most max_undone steps and then says so,
+    naming the limit; within the limit it reports that no schedule exists."""
+    from adept_traj.cycle import PhaseOption, back_to_back
+
+    options = [[PhaseOption(0.0, 0.5, True), PhaseOption(1.0, 0.7, True)]] * 2
+
+    def never_last(k, i, s):  # the last move of the cycle is never certified
+        return not (k == 1 and s > 2.0)
+
+    def rest_ok(k, start, duration):
+        return duration <= 1e-12
+
+    with pytest.raises(CycleError, match="MAX_UNDONE = 3"):
+        back_to_back(options, 2.0, 3, never_last, rest_ok, max_undone=3)
+    assert back_to_back(options, 2.0, 3, never_last, rest_ok) is None
+
+
 def test_rest_profile_is_conservative() -> None:
     """A dwell the rest profile allows is certified by certify_rest at its real scene
     times (several periods later too); the profile refuses the dwells certify_rest
@@ -580,7 +714,7 @@ def test_detour_cycle_on_the_phase_grid_is_certified_at_its_real_start_times(
     """Every move and dwell of every pass of the phase-grid plan clear of the detour
     scene's obstacles at its real scene time, by hand; ``verify`` agrees."""
     summary = json.loads((detour_planned / "cycle.json").read_text())
-    assert summary["clock"]["mode"] == "phase grid (optimised)"
+    assert summary["clock"]["mode"].startswith("phase grid (optimised")  # or back to back
     assert summary["all_certified"]
     scene = Scene.shipped("detour").to_dict()
     pend = scene["pendulum"][0]
@@ -604,3 +738,60 @@ def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Pa
     first = json.loads((detour_planned / "cycle.json").read_text())
     second = json.loads((out / "cycle.json").read_text())
     assert first == second
+
+
+def test_move_certifier_answers_as_certify_at_the_real_start(cluster) -> None:
+    """A plan asked about at the very time it was planned takes its own certificate (no
+    new one); at other scene times the answer is certify's, called directly on a problem
+    started there, the same in this process and in Dask tasks (batches)."""
+    from distributed import Client
+
+    from adept_traj.certification import certify
+    from adept_traj.cycle import MoveCertifier, PlannedMove
+    from adept_traj.problem import TrajectoryProblem
+    from adept_traj.robot import RobotSource
+    from adept_traj.testing.paper_moves import lift_then_lower
+
+    robot, scene = Robot.adept_one_xl(), Scene.shipped("paper")
+    start, goal = np.array(HOME), np.array(PLACE)
+    x = lift_then_lower(TrajectoryProblem(robot, scene, start, goal, workers=1))
+    starts = [0.0, 0.35, 0.8, 1.4]
+    expected = []
+    for s in starts:
+        problem = TrajectoryProblem(robot, scene, start, goal, workers=1, start_time=s)
+        expected.append(bool(certify(problem, x, rate_hz=1000.0).certified))
+        problem.close()
+    assert len(set(expected)) == 2  # the pendulum: certified at some starts only
+    own = not expected[0]  # the plan's own answer at 0, deliberately not certify's
+    plans = [[PlannedMove(start, goal, x, 0.0, own)]]
+    source = RobotSource()  # the shipped AdeptOne XL
+    here = MoveCertifier(source, scene, 1000.0, plans)
+    assert [here(0, 0, s) for s in starts] == [own, *expected[1:]]
+    assert here.computed == len(starts) - 1
+    with Client(cluster.scheduler_address) as client:
+        there = MoveCertifier(source, scene, 1000.0, plans, client=client)
+        there.prefetch([(0, 0, s) for s in starts])
+        assert there.computed == len(starts) - 1
+        assert [there(0, 0, s) for s in starts] == [own, *expected[1:]]
+
+
+def test_back_to_back_beyond_its_limit_names_it() -> None:
+    """More than MAX_BACK_TO_BACK_MOVES moves to chain: not tried (no certificate asked),
+    and the reason names the limit; within it, the chain of every plan certified
+    everywhere is repeat × the fastest plan's T."""
+    from adept_traj.cycle import MAX_BACK_TO_BACK_MOVES, PhaseOption, chain_passes
+
+    options = [[PhaseOption(0.0, 0.5, True), PhaseOption(1.0, 0.7, True)]]
+    asked = []
+
+    def move_ok(k, i, s):
+        asked.append(s)
+        return True
+
+    runs, why = chain_passes(options, 2.0, MAX_BACK_TO_BACK_MOVES + 1, move_ok, lambda *a: True)
+    assert runs is None
+    assert not asked
+    assert f"MAX_BACK_TO_BACK_MOVES = {MAX_BACK_TO_BACK_MOVES}" in why
+    runs, why = chain_passes(options, 2.0, 7, move_ok, lambda *a: True)
+    assert why is None
+    assert [p[0] for p in runs] == [(0, 0.5 * p) for p in range(7)]

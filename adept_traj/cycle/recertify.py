@@ -1,0 +1,181 @@
+"""Planned moves certified again at the scene times they really run, in batches on Dask.
+
+A plan of a cycle's move is certified at the start time it was planned for; run at another
+scene time (a back-to-back pass, a later pass of a periodic cycle) it must be certified
+again there (:func:`~adept_traj.certification.certify` with
+``TrajectoryProblem(..., start_time=s)``). :class:`MoveCertifier` keeps every answer
+(``(move, plan, start)`` → certified), takes a plan's own certificate where the start is
+the one it was planned at (the task certified it there), and computes the others in
+batches: :meth:`MoveCertifier.prefetch` splits the queries into Dask tasks
+(:func:`certify_batch`) on the cycle's cluster, so that the command itself does not
+certify one move after the other. :class:`RestCertifier` keeps the rest certificates
+(:func:`~adept_traj.cycle.certify_rest`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from adept_traj.certification import certify
+from adept_traj.cycle.rest import RestCheck, certify_rest
+from adept_traj.cycle.runner import run_tasks, worker_robot
+from adept_traj.problem import ProblemSettings, TrajectoryProblem
+from adept_traj.robot import RobotSource
+from adept_traj.scene import Scene
+
+__all__ = [
+    "BATCHES_PER_WORKER",
+    "CertifyBatch",
+    "MoveCertifier",
+    "PlannedMove",
+    "RestCertifier",
+    "certify_batch",
+]
+
+#: Dask tasks per worker a batch of queries is split into (unequal certificates balance).
+BATCHES_PER_WORKER = 2
+
+#: A query: (move k, plan i, scene start time [s]).
+Query = tuple[int, int, float]
+
+
+@dataclass(frozen=True)
+class PlannedMove:
+    """A plan of a move: its ends ``start``, ``goal`` (nq,) [rad | m], the decision vector
+    ``x`` (n,) of the member the cycle runs, the scene time ``planned_at`` [s] it was
+    planned and certified at and whether it is ``certified`` there."""
+
+    start: np.ndarray
+    goal: np.ndarray
+    x: np.ndarray
+    planned_at: float
+    certified: bool
+
+
+@dataclass(frozen=True)
+class CertifyBatch:
+    """What a worker needs to certify moves at scene times (pickled to it): the robot,
+    the scene, the certificate rate [Hz] and ``(start, goal, x, start_time)`` per move."""
+
+    robot: RobotSource
+    scene: Scene
+    rate_hz: float
+    moves: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, float], ...]
+
+
+def certify_batch(batch: CertifyBatch) -> list[bool]:
+    """Whether each move of ``batch`` is certified started at its scene time (the body of
+    a Dask task; also callable directly)."""
+    robot = worker_robot(batch.robot)
+    out = []
+    for start, goal, x, t0 in batch.moves:
+        problem = TrajectoryProblem(robot, batch.scene, start, goal, workers=1, start_time=t0)
+        try:
+            out.append(bool(certify(problem, x, rate_hz=batch.rate_hz).certified))
+        finally:
+            problem.close()
+    return out
+
+
+class MoveCertifier:
+    """``certifier(k, i, start)``: whether plan ``i`` of move ``k`` is certified started
+    at the scene time ``start`` [s] (module doc).
+
+    Parameters
+    ----------
+    robot, scene, rate_hz: the cycle's robot source, scene and certificate rate [Hz].
+    plans: per move, its :class:`PlannedMove` plans.
+    client: a ``distributed.Client`` the batches run on; ``None``: in this process.
+    """
+
+    def __init__(
+        self,
+        robot: RobotSource,
+        scene: Scene,
+        rate_hz: float,
+        plans: Sequence[Sequence[PlannedMove]],
+        client: Any = None,
+    ) -> None:
+        self._robot, self._scene, self._rate = robot, scene, float(rate_hz)
+        self._plans = [list(row) for row in plans]
+        self._client = client
+        self._known: dict[Query, bool] = {}
+        self.computed = 0  #: certificates computed (not taken from a plan's own)
+
+    def __call__(self, k: int, i: int, start: float) -> bool:
+        key = (k, i, start)
+        if key not in self._known:
+            self.prefetch([key])
+        return self._known[key]
+
+    def prefetch(self, queries: Iterable[Query]) -> None:
+        """Certify every query not known yet, all at once (Dask tasks when a client is
+        given: :data:`BATCHES_PER_WORKER` per worker)."""
+        todo: list[Query] = []
+        for key in dict.fromkeys(queries):
+            if key in self._known:
+                continue
+            plan = self._plans[key[0]][key[1]]
+            if key[2] == plan.planned_at:  # the task's own certificate, at that very time
+                self._known[key] = plan.certified
+            else:
+                todo.append(key)
+        if not todo:
+            return
+        moves = [self._move(key) for key in todo]
+        if self._client is None:
+            found = certify_batch(self._batch(moves))
+        else:
+            n = max(1, len(self._client.nthreads())) * BATCHES_PER_WORKER
+            bounds = np.linspace(0, len(moves), min(n, len(moves)) + 1).astype(int)
+            parts = [self._batch(moves[a:b]) for a, b in itertools.pairwise(bounds)]
+            found = [ok for part in run_tasks(parts, certify_batch, client=self._client)
+                     for ok in part]  # fmt: skip
+        self.computed += len(todo)
+        self._known.update(zip(todo, found))
+
+    def _move(self, key: Query) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        plan = self._plans[key[0]][key[1]]
+        return plan.start, plan.goal, plan.x, float(key[2])
+
+    def _batch(self, moves: list[tuple[np.ndarray, np.ndarray, np.ndarray, float]]) -> Any:
+        return CertifyBatch(self._robot, self._scene, self._rate, tuple(moves))
+
+
+class RestCertifier:
+    """``rests(k, start, duration)``: the :class:`~adept_traj.cycle.RestCheck` of the
+    robot at rest at site ``k`` (``sites[k]``, (nq,) [rad | m]) over the scene times
+    ``[start, start + duration]`` [s], each computed once
+    (:func:`~adept_traj.cycle.certify_rest`)."""
+
+    def __init__(
+        self,
+        robot: Any,
+        scene: Scene,
+        sites: Sequence[np.ndarray],
+        *,
+        settings: ProblemSettings,
+        rate_hz: float,
+    ) -> None:
+        self._robot, self._scene, self._sites = robot, scene, list(sites)
+        self._settings, self._rate = settings, float(rate_hz)
+        self._known: dict[tuple[int, float, float], RestCheck] = {}
+
+    def __call__(self, k: int, start: float, duration: float) -> RestCheck:
+        key = (k, start, duration)
+        if key not in self._known:
+            self._known[key] = certify_rest(
+                self._robot,
+                self._scene,
+                self._sites[k],
+                start,
+                duration,
+                settings=self._settings,
+                rate_hz=self._rate,
+            )
+        return self._known[key]
