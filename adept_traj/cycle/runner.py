@@ -69,9 +69,9 @@ RETRIES = 2
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
 #: Dask settings of the local cluster (its scheduler runs in this process; the workers
-#: inherit them): no worker profiler (a sample every 10 ms), no GIL monitor (every 1 ms),
-#: system monitor and watchdog every 2 s and 0.5 s (not 0.5 s, 20 ms): CPU time for as
-#: long as the run lasts, serial in the command, for the dashboard only.
+#: inherit them): no worker profiler, no GIL monitor, and the system monitor and the
+#: watchdog less often than Dask's defaults: CPU time for as long as the run lasts,
+#: serial in the command, for the dashboard only.
 LOCAL_DASK_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.gil.enabled": False,

@@ -54,14 +54,10 @@ __all__ = [
 #: File suffixes read as point clouds.
 CLOUD_SUFFIXES = (".ply", ".pcd", ".xyz", ".npy")
 
-#: Bytes per point of a cloud: its (n, 3) float64 array twice (read, then kept), coal's
-#: octree (at most 480 B per point measured, for points each in a cell of its own), the
-#: coarse field's passes over the points (≈ 100 B), the checker's leaf arrays
-#: (:class:`~adept_traj.collision.cloud_distance.CloudCells`: ≤ 600 B per leaf, a leaf
-#: per point at most) and their hierarchy
-#: (:class:`~adept_traj.collision.cloud_tree.CloudTree`: 195 B per leaf kept, 459 B at the
-#: peak of its making, for leaves filling a volume); ``tracemalloc`` peaks,
-#: ``benchmarks/bench_memory.py`` and ``tests/scene/test_point_clouds.py``.
+#: Bytes per point: its (n, 3) float64 array twice (read, kept), coal's octree (≤ 480 B,
+#: a point a cell), the coarse field's passes (≈ 100 B), the checker's leaf arrays
+#: (``CloudCells``: ≤ 600 B a leaf) and their hierarchy (``CloudTree``: 459 B a leaf at
+#: its making's peak); ``tracemalloc`` peaks, ``tests/scene/test_point_clouds.py``.
 _BYTES_PER_POINT = 48 + 480 + 100 + 600 + 460
 
 #: Most cells of a cloud's coarse distance field (4 MB of float32).
