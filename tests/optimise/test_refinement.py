@@ -369,3 +369,16 @@ def test_an_elastic_first_solve_enters_the_rows_from_through_the_crane_load() ->
     c = certify(problem, out.x, 4000.0)
     best, _ = coal_min_distances(problem, c.dense.q, c.dense.t)
     assert best.min() >= problem.settings.margin
+
+
+def test_via_point_starts_evaluated_in_shares_are_the_same_starts() -> None:
+    """processes=2 on a problem evaluating in one process: the batch in two forked shares,
+    the same starts bit for bit (and no worker left)."""
+    scene = at.Scene.shipped("detour")
+    one = at.TrajectoryProblem(at.Robot.adept_one_xl(), scene, scene.start, scene.goal, workers=1)
+    a = via_point_starts(one, 0, n_starts=2, n_moves=60)
+    b = via_point_starts(one, 0, n_starts=2, n_moves=60, processes=2)
+    np.testing.assert_array_equal(a, b)
+    assert children() == []
+    with pytest.raises(ConfigurationError, match="processes"):
+        via_point_starts(one, 0, processes=0)

@@ -205,7 +205,10 @@ def global_stage(
     points are drawn when first asked for.
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
-    via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts)
+    shares = problem.settings.workers if processes is None else processes
+    via = functools.partial(
+        via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts, processes=shares
+    )
     relaxed, floor = relaxed_optimum(problem, n_starts=n_starts, rate_hz=rate_hz,
                                      processes=processes) if known is None else known  # fmt: skip
     timed = functools.partial(np.empty, (0, problem.n_var))

@@ -38,6 +38,7 @@ from adept_traj.errors import ConfigurationError
 from adept_traj.optimise.local.basins import basin_labels
 from adept_traj.optimise.operators.repair import kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
+from adept_traj.process_pool import map_forked
 from adept_traj.validation import as_integer
 
 __all__ = [
@@ -121,7 +122,13 @@ class ViaPointSampling:
 
 
 def via_point_starts(
-    problem: Any, seed: int, *, n_starts: int = 3, n_batches: int = 1, n_moves: int = _BATCH
+    problem: Any,
+    seed: int,
+    *,
+    n_starts: int = 3,
+    n_batches: int = 1,
+    n_moves: int = _BATCH,
+    processes: int = 1,
 ) -> np.ndarray:
     """(k, n_var): the global stage's starts — the fastest evaluator-feasible move of each
     of at most ``n_starts`` basins, fastest first, then the :data:`_LEAST_INFEASIBLE`
@@ -138,11 +145,15 @@ def via_point_starts(
     n_starts: most feasible starts returned (≥ 1).
     n_batches: most batches (≥ 1).
     n_moves: moves of each kind per batch (≥ 1).
+    processes: processes evaluating a batch, each a share of its moves
+        (:func:`~adept_traj.process_pool.map_forked`; ≥ 1, for a problem evaluating in one
+        process; a problem with workers of its own uses them): the same starts.
     """
     seed = as_integer(seed, "seed", minimum=0, error=ConfigurationError)
     n_starts = as_integer(n_starts, "n_starts", minimum=1, error=ConfigurationError)
     n_batches = as_integer(n_batches, "n_batches", minimum=1, error=ConfigurationError)
     n_moves = as_integer(n_moves, "n_moves", minimum=1, error=ConfigurationError)
+    processes = as_integer(processes, "processes", minimum=1, error=ConfigurationError)
     sampler = ViaPointSampling()
     tried, violation = [], []
     for batch in range(n_batches):
@@ -151,7 +162,7 @@ def via_point_starts(
         t = kinematic_time(problem, ramps) * (1.0 + 1e-9)
         ramps[:, 0] = np.clip(t, problem.xl[0], problem.xu[0])
         x = np.concatenate([sampler.moves(problem, n_moves, rng), ramps])
-        g = problem.evaluate_batch(x).constraints
+        g = _constraints(problem, x, processes)
         tried.append(x)
         violation.append(np.maximum(g, 0.0).sum(axis=1))
         ok = np.concatenate(violation) == 0.0
@@ -165,6 +176,15 @@ def via_point_starts(
     worst = np.flatnonzero(v > 0.0)
     least = worst[np.argsort(v[worst], kind="stable")][:_LEAST_INFEASIBLE]
     return np.concatenate([found[np.sort(first)][:n_starts], x[least]])
+
+
+def _constraints(problem: Any, x: np.ndarray, processes: int) -> np.ndarray:
+    """(n, n_con) the constraints of the moves ``x`` (n, n_var), in ``processes`` shares
+    where the problem evaluates in one process (row by row the same values)."""
+    shares = processes if problem.settings.workers == 1 else 1
+    parts = np.array_split(x, min(shares, len(x)))
+    values = map_forked(lambda part: problem.evaluate_batch(part).constraints, parts, len(parts))
+    return np.concatenate(values)
 
 
 def near_lower_bound(problem: Any, outcomes: Any, floor: float = 0.0) -> bool:
