@@ -285,7 +285,7 @@ def check_label_legend_and_controls(browser, result: PlanningResult, problem) ->
     scrub = browser.find_element("id", "scrub")
     width = scrub.size["width"]
     ActionChains(browser).move_to_element_with_offset(scrub, int(0.3 * width), 0).click().perform()
-    wait_for(lambda: abs(now() - stopped) > 1e-6, 10.0)
+    wait_for(lambda: abs(now() - stopped) > 1e-6, 30.0)  # a loaded machine: 10 s too short
     t = now()
     assert abs(t - 0.8 * T) < 0.05 * T, (t, T)
     assert readout.text == f"t = {t:.3f} s / T = {T:.3f} s"
