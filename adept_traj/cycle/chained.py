@@ -22,7 +22,7 @@ from adept_traj.cycle.cycle_file import Cycle
 from adept_traj.cycle.recertify import MoveCertifier, PlannedMove, RestCertifier
 from adept_traj.cycle.runner import MoveTask
 from adept_traj.cycle.schedules import PhaseOption, chain_passes
-from adept_traj.cycle.timeline import ClockedMove, CycleClock
+from adept_traj.cycle.timeline import ClockedPlan, CycleClock, clocked_passes
 from adept_traj.results import PlanningResult
 
 __all__ = ["ChainPlan", "chained_clock"]
@@ -85,33 +85,15 @@ def chained_clock(
     )
     if runs is None:
         return None, [], why
-    rows, results, end = [], [], 0.0
-    for q, path in enumerate(runs):
-        row, row_results = [], []
-        for k, (i, start) in enumerate(path):
-            p = plans[k][i]
-            row.append(
-                ClockedMove(
-                    pass_index=q,
-                    index=k,
-                    name=tasks[k].move.name,
-                    folder=p.folder,
-                    member=p.member,
-                    start_time=start,
-                    dwell=start - end,
-                    T=p.T,
-                    move_certified=move_ok(k, i, start),
-                    rest=rest(k, end, start - end),
-                    candidates=candidates[k],
-                )
-            )
-            row_results.append(p.result)
-            end = start + p.T
-        rows.append(tuple(row))
-        results.append(row_results)
+
+    def described(k: int, i: int) -> ClockedPlan:
+        p = plans[k][i]
+        return ClockedPlan(tasks[k].move.name, p.folder, p.member, p.T, candidates[k], p.result)
+
+    rows, results, _ = clocked_passes(runs, described, move_ok, rest)
     clock = CycleClock(
         period=None,
-        passes=tuple(rows),
+        passes=rows,
         final_dwell=0.0,
         final_rest=None,
         repeat=cycle.repeat,

@@ -69,7 +69,6 @@ import numpy as np
 
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
-    ClockedMove,
     CycleClock,
     check_chained,
     scene_period,
@@ -95,6 +94,7 @@ from adept_traj.cycle.schedules import (
     phase_frontier,
     phase_schedules,
 )
+from adept_traj.cycle.timeline import ClockedPlan, clocked_passes
 from adept_traj.errors import CycleError
 from adept_traj.problem import ProblemSettings
 from adept_traj.results import PlanningResult
@@ -320,35 +320,18 @@ def plan_phase_grid(
             chosen_passes = runs
         else:  # not None: refused above otherwise
             chosen_passes = [path for path in (chosen[schedule],) if path is not None]
-        rows, results = [], []
-        end = 0.0
-        for q, path in enumerate(chosen_passes):
-            row, row_results = [], []
-            for k, (i, start) in enumerate(path):
-                p = plans[k][i]
-                row.append(
-                    ClockedMove(
-                        pass_index=q,
-                        index=k,
-                        name=base[k].move.name,
-                        folder=f"{MOVES_FOLDER}/{p.name}",
-                        member=p.member,
-                        start_time=start,
-                        dwell=start - end,
-                        T=p.option.T,
-                        move_certified=move_ok(k, i, start),
-                        rest=rest(k, end, start - end),
-                        candidates=tuple((o.phase, o.T, o.certified) for o in options[k]),
-                    )
-                )
-                row_results.append(p.result)
-                end = start + p.option.T
-            rows.append(tuple(row))
-            results.append(row_results)
+
+        def described(k: int, i: int) -> ClockedPlan:
+            p = plans[k][i]
+            seen = tuple((o.phase, o.T, o.certified) for o in options[k])
+            folder = f"{MOVES_FOLDER}/{p.name}"
+            return ClockedPlan(base[k].move.name, folder, p.member, p.option.T, seen, p.result)
+
+        rows, results, end = clocked_passes(chosen_passes, described, move_ok, rest)
         final = 0.0 if back else pass_end(end, P, cycle.repeat) - end
         clock = CycleClock(
             period=None if back else P,
-            passes=tuple(rows),
+            passes=rows,
             final_dwell=max(final, 0.0),
             final_rest=rest(K, end, max(final, 0.0)) if cycle.repeat > 1 and not back else None,
             repeat=cycle.repeat,

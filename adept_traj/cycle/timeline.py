@@ -6,11 +6,13 @@ make them and ``cycle.json`` records them.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 from adept_traj.cycle.rest import RestCheck
 
-__all__ = ["ClockedMove", "CycleClock"]
+__all__ = ["ClockedMove", "ClockedPlan", "CycleClock", "clocked_passes"]
 
 
 @dataclass(frozen=True)
@@ -105,3 +107,54 @@ class CycleClock:
             return [[m.start_time for m in moves] for moves in self.passes]
         shift = self.pass_time
         return [[m.start_time + p * shift for m in self.passes[0]] for p in range(self.repeat)]
+
+
+class ClockedPlan(NamedTuple):
+    """What a pass's row says of one plan of a move (:func:`clocked_passes`): its move's
+    name, its folder, the front member, its T [s], the clock's candidates of the move and
+    the plan's result (whatever the caller keeps per move)."""
+
+    name: str
+    folder: str
+    member: int
+    T: float
+    candidates: tuple
+    result: Any
+
+
+def clocked_passes(
+    passes: Sequence[Sequence[tuple[int, float]]],
+    planned: Callable[[int, int], ClockedPlan],
+    move_ok: Callable[[int, int, float], bool],
+    rest: Callable[[int, float, float], RestCheck],
+) -> tuple[tuple[tuple[ClockedMove, ...], ...], list[list[Any]], float]:
+    """The clock's rows of ``passes`` (per pass, per move k the plan index i and its start
+    time [s] on the scene clock), each move's dwell the wait since the previous move's end:
+    (rows, the plans' results per pass, the last move's end [s]). ``planned(k, i)``: plan i
+    of move k; ``move_ok(k, i, start)``: whether it is certified there; ``rest(k, start,
+    duration)``: the certificate of the robot at rest before move k."""
+    rows, results, end = [], [], 0.0
+    for q, path in enumerate(passes):
+        row, row_results = [], []
+        for k, (i, start) in enumerate(path):
+            p = planned(k, i)
+            row.append(
+                ClockedMove(
+                    pass_index=q,
+                    index=k,
+                    name=p.name,
+                    folder=p.folder,
+                    member=p.member,
+                    start_time=start,
+                    dwell=start - end,
+                    T=p.T,
+                    move_certified=move_ok(k, i, start),
+                    rest=rest(k, end, start - end),
+                    candidates=p.candidates,
+                )
+            )
+            row_results.append(p.result)
+            end = start + p.T
+        rows.append(tuple(row))
+        results.append(row_results)
+    return tuple(rows), results, end
