@@ -44,7 +44,6 @@ from adept_traj.validation import as_integer
 
 __all__ = [
     "MAX_BASINS",
-    "RELAXED_KEY",
     "STRETCHES",
     "GlobalStage",
     "fastest_of_basins",
@@ -70,7 +69,7 @@ STRETCHES = (1.0, 1.1, 1.25)
 
 #: The key under which a problem keeps its relaxed problem and optima
 #: (:meth:`~adept_traj.problem.TrajectoryProblem.derived`).
-RELAXED_KEY = "optimise.local.relaxed"
+_RELAXED_KEY = "optimise.local.relaxed"
 
 
 def time_optimal(
@@ -118,7 +117,7 @@ def time_optimal(
     ahead = _relaxed_ahead(problem, n_starts, rate_hz, processes)  # beside the first start
     # Without moving obstacles the global stage has no relaxed or timed starts: the ramps
     # come next whatever the first outcome, and are screened beside it (the same outcomes).
-    first = 1 if problem.scene.moving else _first_group(problem, processes)
+    first = 1 if problem.scene.moving else max(1, int(_wanted(problem, processes)))
     try:
         screened = screen_starts(problem, starts[:first], stop=near, **options)
         known = None if ahead is None or near(screened) else ahead.recv()
@@ -205,10 +204,9 @@ def global_stage(
     points are drawn when first asked for.
 
     Measured figures on the detour scene: ``docs/detour-scene.md``."""
-    shares = problem.settings.workers if processes is None else processes
-    via = functools.partial(
-        via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts, processes=shares
-    )
+    shares = _wanted(problem, processes)
+    via = functools.partial(via_point_starts, problem, GLOBAL_SEED, n_starts=n_starts,
+                            processes=shares)  # fmt: skip
     relaxed, floor = relaxed_optimum(problem, n_starts=n_starts, rate_hz=rate_hz,
                                      processes=processes) if known is None else known  # fmt: skip
     timed = functools.partial(np.empty, (0, problem.n_var))
@@ -229,7 +227,7 @@ def relaxed_optimum(
     Made once per problem, ``n_starts`` and ``rate_hz`` and kept on the problem
     (:meth:`~adept_traj.problem.TrajectoryProblem.derived`; ``processes`` changes only
     how fast: the same moves)."""
-    key = f"{RELAXED_KEY}:{n_starts}:{float(rate_hz)!r}"
+    key = f"{_RELAXED_KEY}:{n_starts}:{float(rate_hz)!r}"
     make = functools.partial(_relaxed_optimum, n_starts=n_starts, rate_hz=rate_hz,
                              processes=processes)  # fmt: skip
     return problem.derived(key, make)
@@ -242,7 +240,7 @@ def _relaxed_optimum(
     relaxed, floor, scene = np.empty((0, problem.n_var)), 0.0, problem.scene
     if scene.moving:
         fixed = relaxed_problem(problem)
-        processes = problem.settings.workers if processes is None else processes
+        processes = _wanted(problem, processes)
         outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes)
         done = [o for o in outcomes if o.certified]
         if done:
@@ -257,7 +255,7 @@ def made_relaxed_optima(problem: Any) -> dict[str, tuple[np.ndarray, float]]:
     """The relaxed optima :func:`relaxed_optimum` has made and kept on ``problem``, by
     their key, to hand to a process forked before they were made (it keeps them with
     :meth:`~adept_traj.problem.TrajectoryProblem.derived`)."""
-    return problem.derived_made(f"{RELAXED_KEY}:")
+    return problem.derived_made(f"{_RELAXED_KEY}:")
 
 
 def relaxed_problem(problem: Any) -> Any:
@@ -265,7 +263,7 @@ def relaxed_problem(problem: Any) -> Any:
     kept on the problem; its feasible set contains the problem's)."""
     scene = problem.scene
     still = dataclasses.replace(scene, obstacles=scene.fixed)
-    return problem.derived(f"{RELAXED_KEY}.problem", lambda p: p.replace(scene=still, workers=1))
+    return problem.derived(f"{_RELAXED_KEY}.problem", lambda p: p.replace(scene=still, workers=1))
 
 
 def initial_starts(
@@ -295,7 +293,7 @@ def _relaxed_ahead(
 ) -> Worker | None:
     """A worker computing :func:`relaxed_optimum` while the caller screens its first start
     (``None`` without moving obstacles, with one process, or without ``fork``)."""
-    n_proc = problem.settings.workers if processes is None else processes
+    n_proc = _wanted(problem, processes)
     if not problem.scene.moving or n_proc <= 1 or not can_fork():
         return None
     return Worker(_send_relaxed, problem, n_starts, rate_hz, processes,
@@ -374,9 +372,9 @@ def _screen_stage(
     return more
 
 
-def _first_group(problem: Any, processes: int | None) -> int:
-    """Starts screened at once (the first group of :func:`screen_starts`)."""
-    return max(1, problem.settings.workers if processes is None else int(processes))
+def _wanted(problem: Any, processes: int | None) -> Any:
+    """The processes asked for: ``processes``, or by default the problem's ``workers``."""
+    return problem.settings.workers if processes is None else processes
 
 
 def _feasible_first(problem: Any, starts: np.ndarray) -> np.ndarray:
