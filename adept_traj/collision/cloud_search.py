@@ -74,19 +74,14 @@ def search_clouds(
 
     Parameters
     ----------
-    checker:
-        The checker (its functors, solids, ``influence``, broad phase).
-    frames:
-        (njoints, 3, 4, N) joint frames (component-major), N = n_motions · ``n_t``.
+    checker, frames, obstacle_poses, n_t:
+        As for :func:`~adept_traj.collision.branch_and_bound.search_pairs` (the checker's
+        broad phase is used too).
     rows:
         (P, n_t · n_solids) the broad-phase bounds [m] of each pair's candidates
         (candidate index ``sample · n_solids + solid``).
     pm, po:
         (P,) int the motion and obstacle of each pair (fixed clouds and moving ones).
-    obstacle_poses:
-        Per obstacle its pose (4, 4) or poses (N, 4, 4) in the base frame.
-    n_t:
-        Samples per motion.
 
     Returns
     -------

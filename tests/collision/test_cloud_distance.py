@@ -131,18 +131,17 @@ def test_checker_with_a_cloud_matches_coal_pair_by_pair(fence):
 
 
 @pytest.mark.slow  # coal's octree distance, the reference, takes ms a call
-def test_cloud_level_bounds_never_above_coal(fence):
+def test_cloud_level_bounds_never_above_coal(fence_checker):
     """The broad phase's point-cloud level (coarse cells, finer cells looked up only under
     a parent within the influence, squares on the faces) against coal's octree distance
     of each solid called directly: never above it at any of 60 configurations × 7 solids,
     and above the influence for at least 95 % of the pairs coal puts 3 cm beyond it (the
     hierarchy keeps the bounds useful)."""
-    fence = PointCloud(fence.points * [0.85, 0.85, 1.0], 0.01)  # within the arm's reach
-    robot, paper = at.Robot.adept_one_xl(), Scene.paper()
-    base = paper.robot_base[:3, 3]
-    ob = Obstacle("fence", fence, FixedPose.from_xyz_rpy((base[0], base[1], 0.2)))
-    scene = Scene((ob,), robot_base=paper.robot_base, start=paper.start, goal=paper.goal)
-    checker = CollisionChecker(robot, scene, influence=CAP)
+    robot, checker = fence_checker  # the fence within the arm's reach
+    assert checker.influence == CAP
+    scene = checker.scene
+    (ob,) = scene.obstacles
+    fence = ob.shape
     rng = np.random.default_rng(11)
     lo, hi = robot.limits.lower, robot.limits.upper
     q = lo + (hi - lo) * rng.uniform(size=(60, robot.nq))

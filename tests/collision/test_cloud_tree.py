@@ -10,12 +10,10 @@ import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
 
-import adept_traj as at
-from adept_traj.collision import CollisionChecker, distance_request
+from adept_traj.collision import distance_request
 from adept_traj.collision.cloud_distance import cloud_cells
 from adept_traj.collision.cloud_search import cloud_obstacles
 from adept_traj.collision.cloud_tree import cloud_tree, descend, solid_support
-from adept_traj.scene import FixedPose, Obstacle, PointCloud, Scene
 
 CAP = 0.05
 
@@ -134,17 +132,16 @@ def _coal_minimum(robot, octree, tf_cloud, q):
 
 
 @pytest.mark.slow  # coal's octree distance, the reference, takes ms a call
-def test_checker_searches_motions_beside_a_cloud_as_coal(fence):
+def test_checker_searches_motions_beside_a_cloud_as_coal(fence_checker):
     """Motions of 6 samples past the fence (the batched search, many candidates a pair):
     the checker's smallest distance per motion equals coal's octree distance of every
     solid at every sample, called directly (to 1e-6 m within the influence, negative where
     coal finds a penetration, a lower bound above the influence beyond it)."""
-    fence = PointCloud(fence.points * [0.85, 0.85, 1.0], 0.01)  # within the arm's reach
-    robot, paper = at.Robot.adept_one_xl(), Scene.paper()
-    base = paper.robot_base[:3, 3]
-    ob = Obstacle("fence", fence, FixedPose.from_xyz_rpy((base[0], base[1], 0.2)))
-    scene = Scene((ob,), robot_base=paper.robot_base, start=paper.start, goal=paper.goal)
-    checker = CollisionChecker(robot, scene, influence=CAP)
+    robot, checker = fence_checker  # the fence within the arm's reach
+    assert checker.influence == CAP
+    scene = checker.scene
+    (ob,) = scene.obstacles
+    fence = ob.shape
     assert cloud_obstacles(checker).all()
     rng = np.random.default_rng(9)
     lo, hi = robot.limits.lower, robot.limits.upper
