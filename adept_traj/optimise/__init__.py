@@ -6,7 +6,7 @@ polishing (``polish``) and :func:`plan`."""
 from __future__ import annotations
 
 from adept_traj.optimise.local.basins import THRESHOLD as BASIN_THRESHOLD
-from adept_traj.optimise.local.basins import basin_labels
+from adept_traj.optimise.local.basins import basin_labels, basin_starts
 from adept_traj.optimise.local.epsilon_constraint import MAX_EVALUATIONS, epsilon_step
 from adept_traj.optimise.local.minimum_time import PolishOutcome, minimum_time
 from adept_traj.optimise.local.multi_start import (
@@ -189,6 +189,7 @@ __all__ = [
     "TournamentArrays",
     "ViaPointSampling",
     "basin_labels",
+    "basin_starts",
     "binary_tournament",
     "cache_violations",
     "capture_checkpoint",

@@ -161,7 +161,7 @@ def _certify_front(
     order: np.ndarray,
     rate_hz: float,
     max_certify: int | None,
-    known: Mapping[bytes, MemberCertificate] | None = None,
+    known: Mapping[int, MemberCertificate] | None = None,
 ) -> tuple[MemberCertificate | None, ...]:
     """(n,) the summary of each member's dense certificate with the continuous guarantee
     (:func:`~adept_traj.analysis.certify_members`, on the problem's workers:
@@ -169,15 +169,15 @@ def _certify_front(
 
     Only members the optimiser marked feasible are certified (a member that violates a
     constraint at the optimiser's samples fails the dense check as well), in the trade-off
-    ``order`` (n,), at most ``max_certify`` of them (``None``: all). A member whose
-    ``x.tobytes()`` is in ``known`` (the polish's summaries, made the same way) keeps that
-    summary instead of being certified again.
+    ``order`` (n,), at most ``max_certify`` of them (``None``: all). A member whose index
+    is in ``known`` (the polish's summaries, made the same way) keeps that summary instead
+    of being certified again.
     """
     candidates = [int(k) for k in order if front.feasible[k]]
     if max_certify is not None:
         candidates = candidates[:max_certify]
     known = {} if known is None else known
-    reused = {k: known[front.x[k].tobytes()] for k in candidates if front.x[k].tobytes() in known}
+    reused = {k: known[k] for k in candidates if k in known}
     todo = [k for k in candidates if k not in reused]
     out = list(certify_front_members(problem, front.x, todo, rate_hz=rate_hz))
     for k, summary in reused.items():
@@ -286,7 +286,7 @@ def plan(
         objective_weights(weights, 6)  # bad weights refused before any long work
     warn_missing_limits(problem.robot.name, problem.robot.limits)
     n_searched: int | None = 0  # population rows made by the search (the rest by the local solver)
-    polished: dict[bytes, MemberCertificate] = {}  # the polish's certificates, by x.tobytes()
+    polished: dict[int, MemberCertificate] = {}  # the polish's certificates, by population row
     if algorithm == TIME_OPTIMAL and weights is not None:
         state, settings_dict = weighted_run(problem, seed, weights, **params)
         weighted = WeightedSum.from_settings(settings_dict)
@@ -342,7 +342,8 @@ def plan(
     )
     choice = best_tradeoff(front.objectives, _weights(weights))
     order = choice.order if weighted is None else weighted.order(front.objectives)
-    summaries = _certify_front(problem, front, order, rate_hz, max_certify, polished)
+    known = {k: polished[r] for k, r in enumerate(rows.tolist()) if r in polished}
+    summaries = _certify_front(problem, front, order, rate_hz, max_certify, known)
     certified = np.array([s is not None and s.feasible for s in summaries], dtype=bool)
     front = Front(
         x=front.x,

@@ -33,9 +33,9 @@ def x(problem: TrajectoryProblem) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def serial(problem: TrajectoryProblem, x: np.ndarray) -> dict[bytes, object]:
+def serial(problem: TrajectoryProblem, x: np.ndarray) -> dict[int, object]:
     out = certify_members(problem, x, MEMBERS, rate_hz=400.0)
-    return {x[k].tobytes(): out[k] for k in MEMBERS}
+    return {k: out[k] for k in MEMBERS}
 
 
 @pytest.fixture
@@ -66,7 +66,7 @@ def test_the_summaries_are_the_serial_ones(problem, x, serial, shares_of_two, pr
 def test_the_caller_certifies_only_the_members_still_wanted(problem, x, serial) -> None:
     early = start_early_certificates(problem, x, MEMBERS, rate_hz=400.0)
     early.cancel()  # the process did nothing: the caller takes every share
-    wanted = {x[4].tobytes(), x[2].tobytes()}
+    wanted = {4, 2}
     assert early.finish(wanted) == {k: serial[k] for k in wanted}
 
 
@@ -121,12 +121,10 @@ def test_failed_shares_are_kept_for_later_and_raised_only_if_still_wanted(
         failed: list[int] = []
         out = early.finish(failed=failed)
         assert failed == [6, 2]  # the share of members 6 and 2 (shares of two)
-        assert out == {k: v for k, v in serial.items() if k not in (x[2].tobytes(), x[6].tobytes())}
-        assert early.certify_again(failed, {x[2].tobytes()}) == {
-            x[2].tobytes(): serial[x[2].tobytes()]
-        }
+        assert out == {k: v for k, v in serial.items() if k not in (2, 6)}
+        assert early.certify_again(failed, {2}) == {2: serial[2]}
         with pytest.raises(RuntimeError, match="member 6"):
-            early.certify_again(failed, {x[2].tobytes(), x[6].tobytes()})
+            early.certify_again(failed, {2, 6})
 
 
 def test_bad_input_is_refused_before_any_process_starts(problem, x) -> None:

@@ -51,10 +51,10 @@ def serial(problem: TrajectoryProblem, searched):
     new = state.X[len(searched.X) :]
     assert len(new) >= 1  # the polish kept a move: the test compares something
     ok = np.flatnonzero(np.all(searched.G <= 0.0, axis=1))
-    start = searched.X[ok[np.argmin(searched.X[ok, 0])]]  # the local solver's first start
-    moves = np.concatenate([new, start[None]])
-    summaries = certify_members(problem, moves, rate_hz=RATE)
-    return state, {x.tobytes(): c for x, c in zip(moves, summaries)}
+    start = ok[np.argmin(searched.X[ok, 0])]  # the local solver's first start (a member)
+    rows = [*range(len(searched.X), len(state.X)), int(start)]
+    summaries = certify_members(problem, state.X, rows, rate_hz=RATE)
+    return state, {k: summaries[k] for k in rows}  # by population row
 
 
 def _same(state, certified, serial) -> None:

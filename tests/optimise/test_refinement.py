@@ -322,7 +322,7 @@ def test_a_member_near_the_relaxed_floor_does_not_stop_the_relaxed_starts(detour
     was screened; that start is screened all the same: within 1 % of the best known move."""
     x = np.array(BEST_MOVES["near_floor_local_optimum"])
     assert refine_minimum_time(detour, x).x[0] == x[0]  # a local optimum of its own
-    outcomes = fastest_of_basins(detour, x[None])
+    outcomes, _ = fastest_of_basins(detour, x[None])
     best = min(o.x[0] for o in outcomes if o.certified)
     assert best <= 1.01 * BEST_MOVES["fastest_time_optimal_windows"][0] < x[0]
 

@@ -33,7 +33,7 @@ import numpy as np
 from adept_traj.errors import ConfigurationError
 from adept_traj.validation import as_batch, as_scalar
 
-__all__ = ["N_INSTANTS", "THRESHOLD", "basin_labels"]
+__all__ = ["N_INSTANTS", "THRESHOLD", "basin_labels", "basin_starts"]
 
 #: Instants at which two moves are compared.
 N_INSTANTS = 48
@@ -72,6 +72,16 @@ def basin_labels(problem: Any, x: Any, *, threshold: float = THRESHOLD) -> np.nd
         labels[i] = len(representatives)
         representatives.append(i)
     return labels
+
+
+def basin_starts(problem: Any, x: Any, max_basins: int) -> np.ndarray:
+    """(k,) int rows of ``x`` (n, n_var): the fastest move of each of the ``max_basins``
+    fastest basins (:func:`basin_labels` of the moves fastest first), fastest first
+    (k ≤ ``max_basins``)."""
+    xs = np.atleast_2d(as_batch(x, "x", problem.n_var))
+    order = np.argsort(xs[:, 0], kind="stable")
+    _, first = np.unique(basin_labels(problem, xs[order]), return_index=True)
+    return order[np.sort(first)[:max_basins]]
 
 
 def _paths(problem: Any, xs: np.ndarray) -> np.ndarray:

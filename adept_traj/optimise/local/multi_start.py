@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.errors import ConfigurationError
-from adept_traj.optimise.local.basins import basin_labels
+from adept_traj.optimise.local.basins import basin_starts
 from adept_traj.optimise.local.refinement import (
     Refinement,
     refine_starts,
@@ -313,17 +313,17 @@ def fastest_of_basins(
     *,
     rate_hz: float = 1000.0,
     max_basins: int = MAX_BASINS,
-) -> list[Refinement]:
-    """Refinements (:func:`~adept_traj.optimise.refine_minimum_time`) of the fastest move
-    of each of the ``max_basins`` fastest basins (:func:`~adept_traj.optimise.basin_labels`)
+) -> tuple[list[Refinement], np.ndarray]:
+    """The refinements (:func:`~adept_traj.optimise.refine_minimum_time`) of the fastest move
+    of each of the ``max_basins`` fastest basins (:func:`~adept_traj.optimise.basin_starts`)
     of the moves ``x`` (n, n_var) and, unless one of them comes within
     :data:`~adept_traj.optimise.GLOBAL_GAP` of the kinematic lower bound (no other basin
     can then be faster by more than that), of the global stage's starts
     (:func:`~adept_traj.optimise.global_starts`): every start screened
     (:func:`~adept_traj.optimise.screen_starts`, fastest basin first, stopping once one is
     near the bound), then the fastest screened moves refined to the end
-    (:func:`~adept_traj.optimise.refine_starts`). Screened and full refinements, in that
-    order.
+    (:func:`~adept_traj.optimise.refine_starts`): the screened and the full refinements,
+    in that order, and (k,) int the rows of ``x`` that the first k of them started from.
 
     Parameters
     ----------
@@ -336,19 +336,18 @@ def fastest_of_basins(
     max_basins = as_integer(max_basins, "max_basins", minimum=1, error=ConfigurationError)
     near = functools.partial(near_lower_bound, problem)
     screened: list[Refinement] = []
+    rows = np.empty(0, dtype=int)
     if len(xs):
-        xs = xs[np.argsort(xs[:, 0], kind="stable")]
-        _, first = np.unique(basin_labels(problem, xs), return_index=True)
-        screened = screen_starts(
-            problem, xs[np.sort(first)[:max_basins]], rate_hz=rate_hz, stop=near
-        )
+        rows = basin_starts(problem, xs, max_basins)
+        screened = screen_starts(problem, xs[rows], rate_hz=rate_hz, stop=near)
+    rows = rows[: len(screened)]  # the screening stops once one is near the bound
     stage = None
     if not near(screened):
         stage = global_stage(problem, n_starts=max_basins, rate_hz=rate_hz)
         screened += _screen_stage(problem, stage, screened, xs[:0], rate_hz=rate_hz)
     if near_lower_bound(problem, screened, floor=stage.floor if stage else 0.0):
-        return screened  # no other basin can be faster by more than GLOBAL_GAP
-    return screened + refine_starts(problem, screened, rate_hz=rate_hz)
+        return screened, rows  # no other basin can be faster by more than GLOBAL_GAP
+    return screened + refine_starts(problem, screened, rate_hz=rate_hz), rows
 
 
 def _screen_stage(

@@ -110,27 +110,28 @@ def polish_fastest(problem: Any, state: RunState, rate_hz: float) -> RunState:
 
 
 def _polish_fastest(
-    problem: Any, state: RunState, rate_hz: float, certified: dict[bytes, MemberCertificate]
+    problem: Any, state: RunState, rate_hz: float, certified: dict[int, MemberCertificate]
 ) -> RunState:
-    """:func:`polish_fastest`, adding the summaries of the certificates of the moves it
-    adds to ``certified`` under each move's ``x.tobytes()``."""
+    """:func:`polish_fastest`, adding to ``certified`` the summaries of the certificates of
+    its member starts and of the moves it adds, under their rows in the population."""
     X = np.asarray(state.X, dtype=float)
     feasible = np.flatnonzero(np.all(np.asarray(state.G) <= 0.0, axis=1))
     tic = time.perf_counter()  # no feasible member: the global stage alone
-    outcomes = fastest_of_basins(problem, X[feasible], rate_hz=rate_hz)
+    outcomes, starts = fastest_of_basins(problem, X[feasible], rate_hz=rate_hz)
     counted = dataclasses.replace(
         state,
         n_evaluations=state.n_evaluations + sum(o.n_evaluations for o in outcomes),
         total_s=state.total_s + time.perf_counter() - tic,
         evaluation_s=state.evaluation_s + sum(o.evaluation_s for o in outcomes),
     )
+    for row, o in zip(feasible[starts], outcomes):
+        certified[int(row)] = o.start_certificate  # a member: not certified again
     kept = []
     for o in outcomes:
-        certified.setdefault(o.start.tobytes(), o.start_certificate)  # a member: not again
         new = o.certified and not (o.start_certified and o.x[0] >= o.start[0])
         if new and not any(np.allclose(o.x, k.x, rtol=0.0, atol=1e-9) for k in kept):
+            certified[len(X) + len(kept)] = o.certificate  # its row once appended
             kept.append(o)
-            certified[o.x.tobytes()] = o.certificate
     return _with_members(counted, kept) if kept else counted
 
 
@@ -154,13 +155,13 @@ def polish_run(problem: Any, state: RunState, rate_hz: float, mode: str, weights
 
 def polish_run_with_certificates(
     problem: Any, state: RunState, rate_hz: float, mode: str, weights: Any
-) -> tuple[RunState, dict[bytes, MemberCertificate]]:
-    """:func:`polish_run`, and the summaries of the certificates it made, by the polished
-    move's ``x.tobytes()`` (:func:`~adept_traj.analysis.certify_members` at ``rate_hz``
+) -> tuple[RunState, dict[int, MemberCertificate]]:
+    """:func:`polish_run`, and the summaries of the certificates it made, by the move's row
+    in the polished population (:func:`~adept_traj.analysis.certify_members` at ``rate_hz``
     with its default tolerance: what :func:`~adept_traj.plan` makes for a front member, so
     that ``plan`` certifies no polished move twice)."""
     mode = polish_mode(mode)
-    certified: dict[bytes, MemberCertificate] = {}
+    certified: dict[int, MemberCertificate] = {}
     if mode == "off":
         return state, certified
     members, scale = _chosen_members(state, mode, weights)
@@ -173,16 +174,6 @@ def polish_run_with_certificates(
         budget -= state.n_evaluations - before
     state = _polish_members(problem, state, members, scale, rate_hz, budget, certified)
     return state, certified
-
-
-def _certified(
-    problem: Any, x: np.ndarray, rate_hz: float, certified: dict[bytes, MemberCertificate]
-) -> bool:
-    """Whether the move ``x`` (n_var,) passes its certificate; its summary is added to
-    ``certified``."""
-    summary = certify_members(problem, x[None], rate_hz=rate_hz)[0]
-    certified[x.tobytes()] = summary
-    return summary.feasible
 
 
 def _chosen_members(state: RunState, mode: str, weights: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -257,10 +248,10 @@ def _polish_members(
     scale: Any,
     rate_hz: float,
     max_evaluations: int | None,
-    certified: dict[bytes, MemberCertificate],
+    certified: dict[int, MemberCertificate],
 ) -> RunState:
-    """:func:`polish_members`, adding the summaries of the certificates it made to
-    ``certified`` under each move's ``x.tobytes()``."""
+    """:func:`polish_members`, adding the summaries of the certificates of the moves it
+    adds to ``certified`` under their rows in the population."""
     rows = np.asarray(members, dtype=int).ravel()
     torque_limit = problem.robot.limits.bound(LIMITS[4].name)
     if problem.settings.z3 != "clearance" or not np.all(np.isfinite(torque_limit)):
@@ -274,15 +265,14 @@ def _polish_members(
             break
         outcome = epsilon_step(problem, X[k], 0, scale)
         tic = time.perf_counter()
-        ok = (
-            outcome.feasible
-            and outcome.x[0] < X[k, 0]
-            and _certified(problem, outcome.x, rate_hz, certified)
-        )
+        summary = None
+        if outcome.feasible and outcome.x[0] < X[k, 0]:
+            summary = certify_members(problem, outcome.x[None], rate_hz=rate_hz)[0]
         seconds += outcome.seconds + time.perf_counter() - tic
         n_evaluations += outcome.n_evaluations
         evaluation_s += outcome.evaluation_s
-        if ok:
+        if summary is not None and summary.feasible:
+            certified[len(X) + len(kept)] = summary  # its row once appended
             kept.append(outcome)
     if n_evaluations == 0:  # no step ran
         return state

@@ -130,10 +130,10 @@ class EarlyCertificates(Helper):
             self._worker = Worker(_work, self, note="raised in the early certificates' worker")
 
     def finish(
-        self, wanted: Collection[bytes] | None = None, *, failed: list[int] | None = None
-    ) -> dict[bytes, MemberCertificate]:
-        """Certify the shares the worker has not taken (only the members whose
-        ``x[k].tobytes()`` is in ``wanted``; ``None``: all), collect the worker's summaries
+        self, wanted: Collection[int] | None = None, *, failed: list[int] | None = None
+    ) -> dict[int, MemberCertificate]:
+        """Certify the shares the worker has not taken (only the members whose row of ``x``
+        is in ``wanted``; ``None``: all), collect the worker's summaries
         and reap it (once: a second call certifies every share again, in the caller).
 
         With a list ``failed``, a share whose certificates raise in the caller is not
@@ -144,7 +144,7 @@ class EarlyCertificates(Helper):
         Returns
         -------
         dict
-            The summary of each certified member by its ``x[k].tobytes()``.
+            The summary of each certified member by its row of ``x``.
 
         Raises
         ------
@@ -182,22 +182,22 @@ class EarlyCertificates(Helper):
             progress.close()
             raise
         progress.close()
-        return {self._x[k].tobytes(): summary for k, summary in mine.items()}
+        return mine
 
     def certify_again(
-        self, rows: list[int], wanted: Collection[bytes]
-    ) -> dict[bytes, MemberCertificate]:
-        """The certificates of the members ``rows`` (from :meth:`finish`'s ``failed``) whose
-        ``x[k].tobytes()`` is in ``wanted``, made in the caller; an error is raised."""
-        return {self._x[k].tobytes(): c for k, c in self._certify(rows, wanted).items()}
+        self, rows: list[int], wanted: Collection[int]
+    ) -> dict[int, MemberCertificate]:
+        """The certificates of the members ``rows`` (from :meth:`finish`'s ``failed``) that
+        are in ``wanted`` (rows of ``x``), made in the caller, by row; an error is raised."""
+        return self._certify(rows, wanted)
 
     def _certify(
         self,
         share: list[int],
-        wanted: Collection[bytes] | None,
+        wanted: Collection[int] | None,
         failed: list[int] | None = None,
     ) -> dict[int, MemberCertificate]:
-        rows = [k for k in share if wanted is None or self._x[k].tobytes() in wanted]
+        rows = [k for k in share if wanted is None or k in wanted]
         try:
             out = certify_members(self._problem, self._x, rows, rate_hz=self._rate)
         except Exception:

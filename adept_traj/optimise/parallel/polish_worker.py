@@ -98,7 +98,7 @@ def polish_with_certificates(
     *,
     early: EarlyCertificates,
     polisher: Polisher | None = None,
-) -> tuple[RunState, dict[bytes, MemberCertificate]]:
+) -> tuple[RunState, dict[int, MemberCertificate]]:
     """:func:`~adept_traj.optimise.polish_run` of the search's final ``state`` and the
     front's certificates made meanwhile.
 
@@ -121,7 +121,8 @@ def polish_with_certificates(
     -------
     tuple
         (the polished state, the summaries of the certificates made by the polish and by
-        ``early`` by the move's ``x.tobytes()``): the same with or without the helper.
+        ``early`` by the move's row in the polished population): the same with or without
+        the helper.
     """
     check_polisher(polisher, problem)
     handed = polisher is not None and polish_mode(mode) != "off"
@@ -135,14 +136,12 @@ def polish_with_certificates(
             done = polish_run_with_certificates(problem, state, rate_hz, mode, weights)
         if failed:
             polished = done[0]
-            keys = {
-                polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)
-            }
-            ahead.update(early.certify_again(failed, keys))
+            front = feasible_front(polished.F, polished.G, weights)
+            ahead.update(early.certify_again(failed, {int(k) for k in front}))
         return done[0], {**ahead, **done[1]}
     polished, certified = polish_run_with_certificates(problem, state, rate_hz, mode, weights)
-    keys = {polished.X[k].tobytes() for k in feasible_front(polished.F, polished.G, weights)}
-    return polished, {**early.finish(keys), **certified}
+    front = feasible_front(polished.F, polished.G, weights)
+    return polished, {**early.finish({int(k) for k in front}), **certified}
 
 
 class Polisher(Helper):
@@ -200,14 +199,14 @@ class Polisher(Helper):
         self._order = {"history": state.history, "fronts": state.fronts}
         return True
 
-    def result(self) -> tuple[RunState, dict[bytes, MemberCertificate]] | None:
+    def result(self) -> tuple[RunState, dict[int, MemberCertificate]] | None:
         """Wait for the polish handed over by :meth:`start` and reap the helper.
 
         Returns
         -------
         tuple or None
-            (the polished state, the polish's certificates by the polished move's
-            ``x.tobytes()``), as the polish in the caller makes them; ``None`` if the
+            (the polished state, the polish's certificates by the move's row in the
+            polished population), as the polish in the caller makes them; ``None`` if the
             helper died without a word: the caller polishes itself.
 
         Raises
