@@ -33,6 +33,7 @@ __all__ = [
     "Scene",
     "check_obstacle_count",
     "pendulum_obstacles",
+    "pendulums",
     "scene_notes",
 ]
 
@@ -149,6 +150,17 @@ def pendulum_obstacles(
         transform_from_xyz_rpy((0.0, 0.0, -length)),
     )
     return rod, bob
+
+
+def pendulums(scene: Scene) -> dict[str, PendulumMotion]:
+    """Each pendulum of ``scene`` by its name — that of its obstacles before the last dot,
+    as :func:`pendulum_obstacles` names them (``pendulum`` of ``pendulum.rod``; a name
+    without a dot is its own) — and its first obstacle's motion law, in obstacle order."""
+    found: dict[str, PendulumMotion] = {}
+    for ob in scene.obstacles:
+        if isinstance(ob.motion, PendulumMotion):
+            found.setdefault(ob.name.rpartition(".")[0] or ob.name, ob.motion)
+    return found
 
 
 def scene_notes(scene: Scene) -> tuple[str, ...]:

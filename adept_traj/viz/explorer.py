@@ -54,11 +54,11 @@ from adept_traj.scene import (
     Capsule,
     Cylinder,
     Mesh,
-    PendulumMotion,
     PointCloud,
     Scene,
     Sphere,
     merge_meshes,
+    pendulums,
 )
 from adept_traj.validation import as_path, check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
@@ -173,15 +173,9 @@ def _obstacles(scene: Scene, horizon: float) -> tuple[list[dict[str, Any]], floa
 
 
 def _pivots(scene: Scene) -> list[dict[str, Any]]:
-    """Each pendulum's pivot (its obstacles share one motion law): the name before the last
-    dot of its first obstacle's (``pendulum`` of ``pendulum.rod``) and the (3,) world
-    point [m]."""
-    found: dict[int, dict[str, Any]] = {}
-    for ob in scene.obstacles:
-        if isinstance(ob.motion, PendulumMotion) and id(ob.motion) not in found:
-            name = ob.name.rpartition(".")[0] or ob.name
-            found[id(ob.motion)] = {"name": name, "point": ob.motion.pivot.tolist()}
-    return list(found.values())
+    """Each pendulum's pivot (:func:`~adept_traj.scene.pendulums`): its name and the (3,)
+    world point [m]."""
+    return [{"name": n, "point": m.pivot.tolist()} for n, m in pendulums(scene).items()]
 
 
 # ============================================================================ members
