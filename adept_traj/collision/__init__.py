@@ -16,6 +16,7 @@ from adept_traj.collision.checker import (
     MinDistances,
     PairDistances,
 )
+from adept_traj.collision.cloud_search import SearchSamples
 from adept_traj.collision.collision_matrix import (
     MATRIX_SAMPLES,
     CollisionMatrix,
@@ -59,6 +60,7 @@ __all__ = [
     "MinDistances",
     "ObstaclePruning",
     "PairDistances",
+    "SearchSamples",
     "SelfCollision",
     "SelfDistances",
     "SelfPairs",

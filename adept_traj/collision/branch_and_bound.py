@@ -27,41 +27,25 @@ time search (each pair's sequence of candidates is the same).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from adept_traj.collision.cloud_search import cloud_obstacles, search_clouds
-
-if TYPE_CHECKING:
-    from adept_traj.collision.checker import CollisionChecker
+from adept_traj.collision.cloud_search import SearchSamples, cloud_obstacles, search_clouds
 
 __all__ = ["search_pairs"]
 
 
 def search_pairs(
-    checker: CollisionChecker,
-    frames: np.ndarray,
-    lower: np.ndarray,
-    known: np.ndarray,
-    obstacle_poses: list[np.ndarray],
-    n_t: int,
+    samples: SearchSamples, lower: np.ndarray, known: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Smallest distance of every (motion, obstacle) pair (module doc).
 
     Parameters
     ----------
-    checker:
-        The checker whose coal functors, solids and ``influence`` are used.
-    frames:
-        (njoints, 3, 4, N) joint frames (component-major), N = n_motions · ``n_t``.
+    samples:
+        The sampled motions (:class:`~adept_traj.collision.cloud_search.SearchSamples`).
     lower, known:
         (n_motions, n_t · n_solids, n_obstacles) lower bounds [m] (candidate index
         ``sample · n_solids + solid``) and whether each is exact.
-    obstacle_poses:
-        Per obstacle its pose (4, 4) or poses (N, 4, 4) in the base frame.
-    n_t:
-        Samples per motion.
 
     Returns
     -------
@@ -74,6 +58,7 @@ def search_pairs(
     calls:
         Number of coal calls made.
     """
+    checker, n_t = samples.checker, samples.n_t
     ns, influence = checker.n_solids, checker.influence
     smallest = lower.argmin(axis=1)  # (n_motions, n_obs): where each smallest bound is
     best = np.take_along_axis(lower, smallest[:, None], axis=1)[:, 0]  # bound until improved
@@ -89,7 +74,7 @@ def search_pairs(
     if cloudy.any():
         cm, co = pm[cloudy], po[cloudy]
         rows = lower[cm, :, co]
-        value, found, calls = search_clouds(checker, frames, rows, cm, co, obstacle_poses, n_t)
+        value, found, calls = search_clouds(samples, rows, cm, co)
         best[cm, co], where[cm, co] = _floor(value, found, rows, influence)
         pm, po = pm[~cloudy], po[~cloudy]
     if len(pm) == 0:
@@ -101,9 +86,8 @@ def search_pairs(
     todo = np.flatnonzero(~known[pm, first, po])
     calls += len(todo)
     value[todo] = _narrow_many(
-        checker, frames, obstacle_poses, pm[todo] * n_t + first[todo] // ns,
-        first[todo] % ns, po[todo],
-    )  # fmt: skip
+        samples, pm[todo] * n_t + first[todo] // ns, first[todo] % ns, po[todo]
+    )
     found = first.copy()
     # 2. The pairs with another candidate whose bound is below the first value and at most
     # influence (their second smallest bound is).
@@ -111,9 +95,7 @@ def search_pairs(
     mask[np.arange(len(pm)), first] = False  # the first candidate, done
     need = np.flatnonzero(mask.any(axis=1))
     if len(need):
-        calls += _walk(
-            checker, frames, obstacle_poses, known, rows, mask, pm, po, need, value, found
-        )
+        calls += _walk(samples, known, rows, mask, pm, po, need, value, found)
     best[pm, po], where[pm, po] = _floor(value, found, rows, influence)
     return best, where, calls
 
@@ -134,27 +116,20 @@ def _floor(
 
 
 def _narrow_many(
-    checker: CollisionChecker,
-    frames: np.ndarray,
-    obstacle_poses: list[np.ndarray],
-    samples: np.ndarray,
-    solids: np.ndarray,
-    obstacles: np.ndarray,
+    samples: SearchSamples, at: np.ndarray, solids: np.ndarray, obstacles: np.ndarray
 ) -> np.ndarray:
-    """Exact distances (R,) [m] by coal of solid ``solids[i]`` at flat sample
-    ``samples[i]`` and obstacle ``obstacles[i]``, the solid poses formed in one batch."""
-    poses = checker.broad_phase.solid_poses(frames, samples, solids)
-    out = np.empty(len(samples))
-    for i, (n, s, o) in enumerate(zip(samples.tolist(), solids.tolist(), obstacles.tolist())):
-        pose_o = obstacle_poses[o]
-        out[i] = checker.narrow_distance(poses[i], pose_o if pose_o.ndim == 2 else pose_o[n], s, o)
+    """Exact distances (R,) [m] by coal of solid ``solids[i]`` at flat sample ``at[i]`` and
+    obstacle ``obstacles[i]``, the solid poses formed in one batch."""
+    checker = samples.checker
+    poses = checker.broad_phase.solid_poses(samples.frames, at, solids)
+    out = np.empty(len(at))
+    for i, (n, s, o) in enumerate(zip(at.tolist(), solids.tolist(), obstacles.tolist())):
+        out[i] = checker.narrow_distance(poses[i], samples.obstacle_pose(o, n), s, o)
     return out
 
 
 def _walk(
-    checker: CollisionChecker,
-    frames: np.ndarray,
-    obstacle_poses: list[np.ndarray],
+    samples: SearchSamples,
     known: np.ndarray,
     rows: np.ndarray,
     mask: np.ndarray,
@@ -168,6 +143,7 @@ def _walk(
     the candidates left, bound at most ``influence`` and below the first value): updates
     ``value`` and ``found`` (candidate of the best value) in place; returns the number of
     coal calls."""
+    checker = samples.checker
     ns, n_t = checker.n_solids, rows.shape[1] // checker.n_solids
     sub = rows[need]
     pair, cand = np.nonzero(mask[need])
@@ -176,13 +152,13 @@ def _walk(
     pair, cand, bound = pair[order], cand[order], bound[order]
     m, o = pm[need][pair], po[need][pair]
     exact = known[m, cand, o]
-    samples, solids = m * n_t + cand // ns, cand % ns
+    flat, solids = m * n_t + cand // ns, cand % ns
     unknown = np.flatnonzero(~exact)
-    poses = checker.broad_phase.solid_poses(frames, samples[unknown], solids[unknown])
+    poses = checker.broad_phase.solid_poses(samples.frames, flat[unknown], solids[unknown])
     slot = np.cumsum(~exact) - 1  # index into poses of each unknown candidate
     ends = np.searchsorted(pair, np.arange(len(need)), side="right").tolist()
     bound_l, exact_l, cand_l = bound.tolist(), exact.tolist(), cand.tolist()
-    samples_l, solids_l, o_l, slot_l = samples.tolist(), solids.tolist(), o.tolist(), slot.tolist()
+    flat_l, solids_l, o_l, slot_l = flat.tolist(), solids.tolist(), o.tolist(), slot.tolist()
     calls, start = 0, 0
     for j, i in enumerate(need.tolist()):
         v, w = float(value[i]), int(found[i])
@@ -192,9 +168,7 @@ def _walk(
             if exact_l[c]:
                 d = bound_l[c]
             else:
-                pose_o = obstacle_poses[o_l[c]]
-                if pose_o.ndim == 3:
-                    pose_o = pose_o[samples_l[c]]
+                pose_o = samples.obstacle_pose(o_l[c], flat_l[c])
                 # only a distance below v matters: a larger one may come as a bound ≥ v
                 d = checker.narrow_distance(poses[slot_l[c]], pose_o, solids_l[c], o_l[c], v)
                 calls += 1

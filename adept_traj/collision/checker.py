@@ -24,7 +24,7 @@ import numpy as np
 from adept_traj.collision.branch_and_bound import search_pairs
 from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.cloud_distance import CloudDistance
-from adept_traj.collision.cloud_search import cloud_obstacles
+from adept_traj.collision.cloud_search import SearchSamples, cloud_obstacles
 from adept_traj.collision.distance_table import DistanceTable
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
@@ -335,7 +335,8 @@ class CollisionChecker:
             lower, known = np.where(self.allowed, np.inf, lower), known | self.allowed
         flat = (n_motions, n_t * self.n_solids, self.n_obstacles)
         lower, known = lower.reshape(flat), known.reshape(flat)
-        best, where, calls = search_pairs(self, frames, lower, known, obstacle_poses, n_t)
+        samples = SearchSamples(self, frames, obstacle_poses, n_t)
+        best, where, calls = search_pairs(samples, lower, known)
         sample = np.where(where >= 0, where // self.n_solids, -1)
         solid = np.where(where >= 0, where % self.n_solids, -1)
         shape = (*batch, self.n_obstacles)
