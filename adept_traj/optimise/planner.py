@@ -74,7 +74,7 @@ from adept_traj.optimise.search.algorithms import make_algorithm
 from adept_traj.optimise.search.loop import GenerationInfo, optimise
 from adept_traj.optimise.search.sampling import check_population_memory
 from adept_traj.problem import TrajectoryProblem, from_pymoo
-from adept_traj.results.record import (
+from adept_traj.results import (
     NO_FEASIBLE_WARNING,
     BestSolution,
     Front,

@@ -27,6 +27,7 @@ import numpy as np
 from adept_traj.collision import SelfPairs
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVE_NAMES, KinematicBound, ProblemSettings
+from adept_traj.results import parts
 from adept_traj.results.certificate_codec import (
     DENSE_FIELDS,
     decode_certificate,
@@ -36,16 +37,6 @@ from adept_traj.results.certificate_codec import (
     encode_member_certificate,
 )
 from adept_traj.results.json_values import json_float, json_floats, jsonable
-from adept_traj.results.parts import (
-    METRIC_NAMES,
-    T_BEST_SOURCES,
-    BestSolution,
-    Front,
-    GenerationRecord,
-    Metrics,
-    RobotInfo,
-    Timing,
-)
 from adept_traj.results.reader import open_json
 from adept_traj.results.unchecked import unchecked
 from adept_traj.robot.limits import LIMITS, JointLimits
@@ -66,8 +57,8 @@ VERSION = 2
 #: Schema versions read.
 READ_VERSIONS = (1, 2)
 
-#: JSON key of each metric of :class:`Metrics`.
-_JSON_METRICS = dict(zip(METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
+#: JSON key of each metric of :class:`~adept_traj.results.Metrics`.
+_JSON_METRICS = dict(zip(parts.METRIC_NAMES, ("SSM", "RNI", "OO", "AE", "HV"), strict=True))
 
 
 def write_json(r: PlanningResult, path: Path) -> Path:
@@ -229,7 +220,7 @@ def _decode(top: Node, result_type: type[PlanningResult]) -> PlanningResult:
     rob = top["robot"]
     lock = rob["locked_joints"]
     robot = rob.build(
-        RobotInfo,
+        parts.RobotInfo,
         name=rob["name"].string(),
         joint_names=rob["joint_names"].strings(),
         urdf=rob["urdf"].string(),
@@ -276,7 +267,7 @@ def _decode(top: Node, result_type: type[PlanningResult]) -> PlanningResult:
     front = _decode_front(top["front"], n_certified.integer(minimum=0, default=None), version)
     bd = top["best"]
     best = bd.build(
-        BestSolution,
+        parts.BestSolution,
         index=bd["index"].integer(),
         f_c=bd["f_c"].number(null=None),
         f_avg=bd["F_avg"].number(null=None),
@@ -290,14 +281,14 @@ def _decode(top: Node, result_type: type[PlanningResult]) -> PlanningResult:
         )
     md, td, vd = top["metrics"], top["timing"], top["versions"]
     metrics = md.build(
-        Metrics,
+        parts.Metrics,
         **{name: md[key].number(null=None) for name, key in _JSON_METRICS.items()},
         hv_reference_point=md["HV_reference_point"].array((len(OBJECTIVE_NAMES),), nullable=True),
         t_best=md["T_best"].number("s", default=None),
-        t_best_source=md["T_best_source"].string(choices=T_BEST_SOURCES, default=None),
+        t_best_source=md["T_best_source"].string(choices=parts.T_BEST_SOURCES, default=None),
     )
     timing = td.build(
-        Timing,
+        parts.Timing,
         total_s=td["total_s"].number(),
         evaluation_s=td["evaluation_s"].number(),
         n_evaluations=td["n_evaluations"].integer(),
@@ -388,7 +379,7 @@ def _decode_self_pairs(node: Node) -> SelfPairs | None:
     return node.build(SelfPairs, checked=checked, left_out=tuple(left))
 
 
-def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:
+def _decode_front(node: Node, n_certified: int | None, version: int) -> parts.Front:
     xs, objs, cons, feas, certificates = [], [], [], [], []
     n_var = n_con = None
     for item in node.items(min_items=1):
@@ -400,7 +391,7 @@ def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:
         if version >= 2:
             certificates.append(decode_member_certificate(item["certificate"]))
     return node.build(
-        Front,
+        parts.Front,
         x=np.array(xs),
         objectives=np.array(objs),
         constraints=np.array(cons),
@@ -410,12 +401,12 @@ def _decode_front(node: Node, n_certified: int | None, version: int) -> Front:
     )
 
 
-def _decode_history(node: Node) -> tuple[GenerationRecord, ...] | None:
+def _decode_history(node: Node) -> tuple[parts.GenerationRecord, ...] | None:
     if not node.present or node.value is None:
         return None
     return tuple(
         item.build(
-            GenerationRecord,
+            parts.GenerationRecord,
             generation=item["generation"].integer(),
             n_evaluations=item["n_evaluations"].integer(),
             n_feasible=item["n_feasible"].integer(),

@@ -36,6 +36,7 @@ from adept_traj.problem import (
     ProblemSettings,
     TrajectoryProblem,
 )
+from adept_traj.results import parts
 from adept_traj.results.csv_codec import (
     check_front_csv,
     check_trajectory_csv,
@@ -50,15 +51,6 @@ from adept_traj.results.json_codec import (
     write_json,
 )
 from adept_traj.results.json_values import jsonable
-from adept_traj.results.parts import (
-    BestSolution,
-    Front,
-    GenerationRecord,
-    Metrics,
-    RobotInfo,
-    Timing,
-    software_versions,
-)
 from adept_traj.results.unchecked import unchecked
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import JointLimits
@@ -101,7 +93,7 @@ class PlanningResult(DeepEqual):
     Attributes
     ----------
     start, goal: (nq,) rest configurations [rad | m].
-    robot: :class:`RobotInfo`.
+    robot: :class:`~adept_traj.results.RobotInfo`.
     scene: the scene as :meth:`Scene.to_dict` (a :class:`Scene` is accepted and converted).
     problem_settings: the problem's :class:`ProblemSettings`.
     limits: the robot's :class:`JointLimits` (SI).
@@ -110,17 +102,18 @@ class PlanningResult(DeepEqual):
     algorithm_settings: its settings, stored as a JSON-compatible copy (numpy values become
         Python values, tuples lists, non-finite floats ``None``, other objects ``str``).
     seed: random seed, or ``None``.
-    front: the final non-dominated set (:class:`Front`, n ≥ 1); when nothing is feasible,
-        the least-infeasible solutions.
-    best: the chosen solution (:class:`BestSolution`, an index into ``front``).
+    front: the final non-dominated set (:class:`~adept_traj.results.Front`, n ≥ 1); when
+        nothing is feasible, the least-infeasible solutions.
+    best: the chosen solution (:class:`~adept_traj.results.BestSolution`, an index into
+        ``front``).
     certificate: the dense :class:`~adept_traj.analysis.Certificate` of the best
         solution (its ``x`` must equal ``front.x[best.index]``).
-    timing: :class:`Timing`.
-    metrics: :class:`Metrics` (default: none computed).
-    history: per-generation :class:`GenerationRecord` tuple, or ``None``.
+    timing: :class:`~adept_traj.results.Timing`.
+    metrics: :class:`~adept_traj.results.Metrics` (default: none computed).
+    history: per-generation :class:`~adept_traj.results.GenerationRecord` tuple, or ``None``.
     warning: a warning for the reader; defaults to :data:`NO_FEASIBLE_WARNING` when no
         solution of the front is feasible.
-    versions: software versions (default: :func:`software_versions` now).
+    versions: software versions (default: :func:`~adept_traj.results.software_versions` now).
     self_pairs: the link pairs the self-collision check covered and those it left out,
         with why (:class:`~adept_traj.collision.SelfPairs`); ``None``: self-collision off
         (or a file written before the field).
@@ -132,7 +125,7 @@ class PlanningResult(DeepEqual):
 
     start: np.ndarray
     goal: np.ndarray
-    robot: RobotInfo
+    robot: parts.RobotInfo
     scene: dict[str, Any]
     problem_settings: ProblemSettings
     limits: JointLimits
@@ -140,14 +133,14 @@ class PlanningResult(DeepEqual):
     algorithm: str
     algorithm_settings: dict[str, Any]
     seed: int | None
-    front: Front
-    best: BestSolution
+    front: parts.Front
+    best: parts.BestSolution
     certificate: Certificate
-    timing: Timing
-    metrics: Metrics = field(default_factory=Metrics)
-    history: tuple[GenerationRecord, ...] | None = None
+    timing: parts.Timing
+    metrics: parts.Metrics = field(default_factory=parts.Metrics)
+    history: tuple[parts.GenerationRecord, ...] | None = None
     warning: str | None = None
-    versions: dict[str, str] = field(default_factory=software_versions)
+    versions: dict[str, str] = field(default_factory=parts.software_versions)
     self_pairs: SelfPairs | None = None
     unchecked: tuple[str, ...] | None = None
 
@@ -157,15 +150,15 @@ class PlanningResult(DeepEqual):
             object.__setattr__(self, "unchecked", statements or None)
         if self.self_pairs is not None:
             check_type(self.self_pairs, SelfPairs, "self_pairs")
-        check_type(self.robot, RobotInfo, "robot")
+        check_type(self.robot, parts.RobotInfo, "robot")
         check_type(self.problem_settings, ProblemSettings, "problem_settings")
         check_type(self.limits, JointLimits, "limits")
         check_type(self.lower_bound, KinematicBound, "lower_bound")
-        check_type(self.front, Front, "front")
-        check_type(self.best, BestSolution, "best")
+        check_type(self.front, parts.Front, "front")
+        check_type(self.best, parts.BestSolution, "best")
         check_type(self.certificate, Certificate, "certificate")
-        check_type(self.timing, Timing, "timing")
-        check_type(self.metrics, Metrics, "metrics")
+        check_type(self.timing, parts.Timing, "timing")
+        check_type(self.metrics, parts.Metrics, "metrics")
         nq = len(self.robot.joint_names)
         if tuple(self.limits.names) != self.robot.joint_names:
             raise InvalidInputError(
@@ -211,7 +204,7 @@ class PlanningResult(DeepEqual):
         if self.history is not None:
             history = tuple(self.history)
             for i, rec in enumerate(history):
-                check_type(rec, GenerationRecord, f"history[{i}]")
+                check_type(rec, parts.GenerationRecord, f"history[{i}]")
             object.__setattr__(self, "history", history)
         warning = self.warning
         if warning is None and not fr.feasible.any():
@@ -230,12 +223,12 @@ class PlanningResult(DeepEqual):
         algorithm: str,
         algorithm_settings: Mapping[str, Any],
         seed: int | None,
-        front: Front,
-        best: BestSolution,
+        front: parts.Front,
+        best: parts.BestSolution,
         certificate: Certificate,
-        timing: Timing,
-        metrics: Metrics | None = None,
-        history: Iterable[GenerationRecord] | None = None,
+        timing: parts.Timing,
+        metrics: parts.Metrics | None = None,
+        history: Iterable[parts.GenerationRecord] | None = None,
         warning: str | None = None,
     ) -> PlanningResult:
         """A result whose start, goal, robot, scene, settings, limits and lower bound are
@@ -243,7 +236,7 @@ class PlanningResult(DeepEqual):
         return cls(
             start=problem.start,
             goal=problem.goal,
-            robot=RobotInfo.of(problem.robot),
+            robot=parts.RobotInfo.of(problem.robot),
             scene=problem.scene.to_dict(),
             problem_settings=problem.settings,
             limits=problem.robot.limits,
@@ -255,7 +248,7 @@ class PlanningResult(DeepEqual):
             best=best,
             certificate=certificate,
             timing=timing,
-            metrics=metrics if metrics is not None else Metrics(),
+            metrics=metrics if metrics is not None else parts.Metrics(),
             history=None if history is None else tuple(history),
             warning=warning,
             self_pairs=problem.self_pairs,
@@ -310,7 +303,7 @@ class PlanningResult(DeepEqual):
         return self.front.objectives
 
     @property
-    def feasible_front(self) -> Front:
+    def feasible_front(self) -> parts.Front:
         """The feasible solutions of the front (possibly empty)."""
         return self.front.subset(self.front.feasible)
 
