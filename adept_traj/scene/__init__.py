@@ -26,7 +26,6 @@ from adept_traj.scene.scene import (
     Scene,
     check_obstacle_count,
     pendulum_obstacles,
-    pendulums,
     scene_notes,
 )
 from adept_traj.scene.scene_file import (
@@ -79,7 +78,6 @@ __all__ = [
     "coal_transform",
     "merge_meshes",
     "pendulum_obstacles",
-    "pendulums",
     "read_cloud_points",
     "read_mesh_arrays",
     "read_paper_scene",

@@ -33,7 +33,6 @@ __all__ = [
     "Scene",
     "check_obstacle_count",
     "pendulum_obstacles",
-    "pendulums",
     "scene_notes",
 ]
 
@@ -150,17 +149,6 @@ def pendulum_obstacles(
         transform_from_xyz_rpy((0.0, 0.0, -length)),
     )
     return rod, bob
-
-
-def pendulums(scene: Scene) -> dict[str, PendulumMotion]:
-    """Each pendulum of ``scene`` by its name — that of its obstacles before the last dot,
-    as :func:`pendulum_obstacles` names them (``pendulum`` of ``pendulum.rod``; a name
-    without a dot is its own) — and its first obstacle's motion law, in obstacle order."""
-    found: dict[str, PendulumMotion] = {}
-    for ob in scene.obstacles:
-        if isinstance(ob.motion, PendulumMotion):
-            found.setdefault(ob.name.rpartition(".")[0] or ob.name, ob.motion)
-    return found
 
 
 def scene_notes(scene: Scene) -> tuple[str, ...]:
@@ -284,6 +272,15 @@ class Scene(ValueObject):
     def fixed(self) -> tuple[Obstacle, ...]:
         """The obstacles that do not move, in order."""
         return tuple(ob for ob in self.obstacles if not ob.is_moving)
+
+    @property
+    def pendulums(self) -> dict[str, PendulumMotion]:
+        """Each pendulum's name (its obstacles' before the last dot) and its motion law."""
+        found: dict[str, PendulumMotion] = {}
+        for ob in self.obstacles:
+            if isinstance(ob.motion, PendulumMotion):
+                found.setdefault(ob.name.rpartition(".")[0] or ob.name, ob.motion)
+        return found
 
     def obstacle(self, name: str) -> Obstacle:
         """The obstacle called ``name`` (raises InvalidInputError listing the names if absent)."""

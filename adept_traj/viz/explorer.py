@@ -58,7 +58,6 @@ from adept_traj.scene import (
     Scene,
     Sphere,
     merge_meshes,
-    pendulums,
 )
 from adept_traj.validation import as_path, check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
@@ -173,9 +172,9 @@ def _obstacles(scene: Scene, horizon: float) -> tuple[list[dict[str, Any]], floa
 
 
 def _pivots(scene: Scene) -> list[dict[str, Any]]:
-    """Each pendulum's pivot (:func:`~adept_traj.scene.pendulums`): its name and the (3,)
-    world point [m]."""
-    return [{"name": n, "point": m.pivot.tolist()} for n, m in pendulums(scene).items()]
+    """Each pendulum's pivot (:attr:`~adept_traj.scene.Scene.pendulums`): its name and the
+    (3,) world point [m]."""
+    return [{"name": n, "point": m.pivot.tolist()} for n, m in scene.pendulums.items()]
 
 
 # ============================================================================ members

@@ -25,7 +25,6 @@ from adept_traj.scene import (
     Scene,
     Shape,
     Sphere,
-    pendulums,
 )
 from adept_traj.viz.meshcat_modules import mg
 
@@ -163,8 +162,8 @@ def solid_parts(gobj: Any, material: mg.Material) -> tuple[Part, ...]:
 
 
 def pendulum_pivots(scene: Scene, color: int) -> list[tuple[str, tuple[Part, ...], np.ndarray]]:
-    """The pivot of each pendulum of ``scene`` (:func:`~adept_traj.scene.pendulums`) as
-    (node path, parts, (4, 4) world pose) of a fixed node ``pivots/NAME`` (NAME: the
+    """The pivot of each pendulum of ``scene`` (:attr:`~adept_traj.scene.Scene.pendulums`)
+    as (node path, parts, (4, 4) world pose) of a fixed node ``pivots/NAME`` (NAME: the
     pendulum's name): a ball at the pivot and an axle along the swing plane's normal
     ``e_n``, the axis the pendulum turns about, in ``color`` (0xRRGGBB). The node's frame:
     origin at the pivot, axes (e_swing, e_n, e_z)."""
@@ -172,7 +171,7 @@ def pendulum_pivots(scene: Scene, color: int) -> list[tuple[str, tuple[Part, ...
     ball = Part(mg.Mesh(mg.Sphere(_PIVOT_RADIUS), material), np.eye(4))
     axle = Part(mg.Mesh(mg.Cylinder(_AXLE_LENGTH, _AXLE_RADIUS), material), np.eye(4))  # along y
     nodes = []
-    for name, motion in pendulums(scene).items():
+    for name, motion in scene.pendulums.items():
         pose = np.eye(4)
         pose[:3, 0], pose[:3, 1], pose[:3, 2] = motion.swing_axis, motion.normal_axis, (0, 0, 1)
         pose[:3, 3] = motion.pivot

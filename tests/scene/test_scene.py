@@ -352,6 +352,24 @@ def test_pendulum_obstacles_rod_and_bob() -> None:
     np.testing.assert_allclose(np.linalg.det(r), 1.0)
 
 
+def test_scene_pendulums_by_name_in_obstacle_order() -> None:
+    """Two pendulums (equal motion laws, other names), a lone obstacle on a pendulum law
+    and a fixed box: one entry per pendulum name, the law of its first obstacle."""
+    first, second, lone = paper_pendulum(), paper_pendulum(), paper_pendulum(omega=1.0)
+    obstacles = (
+        *pendulum_obstacles("b", second, bob_radius=0.08),
+        Obstacle("box", Box([0.1, 0.1, 0.1])),
+        Obstacle("swing", Sphere(0.05), lone),
+        *pendulum_obstacles("a", first, bob_radius=0.05),
+    )
+    found = Scene(obstacles=obstacles).pendulums
+    assert list(found) == ["b", "swing", "a"]
+    assert found["b"] is second
+    assert found["a"] is first
+    assert found["swing"] is lone
+    assert Scene(obstacles=(Obstacle("box", Box([0.1, 0.1, 0.1])),)).pendulums == {}
+
+
 def test_pendulum_other_swing_axis() -> None:
     law = paper_pendulum(swing_axis=[0.0, -2.0, 0.0])
     np.testing.assert_array_equal(law.swing_axis, [0.0, -1.0, 0.0])
