@@ -159,7 +159,24 @@ class Sphere(Shape):
 
 
 @dataclass(frozen=True, eq=False)
-class Cylinder(Shape):
+class _AxialShape(Shape):
+    """A solid of a radius and a length along local z, centred on the origin, made in coal
+    by ``coal_class(radius, length)``: the base of :class:`Cylinder` and :class:`Capsule`."""
+
+    radius: float
+    length: float
+    coal_class: ClassVar[type[coal.ShapeBase]]
+
+    def __post_init__(self) -> None:
+        _store_positive_lengths(self, "radius", "length")
+
+    def to_coal(self) -> coal.ShapeBase:
+        """Return a new coal shape of the class's kind (coal takes the radius and the length)."""
+        return self.coal_class(self.radius, self.length)
+
+
+@dataclass(frozen=True, eq=False)
+class Cylinder(_AxialShape):
     """Solid cylinder centred on the origin, axis along local z (as :class:`coal.Cylinder`).
 
     Attributes
@@ -168,16 +185,8 @@ class Cylinder(Shape):
     length: full length along local z [m] (from z = -length/2 to +length/2); positive.
     """
 
-    radius: float
-    length: float
     kind: ClassVar[str] = "cylinder"
-
-    def __post_init__(self) -> None:
-        _store_positive_lengths(self, "radius", "length")
-
-    def to_coal(self) -> coal.Cylinder:
-        """Return a new :class:`coal.Cylinder` (coal takes the radius and the full length)."""
-        return coal.Cylinder(self.radius, self.length)
+    coal_class: ClassVar[type[coal.ShapeBase]] = coal.Cylinder
 
     @property
     def bounding_radius(self) -> float:
@@ -186,7 +195,7 @@ class Cylinder(Shape):
 
 
 @dataclass(frozen=True, eq=False)
-class Capsule(Shape):
+class Capsule(_AxialShape):
     """Capsule (a segment swept by a ball) centred on the origin, axis along local z.
 
     Attributes
@@ -197,16 +206,8 @@ class Capsule(Shape):
         ``length + 2 * radius``. Positive.
     """
 
-    radius: float
-    length: float
     kind: ClassVar[str] = "capsule"
-
-    def __post_init__(self) -> None:
-        _store_positive_lengths(self, "radius", "length")
-
-    def to_coal(self) -> coal.Capsule:
-        """Return a new :class:`coal.Capsule` (coal takes the radius and the segment length)."""
-        return coal.Capsule(self.radius, self.length)
+    coal_class: ClassVar[type[coal.ShapeBase]] = coal.Capsule
 
     @property
     def bounding_radius(self) -> float:
