@@ -6,8 +6,9 @@ Industrial Robot" (NSGA-II vs MODE). Units are SI throughout.
 
 from __future__ import annotations
 
-import importlib as _importlib
 from typing import Any as _Any
+
+from adept_traj.lazy_names import lazy_names as _lazy_names
 
 #: Where each public name lives: imported on first use (PEP 562), so that ``import
 #: adept_traj`` (and ``adept-traj --help``) loads none of pinocchio, coal, pymoo or scipy
@@ -60,6 +61,8 @@ _PUBLIC = {
     "Shape": "adept_traj.scene.shapes",
     "Sphere": "adept_traj.scene.shapes",
 }
+
+_public = _lazy_names(__name__, _PUBLIC)
 
 __all__ = [
     "ALGORITHMS",
@@ -125,13 +128,9 @@ def _version() -> str:
 def __getattr__(name: str) -> _Any:
     """The public name ``name`` (or ``__version__``), imported from its module on first use
     (then cached)."""
-    if name == "__version__":
-        value: _Any = _version()
-    elif name in _PUBLIC:
-        value = getattr(_importlib.import_module(_PUBLIC[name]), name)
-    else:
-        raise AttributeError(f"module 'adept_traj' has no attribute {name!r}")
-    globals()[name] = value
+    if name != "__version__":
+        return _public(name)
+    globals()[name] = value = _version()
     return value
 
 

@@ -9,9 +9,6 @@ use, for code written before."""
 
 from __future__ import annotations
 
-import importlib as _importlib
-from typing import Any as _Any
-
 from adept_traj.analysis.decision import (
     PAPER_WEIGHTS,
     BestTradeoff,
@@ -38,6 +35,7 @@ from adept_traj.analysis.paper_measures import (
 )
 from adept_traj.analysis.plausibility import REACH_FACTOR, robot_reach, unit_warnings
 from adept_traj.analysis.weighted_sum import WEIGHTED_SUM_REFERENCE, WeightedSum, weighted_sum
+from adept_traj.lazy_names import lazy_names
 from adept_traj.robot.limits import LIMIT_KINDS  # the one vocabulary, re-exported
 
 __all__ = [
@@ -69,11 +67,5 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> _Any:
-    """A public name of :mod:`adept_traj.certification` (moved from here), on first use."""
-    certification = _importlib.import_module("adept_traj.certification")
-    if name in certification.__all__:
-        value = getattr(certification, name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: A public name of :mod:`adept_traj.certification` (moved from here), on first use.
+__getattr__ = lazy_names(__name__, "adept_traj.certification")

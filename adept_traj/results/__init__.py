@@ -12,10 +12,8 @@ written before it moved."""
 
 from __future__ import annotations
 
-import importlib as _importlib
-from typing import Any as _Any
-
 from adept_traj.errors import ResultFormatError
+from adept_traj.lazy_names import lazy_names
 from adept_traj.results.members import (
     MAX_MEMBER_SAMPLES,
     certified_members,
@@ -89,11 +87,5 @@ _MOVED = {
     "Mismatch": "adept_traj.certification.mismatches",
 }
 
-
-def __getattr__(name: str) -> _Any:
-    """The moved names of :data:`_MOVED`, imported on first use (PEP 562)."""
-    if name in _MOVED:
-        value = getattr(_importlib.import_module(_MOVED[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: The moved names of :data:`_MOVED`, imported on first use (PEP 562).
+__getattr__ = lazy_names(__name__, _MOVED)

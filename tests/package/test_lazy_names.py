@@ -1,0 +1,55 @@
+"""lazy_names: a package's names imported on first use from the module that holds them,
+then kept in its namespace; a name not served is an AttributeError."""
+
+from __future__ import annotations
+
+import sys
+import types
+
+import pytest
+
+from adept_traj.lazy_names import lazy_names
+
+
+@pytest.fixture
+def package(monkeypatch: pytest.MonkeyPatch) -> types.ModuleType:
+    """An empty package registered under a name of its own."""
+    module = types.ModuleType("lazy_names_probe")
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    return module
+
+
+def test_a_mapped_name_is_imported_once_and_kept(package) -> None:
+    import json.decoder
+
+    package.__getattr__ = lazy_names(package.__name__, {"JSONDecoder": "json.decoder"})
+    assert "JSONDecoder" not in vars(package)
+    assert package.JSONDecoder is json.decoder.JSONDecoder
+    assert vars(package)["JSONDecoder"] is json.decoder.JSONDecoder  # no second look-up
+    with pytest.raises(AttributeError, match="module 'lazy_names_probe' has no attribute 'x'"):
+        package.x  # noqa: B018
+
+
+def test_a_module_serves_the_names_of_its_all_only(package) -> None:
+    import shutil
+
+    assert "copyfile" in shutil.__all__
+    assert "os" not in shutil.__all__
+    package.__getattr__ = lazy_names(package.__name__, "shutil")
+    assert package.copyfile is shutil.copyfile
+    with pytest.raises(AttributeError, match="no attribute 'os'"):
+        package.os  # noqa: B018
+
+
+def test_the_moved_names_are_found_where_they_were() -> None:
+    import adept_traj.analysis
+    import adept_traj.certification
+    import adept_traj.certification.audit
+    import adept_traj.certification.mismatches
+    import adept_traj.results
+
+    assert adept_traj.analysis.certify is adept_traj.certification.certify
+    assert adept_traj.results.audit is adept_traj.certification.audit.audit
+    assert adept_traj.results.AUDIT_RTOL == adept_traj.certification.mismatches.AUDIT_RTOL
+    with pytest.raises(AttributeError):
+        adept_traj.results.certify  # noqa: B018  (moved to certification, not from results)
