@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 from adept_traj.cli import status
+from adept_traj.cli.result_options import add_member_option, add_result_folder
 
 __all__ = ["add_parser", "run"]
 
@@ -26,12 +27,8 @@ _SUFFIX = {"csv": ".csv", "ros-json": ".json", "ros-yaml": ".yaml"}
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``export`` and its options."""
     p = sub.add_parser("export", help="write a front member for a controller (CSV, ROS)")
-    p.add_argument("folder", type=Path, help="result folder (with result.json)")
-    p.add_argument(
-        "--member",
-        type=int,
-        help="member N of the front (see adept-traj front DIR; default: the best trade-off)",
-    )
+    add_result_folder(p)
+    add_member_option(p, "export")
     p.add_argument("--format", choices=list(_SUFFIX), default="csv", help="default: csv")
     p.add_argument("--dt", type=float, default=0.001, help="time step [s] (default: 0.001)")
     p.add_argument(

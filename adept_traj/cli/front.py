@@ -35,13 +35,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS, best_tradeoff
 from adept_traj.cli import status
 from adept_traj.cli.arguments import floats
+from adept_traj.cli.result_options import add_result_folder
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, certified_members
 
@@ -72,7 +72,7 @@ COLUMNS: dict[str, str] = {
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``front`` and its options."""
     p = sub.add_parser("front", help="list the members of a saved front (to pick one)")
-    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    add_result_folder(p)
     p.add_argument(
         "--sort",
         default=TRADEOFF,

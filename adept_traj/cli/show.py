@@ -35,6 +35,7 @@ from types import FrameType
 from typing import TYPE_CHECKING, NoReturn
 
 from adept_traj.cli import status
+from adept_traj.cli.result_options import add_member_option, add_result_folder
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
 from adept_traj.errors import InvalidInputError
 from adept_traj.results import PlanningResult, Replay, certified_members, member_index
@@ -54,15 +55,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser(
         "show", help="play a saved result in the browser (meshcat) and serve its explorer"
     )
-    p.add_argument("folder", type=Path, help="result folder (with result.json)")
+    add_result_folder(p)
     p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
     p.add_argument("--closest", action="store_true", help="draw the closest-point segment")
     p.add_argument("--open", action="store_true", help="open the page in a web browser")
-    p.add_argument(
-        "--member",
-        type=int,
-        help="play member N of the front (see adept-traj front DIR; default: the best trade-off)",
-    )
+    add_member_option(p, "play")
     p.add_argument(
         "--allow-infeasible",
         action="store_true",
