@@ -97,7 +97,14 @@ class ArrayMating(Mating):
         only duplicates), as pymoo's ``Mating.do`` makes them from the same generator."""
         if random_state is None or not self._plain():
             return super().do(problem, pop, n_offsprings, random_state, n_max_iterations, **kwargs)
-        X = self.offspring(problem, pop, n_offsprings, random_state, n_max_iterations, **kwargs)
+        X = self.offspring(
+            problem,
+            pop,
+            n_offsprings,
+            random_state=random_state,
+            n_max_iterations=n_max_iterations,
+            **kwargs,
+        )
         return Population.new(X=X)
 
     def makes_arrays(self) -> bool:
@@ -110,13 +117,14 @@ class ArrayMating(Mating):
         problem: Any,
         pop: Population,
         n_offsprings: int,
-        random_state: Any = None,
+        *,
+        random_state: Any,
         n_max_iterations: int | None = None,
         **kwargs: Any,
     ) -> np.ndarray:
         """The decision vectors (n, n_var), n ≤ ``n_offsprings``, of the children :meth:`do`
-        makes from the generator ``random_state`` (the same draws), without building their
-        members.
+        makes from the generator ``random_state`` (the same draws, a required keyword),
+        without building their members.
 
         Raises
         ------
