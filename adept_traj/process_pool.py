@@ -106,9 +106,8 @@ def _forget_inherited() -> None:
     for connection in list(_HELD):
         with contextlib.suppress(OSError):  # already closed
             connection.close()
-    _HELD.clear()
-    _LIVE.clear()
-    _UNREAPED.clear()
+    for held in (_HELD, _LIVE, _UNREAPED):
+        held.clear()
 
 
 if hasattr(os, "register_at_fork"):
@@ -168,12 +167,11 @@ def map_forked(
     processes: int,
     note: str = "raised in map_forked",
 ) -> list:
-    """``[function(item) for item in items]`` on up to ``processes`` processes at once:
-    the first item of every group of ``processes`` in this one, the others each in a
-    :class:`Worker` forked for it (it inherits ``function``; its value comes back
-    pickled, its error is raised here with ``note``). In order; the same values as the
-    loop when ``function`` is deterministic. One process (or no ``fork``): the loop
-    itself."""
+    """``[function(item) for item in items]`` on up to ``processes`` processes at once: the
+    first item of every group of ``processes`` in this one, the others each in a
+    :class:`Worker` forked for it (it inherits ``function``; its value comes back pickled,
+    its error is raised here with ``note``). In order, the loop's values for a
+    deterministic ``function``; one process (or no ``fork``): the loop itself."""
     out: list = []
     step = max(1, int(processes)) if can_fork() else 1
     for i in range(0, len(items), step):
@@ -207,8 +205,8 @@ class Worker:
     *args
         Its other arguments, inherited by the fork (nothing is pickled).
     prepare : callable, optional
-        Run first, in a thread of the worker at nice :data:`LOWEST_PRIORITY`; the worker
-        is :meth:`ready` once it has returned. An error is sent as ``target``'s would be.
+        Run first, in a thread of the worker at nice ``prepare_niceness`` (``None``: the
+        caller's); the worker is :meth:`ready` once it has returned; its error is sent.
     note : str
         The note put before the worker's traceback on its error (what the worker does).
 
@@ -230,6 +228,7 @@ class Worker:
         target: Callable[..., None],
         *args: Any,
         prepare: Callable[[], None] | None = None,
+        prepare_niceness: int | None = LOWEST_PRIORITY,
         note: str = "raised in a worker process",
     ) -> None:
         if not can_fork():
@@ -252,7 +251,7 @@ class Worker:
             theirs.close()
             raise
         if pid == 0:  # the worker (never returns)
-            _run(theirs, self._creator, target, args, prepare)
+            _run(theirs, self._creator, target, args, prepare, prepare_niceness)
         theirs.close()
         self.pid, self._connection = pid, mine
         _LIVE[pid] = self
@@ -351,8 +350,8 @@ class Worker:
 
     # ------------------------------------------------------------------ stopping
     def kill(self) -> None:
-        """Stop the worker without waiting for its end (:meth:`close` reaps it): on a busy
-        machine a worker still preparing at nice 19 may wait long for a core to end."""
+        """Stop the worker without waiting for its end (:meth:`close` reaps it; one still
+        preparing at nice 19 on a busy machine may wait long for a core to end)."""
         if self.pid is not None and os.getpid() == self._creator:
             with contextlib.suppress(ProcessLookupError):  # ended already
                 os.kill(self.pid, signal.SIGKILL)
@@ -413,9 +412,10 @@ def _run(
     target: Callable[..., None],
     args: tuple,
     prepare: Callable[[], None] | None,
+    niceness: int | None,
 ) -> None:
-    """In the forked worker: end with the parent, ignore Ctrl-C, prepare, say ready, run
-    ``target``; send its error if it raises; end at once (``os._exit``)."""
+    """In the forked worker: end with the parent, ignore Ctrl-C, prepare at ``niceness``,
+    say ready, run ``target``; send its error; end (``os._exit``)."""
     code = 0
     try:
         _end_with_parent(parent)
@@ -423,12 +423,11 @@ def _run(
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         _HELD.add(connection)  # the worker's own workers do not keep it
         if prepare is not None:
-            failed = prepare_quietly(prepare)
+            failed = prepare_quietly(prepare, niceness)
+            message = (_ERROR, failed, None) if failed else (_READY,)
+            connection.send_bytes(pickle.dumps(message, protocol=_PROTOCOL))
             if failed:
-                code = 1
-                connection.send_bytes(pickle.dumps((_ERROR, failed, None), protocol=_PROTOCOL))
-                return
-            connection.send_bytes(pickle.dumps((_READY,), protocol=_PROTOCOL))
+                os._exit(1)  # its error is sent
         target(Channel(connection), *args)
     except BaseException as exc:  # every error is sent to the caller, which raises it
         code = 1
@@ -447,14 +446,15 @@ def _report(exc: BaseException) -> tuple[str, bytes | None]:
         return text, None
 
 
-def prepare_quietly(work: Callable[[], None]) -> str:
-    """Run ``work`` (e.g. heavy imports) in a thread at nice :data:`LOWEST_PRIORITY` and
-    wait for it; return its traceback, ``""`` when it succeeded."""
+def prepare_quietly(work: Callable[[], None], niceness: int | None = LOWEST_PRIORITY) -> str:
+    """Run ``work`` (e.g. heavy imports) in a thread at nice ``niceness`` (``None``: this
+    thread's) and wait for it; return its traceback, ``""`` when it succeeded."""
     failed: list[str] = []
 
     def quietly() -> None:
         try:
-            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), LOWEST_PRIORITY)
+            if niceness is not None:
+                os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), niceness)
             work()
         except BaseException:  # reported to the caller
             failed.append(traceback.format_exc())

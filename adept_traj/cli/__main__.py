@@ -2,6 +2,6 @@
 
 import sys
 
-from adept_traj.cli.app import main
+from adept_traj.cli.app import run
 
-sys.exit(main())
+sys.exit(run())

@@ -32,16 +32,19 @@ status 130 and one line, without a traceback.
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
 import json
+import os
 import re
 import sys
+import threading
 from collections.abc import Callable, Sequence
 
 from adept_traj.cli import status
 from adept_traj.errors import AdeptTrajError
 
-__all__ = ["main"]
+__all__ = ["main", "run"]
 
 _DESCRIPTION = "Multi-objective, collision-free trajectory planning of industrial robots."
 
@@ -137,3 +140,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"adept-traj: {args.command} interrupted", file=sys.stderr)
         return status.INTERRUPTED
+
+
+def run() -> int:
+    """The ``adept-traj`` program: :func:`main`, then the end of the process.
+
+    Once the command is done and no other thread runs, the exit handlers run
+    (:mod:`atexit`: e.g. the worker processes are reaped), the standard streams are
+    flushed, and the process ends with the command's status without the interpreter's
+    teardown of every module and object (numpy's, pinocchio's, coal's: freed by the
+    system at once). With another thread still running, the normal exit (which waits for
+    it): the status is returned.
+    """
+    code = main()
+    if any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
+        return code
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()
+    os._exit(code)

@@ -3,13 +3,17 @@ describe.
 
 :func:`add_problem_arguments` declares the options; :func:`problem_from_arguments` checks
 them and builds the :class:`~adept_traj.problem.TrajectoryProblem` (on ``--robot`` or the
-scene file's robot, else the AdeptOne XL); :func:`check_rate` checks a verification rate [Hz].
+scene file's robot, else the AdeptOne XL) in two steps a caller may take apart
+(:func:`task_from_arguments`: the checked :class:`Task` with its robot and scene;
+:func:`problem_from_task`: the problem); :func:`check_rate` checks a verification rate [Hz].
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -32,10 +36,13 @@ from adept_traj.validation import as_scalar
 
 __all__ = [
     "MIN_RATE_HZ",
+    "Task",
     "add_problem_arguments",
     "check_rate",
     "floats",
     "problem_from_arguments",
+    "problem_from_task",
+    "task_from_arguments",
 ]
 
 #: Lowest dense-verification rate the commands accept [Hz].
@@ -150,8 +157,40 @@ def scene_from_argument(value: str) -> Scene:
     return Scene.shipped(value) if value in SHIPPED_SCENES else Scene.from_file(value)
 
 
+@dataclass(frozen=True)
+class Task:
+    """What a problem is made of, checked (:func:`task_from_arguments`).
+
+    Attributes
+    ----------
+    robot : Robot
+        The robot (``--robot``, the scene file's, else the AdeptOne XL).
+    scene : Scene
+        The scene (``--scene``).
+    start, goal : numpy.ndarray or None
+        (nq,) start and goal joint positions [rad | m] (``None``: from the given pose).
+    workers : int
+        The problem's evaluation processes (``--workers``, else the free cores).
+    start_time : float or None
+        The move's start on the scene clock [s] (``--start-time``; ``None``: not given, 0).
+    """
+
+    robot: Robot
+    scene: Scene
+    start: Any
+    goal: Any
+    workers: int
+    start_time: float | None
+
+
 def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
-    """The problem the options describe, on the robot of
+    """The problem the options describe: :func:`problem_from_task` of
+    :func:`task_from_arguments` (whose errors it raises)."""
+    return problem_from_task(args, task_from_arguments(args))
+
+
+def task_from_arguments(args: argparse.Namespace) -> Task:
+    """The checked :class:`Task` the options describe, on the robot of
     :func:`~adept_traj.cli.robot_options.robot_from_arguments` (default: the AdeptOne XL).
 
     ``--start``/``--goal`` default to the scene's ``[task]``; ``--weights``, when given, must
@@ -164,10 +203,6 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     InvalidInputError
         Bad weights or rate, or a start/goal outside the joint limits (every joint
         outside named).
-    CollidingConfigurationError
-        A start or goal closer than the margin to an obstacle or (self-collision on) to
-        another link (:func:`~adept_traj.analysis.check_rest_poses`): checked before any
-        search.
     """
     scene = scene_from_argument(args.scene)
     start, goal = args.start, args.goal
@@ -201,11 +236,26 @@ def problem_from_arguments(args: argparse.Namespace) -> TrajectoryProblem:
     goal = _pose_joints(robot, getattr(args, "goal_pose", None), "goal", goal, start, args)
     workers = available_cores() if args.workers is None else args.workers
     start_time = getattr(args, "start_time", None)  # plan --start-time; None: 0
-    extra = {}
     if start_time is not None:
         as_scalar(start_time, "--start-time", "[s] (a scene time)", minimum=0)
-        extra["start_time"] = start_time
-    problem = TrajectoryProblem(robot, scene, start, goal, workers=workers, **extra)
+    return Task(robot, scene, start, goal, workers, start_time)
+
+
+def problem_from_task(args: argparse.Namespace, task: Task) -> TrajectoryProblem:
+    """The :class:`~adept_traj.problem.TrajectoryProblem` of ``task`` (its unit warnings
+    printed on standard error).
+
+    Raises
+    ------
+    CollidingConfigurationError
+        A start or goal closer than the margin to an obstacle or (self-collision on) to
+        another link (:func:`~adept_traj.analysis.check_rest_poses`): checked before any
+        search.
+    """
+    extra = {} if task.start_time is None else {"start_time": task.start_time}
+    problem = TrajectoryProblem(
+        task.robot, task.scene, task.start, task.goal, workers=task.workers, **extra
+    )
     try:
         raw = None if args.scene in SHIPPED_SCENES else read_toml(args.scene, SceneError)
         for warning in unit_warnings(problem, raw):

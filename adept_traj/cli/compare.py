@@ -46,7 +46,7 @@ from adept_traj.cli._run_folder import (
 from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
-from adept_traj.cli.report import finisher_for, save_figures, summary
+from adept_traj.cli.report import figures_line, finisher_for, save_figures, summary
 from adept_traj.cli.robot_options import source_from_arguments
 from adept_traj.cycle import (
     parse_seeds,
@@ -306,7 +306,7 @@ def run(args: argparse.Namespace) -> int:
             _remove_earlier(args.out)  # only with --overwrite: refused above otherwise
             # the figures' helper imports matplotlib while the runs go on (at nice 19)
             finisher = stack.enter_context(
-                finisher_for(problem, figures=not args.no_plots, html=False)
+                finisher_for(problem.robot, problem.scene, figures=not args.no_plots, html=False)
             )
             _plan_both(args, problem, runs, results)
         except PlanningInterrupted as exc:  # no checkpoint: the finished runs are saved
@@ -317,7 +317,7 @@ def run(args: argparse.Namespace) -> int:
         if not args.no_plots:
             figures = args.out / "figures"
             if finisher is not None and finisher.start(results, figures=figures):
-                print(f"{len(finisher.wait())} figures in {figures}")
+                print(figures_line(finisher.wait(), figures, results))
             else:
                 replays = {
                     name: Replay.of(r, robot=problem.robot, scene=problem.scene)

@@ -40,10 +40,11 @@ from adept_traj.cli._run_folder import (
     remove_written,
     write_arguments,
 )
-from adept_traj.cli.arguments import add_problem_arguments, problem_from_arguments
+from adept_traj.cli.arguments import add_problem_arguments, problem_from_task, task_from_arguments
 from adept_traj.cli.limits import check_run_options
 from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import (
+    figures_line,
     finish_figures,
     finisher_for,
     save_collision_matrix,
@@ -233,25 +234,28 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(f"--no-polish conflicts with --polish {opts.polish}")
     if opts.algorithm != TIME_OPTIMAL:
         make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
-    problem = problem_from_arguments(opts)
-    try:
-        # memory of the population and of the dense certificate, before anything is written
-        check_run_options(problem, opts.algorithm, opts.pop, opts.gens, opts.rate)
-        with folder_lock(folder):  # no second process writing into the folder meanwhile
-            if not resume:
-                remove_written(folder)  # only with --overwrite: check_folder refused otherwise
-                saved = {k: getattr(opts, k) for k in _SAVED}
-                saved = {**saved, "ros": _comparable("ros", opts.ros), _WEIGHTED_MODE_KEY: True}
-                if saved["start_time"] is None:  # not given: run.json as before the option
-                    del saved["start_time"]
-                write_arguments(folder, saved)
-            with (
-                finisher_for(problem, figures=not opts.no_plots, html=not opts.no_html) as f,
-                _polisher_for(problem, opts) as polisher,
-            ):
-                return _run(opts, problem, folder, resume, f, polisher)
-    finally:
-        problem.close()
+    task = task_from_arguments(opts)
+    # the finisher needs the robot and scene only: its imports overlap the problem's build
+    outputs = {"figures": not opts.no_plots, "html": not opts.no_html}
+    urgent = opts.algorithm == TIME_OPTIMAL  # a search shorter than the imports
+    with finisher_for(task.robot, task.scene, **outputs, urgent=urgent) as finisher:
+        problem = problem_from_task(opts, task)
+        try:
+            # memory of the population and dense certificate, before anything is written
+            check_run_options(problem, opts.algorithm, opts.pop, opts.gens, opts.rate)
+            with folder_lock(folder):  # no second process writing into the folder meanwhile
+                if not resume:
+                    remove_written(folder)  # only with --overwrite: check_folder refused
+                    saved = {k: getattr(opts, k) for k in _SAVED}
+                    ros = _comparable("ros", opts.ros)
+                    saved = {**saved, "ros": ros, _WEIGHTED_MODE_KEY: True}
+                    if saved["start_time"] is None:  # not given: run.json as before it
+                        del saved["start_time"]
+                    write_arguments(folder, saved)
+                with _polisher_for(problem, opts) as polisher:
+                    return _run(opts, problem, folder, resume, finisher, polisher)
+        finally:
+            problem.close()
 
 
 def _polisher_for(problem: TrajectoryProblem, opts: argparse.Namespace) -> Any:
@@ -340,7 +344,7 @@ def _finish(
         finally:
             finisher.cancel()  # stops the helper if anything above failed (else a no-op)
         if figures is not None:
-            print(f"{len(paths)} figures in {figures}")
+            print(figures_line(paths, figures, {opts.algorithm: result}))
     else:
         _write_outputs(result, folder, opts, replay)
     print(summary(result, folder))
@@ -375,7 +379,7 @@ def _write_outputs(
             meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
             explorer.write_explorer(result, folder / explorer.EXPLORER_FILE,
                                     robot=replay.robot, scene=replay.scene)  # fmt: skip
-        finish_figures(figures, folder / "figures")
+        finish_figures(figures, folder / "figures", {opts.algorithm: result})
     finally:
         if figures is not None:
             figures.cancel()  # stops the drawing if anything above failed (else a no-op)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,7 @@ from adept_traj.viz.finisher import start_finisher
 
 __all__ = [
     "MATRIX_FILE",
+    "figures_line",
     "finish_figures",
     "finisher_for",
     "objectives_text",
@@ -151,7 +153,18 @@ def save_figures(
     except ImportError as exc:
         _note_missing_matplotlib(exc)
         return
-    print(f"{len(paths)} figures in {folder}")
+    print(figures_line(paths, folder, results))
+
+
+def figures_line(paths: list[Path], folder: Path, results: Mapping[str, PlanningResult]) -> str:
+    """``"4 figures in FOLDER"``, with the reason when the front figures were left out
+    (:func:`~adept_traj.viz.plots.all_figures.has_front_figures`)."""
+    from adept_traj.viz.plots.all_figures import has_front_figures
+
+    line = f"{len(paths)} figures in {folder}"
+    if has_front_figures(results):
+        return line
+    return f"{line} (no pareto_matrix.png or best_tradeoffs.png: the front is one move)"
 
 
 def _note_missing_matplotlib(exc: ImportError) -> None:
@@ -180,10 +193,11 @@ def start_figures(
     return plots.start_save_all(results, folder, replays=replays)
 
 
-def finish_figures(drawing: Any, folder: Path) -> None:
-    """Wait for the figures started by :func:`start_figures` (``None``: nothing to do) and
-    say how many were written; their error is raised here (an :class:`ImportError` of
-    matplotlib is a note, as in :func:`save_figures`)."""
+def finish_figures(drawing: Any, folder: Path, results: Mapping[str, PlanningResult]) -> None:
+    """Wait for the figures of ``results`` started by :func:`start_figures` (``None``:
+    nothing to do) and say how many were written (:func:`figures_line`); their error is
+    raised here (an :class:`ImportError` of matplotlib is a note, as in
+    :func:`save_figures`)."""
     if drawing is None:
         return
     try:
@@ -191,18 +205,19 @@ def finish_figures(drawing: Any, folder: Path) -> None:
     except ImportError as exc:
         _note_missing_matplotlib(exc)
         return
-    print(f"{len(paths)} figures in {folder}")
+    print(figures_line(paths, folder, results))
 
 
-def finisher_for(problem: Any, *, figures: bool, html: bool) -> Any:
+def finisher_for(robot: Any, scene: Any, *, figures: bool, html: bool, urgent: bool = False) -> Any:
     """The helper process that will write a run's figures and/or ``playback.html``
     (:func:`adept_traj.viz.finisher.start_finisher`: it imports matplotlib and meshcat at
-    the lowest priority while the run goes on), in a context that stops it; an empty
-    context (``None``) when neither output is asked for, without matplotlib for the figures
-    (the finish says so) or when no process can be forked (the caller writes them)."""
+    the lowest priority while the run goes on, or at the caller's when ``urgent``), in a
+    context that stops it; an empty context (``None``) when neither output is asked for,
+    without matplotlib for the figures (the finish says so) or when no process can be
+    forked (the caller writes them)."""
     if not (figures or html) or (figures and importlib.util.find_spec("matplotlib") is None):
         return contextlib.nullcontext(None)
     try:
-        return start_finisher(problem.robot, problem.scene, figures=figures, html=html)
+        return start_finisher(robot, scene, figures=figures, html=html, urgent=urgent)
     except OSError:  # e.g. no memory to fork: the caller writes the files itself
         return contextlib.nullcontext(None)

@@ -60,18 +60,25 @@ HURRIED_TIMEOUT = 3.0
 _HTML_WEIGHT = 0.3
 
 
-def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> Finisher:
+def start_finisher(
+    robot: Robot, scene: Scene, *, figures: bool, html: bool, urgent: bool = False
+) -> Finisher:
     """Fork the helper that will write a run's figures and/or ``playback.html``.
 
-    Call it once the run's robot and scene exist; the helper imports what the outputs
-    need at nice :data:`IMPORT_NICENESS` and waits for :meth:`Finisher.start`. Without
-    ``fork`` (not Linux) no helper starts: :meth:`Finisher.start` returns ``False``.
+    Call it once the run's robot and scene exist (as early as that: the imports overlap
+    the rest of the run's setup); the helper imports what the outputs need at nice
+    :data:`IMPORT_NICENESS` (``urgent``: at the caller's) and waits for
+    :meth:`Finisher.start`. Without ``fork`` (not Linux) no helper starts:
+    :meth:`Finisher.start` returns ``False``.
 
     Parameters
     ----------
     robot, scene: the run's robot and scene (the helper builds its replays from them).
     figures: the helper will draw the figures (imports matplotlib).
     html: the helper will write ``playback.html`` (imports meshcat).
+    urgent: the run will end soon (e.g. the time-optimal mode, whose search is shorter
+        than these imports): they share the cores with it from the start, instead of
+        taking only idle time and being raised at the end (:data:`HURRIED_TIMEOUT`).
 
     Raises
     ------
@@ -82,7 +89,7 @@ def start_finisher(robot: Robot, scene: Scene, *, figures: bool, html: bool) -> 
     check_type(scene, Scene, "scene")
     if not (figures or html):
         raise InvalidInputError("start_finisher needs figures=True or html=True; got neither")
-    return Finisher(robot, scene, figures=bool(figures), html=bool(html))
+    return Finisher(robot, scene, figures=bool(figures), html=bool(html), urgent=bool(urgent))
 
 
 class Finisher(Helper):
@@ -95,7 +102,9 @@ class Finisher(Helper):
         The helper's process id (``None`` without one, or once it is reaped).
     """
 
-    def __init__(self, robot: Robot, scene: Scene, *, figures: bool, html: bool) -> None:
+    def __init__(
+        self, robot: Robot, scene: Scene, *, figures: bool, html: bool, urgent: bool = False
+    ) -> None:
         self._robot, self._scene = robot, scene
         self._figures, self._html = figures, html
         self._order: tuple | None = None
@@ -106,6 +115,7 @@ class Finisher(Helper):
                 robot,
                 scene,
                 prepare=partial(_preload, figures, html),
+                prepare_niceness=None if urgent else IMPORT_NICENESS,
                 note="raised while writing the figures and page in a worker process",
             )
 

@@ -102,6 +102,7 @@ def test_plan_verify_and_resume(tmp_path: Path, capsys: pytest.CaptureFixture[st
     np.testing.assert_array_equal(resumed.front.x, uninterrupted.front.x)
 
 
+@pytest.mark.slow  # 5–15 s: kept out of the default tier (≤ 3 min)
 def test_compare_writes_tables(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     argv = ["compare", "--gens", "2", "--pop-nsga2", "8", "--pop-mode", "8"]
     assert main([*argv, "--out", str(tmp_path), "--quiet"]) == 0

@@ -365,18 +365,26 @@ def test_output_paths_are_checked_before_the_run(
     assert not (tmp_path / "out" / "run.json").exists()
 
 
+@pytest.mark.parametrize("step", ["task_from_arguments", "problem_from_task"])
 def test_ctrl_c_while_the_problem_is_built_is_one_line(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    step: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """Ctrl-C while the robot and scene are loaded, or (the finisher already forked)
+    while the problem is built: one line, no folder, no helper process left."""
     import adept_traj.cli.plan as plan_command
+    from adept_traj.process_pool import children
 
-    def interrupted(args):
+    def interrupted(*args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(plan_command, "problem_from_arguments", interrupted)
+    monkeypatch.setattr(plan_command, step, interrupted)
     assert main([*_RUN, *_LIGHT, "--out", str(tmp_path / "run")]) == 130
     assert capsys.readouterr().err == "adept-traj: plan interrupted\n"
     assert not (tmp_path / "run").exists()
+    assert children() == []
 
 
 # ------------------------------------------------------------------------ atomic writes

@@ -42,10 +42,10 @@ class _Drawing:
 
 
 def test_background_figures_missing_matplotlib_is_a_note(monkeypatch, tmp_path: Path, capsys):
-    finish_figures(_Drawing("matplotlib.figure"), tmp_path)
+    finish_figures(_Drawing("matplotlib.figure"), tmp_path, {})
     assert "figures skipped" in capsys.readouterr().err
     with pytest.raises(ImportError, match=r"adept_traj\.viz\.plots\.fronts"):
-        finish_figures(_Drawing("adept_traj.viz.plots.fronts"), tmp_path)
+        finish_figures(_Drawing("adept_traj.viz.plots.fronts"), tmp_path, {})
     monkeypatch.setattr(report.importlib.util, "find_spec", lambda name: None)
     assert start_figures({}, tmp_path) is None  # nothing started, nothing checked
     assert "figures skipped (no module named 'matplotlib')" in capsys.readouterr().err

@@ -119,6 +119,16 @@ def test_prepare_runs_at_nice_19_before_the_target_at_the_callers_priority() -> 
         assert worker.recv() == ([LOWEST_PRIORITY], own)
 
 
+def test_prepare_runs_at_the_callers_priority_when_asked() -> None:
+    seen: list[int] = []
+    prepare = lambda: seen.append(os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))  # noqa: E731
+    own = os.getpriority(os.PRIO_PROCESS, 0)
+    assert own != LOWEST_PRIORITY
+    with Worker(_niceness, seen, prepare=prepare, prepare_niceness=None) as worker:
+        assert worker.ready(30.0)
+        assert worker.recv() == ([own], own)
+
+
 def _may_lower_niceness() -> bool:
     """Whether this process may lower a niceness back from 19 (root, or RLIMIT_NICE)."""
     import resource

@@ -75,6 +75,7 @@ def test_the_pendulum_binds_the_fastest_move(problems) -> None:
     assert slow[0] > fast[0] * 1.3  # waiting for the pendulum costs time
 
 
+@pytest.mark.slow  # 5–15 s: kept out of the default tier (≤ 3 min)
 def test_plan_and_verify_on_the_detour_scene(tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
     argv = [

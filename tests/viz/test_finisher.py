@@ -97,6 +97,22 @@ def _plan(monkeypatch, result, out: Path, *options: str, plan=None, **fakes) -> 
     return main(argv)
 
 
+def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
+    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The time-optimal search is shorter than the imports: they share the cores with the
+    run from the start (``urgent``) rather than waiting at nice 19 for an idle one."""
+    marker = tmp_path / "preload"
+    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
+    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
+    code = _plan(monkeypatch, stored, tmp_path / "run", "--algorithm", "time-optimal")
+    assert code == status.NOT_CERTIFIED
+    helper, import_nice = map(int, marker.read_text().split())
+    assert helper != os.getpid()
+    assert import_nice == _nice() != finisher.IMPORT_NICENESS
+    assert len(list((tmp_path / "run" / "figures").iterdir())) == 5
+
+
 def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_nice_19(
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

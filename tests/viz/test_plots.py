@@ -146,6 +146,35 @@ def test_history_missing(
     ]  # no hypervolume_history.png
 
 
+def _one_move(result: PlanningResult) -> PlanningResult:
+    """``result`` with its best trade-off as the only front member."""
+    keep = np.arange(len(result.front)) == result.best.index
+    best = dataclasses.replace(result.best, index=0)
+    return dataclasses.replace(result, front=result.front.subset(keep), best=best)
+
+
+def test_a_one_move_front_has_no_front_figures(
+    results: dict[str, PlanningResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One front member in all (one time-optimal move) has no trade-off to show: no
+    pareto matrix, no best trade-offs; two one-move results (compared) have them."""
+    one = _one_move(dataclasses.replace(results["nsga2"], history=None))
+    assert len(one.front) == 1
+    drawn: list[str] = []
+    for name in ("pareto_matrix", "best_tradeoffs", "joint_motion", "tool_path_3d"):
+        monkeypatch.setattr(
+            all_figures, name, lambda _r, path, _n=name, **_: drawn.append(_n) or Path(path)
+        )
+    written = plots.save_all({"to": one}, tmp_path / "one", processes=1)
+    assert [p.name for p in written] == ["joint_motion_to.png", "tool_path_to.png"]
+    assert sorted(drawn) == ["joint_motion", "tool_path_3d"]
+    assert not all_figures.has_front_figures({"to": one})
+    assert all_figures.has_front_figures({"a": one, "b": one})
+    assert all_figures.has_front_figures({"nsga2": results["nsga2"]})
+    two = plots.save_all({"a": one, "b": one}, tmp_path / "two")
+    assert [p.name for p in two][:2] == ["pareto_matrix.png", "best_tradeoffs.png"]
+
+
 def test_tool_path_with_a_replay_loads_nothing(
     results: dict[str, PlanningResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

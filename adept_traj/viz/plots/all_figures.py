@@ -36,7 +36,15 @@ from adept_traj.viz.plots.motion import joint_motion
 from adept_traj.viz.plots.tool_path import tool_path_3d
 from adept_traj.viz.plots.tradeoffs import best_tradeoffs
 
-__all__ = ["BackgroundFigures", "Job", "draw_jobs", "figure_jobs", "save_all", "start_save_all"]
+__all__ = [
+    "BackgroundFigures",
+    "Job",
+    "draw_jobs",
+    "figure_jobs",
+    "has_front_figures",
+    "save_all",
+    "start_save_all",
+]
 
 #: The note before a worker's traceback on its error.
 _NOTE = "raised while drawing the figures in a forked process"
@@ -51,10 +59,12 @@ def save_all(
 ) -> list[Path]:
     """Write every figure into ``folder`` (created if needed).
 
-    Files: ``pareto_matrix.png``, ``best_tradeoffs.png``, ``hypervolume_history.png``
-    (left out when no result has a history) for all results together, and per result
-    ``joint_motion_<name>.png`` and ``tool_path_<name>.png`` (``<name>``: the mapping key,
-    characters other than letters, digits, ``_ . -`` replaced by ``_``).
+    Files: ``pareto_matrix.png`` and ``best_tradeoffs.png`` (left out when the results
+    hold one front member in all, e.g. one time-optimal move: there is no trade-off to
+    show), ``hypervolume_history.png`` (left out when no result has a history) for all
+    results together, and per result ``joint_motion_<name>.png`` and
+    ``tool_path_<name>.png`` (``<name>``: the mapping key, characters other than letters,
+    digits, ``_ . -`` replaced by ``_``).
 
     Parameters
     ----------
@@ -101,10 +111,10 @@ def figure_jobs(
     # (cost weight, file, drawing): the weights (CPU times per figure on the paper's
     # result [0.1 s], each drawn first in a fresh process) spread the figures evenly over
     # the processes: on two, the tool path and the best trade-offs, and the rest
-    figures: list[tuple[float, Path, Callable[[Path], Path]]] = [
-        (2.2, root / "pareto_matrix.png", partial(pareto_matrix, res)),
-        (1.5, root / "best_tradeoffs.png", partial(best_tradeoffs, res)),
-    ]
+    figures: list[tuple[float, Path, Callable[[Path], Path]]] = []
+    if has_front_figures(res):
+        figures.append((2.2, root / "pareto_matrix.png", partial(pareto_matrix, res)))
+        figures.append((1.5, root / "best_tradeoffs.png", partial(best_tradeoffs, res)))
     if any(r.history for r in res.values()):
         figures.append((1.0, root / "hypervolume_history.png", partial(hypervolume_history, res)))
     for key, r in res.items():
@@ -113,6 +123,13 @@ def figure_jobs(
         figures.append((5.0, root / f"tool_path_{suffixes[key]}.png", draw_path))
     jobs = [(weight, partial(draw, path)) for weight, path, draw in figures]
     return jobs, [path for _, path, _ in figures], n_proc
+
+
+def has_front_figures(results: Mapping[str, PlanningResult]) -> bool:
+    """Whether :func:`save_all` draws ``pareto_matrix.png`` and ``best_tradeoffs.png`` for
+    ``results`` (``{name: PlanningResult}``): when they hold more than one front member in
+    all (one member has no trade-off to show)."""
+    return sum(len(r.front) for r in results.values()) > 1
 
 
 def draw_jobs(jobs: list[Job], processes: int) -> None:
