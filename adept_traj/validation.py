@@ -10,9 +10,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from adept_traj.errors import FrozenObjectError, InputShapeError, InvalidInputEr
 
 __all__ = [
     "DeepEqual",
+    "DerivedData",
     "FrozenAttributes",
     "as_batch",
     "as_finite_array",
@@ -33,6 +34,8 @@ __all__ = [
     "describe_bad_values",
     "readonly_copy",
 ]
+
+_Made = TypeVar("_Made")
 
 
 def describe_bad_values(x: np.ndarray, bad: np.ndarray, limit: int = 3) -> str:
@@ -204,6 +207,39 @@ class DeepEqual:
         return deep_equal(self, other) if type(other) is type(self) else NotImplemented
 
     __hash__ = None  # type: ignore[assignment]
+
+
+class DerivedData:
+    """Data derived from a frozen object alone, made once and kept on it: the one cache
+    of the package's frozen objects (:class:`~adept_traj.problem.TrajectoryProblem`,
+    :class:`~adept_traj.robot.Robot`, :class:`~adept_traj.scene.PointCloud`, a cloud's
+    leaves). Nothing it is made from can change, so nothing is keyed by identity and
+    nothing goes stale; a changed copy (``replace``) starts without it.
+    """
+
+    def derived(self, key: str, make: Callable[[Any], _Made]) -> _Made:
+        """What ``make(self)`` returns, made on the first call for ``key`` only and the same
+        object on every later one.
+
+        Parameters
+        ----------
+        key:
+            Names the data (by convention the module making it, e.g.
+            ``"collision.collision_matrix"``).
+        make:
+            Makes it from this object.
+        """
+        kept = self.__dict__.setdefault("_derived", {})
+        if key not in kept:
+            kept[key] = make(self)
+        return kept[key]
+
+    def derived_made(self, prefix: str) -> dict[str, Any]:
+        """The data :meth:`derived` has made so far whose key starts with ``prefix``, by
+        key (e.g. to hand it to a process forked before it was made, which keeps it with
+        ``derived(key, lambda _: value)``)."""
+        kept = self.__dict__.get("_derived", {})
+        return {k: v for k, v in kept.items() if k.startswith(prefix)}
 
 
 class FrozenAttributes:

@@ -49,6 +49,7 @@ import coal
 import numpy as np
 
 from adept_traj.scene.point_clouds import PointCloud, cube_field_step
+from adept_traj.validation import DerivedData
 
 __all__ = [
     "BUCKET_EDGE",
@@ -73,7 +74,7 @@ TIE = 1e-9
 BUCKET_EDGE = 8.0
 
 
-class CloudCells:
+class CloudCells(DerivedData):
     """The occupied leaves of a coal ``OcTree`` grouped in buckets, in the cloud frame.
 
     Attributes

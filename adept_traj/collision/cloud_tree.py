@@ -35,7 +35,6 @@ a millimetre of coal's distance for a leaf a few centimetres away).
 from __future__ import annotations
 
 import functools
-import weakref
 from dataclasses import dataclass
 
 import coal
@@ -59,10 +58,6 @@ FINE_EDGE = 0.08
 
 #: Subtracted from a slab gap, which can equal the distance: a lower bound under rounding.
 ROUNDING = 1e-9
-_DEBUG = []
-
-#: The trees by the id of their :class:`CloudCells`, with a weak reference to it.
-_TREES: dict[int, tuple[weakref.ref, CloudTree]] = {}
 
 
 @dataclass(frozen=True)
@@ -168,15 +163,9 @@ def solid_support(solid: coal.CollisionGeometry, u: np.ndarray) -> np.ndarray | 
 
 
 def cloud_tree(cells: CloudCells) -> CloudTree:
-    """The :class:`CloudTree` of ``cells``, made once per :class:`CloudCells`."""
-    entry = _TREES.get(id(cells))
-    if entry is None or entry[0]() is not cells:
-        ident = id(cells)
-        entry = _TREES[ident] = (
-            weakref.ref(cells, lambda _, ident=ident: _TREES.pop(ident, None)),
-            CloudTree(cells),
-        )
-    return entry[1]
+    """The :class:`CloudTree` of ``cells``, made once and kept on them
+    (:meth:`~adept_traj.collision.cloud_distance.CloudCells.derived`)."""
+    return cells.derived("collision.cloud_tree", CloudTree)
 
 
 def exact_signed_distance(solid: coal.CollisionGeometry) -> bool:

@@ -26,7 +26,6 @@ apart at a pose is apart, and a pair whose hulls touch at every pose is left out
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,9 +56,6 @@ def quoteattr(text: str) -> str:
     for char, entity in (("&", "&amp;"), ("<", "&lt;"), (">", "&gt;"), ('"', "&quot;")):
         text = text.replace(char, entity)
     return f'"{text}"'
-
-
-_MADE: weakref.WeakKeyDictionary[Robot, CollisionMatrix] = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -155,11 +151,8 @@ def collision_matrix(
 
 def robot_collision_matrix(robot: Robot) -> CollisionMatrix:
     """:func:`collision_matrix` of ``robot`` with the default samples, made the first time
-    it is asked for a robot object and kept with it."""
-    found = _MADE.get(robot)
-    if found is None:
-        found = _MADE[robot] = collision_matrix(robot)
-    return found
+    it is asked for and kept on the robot (:meth:`~adept_traj.robot.Robot.derived`)."""
+    return robot.derived("collision.collision_matrix", collision_matrix)
 
 
 @dataclass(frozen=True)

@@ -43,9 +43,8 @@ from __future__ import annotations
 
 import copy
 import time
-from collections.abc import Callable
 from dataclasses import fields, replace
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 from pymoo.core.problem import Problem
@@ -63,12 +62,11 @@ from adept_traj.robot.limits import LIMITS
 from adept_traj.robot.robot import Robot
 from adept_traj.scene.scene import Scene
 from adept_traj.validation import (
+    DerivedData,
     FrozenAttributes,
     as_batch,
     readonly_copy,
 )
-
-_Derived = TypeVar("_Derived")
 
 __all__ = ["TrajectoryProblem"]
 
@@ -89,7 +87,7 @@ _BLOCK_SAMPLES = 4096
 _PARTS = ("robot", "scene", "start", "goal", "settings")
 
 
-class TrajectoryProblem(FrozenAttributes, Problem):
+class TrajectoryProblem(FrozenAttributes, DerivedData, Problem):
     """The multi-objective trajectory problem (see the module docstring).
 
     Parameters
@@ -226,35 +224,6 @@ class TrajectoryProblem(FrozenAttributes, Problem):
         tables = kept_tables(self.checker, parts["robot"], parts["scene"])
         new._build(*(parts[k] for k in _PARTS), changes, tables)
         return new
-
-    def derived(self, key: str, make: Callable[[TrajectoryProblem], _Derived]) -> _Derived:
-        """Data derived from this problem alone, made once by ``make(self)`` and kept on
-        the problem (it is frozen: nothing it is made from can change).
-
-        Parameters
-        ----------
-        key:
-            Names the data (by convention the module making it, e.g.
-            ``"analysis.continuous.rates"``).
-        make:
-            Makes it from the problem; called on the first request for ``key`` only.
-
-        Returns
-        -------
-        object
-            What ``make`` returned for ``key``, the same object on every call.
-        """
-        try:
-            return self._derived[key]
-        except KeyError:
-            value = self._derived[key] = make(self)
-            return value
-
-    def derived_made(self, prefix: str) -> dict[str, Any]:
-        """The data :meth:`derived` has made so far whose key starts with ``prefix``, by
-        key (e.g. to hand it to a process forked before it was made, which keeps it with
-        ``derived(key, lambda _: value)``)."""
-        return {k: v for k, v in self._derived.items() if k.startswith(prefix)}
 
     # ------------------------------------------------------------------ public
     @property

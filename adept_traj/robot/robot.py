@@ -41,7 +41,7 @@ from adept_traj.robot.urdf_loading import (
     read_srdf_disabled_pairs,
     shipped_file,
 )
-from adept_traj.validation import FrozenAttributes, as_batch, check_type
+from adept_traj.validation import DerivedData, FrozenAttributes, as_batch, check_type
 
 __all__ = ["VELOCITY_AT_REST", "ForwardKinematics", "Robot", "coulomb_sign"]
 
@@ -53,7 +53,7 @@ VELOCITY_AT_REST = 1e-9
 _PARALLEL_MIN_BATCH = 16
 
 
-class Robot(FrozenAttributes):
+class Robot(FrozenAttributes, DerivedData):
     """A serial robot: Pinocchio model, collision model, limits and batched evaluations.
 
     Build one with :meth:`adept_one_xl` or :meth:`from_urdf`. Its attributes are fixed at
@@ -171,8 +171,8 @@ class Robot(FrozenAttributes):
             )
         new = copy.copy(self)
         name = str(changes.get("name", self.name))
-        vars(new).update(limits=limits, name=name, _data=self.model.createData())
-        return new
+        vars(new).update(limits=limits, name=name, _data=self.model.createData(), _derived={})
+        return new  # (its own derived data: e.g. a collision matrix sampled in its limits)
 
     # ------------------------------------------------------------------ construction
     @classmethod

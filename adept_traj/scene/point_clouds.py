@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -39,7 +38,7 @@ import numpy as np
 from adept_traj.errors import InvalidInputError, MeshFileError, ResourceLimitError
 from adept_traj.memory import check_memory
 from adept_traj.scene.shapes import Shape
-from adept_traj.validation import as_finite_array, as_scalar, readonly_copy
+from adept_traj.validation import DerivedData, as_finite_array, as_scalar, readonly_copy
 
 __all__ = [
     "CLOUD_SUFFIXES",
@@ -127,7 +126,7 @@ def check_cloud_memory(
 
 
 @dataclass(frozen=True, eq=False)
-class PointCloud(Shape):
+class PointCloud(DerivedData, Shape):
     """Points in the cloud's frame, as an octree of cells of edge ``resolution``.
 
     Attributes
@@ -208,24 +207,6 @@ class PointCloud(Shape):
     def to_coal(self) -> coal.OcTree:
         """A new ``coal.OcTree`` of the points at the resolution (``coal.makeOctree``)."""
         return coal.makeOctree(np.array(self.points), self.resolution)
-
-    def derived(self, key: str, make: Callable[[PointCloud], Any]) -> Any:
-        """Data derived from this cloud alone (e.g. the collision checker's leaves), made
-        once by ``make(self)`` and kept on the cloud (it is frozen: nothing it is made from
-        can change), the same object on every call for ``key``. Not pickled: a copy in
-        another process makes its own.
-
-        Parameters
-        ----------
-        key:
-            Names the data (by convention the module making it).
-        make:
-            Makes it from the cloud; called on the first request for ``key`` only.
-        """
-        cache = self.__dict__.setdefault("_derived", {})
-        if key not in cache:
-            cache[key] = make(self)
-        return cache[key]
 
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)

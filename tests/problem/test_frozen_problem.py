@@ -14,7 +14,7 @@ from adept_traj.collision.joint_tables import kept_tables
 from adept_traj.errors import AdeptTrajError, ConfigurationError, FrozenObjectError
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
 from adept_traj.robot import Robot
-from adept_traj.scene import Scene
+from adept_traj.scene import PointCloud, Scene
 
 
 @pytest.fixture(scope="module")
@@ -209,3 +209,31 @@ def test_a_copy_takes_over_the_distance_tables_of_the_obstacles_it_keeps(robot):
         kept_tables(problem.checker, robot, detour).keys()
         == problem.checker.broad_phase.tables.keys()
     )
+
+
+def test_every_frozen_object_keeps_its_derived_data_the_same_way(robot):
+    """One mechanism (validation.DerivedData) for the problem, the robot, a point cloud and
+    a cloud's leaves; the robot's collision matrix and a cloud's tree are kept on them, no
+    cache keyed by identity."""
+    from adept_traj.collision import robot_collision_matrix
+    from adept_traj.collision.cloud_distance import CloudCells, cloud_cells
+    from adept_traj.collision.cloud_tree import cloud_tree
+    from adept_traj.validation import DerivedData
+
+    cloud = PointCloud(points=np.random.default_rng(1).uniform(-0.1, 0.1, (200, 3)),
+                          resolution=0.02)  # fmt: skip
+    cells = cloud_cells(cloud.to_coal(), cloud)
+    for kept in (robot, cloud, cells):
+        assert isinstance(kept, DerivedData)
+    assert cloud_cells(cloud.to_coal(), cloud) is cells
+    assert isinstance(cells, CloudCells)
+    tree = cloud_tree(cells)
+    assert cloud_tree(cells) is tree
+    assert cells.derived_made("collision.") == {"collision.cloud_tree": tree}
+    matrix = robot_collision_matrix(robot)
+    assert robot_collision_matrix(robot) is matrix
+    assert robot.derived_made("collision.collision_matrix") == {
+        "collision.collision_matrix": matrix
+    }
+    other = robot.replace(limits=robot.limits)
+    assert other.derived_made("") == {}  # a changed copy starts without them
