@@ -195,3 +195,44 @@ def test_minimum_time_buffer_keeps_the_samples_farther(problem) -> None:
     )
     with pytest.raises(ConfigurationError, match="buffer"):
         minimum_time(problem, x0, buffer=-0.001)
+
+
+@pytest.mark.parametrize(("seconds", "evaluating"), [(0.02, 0.01), (1.0, 0.8)])
+def test_time_optimal_run_never_counts_more_evaluation_than_wall_time(
+    problem, monkeypatch, seconds, evaluating
+) -> None:
+    """Two refinements of ``seconds`` [s] each, ``evaluating`` [s] of it spent evaluating:
+    one after the other (0.02 s each inside a 0.05 s run) their evaluation times add up;
+    at once on worker processes (1 s each inside the same run) their sum exceeds the run's
+    wall time — ``plan`` then refused the result (the optimiser overhead; seen on the
+    loaded machine, post_two_pendulums, seed 1) — and they count by their share of it."""
+    import time
+    from types import SimpleNamespace
+
+    from adept_traj.analysis import optimizer_overhead
+    from adept_traj.optimise.local import polish_modes
+
+    x = problem.trajectory.straight_line(1.5)
+    ev = problem.evaluate_batch(x)
+    outcome = SimpleNamespace(
+        x=x,
+        objectives=ev.objectives,
+        constraints=ev.constraints,
+        n_evaluations=3,
+        seconds=seconds,
+        evaluation_s=evaluating,
+    )
+
+    def two_outcomes(*args, **kwargs):
+        time.sleep(0.05)
+        return [outcome, SimpleNamespace(**{**vars(outcome), "x": x + 0.0})]
+
+    monkeypatch.setattr(polish_modes, "time_optimal", two_outcomes)
+    state, _ = polish_modes.time_optimal_run(problem, 1)
+    assert state.total_s >= 0.05
+    if seconds < 0.025:  # one after the other (2 × 0.02 s inside ≥ 0.05 s): the sum
+        assert state.evaluation_s == pytest.approx(2 * evaluating, rel=1e-12)
+    else:  # at once (2 × 1 s inside a run of < 2 s): their share of the wall time
+        assert state.total_s < 2 * seconds
+        assert state.evaluation_s == pytest.approx(evaluating / seconds * state.total_s)
+    assert 0.0 <= optimizer_overhead(state.total_s, state.evaluation_s) <= 1.0
