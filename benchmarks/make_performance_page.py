@@ -65,6 +65,8 @@ SUMMARY = (
     ("bench_hard", "paper_time-optimal_wall"),
     ("bench_hard", "detour_nsga2_ratio"),
     ("bench_hard", "detour_time-optimal_wall"),
+    ("bench_hard", "wall_crane_nsga2_ratio"),
+    ("bench_hard", "post_two_pendulums_nsga2_ratio"),
     ("bench_polish", "time_optimal_T"),
     ("bench_polish", "nsga2_fastest"),
     ("bench_polish", "nsga2_polish_share"),
