@@ -35,6 +35,17 @@ from adept_traj.cycle.cycle_playback import (
     cycle_html,
     cycle_playback,
 )
+from adept_traj.cycle.move_task import (
+    MoveTask,
+    RelaxedOptima,
+    SavedMove,
+    cycle_tasks,
+    plan_and_encode,
+    plan_move,
+    relaxed_group,
+    relaxed_optima,
+    worker_robot,
+)
 from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
 from adept_traj.cycle.recertify import (
     CertifyBatch,
@@ -50,16 +61,10 @@ from adept_traj.cycle.runner import (
     MOVE_FILE,
     MOVES_FOLDER,
     RETRIES,
-    MoveTask,
-    SavedMove,
-    cycle_tasks,
     dask_client,
-    plan_and_encode,
-    plan_move,
     run_cycle,
     run_planning_tasks,
     run_tasks,
-    worker_robot,
 )
 from adept_traj.cycle.schedules import (
     MAX_BACK_TO_BACK_MOVES,
@@ -138,6 +143,7 @@ __all__ = [
     "MoveTask",
     "PhaseOption",
     "PlannedMove",
+    "RelaxedOptima",
     "RestCertifier",
     "RestCheck",
     "RestProfile",
@@ -167,6 +173,8 @@ __all__ = [
     "plan_on_clock",
     "plan_phase_grid",
     "read_cycle_file",
+    "relaxed_group",
+    "relaxed_optima",
     "run_cycle",
     "run_metrics",
     "run_planning_tasks",

@@ -22,8 +22,9 @@ from typing import Any
 import numpy as np
 
 from adept_traj.certification import certify
+from adept_traj.cycle.move_task import worker_robot
 from adept_traj.cycle.rest import RestCheck, certify_rest
-from adept_traj.cycle.runner import run_tasks, worker_robot
+from adept_traj.cycle.runner import run_tasks
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
 from adept_traj.robot import RobotSource
 from adept_traj.scene import Scene
