@@ -61,15 +61,18 @@ RETRIES = 2
 #: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
-#: Dask settings of the local cluster (its scheduler runs in this process; the workers
-#: inherit them): no worker profiler, no GIL monitor, and the system monitor and the
-#: watchdog less often than Dask's defaults: CPU time for as long as the run lasts,
-#: serial in the command, for the dashboard only.
+#: Dask settings of the local cluster (its scheduler and the workers' nannies run in this
+#: process; the workers inherit them): no worker profiler, no GIL monitor, and the system
+#: monitor, the watchdog and the memory monitor (of each nanny and worker: every 100 ms by
+#: default; the memory limit is still enforced, within a second) less often than Dask's
+#: defaults: CPU time for as long as the run lasts, serial in the command, for the
+#: dashboard only.
 LOCAL_DASK_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.gil.enabled": False,
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.admin.tick.interval": "500ms",
+    "distributed.worker.memory.monitor-interval": "1s",
 }
 
 
