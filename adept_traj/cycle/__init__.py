@@ -48,11 +48,17 @@ from adept_traj.cycle.move_task import (
 )
 from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
 from adept_traj.cycle.recertify import (
+    CHECKS_PER_TASK,
     CertifyBatch,
+    CheckBatch,
     MoveCertifier,
+    MoveCheck,
+    MoveVerdict,
     PlannedMove,
     RestCertifier,
     certify_batch,
+    check_batch,
+    check_moves,
 )
 from adept_traj.cycle.rest import RestCheck, RestProfile, certify_rest
 from adept_traj.cycle.runner import (
@@ -109,6 +115,7 @@ from adept_traj.cycle.timeline import ClockedMove, CycleClock
 __all__ = [
     "ALGORITHM_PAIR",
     "BOXPLOT_FIGURE",
+    "CHECKS_PER_TASK",
     "CHOICES",
     "CLOSE_TIMEOUT",
     "CYCLE_FILE",
@@ -133,14 +140,17 @@ __all__ = [
     "STUDY_REPORT",
     "CertifyBatch",
     "ChainPlan",
+    "CheckBatch",
     "ClockedMove",
     "Cycle",
     "CycleClock",
     "Location",
     "Metric",
     "MoveCertifier",
+    "MoveCheck",
     "MoveSpec",
     "MoveTask",
+    "MoveVerdict",
     "PhaseOption",
     "PlannedMove",
     "RelaxedOptima",
@@ -153,7 +163,9 @@ __all__ = [
     "certify_rest",
     "chain_passes",
     "chained_clock",
+    "check_batch",
     "check_chained",
+    "check_moves",
     "chosen_member",
     "clock_playback",
     "clock_summary",
