@@ -63,8 +63,8 @@ RETRIES = 2
 CLOSE_TIMEOUT = 60.0
 #: Dask settings of the local cluster (its scheduler and the workers' nannies run in this
 #: process; the workers inherit them): no worker profiler, no GIL monitor, and the system
-#: monitor, the watchdog and the memory monitor (of each nanny and worker: every 100 ms by
-#: default; the memory limit is still enforced, within a second) less often than Dask's
+#: monitor, the watchdog and the memory monitor (of each nanny and worker: ten times a
+#: second by default; the limit is still enforced, within a second) less often than Dask's
 #: defaults: CPU time for as long as the run lasts, serial in the command, for the
 #: dashboard only.
 LOCAL_DASK_CONFIG = {
