@@ -220,10 +220,9 @@ def run_planning_tasks(
     (:class:`~adept_traj.errors.CycleError`). ``progress`` is called with each name as its
     result is saved (or found saved). Where obstacles move, each
     :func:`~adept_traj.cycle.move_task.relaxed_group` of the tasks to plan has its relaxed
-    optima made once, by a task of its own that its planning tasks wait for
-    (:func:`~adept_traj.cycle.move_task.relaxed_optima`); ``relaxed``: those already
-    asked for on ``client`` (its Dask futures, by group), kept and added to over the
-    calls of one client."""
+    optima made once, by a task of its own run before its planning tasks
+    (:func:`~adept_traj.cycle.move_task.relaxed_optima`); ``relaxed``: those already made
+    (by group), kept and added to over the calls."""
     where = Path(folder)
     if not resume and where.exists() and any(where.iterdir()):
         raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
@@ -249,7 +248,7 @@ def run_planning_tasks(
         where.mkdir(parents=True, exist_ok=True)
         todo = [tasks[i] for i in pending]
         with _given_or_own(client, workers, scheduler, len(todo)) as own:
-            shared = {} if relaxed is None or own is not client else relaxed
+            shared = {} if relaxed is None else relaxed
             extra = _relaxed_arguments(own, todo, shared)
             run_tasks(todo, plan_and_encode, on_result=saved, client=own, extra=extra)
     return results  # type: ignore[return-value]
@@ -269,19 +268,16 @@ def _relaxed_arguments(
     client: Any, tasks: Sequence[MoveTask], shared: dict[str, Any]
 ) -> list[tuple[Any, ...]]:
     """Per task, the extra argument of :func:`~adept_traj.cycle.move_task.plan_and_encode`:
-    the future of its group's relaxed optima (submitted here unless ``shared`` holds it),
-    or none without moving obstacles."""
-    out: list[tuple[Any, ...]] = []
-    run_id = uuid.uuid4().hex
-    for task in tasks:
-        group = relaxed_group(task)
-        if group is not None and group not in shared:
-            key = f"adept-traj-relaxed-{run_id}-{len(shared)}"
-            shared[group] = client.submit(
-                relaxed_optima, task, key=key, pure=False, retries=RETRIES
-            )
-        out.append(() if group is None else (shared[group],))
-    return out
+    its group's relaxed optima (made here as Dask tasks, one per group that ``shared`` does
+    not hold yet, all at once), or none without moving obstacles. The planning tasks get
+    values, not futures: without dependencies Dask queues them and hands them out in order
+    as workers free up."""
+    groups = [relaxed_group(task) for task in tasks]
+    todo = {g: t for g, t in zip(groups, tasks) if g is not None and g not in shared}
+    if todo:
+        made = run_tasks(list(todo.values()), relaxed_optima, client=client)
+        shared.update(zip(todo, made))
+    return [() if g is None else (shared[g],) for g in groups]
 
 
 def run_cycle(
