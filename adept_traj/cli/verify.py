@@ -21,7 +21,9 @@ acceleration or jerk limit in the robot's files) are listed as ``no limit``.
 ``DIR`` may also be the output folder of ``adept-traj cycle`` (it holds ``cycle.json``):
 then every move of every pass is certified again at its start time on the scene clock,
 and every dwell (:func:`~adept_traj.cycle.verify_cycle`): exit status 0 all certified,
-1 not, 3 the record's clock arithmetic does not hold.
+1 not, 3 the record's clock arithmetic does not hold. With ``--workers N`` (a local Dask
+cluster of N worker processes) or ``--scheduler ADDRESS`` (a running one), as for
+``adept-traj cycle``, the moves are certified as Dask tasks: the same verdicts.
 """
 
 from __future__ import annotations
@@ -38,10 +40,12 @@ from adept_traj.certification.audit import audit
 from adept_traj.cli import status
 from adept_traj.cli.arguments import check_rate, floats, scene_from_argument
 from adept_traj.cli.result_robot import add_result_robot_arguments, result_robot
+from adept_traj.errors import ConfigurationError
 from adept_traj.results import PlanningResult
 from adept_traj.results.unchecked import unchecked_of
 from adept_traj.robot import JointLimits
 from adept_traj.scene import scene_notes
+from adept_traj.validation import as_integer
 
 __all__ = ["add_parser", "run"]
 
@@ -65,6 +69,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "compared with the stored scene (default: the shipped scene of the stored name)",
     )
     add_result_robot_arguments(p)
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="cycle folders: certify the moves as Dask tasks on N local worker processes",
+    )
+    p.add_argument(
+        "--scheduler",
+        help="cycle folders: certify the moves as Dask tasks on a running Dask scheduler "
+        "(tcp://host:8786)",
+    )
     return p
 
 
@@ -86,8 +100,14 @@ def run(args: argparse.Namespace) -> int:
     3 a mismatch)."""
     rate = check_rate(args.rate)
     folder = Path(args.folder)
+    if args.workers is not None:
+        as_integer(args.workers, "--workers", minimum=1, maximum=1024)
     if (folder / "cycle.json").is_file() and not (folder / "result.json").exists():
-        return _verify_cycle(folder)
+        return _verify_cycle(folder, args.workers, args.scheduler)
+    if args.workers is not None or args.scheduler is not None:
+        raise ConfigurationError(
+            f"{folder}: --workers and --scheduler apply to a cycle folder (cycle.json) only"
+        )
     result = PlanningResult.load(args.folder)
     scene = None
     if args.scene is not None:
@@ -145,11 +165,12 @@ def run(args: argparse.Namespace) -> int:
     return status.OK if cert.feasible else status.NOT_CERTIFIED
 
 
-def _verify_cycle(folder: Path) -> int:
-    """``verify`` of a cycle's output folder (:func:`~adept_traj.cycle.verify_cycle`)."""
+def _verify_cycle(folder: Path, workers: int | None, scheduler: str | None) -> int:
+    """``verify`` of a cycle's output folder (:func:`~adept_traj.cycle.verify_cycle`; on
+    Dask with ``workers`` or ``scheduler``)."""
     from adept_traj.cycle.cycle_verify import verify_cycle
 
-    found = verify_cycle(folder)
+    found = verify_cycle(folder, workers=workers, scheduler=scheduler)
     print(f"{folder}: cycle re-certified, {found.n_moves} moves on the scene clock:")
     for line in found.lines:
         print(f"  {line}")

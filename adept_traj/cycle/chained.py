@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from adept_traj.cycle.cycle_file import Cycle
+from adept_traj.cycle.move_task import MoveTask
 from adept_traj.cycle.recertify import MoveCertifier, PlannedMove, RestCertifier
-from adept_traj.cycle.runner import MoveTask
 from adept_traj.cycle.schedules import PhaseOption, chain_passes
 from adept_traj.cycle.timeline import ClockedPlan, CycleClock, clocked_passes
 from adept_traj.results import PlanningResult

@@ -41,14 +41,10 @@ import numpy as np
 from adept_traj.cycle.chained import ChainPlan, chained_clock
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
+from adept_traj.cycle.move_task import cycle_tasks
 from adept_traj.cycle.recertify import RestCertifier
 from adept_traj.cycle.rest import certify_rest
-from adept_traj.cycle.runner import (
-    MOVES_FOLDER,
-    cycle_tasks,
-    dask_client,
-    run_planning_tasks,
-)
+from adept_traj.cycle.runner import MOVES_FOLDER, dask_client, run_planning_tasks
 from adept_traj.cycle.schedules import SAME_TIME
 from adept_traj.cycle.timeline import ClockedMove, CycleClock
 from adept_traj.errors import CycleError
@@ -176,6 +172,7 @@ def plan_on_clock(
     t = 0.0
     chain: list[list[ChainPlan]] = []  # the plans of pass 0, for every pass back to back
     with dask_client(workers, scheduler, len(grid)) as client:
+        relaxed: dict[str, Any] = {}  # each move's relaxed optima, made once (move_task)
         for p in range(planned):
             row, row_results = [], []
             for task in tasks:
@@ -184,7 +181,9 @@ def plan_on_clock(
                     replace(task, move=replace(m, name=f"{m.name}.p{p}.w{j}"), start_time=t + d)
                     for j, d in enumerate(grid.tolist())
                 ]
-                results = run_planning_tasks(candidates, where, resume=True, client=client)
+                results = run_planning_tasks(
+                    candidates, where, resume=True, client=client, relaxed=relaxed
+                )
                 rests = [certify_rest(robot, cycle.scene, task.start, t, d, **rest) for d in grid]
                 rows = [chosen_member(r, m) for r in results]
                 times = [float(r.front.objectives[k, 0]) for r, k in zip(results, rows)]

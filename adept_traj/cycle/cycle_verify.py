@@ -11,21 +11,29 @@ congruent to its start time, or, every pass back to back, at any), then every mo
 the ``repeat`` is certified at its scene start time (a periodic cycle's pass p at the
 first pass's times + p × the pass time), and every dwell (the robot at rest while the
 obstacles move) with :func:`~adept_traj.cycle.certify_rest`.
+
+Given ``workers`` or ``scheduler`` (``adept-traj verify CYCLE_DIR --workers N``), the
+certificates run as Dask tasks on the cycle command's mechanism (a local cluster of
+``workers`` processes, or a running scheduler; :func:`~adept_traj.cycle.check_moves`),
+each move certified alone from the same values as in this process: the same verdicts
+and lines, in the same order.
 """
 
 from __future__ import annotations
 
+import json
 import os
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from adept_traj.certification import certify
-from adept_traj.cycle.rest import certify_rest
+from adept_traj.cycle.recertify import MoveCheck, MoveVerdict, check_moves
+from adept_traj.cycle.runner import dask_client
 from adept_traj.cycle.summary import CYCLE_FILE
 from adept_traj.errors import CycleError
 from adept_traj.files import parse_json, read_bytes_bounded
-from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
 from adept_traj.scene import Scene
 
@@ -53,8 +61,15 @@ class CycleVerification:
     n_moves: int
 
 
-def verify_cycle(folder: str | os.PathLike[str]) -> CycleVerification:
-    """Re-certify the cycle saved in ``folder`` (module doc).
+def verify_cycle(
+    folder: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> CycleVerification:
+    """Re-certify the cycle saved in ``folder`` (module doc); with ``workers`` (local
+    Dask worker processes) or ``scheduler`` (a running Dask scheduler's address) the
+    certificates run as Dask tasks, else in this process.
 
     Raises
     ------
@@ -71,25 +86,12 @@ def verify_cycle(folder: str | os.PathLike[str]) -> CycleVerification:
             results[rel] = PlanningResult.load(where / rel)
         return results[rel]
 
-    clock = summary.get("clock")
-    if clock is None:
-        return _fixed(summary, load)
-    return _on_clock(summary, clock, load)
-
-
-def _fixed(summary: dict[str, Any], load: Any) -> CycleVerification:
-    lines, ok = [], True
-    for m in summary["moves"]:
-        r = load(m["folder"])
-        x = r.front.x[m.get("member", r.best.index)]
-        problem = r.problem()
-        try:
-            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
-        finally:
-            problem.close()
-        ok &= c.feasible
-        lines.append(_line(m["name"], 0, 0.0, float(x[0]), c.feasible, c.min_distance))
-    return CycleVerification(tuple(lines), ok, (), len(lines))
+    parallel = workers is not None or scheduler is not None
+    with _client(parallel, workers, scheduler) as client:
+        clock = summary.get("clock")
+        if clock is None:
+            return _fixed(summary, load, client)
+        return _on_clock(summary, clock, load, client)
 
 
 def _word(ok: bool) -> str:
@@ -100,7 +102,60 @@ def _line(name: str, p: int, start: float, T: float, ok: bool, low: float) -> st
     return f"pass {p} {name}: start {start:.4f} s, T {T:.4f} s: {_word(ok)} (min {low:.4f} m)"
 
 
-def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> CycleVerification:
+@contextmanager
+def _client(parallel: bool, workers: int | None, scheduler: str | None) -> Iterator[Any]:
+    """A Dask client (:func:`~adept_traj.cycle.dask_client`) when ``parallel``, else
+    ``None``."""
+    if not parallel:
+        yield None
+        return
+    with dask_client(workers, scheduler, 1024) as client:
+        yield client
+
+
+def _check_of(r: PlanningResult, x: Any, start: float, dwell: float) -> MoveCheck:
+    """The check of ``r``'s member ``x`` started at scene time ``start`` [s] after a
+    dwell [s] at its start (in one process: ``workers = 1``)."""
+    settings = replace(r.problem_settings, start_time=start, workers=1)
+    span = (start - dwell, dwell)
+    return MoveCheck(settings, r.start, r.goal, x, r.certificate.rate_hz, span)
+
+
+def _verdicts(first: PlanningResult, checks: Sequence[MoveCheck], client: Any) -> list[MoveVerdict]:
+    scene = Scene.from_dict(first.scene, source="result scene")
+    return check_moves(first.robot.source(), scene, checks, client)
+
+
+def _fixed(
+    summary: dict[str, Any], load: Callable[[str], PlanningResult], client: Any
+) -> CycleVerification:
+    moves = summary["moves"]
+    loaded = [load(m["folder"]) for m in moves]
+    xs = [r.front.x[m.get("member", r.best.index)] for m, r in zip(moves, loaded)]
+    found: dict[int, MoveVerdict] = {}
+    groups: dict[tuple[Any, str], list[int]] = {}  # moves of one robot and scene together
+    for i, r in enumerate(loaded):
+        groups.setdefault((r.robot.source(), json.dumps(r.scene, sort_keys=True)), []).append(i)
+    for rows in groups.values():
+        checks = [
+            _check_of(loaded[i], xs[i], loaded[i].problem_settings.start_time, 0.0) for i in rows
+        ]
+        for i, v in zip(rows, _verdicts(loaded[rows[0]], checks, client)):
+            found[i] = v
+    lines, ok = [], True
+    for i, (m, x) in enumerate(zip(moves, xs)):
+        v = found[i]
+        ok &= v.feasible
+        lines.append(_line(m["name"], 0, 0.0, float(x[0]), v.feasible, v.min_distance))
+    return CycleVerification(tuple(lines), ok, (), len(lines))
+
+
+def _on_clock(
+    summary: dict[str, Any],
+    clock: dict[str, Any],
+    load: Callable[[str], PlanningResult],
+    client: Any,
+) -> CycleVerification:
     passes, period = clock["passes"], clock["period"]
     repeat = int(summary["repeat"])
     mismatches = []
@@ -141,40 +196,25 @@ def _on_clock(summary: dict[str, Any], clock: dict[str, Any], load: Any) -> Cycl
         else [(p, m, 0.0) for p, moves in enumerate(passes) for m in moves]
     )
     first = load(passes[0][0]["folder"])
-    robot, scene = first.robot.load(), Scene.from_dict(first.scene, source="result scene")
-    lines, ok = [], True
-    for p, m, shift in schedule:
+    final = clock["final_dwell"]
+    checks = []
+    for _, m, shift in schedule:
         r = load(m["folder"])
-        x = r.front.x[m["member"]]
-        start = m["start_time"] + shift
-        settings = replace(r.problem_settings, start_time=start, workers=1)
-        problem = TrajectoryProblem(robot, scene, r.start, r.goal, settings)
-        try:
-            c = certify(problem, x, rate_hz=r.certificate.rate_hz)
-        finally:
-            problem.close()
-        rest = certify_rest(
-            robot,
-            scene,
-            r.start,
-            start - m["dwell"],
-            m["dwell"],
-            settings=settings,
-            rate_hz=r.certificate.rate_hz,
-        )
-        ok &= bool(c.feasible and rest.certified)
-        line = _line(m["name"], p, start, float(x[0]), c.feasible, c.min_distance)
-        if m["dwell"]:
-            line += f"; its dwell of {m['dwell']:.4f} s: {_word(rest.certified)}"
-        lines.append(line)
-        final = clock["final_dwell"]
+        check = _check_of(r, r.front.x[m["member"]], m["start_time"] + shift, m["dwell"])
         if period is not None and m is passes[0][-1] and repeat > 1 and final > 0:
-            end = start + float(x[0])
-            kept = certify_rest(
-                robot, scene, r.goal, end, final, settings=settings, rate_hz=r.certificate.rate_hz
-            )
-            ok &= kept.certified
+            check = replace(check, after=(check.settings.start_time + float(check.x[0]), final))
+        checks.append(check)
+    lines, ok = [], True
+    for (p, m, _), check, v in zip(schedule, checks, _verdicts(first, checks, client)):
+        start, T = check.settings.start_time, float(check.x[0])
+        ok &= bool(v.feasible and v.before)
+        line = _line(m["name"], p, start, T, v.feasible, v.min_distance)
+        if m["dwell"]:
+            line += f"; its dwell of {m['dwell']:.4f} s: {_word(v.before)}"
+        lines.append(line)
+        if v.after is not None:
+            ok &= v.after
             lines.append(
-                f"pass {p} final dwell {final:.4f} s from {end:.4f} s: {_word(kept.certified)}"
+                f"pass {p} final dwell {final:.4f} s from {start + T:.4f} s: {_word(v.after)}"
             )
     return CycleVerification(tuple(lines), ok, tuple(mismatches), len(schedule))

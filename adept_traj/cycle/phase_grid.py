@@ -74,15 +74,10 @@ from adept_traj.cycle.clock import (
     scene_period,
 )
 from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
+from adept_traj.cycle.move_task import MoveTask, cycle_tasks
 from adept_traj.cycle.recertify import MoveCertifier, PlannedMove, RestCertifier
 from adept_traj.cycle.rest import RestProfile
-from adept_traj.cycle.runner import (
-    MOVES_FOLDER,
-    MoveTask,
-    cycle_tasks,
-    dask_client,
-    run_planning_tasks,
-)
+from adept_traj.cycle.runner import MOVES_FOLDER, dask_client, run_planning_tasks
 from adept_traj.cycle.schedules import (
     SAME_TIME,
     PhaseOption,
@@ -205,8 +200,11 @@ def plan_phase_grid(
 
     plans: list[list[_Plan]] = []
     with dask_client(workers, scheduler, K * n) as client:
+        relaxed: dict[str, Any] = {}  # each move's relaxed optima, made once (move_task)
         tasks = [at(t, f"{t.move.name}.ph{j}", s) for t in base for j, s in enumerate(grid)]
-        flat = _plans(tasks, run_planning_tasks(tasks, where, resume=True, client=client))
+        flat = _plans(
+            tasks, run_planning_tasks(tasks, where, resume=True, client=client, relaxed=relaxed)
+        )
         plans = [flat[k * n : (k + 1) * n] for k in range(K)]
         for k in range(1, K):
             options = [[p.option for p in row] for row in plans[:k]]
@@ -221,7 +219,7 @@ def plan_phase_grid(
             count = len(plans[k]) - n
             extra = [at(base[k], f"{base[k].move.name}.x{count + i}", s) for i, s in enumerate(new)]
             if extra:
-                done = run_planning_tasks(extra, where, resume=True, client=client)
+                done = run_planning_tasks(extra, where, resume=True, client=client, relaxed=relaxed)
                 plans[k] = plans[k] + _plans(extra, done)
 
         options = [[p.option for p in row] for row in plans]

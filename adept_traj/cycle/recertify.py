@@ -10,6 +10,11 @@ batches: :meth:`MoveCertifier.prefetch` splits the queries into Dask tasks
 (:func:`certify_batch`) on the cycle's cluster, so that the command itself does not
 certify one move after the other. :class:`RestCertifier` keeps the rest certificates
 (:func:`~adept_traj.cycle.certify_rest`).
+
+``adept-traj verify CYCLE_DIR`` re-certifies saved moves the same way
+(:func:`check_moves`): each :class:`MoveCheck` a move at its start time with its own
+problem settings and the robot's rests around it, in batches of Dask tasks
+(:func:`check_batch`) when given a client, else one after the other in this process.
 """
 
 from __future__ import annotations
@@ -22,23 +27,33 @@ from typing import Any
 import numpy as np
 
 from adept_traj.certification import certify
+from adept_traj.cycle.move_task import worker_robot
 from adept_traj.cycle.rest import RestCheck, certify_rest
-from adept_traj.cycle.runner import run_tasks, worker_robot
+from adept_traj.cycle.runner import run_tasks
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
-from adept_traj.robot import RobotSource
+from adept_traj.robot import Robot, RobotSource
 from adept_traj.scene import Scene
 
 __all__ = [
     "BATCHES_PER_WORKER",
+    "CHECKS_PER_TASK",
     "CertifyBatch",
+    "CheckBatch",
     "MoveCertifier",
+    "MoveCheck",
+    "MoveVerdict",
     "PlannedMove",
     "RestCertifier",
     "certify_batch",
+    "check_batch",
+    "check_moves",
 ]
 
 #: Dask tasks per worker a batch of queries is split into (unequal certificates balance).
 BATCHES_PER_WORKER = 2
+
+#: Moves per Dask task of :func:`check_moves` (small: the tasks balance over the workers).
+CHECKS_PER_TASK = 8
 
 #: A query: (move k, plan i, scene start time [s]).
 Query = tuple[int, int, float]
@@ -179,3 +194,78 @@ class RestCertifier:
                 rate_hz=self._rate,
             )
         return self._known[key]
+
+
+@dataclass(frozen=True)
+class MoveCheck:
+    """A saved move to certify again: the problem ``settings`` it runs with (its scene
+    start time included), its ends ``start``, ``goal`` (nq,) [rad | m], the decision
+    vector ``x`` (n,), the certificate rate [Hz], and the robot's rests to certify with
+    it, ``(scene start [s], duration [s])``: ``before`` at ``start`` (its dwell) and
+    ``after`` at ``goal`` (a final dwell; ``None``: none)."""
+
+    settings: ProblemSettings
+    start: np.ndarray
+    goal: np.ndarray
+    x: np.ndarray
+    rate_hz: float
+    before: tuple[float, float]
+    after: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True)
+class MoveVerdict:
+    """What :func:`check_moves` found for a :class:`MoveCheck`: the move's certificate
+    ``feasible`` and its ``min_distance`` [m], and whether each rest is ``certified``
+    (``after``: ``None`` when not asked)."""
+
+    feasible: bool
+    min_distance: float
+    before: bool
+    after: bool | None
+
+
+@dataclass(frozen=True)
+class CheckBatch:
+    """What a worker needs to run :class:`MoveCheck` s (pickled to it): the robot's
+    source, the scene and the checks."""
+
+    robot: RobotSource
+    scene: Scene
+    checks: tuple[MoveCheck, ...]
+
+
+def _check(robot: Robot, scene: Scene, check: MoveCheck) -> MoveVerdict:
+    problem = TrajectoryProblem(robot, scene, check.start, check.goal, check.settings)
+    try:
+        c = certify(problem, check.x, rate_hz=check.rate_hz)
+    finally:
+        problem.close()
+    rest = {"settings": check.settings, "rate_hz": check.rate_hz}
+    before = certify_rest(robot, scene, check.start, *check.before, **rest)
+    after = None
+    if check.after is not None:
+        after = certify_rest(robot, scene, check.goal, *check.after, **rest).certified
+    return MoveVerdict(bool(c.feasible), float(c.min_distance), bool(before.certified), after)
+
+
+def check_batch(batch: CheckBatch) -> list[MoveVerdict]:
+    """The verdict of each check of ``batch`` (the body of a Dask task)."""
+    robot = worker_robot(batch.robot)
+    return [_check(robot, batch.scene, c) for c in batch.checks]
+
+
+def check_moves(
+    robot: RobotSource, scene: Scene, checks: Sequence[MoveCheck], client: Any = None
+) -> list[MoveVerdict]:
+    """The verdict of each of ``checks`` (robot and scene: the ones of all of them): in
+    this process, or as Dask tasks of :data:`CHECKS_PER_TASK` checks on ``client`` (the
+    same verdicts: each check is computed alone, from the same values)."""
+    if client is None:
+        loaded = robot.load()
+        return [_check(loaded, scene, c) for c in checks]
+    parts = [
+        CheckBatch(robot, scene, tuple(checks[a : a + CHECKS_PER_TASK]))
+        for a in range(0, len(checks), CHECKS_PER_TASK)
+    ]
+    return [v for part in run_tasks(parts, check_batch, client=client) for v in part]

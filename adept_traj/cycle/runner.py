@@ -19,25 +19,24 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import tempfile
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from adept_traj.cycle.cycle_file import Cycle, MoveSpec
+from adept_traj.cycle.cycle_file import Cycle
+from adept_traj.cycle.move_task import (
+    MoveTask,
+    SavedMove,
+    cycle_tasks,
+    plan_and_encode,
+    relaxed_group,
+    relaxed_optima,
+)
 from adept_traj.errors import CycleError, ResultFormatError
 from adept_traj.files import write_text_atomic
-from adept_traj.optimise import plan
-from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
-from adept_traj.robot import Robot, RobotSource
-from adept_traj.scene import Scene
 from adept_traj.validation import as_integer
 
 __all__ = [
@@ -46,16 +45,10 @@ __all__ = [
     "MOVES_FOLDER",
     "MOVE_FILE",
     "RETRIES",
-    "MoveTask",
-    "SavedMove",
-    "cycle_tasks",
     "dask_client",
-    "plan_and_encode",
-    "plan_move",
     "run_cycle",
     "run_planning_tasks",
     "run_tasks",
-    "worker_robot",
 ]
 
 #: Sub-folder of the output folder holding one result folder per move.
@@ -68,120 +61,19 @@ RETRIES = 2
 #: (Dask's nanny kills it after 0.8 × this; Dask's own default, 5, kills busy machines'
 #: workers and warns "Worker process still alive after 4.0 seconds, killing").
 CLOSE_TIMEOUT = 60.0
-#: Dask settings of the local cluster (its scheduler runs in this process; the workers
-#: inherit them): no worker profiler, no GIL monitor, and the system monitor and the
-#: watchdog less often than Dask's defaults: CPU time for as long as the run lasts,
-#: serial in the command, for the dashboard only.
+#: Dask settings of the local cluster (its scheduler and the workers' nannies run in this
+#: process; the workers inherit them): no worker profiler, no GIL monitor, and the system
+#: monitor, the watchdog and the memory monitor (of each nanny and worker: ten times a
+#: second by default; the limit is still enforced, within a second) less often than Dask's
+#: defaults: CPU time for as long as the run lasts, serial in the command, for the
+#: dashboard only.
 LOCAL_DASK_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.gil.enabled": False,
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.admin.tick.interval": "500ms",
+    "distributed.worker.memory.monitor-interval": "1s",
 }
-
-
-@dataclass(frozen=True)
-class MoveTask:
-    """Everything a worker needs to plan one move (pickled to it).
-
-    Attributes
-    ----------
-    move: the move; start, goal: (nq,) joints [rad | m].
-    robot: where the worker loads the robot; scene: the scene; rate_hz: certificate rate.
-    start_time: scene time [s] at which the move starts (the problem's ``start_time``).
-    """
-
-    move: MoveSpec
-    start: np.ndarray
-    goal: np.ndarray
-    robot: RobotSource
-    scene: Scene
-    rate_hz: float
-    start_time: float = 0.0
-
-    def description(self) -> dict[str, Any]:
-        """The JSON form written to ``move.json`` (what identifies the task's result)."""
-        m = self.move
-        clock = {"start_time": self.start_time} if self.start_time else {}  # 0: as before
-        return json.loads(
-            json.dumps(
-                {
-                    **clock,
-                    "name": m.name,
-                    "from": m.start,
-                    "to": m.goal,
-                    "start": self.start.tolist(),
-                    "goal": self.goal.tolist(),
-                    "algorithm": m.algorithm,
-                    "seed": m.seed,
-                    "pop_size": m.pop_size,
-                    "n_gen": m.n_gen,
-                    "weights": list(m.weights),
-                    "rate_hz": self.rate_hz,
-                    "robot": {"urdf": str(self.robot.urdf), "params": str(self.robot.params)},
-                    "scene": self.scene.to_dict(),
-                }
-            )
-        )
-
-
-def cycle_tasks(cycle: Cycle) -> list[MoveTask]:
-    """One :class:`MoveTask` per move of ``cycle``, in order."""
-    return [
-        MoveTask(
-            move=m,
-            start=cycle.locations[m.start].joints,
-            goal=cycle.locations[m.goal].joints,
-            robot=cycle.robot,
-            scene=cycle.scene,
-            rate_hz=cycle.rate_hz,
-        )
-        for m in cycle.moves
-    ]
-
-
-@lru_cache(maxsize=4)
-def worker_robot(source: RobotSource) -> Robot:
-    """The robot of ``source``, loaded once per worker process."""
-    return source.load()
-
-
-def plan_move(task: MoveTask) -> PlanningResult:
-    """Plan one move (the body of a Dask task; also callable directly)."""
-    m = task.move
-    robot, t0 = worker_robot(task.robot), task.start_time
-    problem = TrajectoryProblem(robot, task.scene, task.start, task.goal, workers=1, start_time=t0)
-    try:
-        return plan(
-            problem,
-            m.algorithm,
-            seed=m.seed,
-            pop_size=m.pop_size,
-            n_gen=m.n_gen,
-            weights=m.weights,
-            rate_hz=task.rate_hz,
-        )
-    finally:
-        problem.close()
-
-
-@dataclass(frozen=True)
-class SavedMove:
-    """What a cycle's task returns: the planning ``result`` and ``files``, file name ->
-    bytes of every file :meth:`~adept_traj.results.PlanningResult.save` writes."""
-
-    result: PlanningResult
-    files: dict[str, bytes]
-
-
-def plan_and_encode(task: MoveTask) -> SavedMove:
-    """Plan one move and encode its result files in the worker (the body of a cycle's
-    Dask task): the command only writes the bytes, so the encoding runs in parallel."""
-    result = plan_move(task)
-    with tempfile.TemporaryDirectory(prefix="adept-traj-move-") as tmp:
-        folder = result.save(Path(tmp) / "result")
-        files = {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
-    return SavedMove(result, files)
 
 
 def _finished(folder: Path, task: MoveTask) -> PlanningResult | None:
@@ -213,22 +105,25 @@ def _save(folder: Path, task: MoveTask, saved: SavedMove) -> Path:
 
 def run_tasks(
     tasks: Sequence[Any],
-    function: Callable[[Any], Any],
+    function: Callable[..., Any],
     *,
     workers: int | None = None,
     scheduler: str | None = None,
     on_result: Callable[[int, Any], None] | None = None,
     client: Any = None,
+    extra: Sequence[tuple[Any, ...]] | None = None,
 ) -> list[Any]:
     """``[function(t) for t in tasks]``, each call a Dask task (``retries`` =
     :data:`RETRIES`), on a new local cluster of ``workers`` single-threaded worker
     processes (default: one per core) or on the scheduler at address ``scheduler``, or on
     the caller's ``distributed.Client`` ``client`` (:func:`dask_client`; left open).
-    ``on_result(i, value)`` is called in this process as each task finishes."""
+    ``extra[i]``: more positional arguments of task i's call (a Dask future among them is
+    a dependency: the task runs once it has finished, with its result). ``on_result(i,
+    value)`` is called in this process as each task finishes."""
     if client is not None:
-        return _run_on(client, tasks, function, on_result)
+        return _run_on(client, tasks, function, on_result, extra)
     with dask_client(workers, scheduler, len(tasks)) as own:
-        return _run_on(own, tasks, function, on_result)
+        return _run_on(own, tasks, function, on_result, extra)
 
 
 @contextmanager
@@ -281,16 +176,18 @@ def _stop_workers(cluster: Any, timeout: float) -> None:
 def _run_on(
     client: Any,
     tasks: Sequence[Any],
-    function: Callable[[Any], Any],
+    function: Callable[..., Any],
     on_result: Callable[[int, Any], None] | None,
+    extra: Sequence[tuple[Any, ...]] | None = None,
 ) -> list[Any]:
     """:func:`run_tasks` on ``client``."""
     from distributed import as_completed
 
     run_id = uuid.uuid4().hex  # keys unique on a shared scheduler
+    more = extra if extra is not None else [()] * len(tasks)
     futures = [
-        client.submit(function, t, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
-        for i, t in enumerate(tasks)
+        client.submit(function, t, *a, key=f"adept-traj-{run_id}-{i}", pure=False, retries=RETRIES)
+        for i, (t, a) in enumerate(zip(tasks, more, strict=True))
     ]
     index = {f.key: i for i, f in enumerate(futures)}
     out: list[Any] = [None] * len(tasks)
@@ -312,6 +209,7 @@ def run_planning_tasks(
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
     client: Any = None,
+    relaxed: dict[str, Any] | None = None,
 ) -> list[PlanningResult]:
     """Plan ``tasks`` on Dask (:func:`run_tasks`; on ``client`` when given), each result
     saved as it arrives into ``folder/NAME/`` (NAME: the task's move name); return the
@@ -320,7 +218,11 @@ def run_planning_tasks(
     ``resume``: a task whose folder holds the same task (``move.json``) is loaded, not
     planned; without it a ``folder`` that already holds results is refused
     (:class:`~adept_traj.errors.CycleError`). ``progress`` is called with each name as its
-    result is saved (or found saved)."""
+    result is saved (or found saved). Where obstacles move, each
+    :func:`~adept_traj.cycle.move_task.relaxed_group` of the tasks to plan has its relaxed
+    optima made once, by a task of its own run before its planning tasks
+    (:func:`~adept_traj.cycle.move_task.relaxed_optima`); ``relaxed``: those already made
+    (by group), kept and added to over the calls."""
     where = Path(folder)
     if not resume and where.exists() and any(where.iterdir()):
         raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
@@ -344,15 +246,38 @@ def run_planning_tasks(
 
     if pending:
         where.mkdir(parents=True, exist_ok=True)
-        run_tasks(
-            [tasks[i] for i in pending],
-            plan_and_encode,
-            workers=workers,
-            scheduler=scheduler,
-            on_result=saved,
-            client=client,
-        )
+        todo = [tasks[i] for i in pending]
+        with _given_or_own(client, workers, scheduler, len(todo)) as own:
+            shared = {} if relaxed is None else relaxed
+            extra = _relaxed_arguments(own, todo, shared)
+            run_tasks(todo, plan_and_encode, on_result=saved, client=own, extra=extra)
     return results  # type: ignore[return-value]
+
+
+@contextmanager
+def _given_or_own(client: Any, workers: int | None, scheduler: str | None, n: int) -> Any:
+    """``client``, or a new one of :func:`dask_client` for ``n`` tasks (closed on leaving)."""
+    if client is not None:
+        yield client
+        return
+    with dask_client(workers, scheduler, n) as own:
+        yield own
+
+
+def _relaxed_arguments(
+    client: Any, tasks: Sequence[MoveTask], shared: dict[str, Any]
+) -> list[tuple[Any, ...]]:
+    """Per task, the extra argument of :func:`~adept_traj.cycle.move_task.plan_and_encode`:
+    its group's relaxed optima (made here as Dask tasks, one per group that ``shared`` does
+    not hold yet, all at once), or none without moving obstacles. The planning tasks get
+    values, not futures: without dependencies Dask queues them and hands them out in order
+    as workers free up."""
+    groups = [relaxed_group(task) for task in tasks]
+    todo = {g: t for g, t in zip(groups, tasks) if g is not None and g not in shared}
+    if todo:
+        made = run_tasks(list(todo.values()), relaxed_optima, client=client)
+        shared.update(zip(todo, made))
+    return [() if g is None else (shared[g],) for g in groups]
 
 
 def run_cycle(

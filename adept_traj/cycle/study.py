@@ -33,7 +33,8 @@ from adept_traj.analysis import (
     objective_bounds,
 )
 from adept_traj.cycle.cycle_file import MoveSpec
-from adept_traj.cycle.runner import MoveTask, run_planning_tasks
+from adept_traj.cycle.move_task import MoveTask
+from adept_traj.cycle.runner import run_planning_tasks
 from adept_traj.cycle.summary import fastest_certified
 from adept_traj.errors import ConfigurationError
 from adept_traj.problem import OBJECTIVES

@@ -141,6 +141,19 @@ def test_three_move_cycle_is_certified_and_reported(cycle_run):
     assert (cycle_run / "cycle.md").read_text().count("| yes |") == 3
 
 
+def test_verify_on_dask_prints_what_it_prints_alone(cycle_run, cluster, capsys):
+    """``verify CYCLE_DIR --scheduler``: each move certified as a Dask task, the same lines
+    as in the command; ``--workers`` on a result folder (not a cycle's) is refused."""
+    capsys.readouterr()
+    assert main(["verify", str(cycle_run)]) == 0
+    alone = capsys.readouterr().out
+    assert alone.count(": certified (min") == 3
+    assert main(["verify", str(cycle_run), "--scheduler", cluster.scheduler_address]) == 0
+    assert capsys.readouterr().out == alone
+    assert main(["verify", str(cycle_run / "moves" / "home-pick"), "--workers", "2"]) == 2
+    assert "apply to a cycle folder" in capsys.readouterr().err
+
+
 def test_resume_plans_only_the_missing_moves(cycle_run, cycle_file, cluster, tmp_path):
     out = tmp_path / "out"
     shutil.copytree(cycle_run, out)

@@ -208,13 +208,16 @@ def test_the_clock_decides_the_dwells(planned: Path) -> None:
 
 
 @pytest.mark.slow  # the planned cycle: ~10 s for the module's plan
-def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path) -> None:
+def test_verify_recertifies_every_pass(planned: Path, capsys, tmp_path: Path, cluster) -> None:
     capsys.readouterr()
     assert main(["verify", str(planned)]) == 0
     text = capsys.readouterr().out
     assert text.count(": certified (min") == 3 * 2
     assert "pass 2 place-home" in text
     assert "every move and dwell certified" in text
+    # the same lines with the moves certified as Dask tasks (verify --scheduler)
+    assert main(["verify", str(planned), "--scheduler", cluster.scheduler_address]) == 0
+    assert capsys.readouterr().out == text
     copy = tmp_path / "copy"
     import shutil
 
@@ -795,3 +798,44 @@ def test_back_to_back_beyond_its_limit_names_it() -> None:
     runs, why = chain_passes(options, 2.0, 7, move_ok, lambda *a: True)
     assert why is None
     assert [p[0] for p in runs] == [(0, 0.5 * p) for p in range(7)]
+
+
+def test_check_moves_answers_as_certify_here_and_on_dask(cluster, monkeypatch) -> None:
+    """``verify``'s checks (a saved move at a scene start time, the rests before and after
+    it): the verdicts of certify and certify_rest called directly, the same in this process
+    and as Dask tasks (two checks per task here), in order."""
+    from distributed import Client
+
+    from adept_traj.certification import certify
+    from adept_traj.cycle import MoveCheck, certify_rest, check_moves, recertify
+    from adept_traj.problem import ProblemSettings, TrajectoryProblem
+    from adept_traj.robot import RobotSource
+    from adept_traj.testing.paper_moves import lift_then_lower
+
+    robot, scene = Robot.adept_one_xl(), Scene.shipped("paper")
+    start, goal = np.array(HOME), np.array(PLACE)
+    x = lift_then_lower(TrajectoryProblem(robot, scene, start, goal, workers=1))
+    starts = [0.0, 0.35, 0.8, 1.4, 0.6]
+    monkeypatch.setattr(recertify, "CHECKS_PER_TASK", 2)  # three tasks, the last of one
+    checks, expected = [], []
+    for n, s in enumerate(starts):
+        settings = ProblemSettings(start_time=s, workers=1)
+        before, after = (max(s - 0.3, 0.0), min(s, 0.3)), (s + x[0], 0.5) if n % 2 else None
+        checks.append(MoveCheck(settings, start, goal, x, 1000.0, before, after))
+        problem = TrajectoryProblem(robot, scene, start, goal, settings)
+        c = certify(problem, x, rate_hz=1000.0)
+        problem.close()
+        rest = {"settings": settings, "rate_hz": 1000.0}
+        kept = certify_rest(robot, scene, start, *before, **rest).certified
+        later = None if after is None else certify_rest(robot, scene, goal, *after, **rest)
+        expected.append(
+            (c.feasible, c.min_distance, kept, None if later is None else later.certified)
+        )
+    assert len({e[0] for e in expected}) == 2  # the pendulum: certified at some starts only
+    source = RobotSource()
+    here = check_moves(source, scene, checks)
+    with Client(cluster.scheduler_address) as client:
+        there = check_moves(source, scene, checks, client)
+    found = [(v.feasible, v.min_distance, v.before, v.after) for v in here]
+    assert found == expected
+    assert there == here
