@@ -235,10 +235,14 @@ def run(args: argparse.Namespace) -> int:
     if opts.algorithm != TIME_OPTIMAL:
         make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
     task = task_from_arguments(opts)
-    # the finisher needs the robot and scene only: its imports overlap the problem's build
-    outputs = {"figures": not opts.no_plots, "html": not opts.no_html}
+    # the finishers need the robot and scene only: their imports (matplotlib for the
+    # figures, meshcat for the page, one process each) overlap the problem's build
     urgent = opts.algorithm == TIME_OPTIMAL  # a search shorter than the imports
-    with finisher_for(task.robot, task.scene, **outputs, urgent=urgent) as finisher:
+    parts = (task.robot, task.scene)
+    with (
+        finisher_for(*parts, figures=not opts.no_plots, html=False, urgent=urgent) as drawer,
+        finisher_for(*parts, figures=False, html=not opts.no_html, urgent=urgent) as pager,
+    ):
         problem = problem_from_task(opts, task)
         try:
             # memory of the population and dense certificate, before anything is written
@@ -253,7 +257,7 @@ def run(args: argparse.Namespace) -> int:
                         del saved["start_time"]
                     write_arguments(folder, saved)
                 with _polisher_for(problem, opts) as polisher:
-                    return _run(opts, problem, folder, resume, finisher, polisher)
+                    return _run(opts, problem, folder, resume, (drawer, pager), polisher)
         finally:
             problem.close()
 
@@ -275,7 +279,7 @@ def _run(
     problem: TrajectoryProblem,
     folder: Path,
     resume: bool,
-    finisher: Finisher | None = None,
+    finishers: tuple[Finisher | None, Finisher | None] = (None, None),
     polisher: Polisher | None = None,
 ) -> int:
     """Plan, save and mark the run complete; on Ctrl-C say how to resume."""
@@ -297,7 +301,7 @@ def _run(
                 polish="off" if opts.no_polish else opts.polish,
                 polisher=polisher,
             )
-        return _finish(result, problem, folder, opts, finisher)
+        return _finish(result, problem, folder, opts, *finishers)
     except PlanningInterrupted as exc:
         if exc.checkpoint is None:
             sys.stderr.write(
@@ -319,34 +323,44 @@ def _finish(
     problem: TrajectoryProblem,
     folder: Path,
     opts: argparse.Namespace,
-    finisher: Finisher | None = None,
+    drawer: Finisher | None = None,
+    pager: Finisher | None = None,
 ) -> int:
     """Write every output of the run, then mark it complete (the last step). The figures
-    and ``playback.html`` are written by ``finisher`` (the helper process started with the
-    run, if it is ready) or else by :func:`_write_outputs`, while this process writes
-    ``result.json``; an error of theirs is raised here, before the run is marked
-    complete."""
+    are drawn by ``drawer`` and ``playback.html`` written by ``pager`` (the helper
+    processes started with the run, if they are ready), else the figures in a forked
+    process and the page here, while this process writes ``result.json``; an error of
+    theirs is raised here, before the run is marked complete."""
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
+    results = {opts.algorithm: result}
     figures = None if opts.no_plots else folder / "figures"
     html = None if opts.no_html else folder / HTML_FILE
+    drawing = None
     try:
-        handed = finisher is not None and finisher.start(
-            {opts.algorithm: result}, figures=figures, html=html
+        drawn = (
+            figures is not None and drawer is not None and drawer.start(results, figures=figures)
         )
-    except BaseException:  # the result is saved all the same
+        paged = html is not None and pager is not None and pager.start(results, html=html)
+        if figures is not None and not drawn:  # drawn in a forked process meanwhile
+            drawing = start_figures(results, figures, {opts.algorithm: replay})
+    except BaseException:  # e.g. no fork possible: the result is saved all the same
         result.save(folder)
         raise
-    if handed:
-        try:
-            result.save(folder)
-            paths = finisher.wait()
-        finally:
-            finisher.cancel()  # stops the helper if anything above failed (else a no-op)
-        if figures is not None:
-            print(figures_line(paths, figures, {opts.algorithm: result}))
-    else:
-        _write_outputs(result, folder, opts, replay)
+    try:
+        result.save(folder)
+        if html is not None and not paged:
+            _write_page(result, folder, replay)
+        if paged:
+            pager.wait()
+        if drawn:
+            print(figures_line(drawer.wait(), figures, results))
+        elif figures is not None:
+            finish_figures(drawing, figures, results)
+    finally:  # stops the helpers and the drawing if anything above failed (else no-ops)
+        for helper in (drawer, pager, drawing):
+            if helper is not None:
+                helper.cancel()
     print(summary(result, folder))
     for note in scene_notes(problem.scene):
         print(f"  obstacle {note}")
@@ -358,31 +372,13 @@ def _finish(
     return code
 
 
-def _write_outputs(
-    result: PlanningResult, folder: Path, opts: argparse.Namespace, replay: Replay
-) -> None:
-    """Without a ready helper: the figures drawn in a forked process while this one writes
-    ``result.json`` and ``playback.html`` (its error raised here)."""
-    figures = None
-    try:
-        if not opts.no_plots:
-            figures = start_figures({opts.algorithm: result}, folder / "figures",
-                                    {opts.algorithm: replay})  # fmt: skip
-    except BaseException:  # e.g. no fork possible: the result is saved all the same
-        result.save(folder)
-        raise
-    try:
-        result.save(folder)
-        if not opts.no_html:
-            from adept_traj.viz import explorer, meshcat_scene
+def _write_page(result: PlanningResult, folder: Path, replay: Replay) -> None:
+    """``playback.html`` and the front explorer beside it, written by this process."""
+    from adept_traj.viz import explorer, meshcat_scene
 
-            meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
-            explorer.write_explorer(result, folder / explorer.EXPLORER_FILE,
-                                    robot=replay.robot, scene=replay.scene)  # fmt: skip
-        finish_figures(figures, folder / "figures", {opts.algorithm: result})
-    finally:
-        if figures is not None:
-            figures.cancel()  # stops the drawing if anything above failed (else a no-op)
+    meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
+    explorer.write_explorer(result, folder / explorer.EXPLORER_FILE,
+                            robot=replay.robot, scene=replay.scene)  # fmt: skip
 
 
 def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool, replay: Replay) -> int:

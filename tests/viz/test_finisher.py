@@ -61,10 +61,11 @@ def _fake(name: str, error: BaseException | None = None):
 
 
 def _marking_preload(marker: Path, seconds: float = 0.0):
-    """A fake import: writes "pid niceness" to ``marker``, then sleeps ``seconds``."""
+    """A fake import: writes "pid niceness" to ``marker`` (the figures' helper; the page's
+    helper to ``marker.page``), then sleeps ``seconds``."""
 
-    def preload(_figures: bool, _html: bool) -> None:
-        marker.write_text(f"{os.getpid()} {_nice()}")
+    def preload(figures: bool, _html: bool) -> None:
+        (marker if figures else marker.with_suffix(".page")).write_text(f"{os.getpid()} {_nice()}")
         time.sleep(seconds)
 
     return preload
@@ -129,6 +130,9 @@ def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_
     assert {int(w[1]) for w in writers} & {helper}  # the helper draws one share …
     assert os.getpid() not in {int(w[1]) for w in writers}  # … its fork the other
     assert {int(w[2]) for w in writers} == {_nice()}  # at the caller's priority
+    pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
+    assert pager not in {helper, os.getpid()}  # the page's imports in a helper of its own
+    assert page_nice == finisher.IMPORT_NICENESS
     # the same files as the caller writes itself
     plain = tmp_path / "plain"
     stored.save(plain)
