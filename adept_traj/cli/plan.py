@@ -46,10 +46,11 @@ from adept_traj.cli.progress import ProgressReporter
 from adept_traj.cli.report import (
     figures_line,
     finish_figures,
-    finisher_for,
+    finishers_for,
     save_collision_matrix,
     start_figures,
     summary,
+    write_page,
 )
 from adept_traj.errors import ConfigurationError
 from adept_traj.optimise import (
@@ -235,13 +236,12 @@ def run(args: argparse.Namespace) -> int:
     if opts.algorithm != TIME_OPTIMAL:
         make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
     task = task_from_arguments(opts)
-    # the finishers need the robot and scene only: their imports (matplotlib for the
-    # figures, meshcat for the page, one process each) overlap the problem's build
-    urgent = opts.algorithm == TIME_OPTIMAL  # a search shorter than the imports
-    parts = (task.robot, task.scene)
-    with (
-        finisher_for(*parts, figures=not opts.no_plots, html=False, urgent=urgent) as drawer,
-        finisher_for(*parts, figures=False, html=not opts.no_html, urgent=urgent) as pager,
+    # the finishers need the robot and scene only: their imports overlap the problem's build
+    time_optimal = opts.algorithm == TIME_OPTIMAL
+    outputs = {"figures": not opts.no_plots, "html": not opts.no_html}
+    with finishers_for(task.robot, task.scene, **outputs, time_optimal=time_optimal) as (
+        drawer,
+        pager,
     ):
         problem = problem_from_task(opts, task)
         try:
@@ -336,11 +336,10 @@ def _finish(
     results = {opts.algorithm: result}
     figures = None if opts.no_plots else folder / "figures"
     html = None if opts.no_html else folder / HTML_FILE
-    drawing = None
+    drawing, its_page = None, html if pager is None else None  # the drawer's page
     try:
-        drawn = (
-            figures is not None and drawer is not None and drawer.start(results, figures=figures)
-        )
+        drawn = drawer is not None and (figures or its_page) is not None
+        drawn = drawn and drawer.start(results, figures=figures, html=its_page)
         paged = html is not None and pager is not None and pager.start(results, html=html)
         if figures is not None and not drawn:  # drawn in a forked process meanwhile
             drawing = start_figures(results, figures, {opts.algorithm: replay})
@@ -349,12 +348,13 @@ def _finish(
         raise
     try:
         result.save(folder)
-        if html is not None and not paged:
-            _write_page(result, folder, replay)
+        if html is not None and not (paged or (drawn and its_page is not None)):
+            write_page(result, folder / HTML_FILE, replay)
         if paged:
             pager.wait()
-        if drawn:
-            print(figures_line(drawer.wait(), figures, results))
+        paths = drawer.wait() if drawn else None
+        if figures is not None and paths is not None:
+            print(figures_line(paths, figures, results))
         elif figures is not None:
             finish_figures(drawing, figures, results)
     finally:  # stops the helpers and the drawing if anything above failed (else no-ops)
@@ -370,15 +370,6 @@ def _finish(
         code = max(code, _export_ros(result, opts.ros, opts.allow_infeasible, replay))
     commit(folder)
     return code
-
-
-def _write_page(result: PlanningResult, folder: Path, replay: Replay) -> None:
-    """``playback.html`` and the front explorer beside it, written by this process."""
-    from adept_traj.viz import explorer, meshcat_scene
-
-    meshcat_scene.static_html(result, folder / HTML_FILE, replay=replay)
-    explorer.write_explorer(result, folder / explorer.EXPLORER_FILE,
-                            robot=replay.robot, scene=replay.scene)  # fmt: skip
 
 
 def _export_ros(result: PlanningResult, path: Path, allow_infeasible: bool, replay: Replay) -> int:

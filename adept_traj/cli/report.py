@@ -29,6 +29,7 @@ __all__ = [
     "summary",
     "t_best_text",
     "weighted_sum_text",
+    "write_page",
 ]
 
 
@@ -221,3 +222,30 @@ def finisher_for(robot: Any, scene: Any, *, figures: bool, html: bool, urgent: b
         return start_finisher(robot, scene, figures=figures, html=html, urgent=urgent)
     except OSError:  # e.g. no memory to fork: the caller writes the files itself
         return contextlib.nullcontext(None)
+
+
+@contextlib.contextmanager
+def finishers_for(robot: Any, scene: Any, *, figures: bool, html: bool, time_optimal: bool) -> Any:
+    """The finish's helpers of ``plan`` (:func:`finisher_for`), stopped when the block is
+    left: ``(drawer, pager)``. For an evolutionary run, whose imports take the idle time
+    of a long search, one helper for the figures and the page (``pager`` ``None``); for
+    the time-optimal mode, whose search is shorter than the imports, one for the figures
+    and one for the page, importing side by side at the caller's priority."""
+    with contextlib.ExitStack() as stack:
+        if not time_optimal:
+            yield stack.enter_context(finisher_for(robot, scene, figures=figures, html=html)), None
+            return
+        parts = (robot, scene)
+        drawer = stack.enter_context(finisher_for(*parts, figures=figures, html=False, urgent=True))
+        pager = stack.enter_context(finisher_for(*parts, figures=False, html=html, urgent=True))
+        yield drawer, pager
+
+
+def write_page(result: PlanningResult, path: Path, replay: Replay) -> None:
+    """``playback.html`` at ``path`` and the front explorer beside it, written by the
+    calling process (``replay``: the run's :class:`~adept_traj.results.Replay`)."""
+    from adept_traj.viz import explorer, meshcat_scene
+
+    meshcat_scene.static_html(result, path, replay=replay)
+    explorer.write_explorer(result, path.parent / explorer.EXPLORER_FILE,
+                            robot=replay.robot, scene=replay.scene)  # fmt: skip

@@ -112,6 +112,11 @@ def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
     assert helper != os.getpid()
     assert import_nice == _nice() != finisher.IMPORT_NICENESS
     assert len(list((tmp_path / "run" / "figures").iterdir())) == 5
+    pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
+    assert pager not in {helper, os.getpid()}  # the page's imports in a helper of its own
+    assert page_nice == _nice()
+    assert (tmp_path / "run" / "playback.html").is_file()
+    assert (tmp_path / "run" / "explorer.html").is_file()
 
 
 def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_nice_19(
@@ -130,9 +135,7 @@ def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_
     assert {int(w[1]) for w in writers} & {helper}  # the helper draws one share …
     assert os.getpid() not in {int(w[1]) for w in writers}  # … its fork the other
     assert {int(w[2]) for w in writers} == {_nice()}  # at the caller's priority
-    pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
-    assert pager not in {helper, os.getpid()}  # the page's imports in a helper of its own
-    assert page_nice == finisher.IMPORT_NICENESS
+    assert not marker.with_suffix(".page").exists()  # one helper: figures and page
     # the same files as the caller writes itself
     plain = tmp_path / "plain"
     stored.save(plain)
