@@ -328,9 +328,10 @@ def _finish(
 ) -> int:
     """Write every output of the run, then mark it complete (the last step). The figures
     are drawn by ``drawer`` and ``playback.html`` written by ``pager`` (the helper
-    processes started with the run, if they are ready), else the figures in a forked
-    process and the page here, while this process writes ``result.json``; an error of
-    theirs is raised here, before the run is marked complete."""
+    processes started with the run, if they are ready; without ``pager``, ``drawer``
+    writes both), else the figures in a forked process and the page here, while this
+    process writes ``result.json``; an error of theirs is raised here, before the run is
+    marked complete."""
     # The views are built from one Replay of the run's own robot and scene (nothing reloaded).
     replay = Replay.of(result, robot=problem.robot, scene=problem.scene)
     results = {opts.algorithm: result}
