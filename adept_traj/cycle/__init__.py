@@ -44,7 +44,6 @@ from adept_traj.cycle.move_task import (
     plan_move,
     relaxed_group,
     relaxed_optima,
-    worker_robot,
 )
 from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
 from adept_traj.cycle.recertify import (
@@ -197,7 +196,6 @@ __all__ = [
     "scene_period",
     "study_markdown",
     "study_statistics",
-    "worker_robot",
     "write_cycle_report",
     "write_study_report",
 ]

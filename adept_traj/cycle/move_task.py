@@ -21,7 +21,6 @@ from __future__ import annotations
 import json
 import tempfile
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +31,9 @@ from adept_traj.optimise import initial_starts, plan
 from adept_traj.optimise.local.multi_start import made_relaxed_optima
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import PlanningResult
-from adept_traj.robot import Robot, RobotSource
+from adept_traj.robot import RobotSource
 from adept_traj.scene import Scene
+from adept_traj.scene.robot_motion import load_robot
 
 __all__ = [
     "MoveTask",
@@ -44,7 +44,6 @@ __all__ = [
     "plan_move",
     "relaxed_group",
     "relaxed_optima",
-    "worker_robot",
 ]
 
 #: The relaxed optima a problem made, by their key (``made_relaxed_optima``): (k, n_var)
@@ -112,14 +111,8 @@ def cycle_tasks(cycle: Cycle) -> list[MoveTask]:
     ]
 
 
-@lru_cache(maxsize=4)
-def worker_robot(source: RobotSource) -> Robot:
-    """The robot of ``source``, loaded once per worker process."""
-    return source.load()
-
-
 def _problem(task: MoveTask) -> TrajectoryProblem:
-    robot = worker_robot(task.robot)
+    robot = load_robot(task.robot)  # once per source in a worker process
     return TrajectoryProblem(
         robot, task.scene, task.start, task.goal, workers=1, start_time=task.start_time
     )

@@ -27,12 +27,12 @@ from typing import Any
 import numpy as np
 
 from adept_traj.certification import certify
-from adept_traj.cycle.move_task import worker_robot
 from adept_traj.cycle.rest import RestCheck, certify_rest
 from adept_traj.cycle.runner import run_tasks
 from adept_traj.problem import ProblemSettings, TrajectoryProblem
 from adept_traj.robot import Robot, RobotSource
 from adept_traj.scene import Scene
+from adept_traj.scene.robot_motion import load_robot
 
 __all__ = [
     "BATCHES_PER_WORKER",
@@ -86,7 +86,7 @@ class CertifyBatch:
 def certify_batch(batch: CertifyBatch) -> list[bool]:
     """Whether each move of ``batch`` is certified started at its scene time (the body of
     a Dask task; also callable directly)."""
-    robot = worker_robot(batch.robot)
+    robot = load_robot(batch.robot)
     out = []
     for start, goal, x, t0 in batch.moves:
         problem = TrajectoryProblem(robot, batch.scene, start, goal, workers=1, start_time=t0)
@@ -251,7 +251,7 @@ def _check(robot: Robot, scene: Scene, check: MoveCheck) -> MoveVerdict:
 
 def check_batch(batch: CheckBatch) -> list[MoveVerdict]:
     """The verdict of each check of ``batch`` (the body of a Dask task)."""
-    robot = worker_robot(batch.robot)
+    robot = load_robot(batch.robot)
     return [_check(robot, batch.scene, c) for c in batch.checks]
 
 
