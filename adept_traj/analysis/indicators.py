@@ -34,10 +34,8 @@ import warnings
 from collections.abc import Sequence
 from typing import Literal
 
-import moocore
 import numpy as np
 from numpy.typing import ArrayLike
-from pymoo.indicators.igd import IGD
 
 from adept_traj.analysis.objective_arrays import (
     as_objectives,
@@ -96,6 +94,8 @@ def non_dominated(
     """
     arr = as_objectives(F, "F")
     P = minimisation_form(arr, as_sense(maximised, arr.shape[1]))
+    import moocore  # on first use (its import costs more than a short run's search)
+
     return moocore.is_nondominated(P, keep_weakly=bool(keep_duplicates))
 
 
@@ -125,6 +125,8 @@ def igd(F: ArrayLike, reference_front: ArrayLike) -> float:
         raise InputShapeError(
             f"reference_front must have {A.shape[1]} columns like F; got shape {R.shape}"
         )
+    from pymoo.indicators.igd import IGD  # with moocore, on first use
+
     return float(IGD(R).do(A))
 
 
@@ -182,6 +184,8 @@ def hypervolume(
     P = P[(r > P).all(axis=1)]
     if len(P) == 0:
         return 0.0
+    import moocore
+
     return float(moocore.hypervolume(P, ref=r))
 
 

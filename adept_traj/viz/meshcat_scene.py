@@ -28,7 +28,7 @@ from adept_traj.errors import MeshcatServerError
 from adept_traj.files import write_text_atomic
 from adept_traj.results import PlanningResult, Replay
 from adept_traj.viz.meshcat_geometry import translation
-from adept_traj.viz.meshcat_modules import meshcat, umsgpack
+from adept_traj.viz.meshcat_modules import Recorder, meshcat, umsgpack
 from adept_traj.viz.playback import (
     CLOSEST_COLOR,
     FIXED_OBSTACLE_COLOR,
@@ -57,8 +57,9 @@ __all__ = [
 BACKGROUND_RGB = (0.96, 0.96, 0.97)
 
 
-def draw(vis: meshcat.Visualizer, playback: Playback, *, loop: bool = True) -> None:
-    """Send ``playback`` to ``vis`` (a top-level visualizer): background, camera, every node,
+def draw(vis: meshcat.Visualizer | Recorder, playback: Playback, *, loop: bool = True) -> None:
+    """Send ``playback`` to ``vis`` (a top-level ``meshcat.Visualizer``, or a
+    :class:`~adept_traj.viz.meshcat_modules.Recorder` for a page): background, camera, every node,
     then the animation (playing; looping forever when ``loop``, else played once).
 
     Meshcat's orbit camera always turns about the viewer's origin, so the visualizer's root
@@ -251,7 +252,7 @@ def render_html(
     :func:`member_label`), legend (:func:`legend`) and play/pause, scrubber and time
     read-out (see the module's description)."""
     window = _RecordingWindow()
-    draw(meshcat.Visualizer(window=window), playback, loop=loop)
+    draw(Recorder(window), playback, loop=loop)
     commands = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in window.commands)
     viewer = (
         f"<script>\n{_viewer_js()}\n</script>\n"

@@ -23,11 +23,13 @@ import zmq
 
 from adept_traj.errors import MeshcatServerError
 from adept_traj.results import PlanningResult, Replay
-from adept_traj.viz.meshcat_modules import ViewerWindow, meshcat
+from adept_traj.viz.meshcat_modules import viewer_modules
 from adept_traj.viz.meshcat_scene import draw, member_page
 from adept_traj.viz.playback import build_animation
 
 __all__ = ["SERVER_TIMEOUT_S", "show"]
+
+meshcat, ViewerWindow = viewer_modules()  # the live viewer needs meshcat's own
 
 #: Seconds to wait for the meshcat server to start, and for each of its answers.
 SERVER_TIMEOUT_S = 30.0
