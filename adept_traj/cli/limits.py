@@ -13,7 +13,7 @@ allows); the table of limits is in ``docs/cli.md``.
 from __future__ import annotations
 
 from adept_traj.certification import check_certificate_memory
-from adept_traj.optimise import TIME_OPTIMAL, check_population_memory, make_algorithm
+from adept_traj.optimise import TIME_OPTIMAL
 from adept_traj.problem import TrajectoryProblem
 
 __all__ = ["check_run_options"]
@@ -48,6 +48,8 @@ def check_run_options(
     """
     run = 0
     if algorithm != TIME_OPTIMAL:  # no population
+        from adept_traj.optimise import check_population_memory, make_algorithm  # pymoo
+
         _, settings = make_algorithm(algorithm, pop, gens)
         run = check_population_memory(
             settings.pop_size, settings.n_gen, options=(pop_option, gens_option)

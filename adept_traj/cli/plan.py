@@ -23,7 +23,7 @@ import argparse
 import contextlib
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from adept_traj.cli import status
 from adept_traj.cli._run_folder import (
@@ -52,23 +52,16 @@ from adept_traj.cli.report import (
     summary,
     write_page,
 )
-from adept_traj.errors import ConfigurationError
-from adept_traj.optimise import (
-    ALGORITHMS,
-    POLISH_MODES,
-    TIME_OPTIMAL,
-    PlanningInterrupted,
-    Polisher,
-    has_checkpoint,
-    make_algorithm,
-    plan,
-    start_polisher,
-)
+from adept_traj.errors import ConfigurationError, PlanningInterrupted
+from adept_traj.optimise import ALGORITHMS, POLISH_MODES, TIME_OPTIMAL
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.results import RESULT_FILE, PlanningResult, Replay, save_ros_joint_trajectory
 from adept_traj.scene import SHIPPED_SCENES, scene_notes
 from adept_traj.validation import as_integer
 from adept_traj.viz.finisher import Finisher
+
+if TYPE_CHECKING:
+    from adept_traj.optimise import Polisher
 
 __all__ = ["RUN_FILE", "add_parser", "run"]
 
@@ -234,6 +227,8 @@ def run(args: argparse.Namespace) -> int:
     if opts.no_polish and opts.polish != "off" and args.polish is not None:
         raise ConfigurationError(f"--no-polish conflicts with --polish {opts.polish}")
     if opts.algorithm != TIME_OPTIMAL:
+        from adept_traj.optimise import make_algorithm  # pymoo: an evolutionary run's
+
         make_algorithm(opts.algorithm, opts.pop, opts.gens)  # refuses bad settings now
     task = task_from_arguments(opts)
     # the finishers need the robot and scene only: their imports overlap the problem's build
@@ -268,6 +263,8 @@ def _polisher_for(problem: TrajectoryProblem, opts: argparse.Namespace) -> Any:
     context (``None``) without a polish or a search, or when no process can be forked."""
     if opts.no_polish or opts.polish == "off" or opts.algorithm == TIME_OPTIMAL:
         return contextlib.nullcontext(None)
+    from adept_traj.optimise import start_polisher
+
     try:
         return start_polisher(problem)
     except OSError:  # e.g. no memory to fork: the polish runs in this process
@@ -283,6 +280,10 @@ def _run(
     polisher: Polisher | None = None,
 ) -> int:
     """Plan, save and mark the run complete; on Ctrl-C say how to resume."""
+    # imported once the finishers are forked (they need none of it): their imports and
+    # these overlap
+    from adept_traj.optimise import has_checkpoint, plan
+
     checkpoint = folder / CHECKPOINT
     try:
         with ProgressReporter(opts.algorithm, quiet=opts.quiet) as progress:

@@ -79,6 +79,7 @@ from adept_traj.collision.primitives import (
 from adept_traj.errors import InvalidInputError
 from adept_traj.robot.kinematics import compose, stack_times
 from adept_traj.robot.robot import Robot, solid_frames
+from adept_traj.scene.point_clouds import PointCloud
 from adept_traj.scene.scene import Scene
 from adept_traj.scene.shapes import Sphere
 
@@ -138,8 +139,10 @@ class BroadPhase:
         #: Parent joint of each solid (n_solids,) and its placement there (n_solids, 4, 4).
         self.parents, self.local = solid_frames(robot.collision_model)
         covers = [covering_spheres(g.geometry) for g in objects]
-        #: Samples of each primitive solid's box for the point-cloud level (None: other).
-        self.cloud_samples = [cloud_samples(g.geometry) for g in objects]
+        #: Samples of each primitive solid's box for the point-cloud level (None: other
+        #: geometry, or a scene without point clouds).
+        has_clouds = any(isinstance(ob.shape, PointCloud) for ob in scene.obstacles)
+        self.cloud_samples = [cloud_samples(g.geometry) if has_clouds else None for g in objects]
         self._cover_centres = [c for c, _ in covers]  # per solid: (k, 3), solid frame
         self._cover_radii = [r for _, r in covers]
         balls = [enclosing_ball(g.geometry) for g in objects]

@@ -70,9 +70,7 @@ from adept_traj.optimise.parallel.polish_worker import (
     check_polisher,
     polish_with_certificates,
 )
-from adept_traj.optimise.search.algorithms import make_algorithm
-from adept_traj.optimise.search.loop import GenerationInfo, optimise
-from adept_traj.optimise.search.sampling import check_population_memory
+from adept_traj.optimise.search.run_records import GenerationInfo
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.results import (
     NO_FEASIBLE_WARNING,
@@ -295,6 +293,11 @@ def plan(
         state, settings_dict = time_optimal_run(problem, seed, **params)
         name = TIME_OPTIMAL
     else:
+        # the evolutionary search, and pymoo with it, imported only for it
+        from adept_traj.optimise.search.algorithms import make_algorithm
+        from adept_traj.optimise.search.loop import optimise
+        from adept_traj.optimise.search.sampling import check_population_memory
+
         alg, settings = make_algorithm(algorithm, pop_size, n_gen, **params)
         check_population_memory(settings.pop_size, settings.n_gen)  # before any allocation
         if not {"sampling", "starts"} & params.keys():  # the global stage's starts (#24),

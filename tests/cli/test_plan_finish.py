@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-import adept_traj.cli.plan as plan_command
 import adept_traj.cli.report as report
+import adept_traj.optimise as optimise  # cli.plan runs its plan (imported on use)
 from adept_traj.cli.app import main
 from adept_traj.results import PlanningResult
 from adept_traj.viz.plots import all_figures
@@ -49,7 +49,7 @@ def _fake(name: str, error: BaseException | None = None):
 
 def _plan(monkeypatch: pytest.MonkeyPatch, result: PlanningResult, out: Path, **fakes) -> int:
     """``adept-traj plan --out out`` whose optimiser returns ``result`` at once."""
-    monkeypatch.setattr(plan_command, "plan", lambda *_args, **_kwargs: result)
+    monkeypatch.setattr(optimise, "plan", lambda *_args, **_kwargs: result)
     for name in (*_DRAWINGS, "tool_path_3d"):
         monkeypatch.setattr(all_figures, name, fakes.get(name, _fake(name)))
     monkeypatch.setattr(all_figures, "load_matplotlib", lambda: None)  # the fakes need none

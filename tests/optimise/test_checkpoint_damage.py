@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import adept_traj.cli.plan as plan_command
+import adept_traj.optimise as optimise  # cli.plan runs its plan (imported on use)
 from adept_traj import plan
 from adept_traj.cli import main
 from adept_traj.errors import CheckpointFormatError, ConfigurationError, PlanningInterrupted
@@ -42,13 +42,13 @@ def _stop_after_first(progress: Callable | None) -> Callable:
 def cli_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A run folder of ``adept-traj plan`` stopped after generation 1 of 2."""
     folder = tmp_path_factory.mktemp("cli") / "run"
-    real = plan_command.plan
+    real = optimise.plan
 
     def stopped(*args, progress=None, **kwargs):
         return real(*args, progress=_stop_after_first(progress), **kwargs)
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(plan_command, "plan", stopped)
+        mp.setattr(optimise, "plan", stopped)
         assert main([*_RUN, "--no-plots", "--out", str(folder)]) == 130
     assert (folder / "checkpoint" / "checkpoint.npz").is_file()
     assert (folder / "run.json").is_file()

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import adept_traj.cli.plan as plan_command
+import adept_traj.optimise as optimise_package  # cli.plan runs its plan (imported on use)
 import adept_traj.optimise.parallel.early_certificates as early_module
 import adept_traj.optimise.parallel.polish_worker as polisher_module
 from adept_traj import Robot, Scene, TrajectoryProblem, plan
@@ -241,7 +241,7 @@ def test_adept_traj_plan_leaves_no_helper_behind(
             raise KeyboardInterrupt
         return stored
 
-    monkeypatch.setattr(plan_command, "plan", fake_plan)
+    monkeypatch.setattr(optimise_package, "plan", fake_plan)
     argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html"]
     argv += ["--out", str(tmp_path / "run")]
     if end == "error":
@@ -260,7 +260,7 @@ def test_no_polisher_without_a_polish(tmp_path: Path, monkeypatch: pytest.Monkey
     stored = PlanningResult.load(DATA / "result_v1")
     seen = []
     monkeypatch.setattr(
-        plan_command, "plan", lambda *a, polisher=None, **k: seen.append(polisher) or stored
+        optimise_package, "plan", lambda *a, polisher=None, **k: seen.append(polisher) or stored
     )
     argv = ["plan", "--workers", "1", "--quiet", "--no-plots", "--no-html", "--no-polish"]
     assert main([*argv, "--out", str(tmp_path / "run")]) == 1  # (its best: not certified)

@@ -26,6 +26,7 @@ import pytest
 import adept_traj as at
 import adept_traj.cli.plan as plan_command
 import adept_traj.cli.report as report
+import adept_traj.optimise as optimise  # cli.plan runs its plan (imported on use)
 from adept_traj.cli import status
 from adept_traj.cli.app import main
 from adept_traj.errors import InvalidInputError
@@ -90,7 +91,7 @@ def _gone(pid: int, within: float = 10.0) -> bool:
 
 def _plan(monkeypatch, result, out: Path, *options: str, plan=None, **fakes) -> int:
     """``adept-traj plan --out out`` whose optimiser returns ``result`` (or runs ``plan``)."""
-    monkeypatch.setattr(plan_command, "plan", plan or (lambda *_a, **_k: result))
+    monkeypatch.setattr(optimise, "plan", plan or (lambda *_a, **_k: result))
     for name in (*_DRAWINGS, "tool_path_3d"):
         monkeypatch.setattr(all_figures, name, fakes.get(name, _fake(name)))
     monkeypatch.setattr(all_figures, "load_matplotlib", lambda: None)  # the fakes need none

@@ -20,7 +20,7 @@ The grouping is greedy in the given order (pass the moves fastest first): a move
 first basin whose first move (its representative) is within the threshold, else it starts
 a new basin. Chosen over a topological signature (which side of each obstacle a move
 passes, at which phase of each swing) because it needs nothing of the obstacles' shapes
-and works the same for any robot and scene; the threshold (:data:`THRESHOLD`, 10 % of each
+and works the same for any robot and scene; the threshold (:data:`BASIN_THRESHOLD`, 10 % of each
 joint's range) is documented in ``docs/detour-scene.md``.
 """
 
@@ -33,16 +33,16 @@ import numpy as np
 from adept_traj.errors import ConfigurationError
 from adept_traj.validation import as_batch, as_scalar
 
-__all__ = ["N_INSTANTS", "THRESHOLD", "basin_labels", "basin_starts"]
+__all__ = ["BASIN_THRESHOLD", "N_INSTANTS", "basin_labels", "basin_starts"]
 
 #: Instants at which two moves are compared.
 N_INSTANTS = 48
 
 #: Largest joint distance of one basin, as a fraction of each joint's range.
-THRESHOLD = 0.10
+BASIN_THRESHOLD = 0.10
 
 
-def basin_labels(problem: Any, x: Any, *, threshold: float = THRESHOLD) -> np.ndarray:
+def basin_labels(problem: Any, x: Any, *, threshold: float = BASIN_THRESHOLD) -> np.ndarray:
     """(n,) int basin of each move ``x`` (n, n_var), numbered 0, 1, … in order of first
     appearance (module docstring).
 

@@ -50,7 +50,7 @@ from adept_traj.optimise.local.multi_start import fastest_of_basins, time_optima
 from adept_traj.optimise.local.refinement import (
     SCREEN_BOXES,
 )
-from adept_traj.optimise.search.loop import RunState
+from adept_traj.optimise.search.run_records import RunState
 from adept_traj.problem import from_pymoo, to_pymoo
 from adept_traj.robot.limits import LIMITS
 

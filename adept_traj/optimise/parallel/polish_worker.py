@@ -37,7 +37,7 @@ from adept_traj.errors import ConfigurationError, WorkerDiedError
 from adept_traj.optimise.local.multi_start import made_relaxed_optima
 from adept_traj.optimise.local.polish_modes import polish_mode, polish_run_with_certificates
 from adept_traj.optimise.parallel.early_certificates import EarlyCertificates, feasible_front
-from adept_traj.optimise.search.loop import RunState
+from adept_traj.optimise.search.run_records import RunState
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.process_helper import Helper
 from adept_traj.process_pool import Channel, Worker, can_fork

@@ -56,28 +56,12 @@ from adept_traj.optimise.operators.population import ArrayEvaluator, ranked_opti
 from adept_traj.optimise.operators.repair import KinematicTimeRepair
 from adept_traj.optimise.operators.survival import RankAndCrowdingSurvival
 from adept_traj.optimise.operators.tournament import binary_tournament
+from adept_traj.optimise.search.algorithm_names import ALGORITHMS, PAPER_SETTINGS
 from adept_traj.optimise.search.fast_end_search import FastEndSearch
 from adept_traj.optimise.search.sampling import RampSampling, SeededInitialization
 from adept_traj.validation import as_integer, as_scalar
 
-__all__ = ["ALGORITHMS", "AlgorithmSettings", "make_algorithm"]
-
-#: Paper defaults per algorithm (population, generations, operator parameters).
-_PAPER: dict[str, dict[str, Any]] = {
-    "nsga2": {
-        "pop_size": 100,
-        "n_gen": 100,
-        "crossover_prob": 0.7,
-        "crossover_eta": 10.0,
-        "mutation_prob_var": 0.01,
-        "mutation_eta": 100.0,
-    },
-    "mode": {"pop_size": 500, "n_gen": 100, "CR": 0.9, "F": 0.5},
-}
-_OTHERS = ("nsga3", "unsga3", "smsemoa", "rvea")
-
-#: Names accepted by :func:`make_algorithm`.
-ALGORITHMS: tuple[str, ...] = (*_PAPER, *_OTHERS)
+__all__ = ["AlgorithmSettings", "make_algorithm"]
 
 
 @dataclass(frozen=True)
@@ -145,7 +129,7 @@ def make_algorithm(
     key = {"nsgaii": "nsga2", "mode/rand/bin": "mode", "nsgaiii": "nsga3"}.get(key, key)
     if key not in ALGORITHMS:
         raise ConfigurationError(f"unknown algorithm {name!r}; choose one of {list(ALGORITHMS)}")
-    defaults = dict(_PAPER.get(key, {"pop_size": 100, "n_gen": 100}))
+    defaults = dict(PAPER_SETTINGS.get(key, {"pop_size": 100, "n_gen": 100}))
     default_pop, default_gens = defaults.pop("pop_size"), defaults.pop("n_gen")
     pop_size = default_pop if pop_size is None else pop_size
     n_gen = default_gens if n_gen is None else n_gen

@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -44,51 +43,13 @@ from adept_traj.optimise.search.checkpoint import (
     restore_algorithm,
     write_checkpoint,
 )
+from adept_traj.optimise.search.run_records import GenerationInfo, RunState
 from adept_traj.validation import as_scalar
 
-__all__ = ["CHECKPOINT_INTERVAL", "GenerationInfo", "RunState", "optimise"]
+__all__ = ["CHECKPOINT_INTERVAL", "optimise"]
 
 #: Shortest wall time [s] between two checkpoint writes (each one flushed to disk).
 CHECKPOINT_INTERVAL = 1.0
-
-
-@dataclass(frozen=True)
-class GenerationInfo:
-    """Progress of one finished generation (passed to the progress callback)."""
-
-    generation: int
-    n_gen: int
-    n_evaluations: int
-    n_feasible: int
-    #: Smallest travel time z1 [s] among the feasible individuals (None if none is feasible).
-    best_time: float | None
-    #: Wall time [s] since the run started (a resumed run includes the earlier sessions).
-    elapsed_s: float
-
-
-@dataclass(frozen=True)
-class RunState:
-    """Final population and bookkeeping of a run.
-
-    ``X`` (pop, n_var), ``F`` (pop, n_obj) as pymoo sees them (maximised columns negated:
-    :func:`~adept_traj.problem.to_pymoo`), ``G`` (pop, n_constr), ``CV`` (pop,) total
-    constraint violation; ``total_s`` and
-    ``evaluation_s`` [s] the wall time of the run and the part spent evaluating (earlier
-    sessions of a resumed run included); ``history`` one dict per generation.
-    """
-
-    X: np.ndarray
-    F: np.ndarray
-    G: np.ndarray
-    CV: np.ndarray
-    n_generations: int
-    n_evaluations: int
-    total_s: float
-    evaluation_s: float
-    history: list[dict[str, Any]] = field(default_factory=list)
-    #: Per generation (restored on resume): the objectives (pymoo's sense) of the
-    #: population's feasible non-dominated members, for the hypervolume history.
-    fronts: list[np.ndarray] = field(default_factory=list)
 
 
 def optimise(
