@@ -58,6 +58,7 @@ __all__ = [
     "certify_member",
     "certify_members",
     "certifying_problem",
+    "checked_members",
 ]
 
 #: Influence distance above the margin [m] of the front's certificates: the distances at
@@ -181,14 +182,8 @@ def certify_members(
     tuple
         (n,) a :class:`MemberCertificate` per certified row, ``None`` for the others.
     """
-    check_type(problem, TrajectoryProblem, "problem")
-    xs = as_batch(x, "x", problem.n_var)
-    if xs.ndim != 2:
-        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
-    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    xs, rows, rate = checked_members(problem, x, members, rate_hz)
     tol = as_scalar(tolerance, "tolerance", minimum=0.0)
-    rows = range(len(xs)) if members is None else members
-    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in rows]
     out: list[MemberCertificate | None] = [None] * len(xs)
     if not rows:
         return tuple(out)
@@ -209,6 +204,33 @@ def certify_members(
             )
             out[k] = MemberCertificate.of(certificate, influence)
     return tuple(out)
+
+
+def checked_members(
+    problem: Any, x: Any, members: Iterable[int] | None, rate_hz: Any
+) -> tuple[np.ndarray, list[int], float]:
+    """The input of the front members' certificates, checked: ``problem`` a
+    :class:`~adept_traj.problem.TrajectoryProblem`, ``x`` (n, n_var) decision vectors,
+    ``members`` rows of ``x`` (``None``: all), ``rate_hz`` [Hz] > 0.
+
+    Returns
+    -------
+    tuple
+        (``x`` as a float array (n, n_var), the rows as integers, the rate [Hz]).
+
+    Raises
+    ------
+    InvalidInputError
+        A value out of its range (:class:`~adept_traj.errors.InputShapeError`: ``x`` of
+        another shape).
+    """
+    check_type(problem, TrajectoryProblem, "problem")
+    xs = as_batch(x, "x", problem.n_var)
+    if xs.ndim != 2:
+        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
+    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
+    rows = range(len(xs)) if members is None else members
+    return xs, [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in rows], rate
 
 
 def certify_member(

@@ -44,7 +44,12 @@ from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
 from adept_traj.cycle.move_task import cycle_tasks
 from adept_traj.cycle.recertify import RestCertifier
 from adept_traj.cycle.rest import certify_rest
-from adept_traj.cycle.runner import MOVES_FOLDER, dask_client, run_planning_tasks
+from adept_traj.cycle.runner import (
+    MOVES_FOLDER,
+    dask_client,
+    refuse_earlier_run,
+    run_planning_tasks,
+)
 from adept_traj.cycle.schedules import SAME_TIME
 from adept_traj.cycle.timeline import ClockedMove, CycleClock
 from adept_traj.errors import CycleError
@@ -163,8 +168,7 @@ def plan_on_clock(
             f"moves, more than MAX_CLOCKED_MOVES = {MAX_CLOCKED_MOVES}; lower repeat"
         )
     where = Path(out) / MOVES_FOLDER
-    if not resume and where.exists() and any(where.iterdir()):
-        raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
+    refuse_earlier_run(where, resume)
     robot, settings = cycle.robot.load(), ProblemSettings()
     rest = {"settings": settings, "rate_hz": cycle.rate_hz}
     tasks = cycle_tasks(cycle)

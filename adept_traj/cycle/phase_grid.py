@@ -77,7 +77,12 @@ from adept_traj.cycle.cycle_file import MAX_DWELL_CANDIDATES, Cycle
 from adept_traj.cycle.move_task import MoveTask, cycle_tasks
 from adept_traj.cycle.recertify import MoveCertifier, PlannedMove, RestCertifier
 from adept_traj.cycle.rest import RestProfile
-from adept_traj.cycle.runner import MOVES_FOLDER, dask_client, run_planning_tasks
+from adept_traj.cycle.runner import (
+    MOVES_FOLDER,
+    dask_client,
+    refuse_earlier_run,
+    run_planning_tasks,
+)
 from adept_traj.cycle.schedules import (
     SAME_TIME,
     PhaseOption,
@@ -180,8 +185,7 @@ def plan_phase_grid(
             "periodic with a common period); plan it with plan_on_clock"
         )
     where = Path(out) / MOVES_FOLDER
-    if not resume and where.exists() and any(where.iterdir()):
-        raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
+    refuse_earlier_run(where, resume)
     grid = P * np.arange(n) / n
     base = cycle_tasks(cycle)
     K = len(base)

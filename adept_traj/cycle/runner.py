@@ -46,6 +46,7 @@ __all__ = [
     "MOVE_FILE",
     "RETRIES",
     "dask_client",
+    "refuse_earlier_run",
     "run_cycle",
     "run_planning_tasks",
     "run_tasks",
@@ -200,6 +201,23 @@ def _run_on(
     return out
 
 
+def refuse_earlier_run(folder: Path, resume: bool) -> None:
+    """Refuse to plan a cycle into a folder that holds an earlier run, unless resuming.
+
+    Parameters
+    ----------
+    folder: the moves' folder of the run (``out/moves``).
+    resume: the run keeps the moves already saved there (nothing is refused).
+
+    Raises
+    ------
+    CycleError
+        ``folder`` exists and is not empty, and ``resume`` is false.
+    """
+    if not resume and folder.exists() and any(folder.iterdir()):
+        raise CycleError(f"{folder} holds an earlier run: give --resume or another folder")
+
+
 def run_planning_tasks(
     tasks: Sequence[MoveTask],
     folder: str | os.PathLike[str],
@@ -224,8 +242,7 @@ def run_planning_tasks(
     (:func:`~adept_traj.cycle.move_task.relaxed_optima`); ``relaxed``: those already made
     (by group), kept and added to over the calls."""
     where = Path(folder)
-    if not resume and where.exists() and any(where.iterdir()):
-        raise CycleError(f"{where} holds an earlier run: give --resume or another folder")
+    refuse_earlier_run(where, resume)
     results: list[PlanningResult | None] = [None] * len(tasks)
     pending = []
     for i, task in enumerate(tasks):

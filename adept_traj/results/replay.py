@@ -53,14 +53,9 @@ class Replay:
     start_time: float = 0.0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.robot, Robot):
-            raise InvalidInputError(f"robot must be a Robot; got {type(self.robot).__name__}")
-        if not isinstance(self.scene, Scene):
-            raise InvalidInputError(f"scene must be a Scene; got {type(self.scene).__name__}")
-        if not isinstance(self.trajectory, BSplineTrajectory):
-            raise InvalidInputError(
-                f"trajectory must be a BSplineTrajectory; got {type(self.trajectory).__name__}"
-            )
+        check_type(self.robot, Robot, "robot")
+        check_type(self.scene, Scene, "scene")
+        check_type(self.trajectory, BSplineTrajectory, "trajectory")
         if self.trajectory.nq != self.robot.nq:
             raise InputShapeError(
                 f"trajectory has {self.trajectory.nq} joints, the robot {self.robot.nq}"

@@ -40,9 +40,12 @@ import numpy as np
 
 from adept_traj.analysis.decision import best_tradeoff
 from adept_traj.analysis.indicators import non_dominated
-from adept_traj.certification.member_certificate import MemberCertificate, certify_members
+from adept_traj.certification.member_certificate import (
+    MemberCertificate,
+    certify_members,
+    checked_members,
+)
 from adept_traj.errors import WorkerDiedError
-from adept_traj.optimise.parallel.front_certificates import checked_members
 from adept_traj.problem import TrajectoryProblem, from_pymoo
 from adept_traj.process_helper import Helper
 from adept_traj.process_pool import Channel, Worker, can_fork

@@ -17,19 +17,17 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
-
 from adept_traj.certification.member_certificate import (
     MemberCertificate,
     certify_members,
     certifying_problem,
+    checked_members,
 )
-from adept_traj.errors import InputShapeError
 from adept_traj.problem import TrajectoryProblem
 from adept_traj.process_pool import can_fork, map_forked
-from adept_traj.validation import as_batch, as_integer, as_scalar, check_type
+from adept_traj.validation import as_integer
 
-__all__ = ["certify_front_members", "checked_members"]
+__all__ = ["certify_front_members"]
 
 
 def certify_front_members(
@@ -76,30 +74,3 @@ def certify_front_members(
         for k, certificate in zip(share, part):
             out[k] = certificate
     return tuple(out)
-
-
-def checked_members(
-    problem: Any, x: Any, members: Sequence[int], rate_hz: Any
-) -> tuple[np.ndarray, list[int], float]:
-    """The input of a front's certificates, checked: ``problem`` a
-    :class:`~adept_traj.problem.TrajectoryProblem`, ``x`` (n, n_var) decision vectors,
-    ``members`` rows of ``x``, ``rate_hz`` [Hz] > 0.
-
-    Returns
-    -------
-    tuple
-        (``x`` as a float array (n, n_var), the rows as integers, the rate [Hz]).
-
-    Raises
-    ------
-    InvalidInputError
-        A value out of its range (:class:`~adept_traj.errors.InputShapeError`: ``x`` of
-        another shape).
-    """
-    check_type(problem, TrajectoryProblem, "problem")
-    xs = as_batch(x, "x", problem.n_var)
-    if xs.ndim != 2:
-        raise InputShapeError(f"x must have shape (n, {problem.n_var}); got {xs.shape}")
-    rate = as_scalar(rate_hz, "rate_hz", "[Hz]", minimum=0.0, strict=True)
-    rows = [as_integer(k, "member", minimum=0, maximum=len(xs) - 1) for k in members]
-    return xs, rows, rate
