@@ -53,3 +53,25 @@ def test_the_moved_names_are_found_where_they_were() -> None:
     assert adept_traj.results.AUDIT_RTOL == adept_traj.certification.mismatches.AUDIT_RTOL
     with pytest.raises(AttributeError):
         adept_traj.results.certify  # noqa: B018  (moved to certification, not from results)
+
+
+def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_search() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from adept_traj.optimise import ALGORITHMS, POLISH_MODES, TIME_OPTIMAL, RunState\n"
+        "heavy = ('moocore', 'pymoo.algorithms', 'pymoo.util.nds', 'adept_traj.optimise.search.loop')\n"
+        "print(sorted(m for m in sys.modules if m.startswith(heavy)))\n"
+        "import adept_traj.optimise as o\n"
+        "missing = [n for n in o.__all__ if getattr(o, n, None) is None]\n"
+        "print(len(o.__all__), missing)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    light, resolved = done.stdout.splitlines()
+    assert light == "[]"
+    count, missing = resolved.split(" ", 1)
+    assert int(count) > 90
+    assert missing == "[]"
