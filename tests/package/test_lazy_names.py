@@ -62,7 +62,8 @@ def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_se
     code = (
         "import sys\n"
         "from adept_traj.optimise import ALGORITHMS, POLISH_MODES, TIME_OPTIMAL, RunState\n"
-        "heavy = ('moocore', 'pymoo.algorithms', 'pymoo.util.nds', 'adept_traj.optimise.search.loop')\n"
+        "heavy = ('moocore', 'pymoo.algorithms', 'pymoo.util.nds',"
+        " 'adept_traj.optimise.search.loop')\n"
         "print(sorted(m for m in sys.modules if m.startswith(heavy)))\n"
         "import adept_traj.optimise as o\n"
         "missing = [n for n in o.__all__ if getattr(o, n, None) is None]\n"
