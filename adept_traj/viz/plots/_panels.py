@@ -4,7 +4,7 @@ A matplotlib ``Axes`` is costly to make and draw (its axis objects, ticks and
 spines), so the figures with many panels (the Pareto matrix: 36, the joint motion: 20)
 draw every panel as a cell of one ``Axes`` with its own scale, each kind of line as one
 collection over all the cells, and only the tick labels that are seen as text. The texts
-are made by :func:`panel_text` (as ``Axes.text`` makes them, without the unused clip path),
+are made by :func:`panel_texts` (as ``Axes.text`` makes them, their unused clip path shared),
 their offset transforms shared (:func:`shifter`).
 """
 
@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["hidden_axes", "panel_text", "shifted", "shifter", "tick_labels"]
+__all__ = ["hidden_axes", "panel_texts", "shifted", "shifter", "tick_labels"]
 
 _SUPERSCRIPT = str.maketrans("-−0123456789", "⁻⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
@@ -53,16 +53,22 @@ def shifter(ax: Any) -> Callable[[float, float], Any]:
     return shift
 
 
-def panel_text(ax: Any, x: float, y: float, s: str, **kwargs: Any) -> Any:
-    """A text at (``x``, ``y``) in ``ax``'s data coordinates (or ``transform=``), with
-    ``Axes.text``'s defaults (left, baseline, not clipped) and ``kwargs`` (``Text``
-    properties), drawn by the figure just after the axes (texts are on top of every
-    panel). ``Axes.text`` would give it the axes' patch as clip path, whose transform is
-    costly to make and unused: the text is not clipped. Returns the ``Text``."""
+def panel_texts(ax: Any) -> Callable[..., Any]:
+    """``Axes.text`` for ``ax``, made cheaper: ``text(x, y, s, **kwargs)`` adds a text at
+    (``x``, ``y``) in ``ax``'s data coordinates (or ``transform=``) with ``Axes.text``'s
+    defaults (left, baseline, not clipped) and returns it. ``Axes.text`` gives every text
+    the axes' patch as clip path, whose transform is costly to make, and unused (the text
+    is not clipped): these texts share one, made once."""
     from matplotlib.text import Text
+    from matplotlib.transforms import TransformedPatchPath
 
-    text = Text(x, y, s, **{"transform": ax.transData, "clip_on": False, **kwargs})
-    ax.figure.add_artist(text)
+    clip = TransformedPatchPath(ax.patch)
+
+    def text(x: float, y: float, s: str, **kwargs: Any) -> Any:
+        t = Text(x, y, s, **{"transform": ax.transData, "clip_on": False, **kwargs})
+        t.set_clip_path(clip)
+        return ax.add_artist(t)
+
     return text
 
 

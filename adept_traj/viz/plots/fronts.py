@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.results import PlanningResult
-from adept_traj.viz.plots._panels import hidden_axes, panel_text, shifter, tick_labels
+from adept_traj.viz.plots._panels import hidden_axes, panel_texts, shifter, tick_labels
 from adept_traj.viz.plots.common import (
     COLOURS,
     MARKERS,
@@ -152,6 +152,7 @@ def _frames_and_ticks(ax: Any, limits: np.ndarray) -> None:
 
     m = len(limits)
     shift = shifter(ax)
+    put = panel_texts(ax)
     boxes = [Rectangle((j, m - 1 - i), _SIDE, _SIDE) for i in range(m) for j in range(m)]
     shade = ["#f4f4f4" if i == j else "white" for i in range(m) for j in range(m)]
     ax.add_collection(PatchCollection(boxes, facecolors=shade, edgecolors="none", zorder=0))
@@ -167,19 +168,19 @@ def _frames_and_ticks(ax: Any, limits: np.ndarray) -> None:
         for p, text in zip(pos, texts):
             ticks.append([(j + p, 0.0), (j + p, -0.012)])
             ticks.append([(0.0, m - 1 - j + p), (-0.012, m - 1 - j + p)])
-            panel_text(ax, j + p, 0.0, text, transform=below, fontsize=7, ha="center", va="top")
-            panel_text(ax, 0.0, m - 1 - j + p, text, transform=left_of, fontsize=7, ha="right",
-                    va="center")  # fmt: skip
+            put(j + p, 0.0, text, transform=below, fontsize=7, ha="center", va="top")
+            put(0.0, m - 1 - j + p, text, transform=left_of, fontsize=7, ha="right",
+                va="center")  # fmt: skip
         if offset:
-            panel_text(ax, j + _SIDE, 0.0, offset, transform=shift(0.0, -13.0), fontsize=7,
-                    ha="right", va="top")  # fmt: skip
-            panel_text(ax, 0.0, m - 1 - j + _SIDE, offset, transform=shift(0.0, 2.0),
-                    fontsize=7, ha="left", va="bottom")  # fmt: skip
-        panel_text(ax, j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shift(0.0, -14.0),
-                fontsize=9, ha="center", va="top")  # fmt: skip
-        panel_text(ax, 0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j],
+            put(j + _SIDE, 0.0, offset, transform=shift(0.0, -13.0), fontsize=7,
+                ha="right", va="top")  # fmt: skip
+            put(0.0, m - 1 - j + _SIDE, offset, transform=shift(0.0, 2.0),
+                fontsize=7, ha="left", va="bottom")  # fmt: skip
+        put(j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shift(0.0, -14.0),
+            fontsize=9, ha="center", va="top")  # fmt: skip
+        put(0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j],
                 transform=shift(-30.0, 0.0), fontsize=9, ha="right", va="center",
                 rotation=90)  # fmt: skip
-        panel_text(ax, j + 0.04 * _SIDE, m - 1 - j + 0.93 * _SIDE, f"z{j + 1}", fontsize=10,
-                fontweight="bold", va="top")  # fmt: skip
+        put(j + 0.04 * _SIDE, m - 1 - j + 0.93 * _SIDE, f"z{j + 1}", fontsize=10,
+            fontweight="bold", va="top")  # fmt: skip
     ax.add_collection(LineCollection(ticks, colors="black", lw=0.8))
