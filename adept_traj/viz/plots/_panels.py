@@ -3,17 +3,20 @@
 A matplotlib ``Axes`` is costly to make and draw (its axis objects, ticks and
 spines), so the figures with many panels (the Pareto matrix: 36, the joint motion: 20)
 draw every panel as a cell of one ``Axes`` with its own scale, each kind of line as one
-collection over all the cells, and only the tick labels that are seen as text.
+collection over all the cells, and only the tick labels that are seen as text. The texts
+are made by :func:`panel_texts` (as ``Axes.text`` makes them, their unused clip path shared),
+their offset transforms shared (:func:`shifter`).
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-__all__ = ["hidden_axes", "shifted", "tick_labels"]
+__all__ = ["hidden_axes", "panel_texts", "shifted", "shifter", "tick_labels"]
 
 _SUPERSCRIPT = str.maketrans("-−0123456789", "⁻⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
@@ -35,6 +38,38 @@ def shifted(ax: Any, dx: float, dy: float) -> Any:
     from matplotlib.transforms import offset_copy
 
     return offset_copy(ax.transData, fig=ax.figure, x=dx, y=dy, units="points")
+
+
+def shifter(ax: Any) -> Callable[[float, float], Any]:
+    """:func:`shifted` for ``ax``, each offset (``dx``, ``dy``) [points] made once: the texts
+    at one offset share its transform."""
+    made: dict[tuple[float, float], Any] = {}
+
+    def shift(dx: float, dy: float) -> Any:
+        if (dx, dy) not in made:
+            made[dx, dy] = shifted(ax, dx, dy)
+        return made[dx, dy]
+
+    return shift
+
+
+def panel_texts(ax: Any) -> Callable[..., Any]:
+    """``Axes.text`` for ``ax``, made cheaper: ``text(x, y, s, **kwargs)`` adds a text at
+    (``x``, ``y``) in ``ax``'s data coordinates (or ``transform=``) with ``Axes.text``'s
+    defaults (left, baseline, not clipped) and returns it. ``Axes.text`` gives every text
+    the axes' patch as clip path, whose transform is costly to make, and unused (the text
+    is not clipped): these texts share one, made once."""
+    from matplotlib.text import Text
+    from matplotlib.transforms import TransformedPatchPath
+
+    clip = TransformedPatchPath(ax.patch)
+
+    def text(x: float, y: float, s: str, **kwargs: Any) -> Any:
+        t = Text(x, y, s, **{"transform": ax.transData, "clip_on": False, **kwargs})
+        t.set_clip_path(clip)
+        return ax.add_artist(t)
+
+    return text
 
 
 def tick_labels(

@@ -42,12 +42,13 @@ def encode_png(rgba: np.ndarray, dpi: float, level: int) -> bytes:
     The PNG file: 8-bit RGB (colour type 2) when every pixel is opaque, else RGBA (6);
     rows unfiltered (filter type 0); no text chunks.
     """
-    pixels = np.asarray(rgba, dtype=np.uint8)
+    pixels = np.ascontiguousarray(rgba, dtype=np.uint8)
     h, w = pixels.shape[:2]
-    opaque = bool((pixels[..., 3] == 255).all())
+    opaque = int(pixels[..., 3].min()) == 255
     channels = 3 if opaque else 4
-    rows = np.zeros((h, 1 + w * channels), dtype=np.uint8)  # a filter byte 0 per row
-    rows[:, 1:] = pixels[..., :channels].reshape(h, w * channels)
+    rows = np.empty((h, 1 + w * channels), dtype=np.uint8)
+    rows[:, 0] = 0  # filter type 0 (none) for every row
+    rows[:, 1:].reshape(h, w, channels)[...] = pixels[..., :channels]  # a view: no copy
     ppm = int(dpi / _INCH + 0.5)  # pixels per metre, as Pillow rounds them
     header = struct.pack(">IIBBBBB", w, h, 8, 2 if opaque else 6, 0, 0, 0)
     return b"".join(

@@ -16,8 +16,10 @@ swallowed; a worker that dies without a word has its figures drawn again by the 
 
 from __future__ import annotations
 
+import gc
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -144,8 +146,9 @@ def draw_jobs(jobs: list[Job], processes: int) -> None:
     """
     processes = min(processes, len(jobs))
     if processes == 1 or not can_fork():
-        for _, draw in jobs:
-            draw()
+        with _frozen_heap():
+            for _, draw in jobs:
+                draw()
         return
     load_matplotlib()  # imported once, before the fork, for every process
     shares: list[list[int]] = [[] for _ in range(processes)]
@@ -158,8 +161,9 @@ def draw_jobs(jobs: list[Job], processes: int) -> None:
     try:
         for share in shares[1:]:
             workers.append(Worker(_draw_share, [jobs[i][1] for i in share], note=_NOTE))
-        for i in shares[0]:
-            jobs[i][1]()
+        with _frozen_heap():
+            for i in shares[0]:
+                jobs[i][1]()
         for worker, share in zip(workers, shares[1:]):
             try:
                 worker.recv()
@@ -173,9 +177,24 @@ def draw_jobs(jobs: list[Job], processes: int) -> None:
 
 def _draw_share(channel: Channel, draws: list[Callable[[], Path]]) -> None:
     """A worker: draw these figures, then say so."""
-    for draw in draws:
-        draw()
+    with _frozen_heap():
+        for draw in draws:
+            draw()
     channel.send(None)
+
+
+@contextmanager
+def _frozen_heap() -> Iterator[None]:
+    """The objects alive on entry moved out of the garbage collector's reach
+    (:func:`gc.freeze`) until the block ends: the collections that the figures' many new
+    matplotlib objects trigger then scan these objects only, not the whole heap (the
+    robot, the results, numpy and matplotlib themselves). Garbage of the block is
+    collected as usual."""
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 def _replays(replays: Any, results: Mapping[str, PlanningResult]) -> dict[str, Replay]:

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from adept_traj.results import PlanningResult
-from adept_traj.viz.plots._panels import hidden_axes, shifted, tick_labels
+from adept_traj.viz.plots._panels import hidden_axes, panel_texts, shifter, tick_labels
 from adept_traj.viz.plots.common import (
     COLOURS,
     MARKERS,
@@ -151,12 +151,14 @@ def _frames_and_ticks(ax: Any, limits: np.ndarray) -> None:
     from matplotlib.patches import Rectangle
 
     m = len(limits)
+    shift = shifter(ax)
+    put = panel_texts(ax)
     boxes = [Rectangle((j, m - 1 - i), _SIDE, _SIDE) for i in range(m) for j in range(m)]
     shade = ["#f4f4f4" if i == j else "white" for i in range(m) for j in range(m)]
     ax.add_collection(PatchCollection(boxes, facecolors=shade, edgecolors="none", zorder=0))
     frames = PatchCollection(boxes, facecolors="none", edgecolors="black", lw=0.8, zorder=2.5)
     ax.add_collection(frames)
-    below, left_of = shifted(ax, 0.0, -3.5), shifted(ax, -3.5, 0.0)
+    below, left_of = shift(0.0, -3.5), shift(-3.5, 0.0)
     ticks = []
     for j in range(m):
         lo, hi = limits[j]
@@ -166,19 +168,19 @@ def _frames_and_ticks(ax: Any, limits: np.ndarray) -> None:
         for p, text in zip(pos, texts):
             ticks.append([(j + p, 0.0), (j + p, -0.012)])
             ticks.append([(0.0, m - 1 - j + p), (-0.012, m - 1 - j + p)])
-            ax.text(j + p, 0.0, text, transform=below, fontsize=7, ha="center", va="top")
-            ax.text(0.0, m - 1 - j + p, text, transform=left_of, fontsize=7, ha="right",
-                    va="center")  # fmt: skip
+            put(j + p, 0.0, text, transform=below, fontsize=7, ha="center", va="top")
+            put(0.0, m - 1 - j + p, text, transform=left_of, fontsize=7, ha="right",
+                va="center")  # fmt: skip
         if offset:
-            ax.text(j + _SIDE, 0.0, offset, transform=shifted(ax, 0.0, -13.0), fontsize=7,
-                    ha="right", va="top")  # fmt: skip
-            ax.text(0.0, m - 1 - j + _SIDE, offset, transform=shifted(ax, 0.0, 2.0),
-                    fontsize=7, ha="left", va="bottom")  # fmt: skip
-        ax.text(j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shifted(ax, 0.0, -14.0),
-                fontsize=9, ha="center", va="top")  # fmt: skip
-        ax.text(0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j],
-                transform=shifted(ax, -30.0, 0.0), fontsize=9, ha="right", va="center",
+            put(j + _SIDE, 0.0, offset, transform=shift(0.0, -13.0), fontsize=7,
+                ha="right", va="top")  # fmt: skip
+            put(0.0, m - 1 - j + _SIDE, offset, transform=shift(0.0, 2.0),
+                fontsize=7, ha="left", va="bottom")  # fmt: skip
+        put(j + 0.5 * _SIDE, 0.0, OBJECTIVE_LABELS[j], transform=shift(0.0, -14.0),
+            fontsize=9, ha="center", va="top")  # fmt: skip
+        put(0.0, m - 1 - j + 0.5 * _SIDE, OBJECTIVE_LABELS[j],
+                transform=shift(-30.0, 0.0), fontsize=9, ha="right", va="center",
                 rotation=90)  # fmt: skip
-        ax.text(j + 0.04 * _SIDE, m - 1 - j + 0.93 * _SIDE, f"z{j + 1}", fontsize=10,
-                fontweight="bold", va="top")  # fmt: skip
+        put(j + 0.04 * _SIDE, m - 1 - j + 0.93 * _SIDE, f"z{j + 1}", fontsize=10,
+            fontweight="bold", va="top")  # fmt: skip
     ax.add_collection(LineCollection(ticks, colors="black", lw=0.8))

@@ -14,7 +14,7 @@ import numpy as np
 from adept_traj.results import PlanningResult, certified_members, member_dense, member_index
 from adept_traj.robot import LIMITS
 from adept_traj.viz.inputs import as_result
-from adept_traj.viz.plots._panels import hidden_axes, shifted, tick_labels
+from adept_traj.viz.plots._panels import hidden_axes, panel_texts, shifter, tick_labels
 from adept_traj.viz.plots.common import (
     display_name,
     new_figure,
@@ -108,6 +108,8 @@ def joint_motion(
     fig = new_figure(4.0 * nq + 1.0, 13.5)
     n_rows = len(LIMITS)
     ax = hidden_axes(fig, _BOX, nq * _PITCH_X - _GAP_X, n_rows * _PITCH_Y - _GAP_Y)
+    shift = shifter(ax)
+    put = panel_texts(ax)
     t0, t1 = float(t[0]), float(t[-1])
     x_locs, x_texts, _ = tick_labels(t0, t1, 5)  # the columns share the time axis
     x_pos = (x_locs - t0) / (t1 - t0)
@@ -137,19 +139,17 @@ def joint_motion(
             x_ticks += [(x0 + x, y0) for x in x_pos]
             y_ticks += [(x0, y) for y in y_pos]
             for y, text in zip(y_pos, y_texts):
-                ax.text(x0, y, text, transform=shifted(ax, -7.0, 0.0), fontsize=8, ha="right",
-                        va="center")  # fmt: skip
+                put(x0, y, text, transform=shift(-7.0, 0.0), fontsize=8, ha="right",
+                    va="center")  # fmt: skip
             if offset:
-                ax.text(
-                    x0, y0 + 1.0, offset, transform=shifted(ax, 0.0, 2.0), fontsize=8, va="bottom"
-                )
+                put(x0, y0 + 1.0, offset, transform=shift(0.0, 2.0), fontsize=8, va="bottom")
             # the label left of the widest tick label (about 0.62 em a character) [points]
             width = 7.0 + 0.62 * 8 * max((len(s) for s in y_texts), default=0) + 4.0
-            ax.text(x0, y0 + 0.5, f"{title} [{unit}]", transform=shifted(ax, -width, 0.0),
-                    fontsize=9, ha="right", va="center", rotation=90)  # fmt: skip
+            put(x0, y0 + 0.5, f"{title} [{unit}]", transform=shift(-width, 0.0),
+                fontsize=9, ha="right", va="center", rotation=90)  # fmt: skip
             note = _note(limits, kind.name, j, data[:, j])
             if note:
-                ax.text(
+                put(
                     x0 + 0.98,
                     y0 + 0.04,
                     note,
@@ -161,21 +161,21 @@ def joint_motion(
                 )
             if row == 0:
                 joint_type = "revolute" if limits.units[j] == "rad" else "prismatic"
-                ax.text(
+                put(
                     x0 + 0.5,
                     y0 + 1.0,
                     f"{limits.names[j]} ({joint_type})",
-                    transform=shifted(ax, 0.0, 6.0),
+                    transform=shift(0.0, 6.0),
                     fontsize=11,
                     ha="center",
                     va="bottom",
                 )
             if row == n_rows - 1:
                 for x, text in zip(x_pos, x_texts):
-                    ax.text(x0 + x, y0, text, transform=shifted(ax, 0.0, -7.0), fontsize=8,
-                            ha="center", va="top")  # fmt: skip
-                ax.text(x0 + 0.5, y0, "time t [s]", transform=shifted(ax, 0.0, -19.0),
-                        fontsize=9, ha="center", va="top")  # fmt: skip
+                    put(x0 + x, y0, text, transform=shift(0.0, -7.0), fontsize=8,
+                        ha="center", va="top")  # fmt: skip
+                put(x0 + 0.5, y0, "time t [s]", transform=shift(0.0, -19.0),
+                    fontsize=9, ha="center", va="top")  # fmt: skip
     ax.add_collection(LineCollection(grid, colors="#b0b0b0", alpha=0.3, lw=0.8, zorder=1.5))
     ax.add_collection(LineCollection(curves, colors="tab:blue", lw=1.3, zorder=2))
     ax.add_collection(LineCollection(limit_lines, colors="tab:red", linestyles="--", lw=1.0,

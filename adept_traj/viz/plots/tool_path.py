@@ -56,6 +56,25 @@ def _layers(
     return layers
 
 
+def _one_style_per_line(
+    layers: list[tuple[list[np.ndarray], dict[str, Any]]],
+) -> tuple[list[np.ndarray], dict[str, Any]]:
+    """The polylines of every layer in order and the style of one collection drawing them
+    as the layers' collections would, one after the other (colours with their alpha, line
+    widths and styles per line)."""
+    from matplotlib.colors import to_rgba
+
+    lines: list[np.ndarray] = []
+    style: dict[str, list[Any]] = {"colors": [], "linewidths": [], "linestyles": []}
+    for polylines, st in layers:
+        n = len(polylines)
+        lines += polylines
+        style["colors"] += [to_rgba(st["colors"], st.get("alpha"))] * n
+        style["linewidths"] += [st["linewidths"]] * n
+        style["linestyles"] += [st.get("linestyles", "solid")] * n
+    return lines, style
+
+
 def tool_path_3d(
     result: PlanningResult, path: str | os.PathLike[str], *, replay: Replay | None = None
 ) -> Path:
@@ -153,12 +172,12 @@ def tool_path_3d(
         for g, pose in zip(robot.collision_model.geometryObjects, poses):
             close_layer += solid_wireframe(g.geometry, pose)
     close_style = {"colors": "black", "linewidths": 0.9, "linestyles": ":"}
+    flat, flat_style = _one_style_per_line([*layers, (close_layer, close_style)])
     for axv, dims, title in views:
         i, j = dims
-        for lines, style in (*layers, (close_layer, close_style)):
-            if lines:
-                flat = [ln[:, dims] for ln in lines]
-                axv.add_collection(LineCollection(flat, cmap=cmap, **style))
+        if flat:  # every layer in one collection, in the same order
+            flat2 = [ln[:, dims] for ln in flat]
+            axv.add_collection(LineCollection(flat2, cmap=cmap, **flat_style))
         path2 = LineCollection(segments[:, :, dims], cmap=cmap, norm=norm, linewidths=2.6)
         path2.set_array(t_mid)
         axv.add_collection(path2)
@@ -172,7 +191,7 @@ def tool_path_3d(
         axv.set_aspect("equal", adjustable="box")
         axv.set_xlabel(f"{'xyz'[i]} [m]")
         axv.set_ylabel(f"{'xyz'[j]} [m]")
-        axv.set_title(title, fontsize=10)
+        axv.set_title(title, fontsize=10, y=1.0)  # where matplotlib puts it, not searched
         axv.grid(alpha=0.3)
     cb = fig.colorbar(path3, ax=[v[0] for v in views], shrink=0.8, pad=0.03)
     cb.set_label("time along the tool path t [s]")
