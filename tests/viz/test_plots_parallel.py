@@ -207,3 +207,24 @@ def test_cancel_stops_the_forked_process(
 def test_start_save_all_checks_its_arguments_first(result: PlanningResult, tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match=r"processes must be an integer in \[1, ∞\]"):
         plots.start_save_all(result, tmp_path, processes=0)
+
+
+def test_drawing_keeps_a_caller_s_frozen_heap_frozen_and_leaves_none_frozen_itself() -> None:
+    import gc
+
+    seen: list[int] = []
+    jobs = [(1.0, lambda: seen.append(gc.get_freeze_count()))]
+    before = gc.get_freeze_count()
+    all_figures.draw_jobs(jobs, 1)
+    assert gc.get_freeze_count() == before  # its own freeze undone
+    assert seen[0] > before  # the heap was frozen while drawing
+    keep = [object() for _ in range(10)]
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        all_figures.draw_jobs(jobs, 1)
+        assert gc.get_freeze_count() == frozen  # the caller's freeze kept
+        assert seen[1] == frozen
+    finally:
+        gc.unfreeze()
+    assert keep

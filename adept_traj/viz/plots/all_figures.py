@@ -189,7 +189,11 @@ def _frozen_heap() -> Iterator[None]:
     (:func:`gc.freeze`) until the block ends: the collections that the figures' many new
     matplotlib objects trigger then scan these objects only, not the whole heap (the
     robot, the results, numpy and matplotlib themselves). Garbage of the block is
-    collected as usual."""
+    collected as usual. A caller that froze objects itself keeps its freeze: nothing is
+    frozen or unfrozen then (:func:`gc.unfreeze` would release the caller's objects too)."""
+    if gc.get_freeze_count():
+        yield
+        return
     gc.freeze()
     try:
         yield
