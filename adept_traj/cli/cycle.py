@@ -35,6 +35,7 @@ from adept_traj.cycle import (
     run_cycle,
     write_cycle_report,
 )
+from adept_traj.errors import CycleError
 from adept_traj.validation import as_integer
 
 __all__ = ["add_parser", "run"]
@@ -58,6 +59,13 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="periodic moving obstacles: plan every move at N start phases at once and "
         "choose the sequence of least pass time (dynamic programming; docs/cycles.md)",
     )
+    p.add_argument(
+        "--max-phases",
+        type=int,
+        metavar="M",
+        help="with --phase-grid: where no schedule is certified, the grid is refined (2N, "
+        "4N, … phases) up to M phases (default 32; N: no refinement)",
+    )
     return p
 
 
@@ -65,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
     """Run ``cycle``; return the exit status."""
     if args.workers is not None:
         as_integer(args.workers, "--workers", minimum=1, maximum=1024)
+    if args.max_phases is not None and args.phase_grid is None:
+        raise CycleError(f"--max-phases {args.max_phases}: it refines a --phase-grid N grid")
     out = as_path(args.out, "--out")
     cycle = read_cycle_file(args.file)  # every location solved before any task starts
     with folder_lock(out):  # no second process writing into the folder meanwhile
@@ -112,6 +122,7 @@ def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
             cycle,
             out,
             phases=args.phase_grid,
+            max_phases=args.max_phases,
             workers=args.workers,
             scheduler=args.scheduler,
             resume=args.resume,
@@ -119,8 +130,10 @@ def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
         best, naive = report["optimised"], report["naive"]
         gain = "" if naive is None else f", gain {100 * (1 - best / naive):.1f} %"
         how = "every pass back to back" if clock.period is None else "periodic passes"
+        sizes = report["grid_sizes"]
+        refined = "" if len(sizes) == 1 else f", refined to {sizes[-1]}"
         print(
-            f"phase grid of {args.phase_grid} ({sum(report['plans'])} plans): cycle time "
+            f"phase grid of {args.phase_grid}{refined} ({sum(report['plans'])} plans): cycle time "
             f"{best:.3f} s ({how}), naive back-to-back {_seconds(naive)} s{gain}; periodic "
             f"{_seconds(report['periodic'])} s"
             f"{'' if report['periodic_certified'] else ' (not re-certified)'}, back to back "

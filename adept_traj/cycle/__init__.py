@@ -10,6 +10,11 @@ Dask (``distributed``) is imported only when a cycle runs."""
 
 from __future__ import annotations
 
+from adept_traj.cycle.certified_schedule import (
+    ScheduleChoice,
+    certified_schedules,
+    schedule_span,
+)
 from adept_traj.cycle.chained import ChainPlan, chained_clock
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
@@ -45,7 +50,13 @@ from adept_traj.cycle.move_task import (
     relaxed_group,
     relaxed_optima,
 )
-from adept_traj.cycle.phase_grid import DEFAULT_PHASES, RECERTIFIED_PASSES, plan_phase_grid
+from adept_traj.cycle.phase_grid import (
+    DEFAULT_PHASES,
+    MAX_PHASES,
+    MAX_REFINED_PHASES,
+    RECERTIFIED_PASSES,
+    plan_phase_grid,
+)
 from adept_traj.cycle.recertify import (
     CHECKS_PER_TASK,
     CertifyBatch,
@@ -127,6 +138,8 @@ __all__ = [
     "MAX_CLOCKED_MOVES",
     "MAX_DWELL_CANDIDATES",
     "MAX_MOVES",
+    "MAX_PHASES",
+    "MAX_REFINED_PHASES",
     "MAX_UNDONE",
     "METRICS",
     "MOVES_FOLDER",
@@ -158,7 +171,9 @@ __all__ = [
     "RestCheck",
     "RestProfile",
     "SavedMove",
+    "ScheduleChoice",
     "back_to_back",
+    "certified_schedules",
     "certify_batch",
     "certify_rest",
     "chain_passes",
@@ -196,6 +211,7 @@ __all__ = [
     "save_boxplots",
     "save_gantt",
     "scene_period",
+    "schedule_span",
     "study_markdown",
     "study_statistics",
     "write_cycle_report",

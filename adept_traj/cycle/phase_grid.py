@@ -40,8 +40,18 @@ plan is certified at its phase. A chosen schedule is then **re-certified at its 
 times**: every move of every pass (:func:`~adept_traj.analysis.certify` at
 :math:`s_k + p \cdot` pass time) and every dwell and final dwell
 (:func:`~adept_traj.cycle.certify_rest`); a step that fails any of them is banned and the
-schedule chosen again, until a schedule passes every check or none is left. So only
-moves and dwells certified at the times they run are reported.
+schedule chosen again, until a schedule passes every check or none is left
+(:func:`~adept_traj.cycle.certified_schedules`). So only moves and dwells certified at the
+times they run are reported.
+
+3. **refinement**: where no schedule is certified, the grid is refined: every move is
+   planned at the phases :math:`(2j + 1) P / 2N` halfway between the grid's (the grid
+   becomes 2N phases, the plans made so far kept), the arrivals' round runs again over
+   every plan, and the schedules are chosen again; up to ``max_phases`` phases
+   (:data:`MAX_PHASES` by default), after which the cycle is refused, naming the grids
+   tried. A coarse grid whose moves all end where the next move can neither start nor
+   wait (a pendulum at its start location then) is so still planned, with plans
+   ending at other phases.
 
 With ``repeat`` > 1 the final dwell that makes a pass a multiple of P is a choice, not a
 need: where ``repeat`` × K ≤ :data:`~adept_traj.cycle.MAX_BACK_TO_BACK_MOVES`, every pass
@@ -67,6 +77,7 @@ from typing import Any
 
 import numpy as np
 
+from adept_traj.cycle.certified_schedule import certified_schedules, schedule_span
 from adept_traj.cycle.choice import chosen_member
 from adept_traj.cycle.clock import (
     CycleClock,
@@ -86,13 +97,10 @@ from adept_traj.cycle.runner import (
 from adept_traj.cycle.schedules import (
     SAME_TIME,
     PhaseOption,
-    Step,
-    chain_passes,
     congruent,
     naive_schedule,
     pass_end,
     phase_frontier,
-    phase_schedules,
 )
 from adept_traj.cycle.timeline import ClockedPlan, clocked_passes
 from adept_traj.errors import CycleError
@@ -100,10 +108,20 @@ from adept_traj.problem import ProblemSettings
 from adept_traj.results import PlanningResult
 from adept_traj.validation import as_integer
 
-__all__ = ["DEFAULT_PHASES", "RECERTIFIED_PASSES", "plan_phase_grid"]
+__all__ = [
+    "DEFAULT_PHASES",
+    "MAX_PHASES",
+    "MAX_REFINED_PHASES",
+    "RECERTIFIED_PASSES",
+    "plan_phase_grid",
+]
 
 #: Start phases per period by default.
 DEFAULT_PHASES = 8
+#: Most start phases per period a refined grid reaches by default (``max_phases``).
+MAX_PHASES = 32
+#: The bound of ``max_phases`` (each phase is a planning task per move).
+MAX_REFINED_PHASES = 1024
 #: Passes re-certified one by one at their scene times; later passes (congruent modulo P)
 #: are covered by the periodicity.
 RECERTIFIED_PASSES = 100
@@ -143,6 +161,7 @@ def plan_phase_grid(
     phases: int = DEFAULT_PHASES,
     beam: int | None = None,
     schedule: str = "optimised",
+    max_phases: int | None = None,
     workers: int | None = None,
     scheduler: str | None = None,
     resume: bool = False,
@@ -158,14 +177,18 @@ def plan_phase_grid(
     Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase J) and ``out/moves/NAME.xI/``
     (arrival I).
 
-    ``beam``: schedules kept per move (default: ``phases``).
+    ``beam``: schedules kept per move (default: ``phases``). ``max_phases``: the most
+    phases a refined grid may reach (module doc; default :data:`MAX_PHASES`, at least
+    ``phases``; ``phases`` itself: no refinement); the report's ``"grid_sizes"`` lists the
+    grid's sizes, ``"phases"`` the phases of the last.
+    Refined phases are saved into ``out/moves/NAME.phJofM/`` (phase J P / M).
 
     Raises
     ------
     CycleError
         The scene is not periodic; the moves do not chain; no certified schedule exists;
-        ``phases`` or ``beam`` not in [1, MAX_DWELL_CANDIDATES]; ``out`` holds an earlier
-        run and ``resume`` is false.
+        ``phases`` or ``beam`` not in [1, MAX_DWELL_CANDIDATES], ``max_phases`` not in
+        [``phases``, 1024]; ``out`` holds an earlier run and ``resume`` is false.
     """
     n = as_integer(phases, "phases", minimum=1, maximum=MAX_DWELL_CANDIDATES, error=CycleError)
     width = as_integer(
@@ -173,6 +196,13 @@ def plan_phase_grid(
         "beam",
         minimum=1,
         maximum=MAX_DWELL_CANDIDATES,
+        error=CycleError,
+    )
+    most = as_integer(
+        max(MAX_PHASES, n) if max_phases is None else max_phases,
+        "max_phases",
+        minimum=n,
+        maximum=MAX_REFINED_PHASES,
         error=CycleError,
     )
     if schedule not in ("optimised", "naive"):
@@ -202,103 +232,72 @@ def plan_phase_grid(
     def at(task: MoveTask, name: str, start: float) -> MoveTask:
         return replace(task, move=replace(task.move, name=name), start_time=float(start))
 
-    plans: list[list[_Plan]] = []
+    rest = RestCertifier(robot, cycle.scene, sites, settings=settings, rate_hz=cycle.rate_hz)
+    sizes = [n]  # the grid's sizes, each refinement doubling it
     with dask_client(workers, scheduler, K * n) as client:
         relaxed: dict[str, Any] = {}  # each move's relaxed optima, made once (move_task)
+
+        def planned(tasks: list[MoveTask]) -> list[_Plan]:
+            done = run_planning_tasks(tasks, where, resume=True, client=client, relaxed=relaxed)
+            return _plans(tasks, done)
+
         tasks = [at(t, f"{t.move.name}.ph{j}", s) for t in base for j, s in enumerate(grid)]
-        flat = _plans(
-            tasks, run_planning_tasks(tasks, where, resume=True, client=client, relaxed=relaxed)
-        )
+        flat = planned(tasks)
         plans = [flat[k * n : (k + 1) * n] for k in range(K)]
-        for k in range(1, K):
-            options = [[p.option for p in row] for row in plans[:k]]
-            ends = [e for e, _ in phase_frontier(options, P, allowed, beam=width)[-1][:width]]
-            naive = naive_schedule(options, P, allowed, frozenset())
-            ends += [] if naive is None else [naive[0]]
-            new: list[float] = []
-            for e in ends:  # a start phase not planned yet
-                known = [f.option.phase for f in plans[k]] + new
-                if not any(congruent(e, f, P) for f in known):
-                    new.append(math.fmod(e, P))
-            count = len(plans[k]) - n
-            extra = [at(base[k], f"{base[k].move.name}.x{count + i}", s) for i, s in enumerate(new)]
-            if extra:
-                done = run_planning_tasks(extra, where, resume=True, client=client, relaxed=relaxed)
-                plans[k] = plans[k] + _plans(extra, done)
-
-        options = [[p.option for p in row] for row in plans]
-        move_ok = MoveCertifier(
-            cycle.robot,
-            cycle.scene,
-            cycle.rate_hz,
-            [[_planned(base[k], p) for p in row] for k, row in enumerate(plans)],
-            client=client,
-        )
-        rest = RestCertifier(robot, cycle.scene, sites, settings=settings, rate_hz=cycle.rate_hz)
-
-        def failures(path: tuple[Step, ...]) -> set[tuple[int, int, float]]:
-            """The steps of ``path`` not certified at their real scene times, every pass."""
-            end = path[-1][1] + options[-1][path[-1][0]].T
-            span = pass_end(end, P, cycle.repeat)
-            passes = range(min(cycle.repeat, RECERTIFIED_PASSES))
-            move_ok.prefetch(
-                [(k, i, s + p * span) for p in passes for k, (i, s) in enumerate(path)]
+        arrivals = [0] * K  # arrival plans per move so far
+        while True:
+            for k in range(1, K):
+                extra = []
+                for s in _arrival_phases(plans[:k], plans[k], P, allowed, width):
+                    name = f"{base[k].move.name}.x{arrivals[k]}"
+                    extra.append(at(base[k], name, s))
+                    arrivals[k] += 1
+                if extra:
+                    plans[k] = plans[k] + planned(extra)
+            options = [[p.option for p in row] for row in plans]
+            move_ok = MoveCertifier(
+                cycle.robot,
+                cycle.scene,
+                cycle.rate_hz,
+                [[_planned(base[k], p) for p in row] for k, row in enumerate(plans)],
+                client=client,
             )
-            bad = set()
-            for p in passes:
-                shift, e = p * span, 0.0
-                for k, (i, s) in enumerate(path):
-                    if not (move_ok(k, i, s + shift) and rest(k, e + shift, s - e).certified):
-                        bad.add((k, i, s))
-                    e = s + options[k][i].T
-                if cycle.repeat > 1 and not rest(K, e + shift, span - e).certified:
-                    bad.add((K - 1, *path[-1]))
-            return bad
-
-        runs, why = None, None  # every pass back to back, no final dwell (module doc)
-        if cycle.repeat > 1:
-            runs, why = chain_passes(
+            choice = certified_schedules(
                 options,
                 P,
                 cycle.repeat,
-                move_ok,
-                lambda k, s, d: allowed(k, s, d) and rest(k, s, d).certified,
+                allowed=allowed,
+                move_ok=move_ok,
+                rest=rest,
+                beam=width,
+                passes=RECERTIFIED_PASSES,
             )
-        runs_time = None
-        if runs is not None:
-            i, s = runs[-1][-1]
-            runs_time = s + options[-1][i].T
-        chosen: dict[str, tuple[Step, ...] | None] = {"optimised": None, "naive": None}
-        bound = None  # a periodic schedule no shorter than the back-to-back one, not re-certified
-        for name in ("optimised",) if runs is not None else ("optimised", "naive"):
-            banned: frozenset[tuple[int, int, float]] = frozenset()
-            while True:
-                path = phase_schedules(
-                    options, P, allowed, beam=width, repeat=cycle.repeat, banned=banned
-                )[name]
-                if path is not None and runs_time is not None:
-                    span = cycle.repeat * _span(path, options, P, cycle.repeat)
-                    if span >= runs_time - SAME_TIME:
-                        bound = span
-                        break
-                bad = set() if path is None else failures(path)
-                if not bad:
-                    chosen[name] = path
-                    break
-                banned = banned | bad
-        if chosen["optimised"] is not None and chosen["naive"] is not None:
-            span = {k: _span(v, options, P, cycle.repeat) for k, v in chosen.items()}
-            if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
-                chosen["optimised"] = chosen["naive"]
+            if choice.back_to_back is not None or getattr(choice, schedule) is not None:
+                break
+            m = 2 * sizes[-1]
+            if m > most:
+                break
+            sizes.append(m)  # refine: the phases (2j + 1) P / m between the grid's
+            tasks = [
+                at(t, f"{t.move.name}.ph{j}of{m}", P * j / m) for t in base for j in range(1, m, 2)
+            ]
+            flat = planned(tasks)
+            half = m // 2
+            plans = [plans[k] + flat[k * half : (k + 1) * half] for k in range(K)]
+            grid = P * np.arange(m) / m
+
+        runs, runs_time = choice.back_to_back, choice.back_to_back_time
+        chosen = {"optimised": choice.optimised, "naive": choice.naive}
         times = {
-            name: None if v is None else cycle.repeat * _span(v, options, P, cycle.repeat)
+            name: None if v is None else cycle.repeat * schedule_span(v, options, P, cycle.repeat)
             for name, v in chosen.items()
         }
         report: dict[str, Any] = {
-            "periodic": times["optimised"] if bound is None else bound,
+            "periodic": times["optimised"] if choice.bound is None else choice.bound,
             "periodic_certified": times["optimised"] is not None,
             "back_to_back": runs_time,
-            "back_to_back_note": why,
+            "back_to_back_note": choice.back_to_back_note,
+            "grid_sizes": list(sizes),
         }
         back = False
         if runs_time is not None:  # the naive schedule is the back-to-back one
@@ -313,10 +312,11 @@ def plan_phase_grid(
                 f"{t.move.name} {sum(p.option.certified for p in row)}/{len(row)}"
                 for t, row in zip(base, plans)
             )
+            grids = " → ".join(str(m) for m in sizes)
             raise CycleError(
                 f"{cycle.source}: no {schedule} schedule certified at its real start times on "
-                f"a grid of {n} phases and the arrivals (plans certified at their phase: "
-                f"{counts}); plan the cycle without --phase-grid"
+                f"a grid of {grids} phases (max_phases = {most}) and the arrivals (plans "
+                f"certified at their phase: {counts}); plan the cycle without --phase-grid"
             )
         if back and runs is not None:
             chosen_passes = runs
@@ -346,9 +346,23 @@ def plan_phase_grid(
         return clock, results, report
 
 
-def _span(
-    path: tuple[Step, ...], options: Sequence[Sequence[PhaseOption]], period: float, repeat: int
-) -> float:
-    """Pass time [s] of the schedule ``path``."""
-    i, s = path[-1]
-    return pass_end(s + options[len(path) - 1][i].T, period, repeat)
+def _arrival_phases(
+    earlier: Sequence[Sequence[_Plan]],
+    row: Sequence[_Plan],
+    period: float,
+    allowed: Any,
+    beam: int,
+) -> list[float]:
+    """The start phases [s] in [0, P) of the arrivals of a move (module doc) not planned
+    yet: the ends mod P of the ``beam`` earliest schedules over the ``earlier`` moves'
+    plans and of their naive schedule, not congruent to a phase of ``row``'s plans."""
+    options = [[p.option for p in r] for r in earlier]
+    ends = [e for e, _ in phase_frontier(options, period, allowed, beam=beam)[-1][:beam]]
+    naive = naive_schedule(options, period, allowed, frozenset())
+    ends += [] if naive is None else [naive[0]]
+    new: list[float] = []
+    for e in ends:
+        known = [p.option.phase for p in row] + new
+        if not any(congruent(e, f, period) for f in known):
+            new.append(math.fmod(e, period))
+    return new

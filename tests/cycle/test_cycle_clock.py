@@ -743,6 +743,62 @@ def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Pa
     assert first == second
 
 
+@pytest.mark.slow  # the detour cycle on the phase grid: minutes
+def test_phase_grid_refines_only_where_its_grid_has_no_certified_schedule(
+    detour_planned: Path, tmp_path: Path, capsys
+) -> None:
+    """The grid of the detour cycle's plan is 2 phases, or a refinement of it (4, 8, …:
+    the phases halfway between, saved as NAME.phJofM) made because the 2-phase grid had
+    no certified schedule: planned again from its saved 2-phase plans with
+    ``--max-phases 2`` (no refinement allowed) the cycle is then refused, naming the grid
+    and the bound; else it is the same cycle.json."""
+    import shutil
+
+    summary = json.loads((detour_planned / "cycle.json").read_text())
+    P = scene_period(Scene.shipped("detour"))
+    phases = summary["clock"]["phase_grid"]
+    m = len(phases)
+    assert m in (2, 4, 8, 16, 32)
+    np.testing.assert_allclose(phases, P * np.arange(m) / m, rtol=0, atol=1e-12)
+    folders = {p.name for p in (detour_planned / "moves").iterdir()}
+    refined = {f for f in folders if re.fullmatch(r"(a-b|b-a)\.ph\d+of\d+", f)}
+    assert {"a-b.ph0", "a-b.ph1", "b-a.ph0", "b-a.ph1"} <= folders
+    assert len(refined) == 2 * (m - 2)  # every move at each of the m - 2 refined phases
+    out = tmp_path / "coarse"
+    out.mkdir()
+    for f in folders - refined:
+        shutil.copytree(detour_planned / "moves" / f, out / "moves" / f)
+    source = summary["source"]
+    argv = ["cycle", source, "--out", str(out), "--workers", "1", "--resume", "--quiet"]
+    argv += ["--no-playback", "--no-plots", "--phase-grid", "2", "--max-phases", "2"]
+    capsys.readouterr()
+    status = main(argv)
+    err = capsys.readouterr().err
+    if m > 2:
+        assert status == 2
+        assert "no optimised schedule certified" in err
+        assert "a grid of 2 phases (max_phases = 2)" in err
+    else:
+        assert status == 0
+        assert json.loads((out / "cycle.json").read_text())["clock"] == summary["clock"]
+
+
+def test_phase_grid_bounds_are_checked_before_any_plan(tmp_path: Path, capsys) -> None:
+    """``max_phases`` below ``phases`` or above 1024, and ``--max-phases`` without
+    ``--phase-grid``: a CycleError naming the value and its range, nothing planned."""
+    path = write_cycle(tmp_path, DETOUR_CYCLE, scenes={})
+    cycle = read_cycle_file(path)
+    for bad, words in ((3, "max_phases"), (2000, "max_phases")):
+        with pytest.raises(CycleError, match=words) as info:
+            plan_phase_grid(cycle, tmp_path / "out", phases=4, max_phases=bad)
+        assert str(bad) in str(info.value)
+    assert not (tmp_path / "out").exists()
+    argv = ["cycle", str(path), "--out", str(tmp_path / "cli"), "--max-phases", "4"]
+    assert main(argv) == 2
+    assert "--max-phases 4" in capsys.readouterr().err
+    assert not (tmp_path / "cli").exists()
+
+
 def test_move_certifier_answers_as_certify_at_the_real_start(cluster) -> None:
     """A plan asked about at the very time it was planned takes its own certificate (no
     new one); at other scene times the answer is certify's, called directly on a problem
