@@ -118,15 +118,24 @@ def _run_on_clock(args: argparse.Namespace, cycle: Any, out: Path) -> int:
     """A scene with moving obstacles: the moves planned in the order they run, each at its
     start time on the scene clock (:func:`~adept_traj.cycle.plan_on_clock`)."""
     if args.phase_grid is not None:
-        clock, passes, report = plan_phase_grid(
-            cycle,
-            out,
-            phases=args.phase_grid,
-            max_phases=args.max_phases,
-            workers=args.workers,
-            scheduler=args.scheduler,
-            resume=args.resume,
-        )
+        with tqdm(desc="plans", unit="plan", disable=args.quiet, file=sys.stderr) as bar:
+
+            def refining(m: int) -> None:
+                if not args.quiet:
+                    bar.write(f"phase grid: no certified schedule; refined to {m} phases",
+                              file=sys.stderr)  # fmt: skip
+
+            clock, passes, report = plan_phase_grid(
+                cycle,
+                out,
+                phases=args.phase_grid,
+                max_phases=args.max_phases,
+                workers=args.workers,
+                scheduler=args.scheduler,
+                resume=args.resume,
+                progress=lambda name: bar.update(1),
+                refining=refining,
+            )
         best, naive = report["optimised"], report["naive"]
         gain = "" if naive is None else f", gain {100 * (1 - best / naive):.1f} %"
         how = "every pass back to back" if clock.period is None else "periodic passes"

@@ -70,7 +70,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -165,6 +165,8 @@ def plan_phase_grid(
     workers: int | None = None,
     scheduler: str | None = None,
     resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+    refining: Callable[[int], None] | None = None,
 ) -> tuple[CycleClock, list[list[PlanningResult]], dict[str, Any]]:
     """Plan a periodic ``cycle`` on the phase grid (module doc): returns the clock of the
     ``schedule`` (``"optimised"`` or ``"naive"``), the chosen results (per pass of the
@@ -182,6 +184,8 @@ def plan_phase_grid(
     ``phases``; ``phases`` itself: no refinement); the report's ``"grid_sizes"`` lists the
     grid's sizes, ``"phases"`` the phases of the last.
     Refined phases are saved into ``out/moves/NAME.phJofM/`` (phase J P / M).
+    ``progress`` is called with each task's folder name as its plan is saved (or found
+    saved); ``refining`` with the refined grid's size M as a refinement starts.
 
     Raises
     ------
@@ -238,7 +242,9 @@ def plan_phase_grid(
         relaxed: dict[str, Any] = {}  # each move's relaxed optima, made once (move_task)
 
         def planned(tasks: list[MoveTask]) -> list[_Plan]:
-            done = run_planning_tasks(tasks, where, resume=True, client=client, relaxed=relaxed)
+            done = run_planning_tasks(
+                tasks, where, resume=True, client=client, relaxed=relaxed, progress=progress
+            )
             return _plans(tasks, done)
 
         tasks = [at(t, f"{t.move.name}.ph{j}", s) for t in base for j, s in enumerate(grid)]
@@ -278,6 +284,8 @@ def plan_phase_grid(
             if m > most:
                 break
             sizes.append(m)  # refine: the phases (2j + 1) P / m between the grid's
+            if refining is not None:
+                refining(m)
             tasks = [
                 at(t, f"{t.move.name}.ph{j}of{m}", P * j / m) for t in base for j in range(1, m, 2)
             ]

@@ -728,19 +728,26 @@ def test_detour_cycle_on_the_phase_grid_is_certified_at_its_real_start_times(
 
 
 @pytest.mark.slow  # the detour cycle on the phase grid: minutes
-def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Path) -> None:
+def test_phase_grid_schedule_is_deterministic(detour_planned: Path, tmp_path: Path, capsys) -> None:
     """The same plans give the same schedule: the saved moves planned again by resume
-    into another folder (nothing planned anew) give the same cycle.json, bit for bit."""
+    into another folder (nothing planned anew) give the same cycle.json, bit for bit; a
+    refinement made is said as it starts and in the summary line."""
     import shutil
 
     out = tmp_path / "again"
     shutil.copytree(detour_planned / "moves", out / "moves")
     source = json.loads((detour_planned / "cycle.json").read_text())["source"]
-    argv = ["cycle", source, "--out", str(out), "--workers", "1", "--resume", "--quiet"]
+    argv = ["cycle", source, "--out", str(out), "--workers", "1", "--resume"]
+    capsys.readouterr()
     assert main([*argv, "--no-playback", "--no-plots", "--phase-grid", "2"]) == 0
+    err = capsys.readouterr().err
     first = json.loads((detour_planned / "cycle.json").read_text())
     second = json.loads((out / "cycle.json").read_text())
     assert first == second
+    m = len(first["clock"]["phase_grid"])
+    said = [f"refined to {n} phases" for n in (4, 8, 16, 32) if n <= m]
+    assert all(f"no certified schedule; {words}" in err for words in said)
+    assert (f"phase grid of 2, refined to {m} (" in err) == (m > 2)
 
 
 @pytest.mark.slow  # the detour cycle on the phase grid: minutes
