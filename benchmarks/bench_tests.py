@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/bench_tests.py [--slow]`` from a checkout (takes minutes: the
 default tier is ``python -m pytest``, ``.ci/run``'s first command; ``--slow`` also times
-the slow tier, ``python -m pytest -m slow``, about a quarter of an hour). Each tier runs in
+the slow tier, ``python -m pytest -m slow -n 0``, about a quarter of an hour). Each tier runs in
 a fresh process in the checkout's root, timed from start to exit; the count is pytest's
 own summary line. Target of the default tier: ≤ 3 min on the 2-core machine.
 """
@@ -56,10 +56,10 @@ def main() -> None:
         note=f"{passed(summary)} tests passed",
     )  # fmt: skip
     if args.slow:
-        wall, summary = tier(["-m", "slow"])
+        wall, summary = tier(["-m", "slow", "-n", "0"])
         print(f"slow tier: {wall:.0f} s ({summary})")
         figure(
-            "slow_tier", "`python -m pytest -m slow`", round(wall), "s",
+            "slow_tier", "`python -m pytest -m slow -n 0`", round(wall), "s",
             note=f"{passed(summary)} tests passed",
         )  # fmt: skip
 

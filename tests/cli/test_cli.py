@@ -220,7 +220,8 @@ def test_progress_in_a_log_is_about_ten_plain_lines(n_gen: int, printed: list[in
     )
 
 
-def test_progress_on_a_terminal_is_one_bar() -> None:
+def test_progress_on_a_terminal_is_one_bar(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("COLUMNS", "160")  # the bar's width, whatever runs the tests
     stream = _Terminal()
     reporter = ProgressReporter("mode", stream)
     for info in _generations(5):

@@ -1,4 +1,4 @@
-"""The slow tier (``python -m pytest -m slow``, run by ``.ci/run`` after the default tier):
+"""The slow tier (``python -m pytest -m slow -n 0``, run by ``.ci/run`` after the default tier):
 the README's main job as a user types it, and the paper's comparison, at full budget.
 
 Every figure checked here is recomputed from the result folder with plain numpy and JSON,
