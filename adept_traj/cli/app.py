@@ -32,14 +32,14 @@ status 130 and one line, without a traceback.
 from __future__ import annotations
 
 import argparse
-import atexit
+import gc
 import importlib
 import json
-import os
 import re
 import sys
 import threading
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
 from adept_traj.cli import status
 from adept_traj.errors import AdeptTrajError
@@ -142,20 +142,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         return status.INTERRUPTED
 
 
-def run() -> int:
-    """The ``adept-traj`` program: :func:`main`, then the end of the process.
+def run() -> NoReturn:
+    """The ``adept-traj`` program: :func:`main`, then the end of the process with the
+    command's status (``SystemExit``).
 
-    Once the command is done and no other thread runs, the exit handlers run
-    (:mod:`atexit`: e.g. the worker processes are reaped), the standard streams are
-    flushed, and the process ends with the command's status without the interpreter's
-    teardown of every module and object (numpy's, pinocchio's, coal's: freed by the
-    system at once). With another thread still running, the normal exit (which waits for
-    it): the status is returned.
+    The interpreter's normal exit follows: threads still running are waited for, the exit
+    handlers run (:mod:`atexit`: e.g. the worker processes are reaped), the standard
+    streams are flushed. With no other thread running, the cyclic garbage collector is
+    first stopped and every object frozen (:func:`gc.freeze`), so that the exit does not
+    walk every object of numpy, pinocchio and coal once more: the system frees them at
+    once.
     """
     code = main()
-    if any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
-        return code
-    atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        stream.flush()
-    os._exit(code)
+    if not any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
+        gc.disable()
+        gc.freeze()
+    raise SystemExit(code)

@@ -1,11 +1,15 @@
 """The ``adept-traj`` program (:func:`adept_traj.cli.run`): the command's status, its whole
-output and the exit handlers, ending without the interpreter's teardown."""
+output and the exit handlers, ending with the interpreter's normal exit, the cyclic
+collector stopped and every object frozen first."""
 
 from __future__ import annotations
 
+import gc
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 import adept_traj.cli
 from adept_traj.cli import main
@@ -61,3 +65,23 @@ def test_a_thread_still_running_gets_the_normal_exit(tmp_path: Path) -> None:
     done = _program("thread", "verify", str(tmp_path / "missing"))
     assert done.returncode == 2
     assert done.stdout.splitlines()[-2:] == ["thread ended", "exit handler ran"]
+
+
+def test_the_program_ends_with_system_exit_and_the_collector_frozen(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """``run`` raises ``SystemExit`` with the command's status (the interpreter's normal
+    exit follows), the collector stopped and the objects frozen."""
+    monkeypatch.setattr(sys, "argv", ["adept-traj", "verify", str(tmp_path / "missing")])
+    enabled, frozen = gc.isenabled(), gc.get_freeze_count()
+    gc.collect()
+    try:
+        with pytest.raises(SystemExit) as info:
+            adept_traj.cli.run()
+        assert info.value.code == 2
+        assert not gc.isenabled()
+        assert gc.get_freeze_count() > frozen
+    finally:
+        gc.unfreeze()
+        if enabled:
+            gc.enable()
