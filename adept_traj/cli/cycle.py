@@ -26,6 +26,7 @@ from tqdm import tqdm
 from adept_traj.cli import status
 from adept_traj.cli._run_folder import as_path, folder_lock
 from adept_traj.cycle import (
+    MAX_PHASES,
     PLAYBACK_FILE,
     chosen_member,
     cycle_html,
@@ -64,7 +65,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=int,
         metavar="M",
         help="with --phase-grid: where no schedule is certified, the grid is refined (2N, "
-        "4N, … phases) up to M phases (default 32; N: no refinement)",
+        f"4N, … phases) up to M phases (default {MAX_PHASES}; N: no refinement)",
     )
     return p
 

@@ -58,11 +58,6 @@ class ScheduleChoice:
     back_to_back_note: str | None
     bound: float | None
 
-    @property
-    def found(self) -> bool:
-        """Some schedule is certified at its real scene times."""
-        return self.optimised is not None or self.back_to_back is not None
-
 
 def schedule_span(
     path: tuple[Step, ...], options: Sequence[Sequence[PhaseOption]], period: float, repeat: int
@@ -97,6 +92,12 @@ def certified_schedules(
     rest: the rest certificates (:class:`~adept_traj.cycle.RestCertifier`).
     beam: schedules kept per move (:func:`~adept_traj.cycle.phase_frontier`).
     passes: passes re-certified one by one (later ones are congruent modulo P).
+
+    Returns
+    -------
+    ScheduleChoice
+        The optimised schedule is never longer than the naive one (the naive one where the
+        beam left it out); both ``None`` where none is certified.
     """
     K = len(options)
     prefetch = getattr(move_ok, "prefetch", None)
@@ -148,8 +149,10 @@ def certified_schedules(
                 chosen[name] = path
                 break
             banned = banned | bad
-    if chosen["optimised"] is not None and chosen["naive"] is not None:
-        span = {k: schedule_span(v, options, period, repeat) for k, v in chosen.items()}
-        if span["naive"] < span["optimised"]:  # the beam after a ban may miss the naive
+    if chosen["naive"] is not None:  # the beam after a ban may miss the naive schedule
+        span = {
+            k: schedule_span(v, options, period, repeat) for k, v in chosen.items() if v is not None
+        }
+        if chosen["optimised"] is None or span["naive"] < span["optimised"]:
             chosen["optimised"] = chosen["naive"]
     return ScheduleChoice(chosen["optimised"], chosen["naive"], runs, runs_time, why, bound)

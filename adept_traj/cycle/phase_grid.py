@@ -97,6 +97,7 @@ from adept_traj.cycle.runner import (
 from adept_traj.cycle.schedules import (
     SAME_TIME,
     PhaseOption,
+    RestOk,
     congruent,
     naive_schedule,
     pass_end,
@@ -175,11 +176,13 @@ def plan_phase_grid(
     "periodic_certified": whether it was re-certified (not when the back-to-back schedule
     is no longer: then "periodic" is its uncertified cycle time), "back_to_back": the
     back-to-back schedule's | None, "back_to_back_note": why there is none | None, "plans":
-    plans per move, "phases": (N,) grid [s]}``.
+    plans per move, "phases": (M,) phases of the last grid [s], "grid_sizes": the grid's
+    sizes, N first}``.
     Tasks are saved into ``out/moves/NAME.phJ/`` (grid phase J) and ``out/moves/NAME.xI/``
     (arrival I).
 
-    ``beam``: schedules kept per move (default: ``phases``). ``max_phases``: the most
+    ``beam``: schedules kept per move (default: ``phases``, the first grid's size, also
+    on a refined grid). ``max_phases``: the most
     phases a refined grid may reach (module doc; default :data:`MAX_PHASES`, at least
     ``phases``; ``phases`` itself: no refinement); the report's ``"grid_sizes"`` lists the
     grid's sizes, ``"phases"`` the phases of the last.
@@ -358,7 +361,7 @@ def _arrival_phases(
     earlier: Sequence[Sequence[_Plan]],
     row: Sequence[_Plan],
     period: float,
-    allowed: Any,
+    allowed: RestOk,
     beam: int,
 ) -> list[float]:
     """The start phases [s] in [0, P) of the arrivals of a move (module doc) not planned
