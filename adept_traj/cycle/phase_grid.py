@@ -252,7 +252,18 @@ def plan_phase_grid(
 
         tasks = [at(t, f"{t.move.name}.ph{j}", s) for t in base for j, s in enumerate(grid)]
         flat = planned(tasks)
-        plans = [flat[k * n : (k + 1) * n] for k in range(K)]
+        plans: list[list[_Plan]] = [[] for _ in range(K)]
+        # one certifier over every round: plans are only appended, answers are kept
+        move_ok = MoveCertifier(
+            cycle.robot, cycle.scene, cycle.rate_hz, [[] for _ in range(K)], client=client
+        )
+
+        def add(k: int, new: list[_Plan]) -> None:
+            plans[k].extend(new)
+            move_ok.add(k, [_planned(base[k], p) for p in new])
+
+        for k in range(K):
+            add(k, flat[k * n : (k + 1) * n])
         arrivals = [0] * K  # arrival plans per move so far
         while True:
             for k in range(1, K):
@@ -262,15 +273,8 @@ def plan_phase_grid(
                     extra.append(at(base[k], name, s))
                     arrivals[k] += 1
                 if extra:
-                    plans[k] = plans[k] + planned(extra)
+                    add(k, planned(extra))
             options = [[p.option for p in row] for row in plans]
-            move_ok = MoveCertifier(
-                cycle.robot,
-                cycle.scene,
-                cycle.rate_hz,
-                [[_planned(base[k], p) for p in row] for k, row in enumerate(plans)],
-                client=client,
-            )
             choice = certified_schedules(
                 options,
                 P,
@@ -294,7 +298,8 @@ def plan_phase_grid(
             ]
             flat = planned(tasks)
             half = m // 2
-            plans = [plans[k] + flat[k * half : (k + 1) * half] for k in range(K)]
+            for k in range(K):
+                add(k, flat[k * half : (k + 1) * half])
             grid = P * np.arange(m) / m
 
         runs, runs_time = choice.back_to_back, choice.back_to_back_time

@@ -122,6 +122,11 @@ class MoveCertifier:
         self._known: dict[Query, bool] = {}
         self.computed = 0  #: certificates computed (not taken from a plan's own)
 
+    def add(self, k: int, plans: Sequence[PlannedMove]) -> None:
+        """Append ``plans`` to move ``k``'s (their indices follow the plans it has): the
+        answers known so far are kept."""
+        self._plans[k].extend(plans)
+
     def __call__(self, k: int, i: int, start: float) -> bool:
         key = (k, i, start)
         if key not in self._known:

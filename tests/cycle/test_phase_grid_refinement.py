@@ -60,7 +60,10 @@ def stand_ins(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
 
     class MoveCertifier:
         def __init__(self, robot, scene, rate_hz, plans, client=None):
-            self.plans = plans
+            self.plans = [list(row) for row in plans]
+
+        def add(self, k: int, plans) -> None:
+            self.plans[k].extend(plans)
 
         def __call__(self, k: int, i: int, start: float) -> bool:
             return _good(self.plans[k][i].planned_at, period)
