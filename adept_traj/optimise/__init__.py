@@ -25,6 +25,7 @@ _WHERE: dict[str, str] = {
         [
             "GlobalStage",
             "MAX_BASINS",
+            "RELAXED_GAP",
             "STRETCHES",
             "fastest_of_basins",
             "global_stage",

@@ -156,3 +156,41 @@ def test_a_seeded_run_interrupted_and_resumed_is_the_uninterrupted_one(detour, t
     np.testing.assert_array_equal(resumed.front.x, full.front.x)
     np.testing.assert_array_equal(resumed.front.objectives, full.front.objectives)
     assert resumed.algorithm_settings == full.algorithm_settings
+
+
+def test_a_bad_gap_is_refused_before_any_work(paper, monkeypatch) -> None:
+    """``time_optimal``'s ``gap`` is a positive fraction: 0, −0.01, NaN and a string are
+    refused with the library's error naming it, before any start is made."""
+    monkeypatch.setattr(multi_start, "_starts", _never)
+    for bad in (0.0, -0.01, float("nan"), "0.05"):
+        with pytest.raises(ConfigurationError, match="gap"):
+            multi_start.time_optimal(paper, 1, 2, gap=bad)
+
+
+@pytest.mark.slow  # ~3–6 s: the relaxed problem's search on a fresh copy of detour
+def test_the_relaxed_search_ends_at_its_first_move_within_the_relaxed_gap(
+    detour, monkeypatch
+) -> None:
+    """On detour the relaxed problem's fastest screened move lies 2.9 % above T_lb: more
+    than GLOBAL_GAP (the problem's own searches would go on), less than RELAXED_GAP, so
+    its search ends there — no full refinement and no via-point start of the relaxed
+    problem — with a certified floor inside the relaxed gap."""
+    fresh = detour.replace()
+    fixed = multi_start.relaxed_problem(fresh)
+    calls: list[str] = []
+    for name in ("refine_starts", "via_point_starts"):
+        real = getattr(multi_start, name)
+
+        def spy(problem, *args, _real=real, _name=name, **kwargs):
+            if problem is fixed:
+                calls.append(_name)
+            return _real(problem, *args, **kwargs)
+
+        monkeypatch.setattr(multi_start, name, spy)
+    relaxed, floor = relaxed_optimum(fresh)
+    t_lb = fresh.lower_bound.T_min
+    assert t_lb * (1.0 + GLOBAL_GAP) < floor <= t_lb * (1.0 + multi_start.RELAXED_GAP)
+    assert calls == []
+    assert len(relaxed) == len(multi_start.STRETCHES)
+    summary = at.certify(fixed, relaxed[0])
+    assert summary.feasible
