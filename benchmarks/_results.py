@@ -113,6 +113,28 @@ def figure(
     )
 
 
+def cpu_times() -> list[int] | None:
+    """The machine's CPU times since boot (``/proc/stat``'s ``cpu`` line, in clock ticks:
+    user, nice, system, idle, iowait, irq, softirq, steal, …); ``None`` where there is none."""
+    try:
+        fields = Path("/proc/stat").read_text().splitlines()[0].split()
+    except (OSError, IndexError):
+        return None
+    return [int(v) for v in fields[1:]] if fields and fields[0] == "cpu" else None
+
+
+def steal_share(start: list[int] | None, end: list[int] | None) -> float | None:
+    """The share of the machine's CPU time between two :func:`cpu_times` that the
+    hypervisor gave to other machines (*steal*, 0–1; ``None`` where unknown). On a shared
+    virtual machine a high share makes every wall time of the run longer than the
+    machine's own speed: the page shows it beside the load average."""
+    if start is None or end is None or len(start) < 8 or len(end) < 8:
+        return None
+    spent = [b - a for a, b in zip(start[:8], end[:8])]
+    total = sum(spent)
+    return round(spent[7] / total, 3) if total > 0 else None
+
+
 class _Tee(io.TextIOBase):
     def __init__(self, *streams: Any) -> None:
         self._streams = streams
@@ -154,10 +176,12 @@ def recorded(
         "date": _now(),
         "machine": machine(),
         "load_average": {"start": _load(), "end": None},
+        "steal": None,
         "figures": [],
         "output": "",
     }
     captured = io.StringIO()
+    cpu_start = cpu_times()
     stdout = sys.stdout
     _current, sys.stdout = record, _Tee(stdout, captured)
     ok = False
@@ -170,6 +194,7 @@ def recorded(
     finally:
         sys.stdout, _current = stdout, None
         if ok:
+            record["steal"] = steal_share(cpu_start, cpu_times())
             _write(record, captured.getvalue(), name, argv)
 
 

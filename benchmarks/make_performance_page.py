@@ -47,6 +47,7 @@ ORDER = (
     "bench_robots",
     "bench_cells",
     "bench_cycle",
+    "bench_cores",
     "bench_robot",
     "bench_indicators",
 )
@@ -148,6 +149,11 @@ def _load(record: dict[str, Any]) -> str:
     return "; ".join(parts) if parts else "not recorded"
 
 
+def _steal(record: dict[str, Any]) -> str:
+    steal = record.get("steal")
+    return "not recorded" if steal is None else f"{100 * steal:.1f} %"
+
+
 def _cell(text: Any) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
@@ -218,6 +224,7 @@ def render_page(results: dict[str, dict[str, Any]]) -> str:
             f"- date: {r['date']}",
             f"- machine: {_machine(r['machine'])}",
             f"- load average (1, 5, 15 min): {_load(r)}",
+            f"- CPU time taken by the hypervisor (steal) during the run: {_steal(r)}",
             f"- source: {r['source']}",
             "",
         ]

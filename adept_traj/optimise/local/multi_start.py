@@ -235,7 +235,11 @@ def global_stage(
 
 
 def relaxed_optimum(
-    problem: Any, *, n_starts: int = MAX_BASINS, rate_hz: float = 1000.0, processes: int | None = None
+    problem: Any,
+    *,
+    n_starts: int = MAX_BASINS,
+    rate_hz: float = 1000.0,
+    processes: int | None = None,
 ) -> tuple[np.ndarray, float]:
     """The relaxed part of :func:`global_stage`: (k, n_var) the fastest certified move of
     the problem without its moving obstacles at :data:`STRETCHES` × its T, and that T [s]
@@ -316,9 +320,7 @@ def _relaxed_ahead(problem: Any, rate_hz: float, processes: int | None) -> Worke
                   note="raised in the relaxed problem's worker")  # fmt: skip
 
 
-def _send_relaxed(
-    channel: Channel, problem: Any, rate_hz: float, processes: int | None
-) -> None:
+def _send_relaxed(channel: Channel, problem: Any, rate_hz: float, processes: int | None) -> None:
     """The worker of :func:`_relaxed_ahead`."""
     channel.send(relaxed_optimum(problem, rate_hz=rate_hz, processes=processes))
 

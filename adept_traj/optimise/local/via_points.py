@@ -192,11 +192,12 @@ def near_lower_bound(
 ) -> bool:
     """Whether a certified refinement of ``outcomes`` (each with ``certified`` and ``x``)
     has a T within ``gap`` (a fraction, default :data:`GLOBAL_GAP`) of the problem's
-    kinematic lower bound, or of ``floor`` [s] when larger (no move can then be faster by more than that, and the
-    global stage is not needed). ``floor``: the fastest certified move of a relaxation of
-    the problem (:func:`~adept_traj.optimise.global_stage`: the problem without its moving
-    obstacles, whose feasible set contains the problem's), a bound as good as the
-    relaxation's own search."""
+    kinematic lower bound, or of ``floor`` [s] when larger (no move can then be faster by
+    more than that, and the global stage is not needed). ``floor``: the fastest certified
+    move of a relaxation of the problem (:func:`~adept_traj.optimise.global_stage`: the
+    problem without its moving obstacles, whose feasible set contains the problem's), a
+    bound as good as the relaxation's own search (which ends within
+    :data:`~adept_traj.optimise.RELAXED_GAP` of T_lb)."""
     bound = max(problem.lower_bound.T_min, float(floor)) * (1.0 + gap)
     return any(o.certified and o.x[0] <= bound for o in outcomes)
 
