@@ -20,7 +20,9 @@ Every worker, the same way:
   (``PR_SET_PDEATHSIG``), however the parent ends (even by SIGKILL), and ends at once if
   the parent is gone already; a worker's own workers end with it in turn. (Linux sends the
   signal when the *thread* that forked the worker ends: fork workers from a thread that
-  outlives them, e.g. the main thread.) Ctrl-C is the caller's: a worker ignores SIGINT.
+  outlives them, e.g. the main thread.) Ctrl-C is the caller's: a worker ignores SIGINT,
+  held from before the fork until then (else a SIGINT at the fork's instant would raise in
+  the new process, which would run on as a copy of the caller).
 - **Holds no other worker's pipe**: every process forked after a worker (another worker,
   or any fork) closes, at once, its copies of the caller's ends of every worker's pipe
   (:func:`os.register_at_fork`), so workers may be started in any order and a worker's
@@ -58,23 +60,12 @@ from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection, Pipe
 from typing import Any
 
-from adept_traj.errors import (
-    ConfigurationError,
-    WorkerDiedError,
-    WorkerError,
-    error_from_process,
-)
+from adept_traj.errors import ConfigurationError, WorkerDiedError, WorkerError, error_from_process
 
 __all__ = [
-    "LOWEST_PRIORITY",
-    "Channel",
-    "Worker",
-    "can_fork",
-    "children",
-    "map_forked",
-    "prepare_quietly",
-    "serve",
-]
+    "LOWEST_PRIORITY", "Channel", "Worker", "can_fork", "children", "map_forked",
+    "prepare_quietly", "serve",
+]  # fmt: skip
 
 #: Niceness of a worker's preparing thread (the lowest priority).
 LOWEST_PRIORITY = 19
@@ -243,15 +234,18 @@ class Worker:
         for stream in (sys.stdout, sys.stderr):  # not written twice by the fork
             with contextlib.suppress(AttributeError, ValueError, OSError):  # closed streams
                 stream.flush()
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
         try:
             pid = os.fork()
         except BaseException:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
             _HELD.discard(mine)
             mine.close()
             theirs.close()
             raise
         if pid == 0:  # the worker (never returns)
-            _run(theirs, self._creator, target, args, prepare, prepare_niceness)
+            _run(theirs, self._creator, target, args, prepare, prepare_niceness, held)
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
         theirs.close()
         self.pid, self._connection = pid, mine
         _LIVE[pid] = self
@@ -413,13 +407,15 @@ def _run(
     args: tuple,
     prepare: Callable[[], None] | None,
     niceness: int | None,
+    mask: set[signal.Signals],
 ) -> None:
-    """In the forked worker: end with the parent, ignore Ctrl-C, prepare at ``niceness``,
-    say ready, run ``target``; send its error; end (``os._exit``)."""
+    """In the forked worker: end with the parent, ignore Ctrl-C (then take the caller's
+    signal ``mask``), prepare at ``niceness``, say ready, run ``target``; send its error."""
     code = 0
     try:
         _end_with_parent(parent)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops its workers
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a SIGINT held is now dropped
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         _HELD.add(connection)  # the worker's own workers do not keep it
         if prepare is not None:

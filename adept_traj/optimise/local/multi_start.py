@@ -68,12 +68,9 @@ MAX_BASINS = 3
 #: Factors of the fixed-obstacle optimum's T at which :func:`global_starts` offers it.
 STRETCHES = (1.0, 1.1, 1.25)
 
-#: The relaxed problem's own search (:func:`relaxed_optimum`) ends at a certified move
-#: within this fraction of the kinematic lower bound (the problem's own searches: within
-#: :data:`~adept_traj.optimise.GLOBAL_GAP`). Its move is a start and a floor of the
-#: problem's search, not the answer; measured on the detour scene
-#: (``docs/engine.md``), searching on from 1.029 × T_lb bought 0.03 % of the relaxed T
-#: and nothing of the problem's, for twice the time of the whole time-optimal mode.
+#: The relaxed problem's own search (:func:`relaxed_optimum`: a start and a floor of the
+#: problem's, not its answer) ends at a certified move within this fraction of T_lb
+#: (the problem's: :data:`~adept_traj.optimise.GLOBAL_GAP`; why: ``docs/engine.md``).
 RELAXED_GAP = 0.05
 
 #: The key under which a problem keeps its relaxed problem and optima
@@ -117,10 +114,8 @@ def time_optimal(
     processes:
         Refinements run at once (≥ 1; default: the problem's ``workers``).
     gap:
-        A certified move within this fraction of the kinematic lower bound (or of the
-        global stage's floor) ends the search (> 0; default
-        :data:`~adept_traj.optimise.GLOBAL_GAP`; the relaxed problem's own search:
-        :data:`RELAXED_GAP`).
+        A certified move within this fraction (> 0, default ``GLOBAL_GAP``) of T_lb or of
+        the floor ends the search (the relaxed problem's own: :data:`RELAXED_GAP`).
     options:
         ``max_boxes`` of the screening (:func:`~adept_traj.optimise.screen_starts`).
     """
@@ -142,9 +137,8 @@ def time_optimal(
             ahead.close()  # not needed when the first start is near the bound
     stage = None
     if not near(screened):  # the relaxed problem's optimum before the other starts
-        stage = global_stage(
-            problem, n_starts=n_starts, rate_hz=rate_hz, processes=processes, known=known
-        )
+        stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz,
+                             processes=processes, known=known)  # fmt: skip
         screened += _screen_stage(problem, stage, screened, starts[first:], gap=gap, **options)
     if near_lower_bound(problem, screened, floor=stage.floor if stage else 0.0, gap=gap):
         return screened
@@ -198,14 +192,9 @@ def global_starts(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0) -
     return global_stage(problem, n_starts=n_starts, rate_hz=rate_hz).starts
 
 
-def global_stage(
-    problem: Any,
-    *,
-    n_starts: int = 3,
-    rate_hz: float = 1000.0,
-    processes: int | None = None,
-    known: tuple[np.ndarray, float] | None = None,
-) -> GlobalStage:
+def global_stage(problem: Any, *, n_starts: int = 3, rate_hz: float = 1000.0,
+                 processes: int | None = None,
+                 known: tuple[np.ndarray, float] | None = None) -> GlobalStage:  # fmt: skip
     """The global stage's starts and the floor [s] of
     :func:`~adept_traj.optimise.near_lower_bound`. Where obstacles move: the fastest
     certified move of the problem **without its moving obstacles** (its own
@@ -234,13 +223,8 @@ def global_stage(
     return GlobalStage(relaxed=relaxed, floor=floor, make_timed=timed, make_via=via)
 
 
-def relaxed_optimum(
-    problem: Any,
-    *,
-    n_starts: int = MAX_BASINS,
-    rate_hz: float = 1000.0,
-    processes: int | None = None,
-) -> tuple[np.ndarray, float]:
+def relaxed_optimum(problem: Any, *, n_starts: int = MAX_BASINS, rate_hz: float = 1000.0,
+                    processes: int | None = None) -> tuple[np.ndarray, float]:  # fmt: skip
     """The relaxed part of :func:`global_stage`: (k, n_var) the fastest certified move of
     the problem without its moving obstacles at :data:`STRETCHES` × its T, and that T [s]
     (the floor); (0, n_var) and 0 without moving obstacles or without a certified move.
@@ -261,9 +245,8 @@ def _relaxed_optimum(
     if scene.moving:
         fixed = relaxed_problem(problem)
         processes = _wanted(problem, processes)
-        outcomes = time_optimal(
-            fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz, processes=processes, gap=RELAXED_GAP
-        )
+        outcomes = time_optimal(fixed, GLOBAL_SEED, n_starts, rate_hz=rate_hz,
+                                processes=processes, gap=RELAXED_GAP)  # fmt: skip
         done = [o for o in outcomes if o.certified]
         if done:
             best = min(done, key=lambda o: float(o.x[0])).x
