@@ -31,16 +31,23 @@ def _problem(obstacles: tuple[Obstacle, ...]) -> TrajectoryProblem:
     return TrajectoryProblem(Robot.adept_one_xl(), scene, START, GOAL)
 
 
-def _reference_distances(problem: TrajectoryProblem, x: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """(n,) smallest solid–obstacle distance [m] at times ``t`` by coal, called directly."""
-    robot, scene = problem.robot, problem.scene
+def _reference_distances(
+    problem: TrajectoryProblem,
+    x: np.ndarray,
+    t: np.ndarray,
+    obstacles: tuple[Obstacle, ...] | None = None,
+) -> np.ndarray:
+    """(n,) smallest solid–obstacle distance [m] at times ``t`` by coal, called directly,
+    to ``obstacles`` (default: the problem's scene's)."""
+    robot = problem.robot
+    obstacles = problem.scene.obstacles if obstacles is None else obstacles
     t = np.asarray(t, dtype=float)
     q = problem.trajectory.sample(x, t / x[0], orders=(0,)).q
     poses = robot.geometry_poses(q)  # (n, n_solids, 4, 4), world = base (identity)
     request, result = coal.DistanceRequest(), coal.DistanceResult()
     request.gjk_tolerance = 1e-9
     out = np.full(len(t), np.inf)
-    for ob in scene.obstacles:
+    for ob in obstacles:
         geometry_o = ob.shape.to_coal()
         pose_o = ob.pose(t)
         for s, g in enumerate(robot.collision_model.geometryObjects):
@@ -83,12 +90,12 @@ def _dip_between_samples() -> tuple[TrajectoryProblem, np.ndarray]:
     window = t_star + np.linspace(-0.05, 0.05, 2001)
     radius = reach + 0.05
     for _ in range(3):  # alternate: turn the post to t*, then move it to d(t*) = margin − 10 µm
-        d = _reference_distances(_problem((_thin_post(angle, radius),)), x, window)
+        d = _reference_distances(problem, x, window, (_thin_post(angle, radius),))
         angle += float(theta1(t_star)[0] - theta1(window[np.argmin(d)])[0])
         lo, hi = radius - 0.1, radius + 0.1
         for _ in range(40):
             mid = 0.5 * (lo + hi)
-            d_star = _reference_distances(_problem((_thin_post(angle, mid),)), x, [t_star])[0]
+            d_star = _reference_distances(problem, x, [t_star], (_thin_post(angle, mid),))[0]
             lo, hi = (mid, hi) if d_star < margin - 1e-5 else (lo, mid)
         radius = hi
     return _problem((_thin_post(angle, radius),)), x

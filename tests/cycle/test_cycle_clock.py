@@ -806,14 +806,12 @@ def test_phase_grid_bounds_are_checked_before_any_plan(tmp_path: Path, capsys) -
     assert not (tmp_path / "cli").exists()
 
 
-def test_move_certifier_answers_as_certify_at_the_real_start(cluster) -> None:
-    """A plan asked about at the very time it was planned takes its own certificate (no
-    new one); at other scene times the answer is certify's, called directly on a problem
-    started there, the same in this process and in Dask tasks (batches)."""
-    from distributed import Client
-
+def _certifier_case() -> tuple:
+    """A plan at 0 s of the paper scene, the scene times to ask about it, its own answer at
+    0 s (deliberately not certify's) and certify's answers, called directly on a problem
+    started at each time: (source, scene, plans, starts, answers)."""
     from adept_traj.certification import certify
-    from adept_traj.cycle import MoveCertifier, PlannedMove
+    from adept_traj.cycle import PlannedMove
     from adept_traj.problem import TrajectoryProblem
     from adept_traj.robot import RobotSource
     from adept_traj.testing.paper_moves import lift_then_lower
@@ -828,17 +826,37 @@ def test_move_certifier_answers_as_certify_at_the_real_start(cluster) -> None:
         expected.append(bool(certify(problem, x, rate_hz=1000.0).certified))
         problem.close()
     assert len(set(expected)) == 2  # the pendulum: certified at some starts only
-    own = not expected[0]  # the plan's own answer at 0, deliberately not certify's
+    own = not expected[0]
     plans = [[PlannedMove(start, goal, x, 0.0, own)]]
-    source = RobotSource()  # the shipped AdeptOne XL
+    return RobotSource(), scene, plans, starts, [own, *expected[1:]]
+
+
+def test_move_certifier_answers_as_certify_at_the_real_start() -> None:
+    """A plan asked about at the very time it was planned takes its own certificate (no
+    new one); at other scene times the answer is certify's, called directly on a problem
+    started there."""
+    from adept_traj.cycle import MoveCertifier
+
+    source, scene, plans, starts, answers = _certifier_case()
     here = MoveCertifier(source, scene, 1000.0, plans)
-    assert [here(0, 0, s) for s in starts] == [own, *expected[1:]]
+    assert [here(0, 0, s) for s in starts] == answers
     assert here.computed == len(starts) - 1
+
+
+@pytest.mark.slow  # the same answers in Dask tasks: the cluster's part is the slow one
+def test_move_certifier_on_dask_answers_as_certify(cluster) -> None:
+    """The answers of :func:`test_move_certifier_answers_as_certify_at_the_real_start`,
+    computed in Dask tasks (batches, prefetched)."""
+    from distributed import Client
+
+    from adept_traj.cycle import MoveCertifier
+
+    source, scene, plans, starts, answers = _certifier_case()
     with Client(cluster.scheduler_address) as client:
         there = MoveCertifier(source, scene, 1000.0, plans, client=client)
         there.prefetch([(0, 0, s) for s in starts])
         assert there.computed == len(starts) - 1
-        assert [there(0, 0, s) for s in starts] == [own, *expected[1:]]
+        assert [there(0, 0, s) for s in starts] == answers
 
 
 def test_back_to_back_beyond_its_limit_names_it() -> None:
@@ -863,14 +881,12 @@ def test_back_to_back_beyond_its_limit_names_it() -> None:
     assert [p[0] for p in runs] == [(0, 0.5 * p) for p in range(7)]
 
 
-def test_check_moves_answers_as_certify_here_and_on_dask(cluster, monkeypatch) -> None:
-    """``verify``'s checks (a saved move at a scene start time, the rests before and after
-    it): the verdicts of certify and certify_rest called directly, the same in this process
-    and as Dask tasks (two checks per task here), in order."""
-    from distributed import Client
-
+def _check_moves_case() -> tuple:
+    """``verify``'s checks of a saved move at five scene start times, with rests before
+    and after it, and the verdicts of certify and certify_rest called directly:
+    (source, scene, checks, expected (feasible, min distance, before, after) per check)."""
     from adept_traj.certification import certify
-    from adept_traj.cycle import MoveCheck, certify_rest, check_moves, recertify
+    from adept_traj.cycle import MoveCheck, certify_rest
     from adept_traj.problem import ProblemSettings, TrajectoryProblem
     from adept_traj.robot import RobotSource
     from adept_traj.testing.paper_moves import lift_then_lower
@@ -878,10 +894,8 @@ def test_check_moves_answers_as_certify_here_and_on_dask(cluster, monkeypatch) -
     robot, scene = Robot.adept_one_xl(), Scene.shipped("paper")
     start, goal = np.array(HOME), np.array(PLACE)
     x = lift_then_lower(TrajectoryProblem(robot, scene, start, goal, workers=1))
-    starts = [0.0, 0.35, 0.8, 1.4, 0.6]
-    monkeypatch.setattr(recertify, "CHECKS_PER_TASK", 2)  # three tasks, the last of one
     checks, expected = [], []
-    for n, s in enumerate(starts):
+    for n, s in enumerate([0.0, 0.35, 0.8, 1.4, 0.6]):
         settings = ProblemSettings(start_time=s, workers=1)
         before, after = (max(s - 0.3, 0.0), min(s, 0.3)), (s + x[0], 0.5) if n % 2 else None
         checks.append(MoveCheck(settings, start, goal, x, 1000.0, before, after))
@@ -895,10 +909,32 @@ def test_check_moves_answers_as_certify_here_and_on_dask(cluster, monkeypatch) -
             (c.feasible, c.min_distance, kept, None if later is None else later.certified)
         )
     assert len({e[0] for e in expected}) == 2  # the pendulum: certified at some starts only
-    source = RobotSource()
-    here = check_moves(source, scene, checks)
+    return RobotSource(), scene, checks, expected
+
+
+def test_check_moves_answers_as_certify() -> None:
+    """``verify``'s checks (a saved move at a scene start time, the rests before and after
+    it) in this process: the verdicts of certify and certify_rest called directly, in
+    order."""
+    from adept_traj.cycle import check_moves
+
+    source, scene, checks, expected = _check_moves_case()
+    found = [
+        (v.feasible, v.min_distance, v.before, v.after) for v in check_moves(source, scene, checks)
+    ]
+    assert found == expected
+
+
+@pytest.mark.slow  # the same verdicts in Dask tasks: the cluster's part is the slow one
+def test_check_moves_on_dask_answers_as_certify(cluster, monkeypatch) -> None:
+    """The verdicts of :func:`test_check_moves_answers_as_certify` as Dask tasks (two
+    checks per task here: three tasks, the last of one), in order."""
+    from distributed import Client
+
+    from adept_traj.cycle import check_moves, recertify
+
+    source, scene, checks, expected = _check_moves_case()
+    monkeypatch.setattr(recertify, "CHECKS_PER_TASK", 2)
     with Client(cluster.scheduler_address) as client:
         there = check_moves(source, scene, checks, client)
-    found = [(v.feasible, v.min_distance, v.before, v.after) for v in here]
-    assert found == expected
-    assert there == here
+    assert [(v.feasible, v.min_distance, v.before, v.after) for v in there] == expected
