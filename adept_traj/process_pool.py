@@ -22,7 +22,8 @@ Every worker, the same way:
   signal when the *thread* that forked the worker ends: fork workers from a thread that
   outlives them, e.g. the main thread.) Ctrl-C is the caller's: a worker ignores SIGINT,
   held from before the fork until then (else a SIGINT at the fork's instant would raise in
-  the new process, which would run on as a copy of the caller).
+  the new process, which would run on as a copy of the caller); the caller's own Ctrl-C
+  held meanwhile is raised in it just after the fork, the new worker stopped.
 - **Holds no other worker's pipe**: every process forked after a worker (another worker,
   or any fork) closes, at once, its copies of the caller's ends of every worker's pipe
   (:func:`os.register_at_fork`), so workers may be started in any order and a worker's
@@ -245,11 +246,15 @@ class Worker:
             raise
         if pid == 0:  # the worker (never returns)
             _run(theirs, self._creator, target, args, prepare, prepare_niceness, held)
-        signal.pthread_sigmask(signal.SIG_SETMASK, held)
         theirs.close()
         self.pid, self._connection = pid, mine
         _LIVE[pid] = self
         self._finalizer = weakref.finalize(self, _stop, pid, mine, self._creator, False)
+        try:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)  # a Ctrl-C held is raised here
+        except BaseException:
+            self.close()
+            raise
 
     # ------------------------------------------------------------------ talking
     def send(self, *args: Any) -> None:

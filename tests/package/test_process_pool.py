@@ -226,6 +226,40 @@ def test_a_sigint_at_the_fork_instant_is_ignored_too() -> None:
     assert signal.pthread_sigmask(signal.SIG_BLOCK, set()) == mask
 
 
+_SIGINT_AT_FORK: list[int] = []  # the pid to signal at the next fork (then emptied)
+
+
+def _signal_at_fork() -> None:
+    if _SIGINT_AT_FORK:
+        os.kill(_SIGINT_AT_FORK.pop(), signal.SIGINT)
+
+
+os.register_at_fork(before=_signal_at_fork)
+
+
+def test_a_ctrl_c_of_the_caller_during_the_fork_is_raised_after_it_and_stops_the_worker():
+    """The user's Ctrl-C arrives while the caller forks (sent from the fork's own hook):
+    held over the fork, it is the caller's KeyboardInterrupt at once after it, and the
+    worker just forked is stopped (no process left behind)."""
+    before = _os_children()
+    _SIGINT_AT_FORK.append(os.getpid())
+    with pytest.raises(KeyboardInterrupt):
+        Worker(serve, len)
+    assert not _SIGINT_AT_FORK
+    gc.collect()
+    deadline = time.monotonic() + 10.0
+    while _os_children() != before:  # killed, and reaped once it ended
+        assert time.monotonic() < deadline, _os_children() - before
+        children()  # reaps what was killed
+        time.sleep(0.02)
+
+
+def _os_children() -> set[int]:
+    """The process ids of every child process of this one (from /proc, zombies included)."""
+    tasks = Path(f"/proc/{os.getpid()}/task")
+    return {int(p) for t in tasks.iterdir() for p in (t / "children").read_text().split()}
+
+
 def test_a_collected_worker_is_stopped() -> None:
     worker = Worker(serve, len)
     pid = worker.pid
