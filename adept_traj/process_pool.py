@@ -22,8 +22,8 @@ Every worker, the same way:
   signal when the *thread* that forked the worker ends: fork workers from a thread that
   outlives them, e.g. the main thread.) Ctrl-C is the caller's: a worker ignores SIGINT,
   held from before the fork until then (else a SIGINT at the fork's instant would raise in
-  the new process, which would run on as a copy of the caller); the caller's own Ctrl-C
-  held meanwhile is raised in it just after the fork, the new worker stopped.
+  the new process, which would run on as a copy of the caller); a Ctrl-C held meanwhile
+  is the caller's, raised just after the fork, the new worker stopped.
 - **Holds no other worker's pipe**: every process forked after a worker (another worker,
   or any fork) closes, at once, its copies of the caller's ends of every worker's pipe
   (:func:`os.register_at_fork`), so workers may be started in any order and a worker's
@@ -125,8 +125,7 @@ class Channel:
         self._connection = connection
 
     def send(self, value: Any) -> None:
-        """Send ``value`` to the caller (its :meth:`Worker.recv` returns it); the worker
-        ends quietly if the caller is gone."""
+        """Send ``value`` to the caller (:meth:`Worker.recv`); end quietly if it is gone."""
         payload = pickle.dumps((_VALUE, value), protocol=_PROTOCOL)
         try:
             self._connection.send_bytes(payload)
@@ -252,7 +251,7 @@ class Worker:
         self._finalizer = weakref.finalize(self, _stop, pid, mine, self._creator, False)
         try:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)  # a Ctrl-C held is raised here
-        except BaseException:
+        except BaseException:  # the worker must not outlive its Worker
             self.close()
             raise
 
