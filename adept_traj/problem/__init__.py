@@ -12,7 +12,7 @@ reference (``reference``).
 
 from __future__ import annotations
 
-from adept_traj.problem._heap import keep_heap
+from adept_traj.problem._heap import heap_environment, keep_heap
 from adept_traj.problem.bspline import BSplineTrajectory
 from adept_traj.problem.evaluation import Evaluation
 from adept_traj.problem.evaluator import ParallelEvaluator, available_cores
@@ -63,6 +63,7 @@ __all__ = [
     "check_differentiable",
     "derivative_abs_max",
     "from_pymoo",
+    "heap_environment",
     "keep_heap",
     "kinematic_lower_bound",
     "local_constraints",

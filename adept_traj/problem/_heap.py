@@ -30,7 +30,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["keep_heap"]
+__all__ = ["heap_environment", "keep_heap"]
 
 #: Arrays of at least this many bytes [B] are mapped on their own (32 MiB).
 _MMAP_THRESHOLD = 32 * 2**20
@@ -64,6 +64,22 @@ def keep_heap() -> bool:
     if _kept is None:
         _kept = _set_parameters()
     return _kept
+
+
+def heap_environment() -> dict[str, str]:
+    """The environment variables that give a process started afresh (not forked) the
+    ``malloc`` parameters of :func:`keep_heap`: glibc reads them at the process's start.
+
+    Returns
+    -------
+    dict
+        ``{"MALLOC_MMAP_THRESHOLD_": "33554432", "MALLOC_TRIM_THRESHOLD_": "536870912"}``
+        (32 MiB and 512 MiB, in bytes).
+    """
+    return {
+        "MALLOC_MMAP_THRESHOLD_": str(_MMAP_THRESHOLD),
+        "MALLOC_TRIM_THRESHOLD_": str(_TRIM_THRESHOLD),
+    }
 
 
 def _set_parameters() -> bool:
