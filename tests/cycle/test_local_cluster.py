@@ -16,8 +16,12 @@ def _malloc_environment() -> dict[str, str | None]:
     return {k: os.environ.get(k) for k in ("MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")}
 
 
-def test_local_workers_keep_their_heap_and_dask_s_other_settings() -> None:
+def test_local_workers_keep_their_heap_and_dask_s_other_settings(monkeypatch) -> None:
+    """(A user's own ``MALLOC_*_`` variables would win, as Dask's nanny lets them: so would
+    those an earlier nanny in this process left, hence they are cleared here.)"""
     pytest.importorskip("distributed")
+    for name in heap_environment():
+        monkeypatch.delenv(name, raising=False)
     with dask_client(2, None, 2) as client:
         found = client.run(_malloc_environment)
         threads = client.run(lambda: os.environ.get("OPENBLAS_NUM_THREADS"))

@@ -226,12 +226,12 @@ def test_a_sigint_at_the_fork_instant_is_ignored_too() -> None:
     assert signal.pthread_sigmask(signal.SIG_BLOCK, set()) == mask
 
 
-_SIGINT_AT_FORK: list[int] = []  # the pid to signal at the next fork (then emptied)
+_SIGINT_AT_FORK: list[int] = []  # the thread to signal at the next fork (then emptied)
 
 
 def _signal_at_fork() -> None:
-    if _SIGINT_AT_FORK:
-        os.kill(_SIGINT_AT_FORK.pop(), signal.SIGINT)
+    if _SIGINT_AT_FORK:  # to the forking thread: a process-wide SIGINT may go to another
+        signal.pthread_kill(_SIGINT_AT_FORK.pop(), signal.SIGINT)
 
 
 os.register_at_fork(before=_signal_at_fork)
@@ -242,9 +242,15 @@ def test_a_ctrl_c_of_the_caller_during_the_fork_is_raised_after_it_and_stops_the
     held over the fork, it is the caller's KeyboardInterrupt at once after it, and the
     worker just forked is stopped (no process left behind)."""
     before = _os_children()
-    _SIGINT_AT_FORK.append(os.getpid())
-    with pytest.raises(KeyboardInterrupt):
-        Worker(serve, len)
+    handler = signal.signal(signal.SIGINT, signal.default_int_handler)  # xdist ignores it
+    mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # and may block it
+    try:
+        _SIGINT_AT_FORK.append(threading.get_ident())
+        with pytest.raises(KeyboardInterrupt):
+            Worker(serve, len)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        signal.signal(signal.SIGINT, handler)
     assert not _SIGINT_AT_FORK
     gc.collect()
     deadline = time.monotonic() + 10.0
