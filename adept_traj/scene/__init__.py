@@ -47,6 +47,7 @@ from adept_traj.scene.shapes import (
     Sphere,
     coal_transform,
 )
+from adept_traj.scene.triangulation import shape_triangles
 
 __all__ = [
     "CLOUD_SUFFIXES",
@@ -91,5 +92,6 @@ __all__ = [
     "scene_notes",
     "scene_to_dict",
     "scene_to_toml",
+    "shape_triangles",
     "write_scene_file",
 ]

@@ -42,23 +42,13 @@ import numpy as np
 
 from adept_traj.analysis import PAPER_WEIGHTS
 from adept_traj.certification import MemberCertificate
-from adept_traj.errors import InvalidInputError
 from adept_traj.export import DEFAULT_DT, csv_header
 from adept_traj.files import write_text_atomic
 from adept_traj.problem import OBJECTIVES
 from adept_traj.results import PlanningResult, Replay, certified_members
 from adept_traj.robot import Robot
 from adept_traj.robot.limits import LIMIT_KINDS
-from adept_traj.scene import (
-    Box,
-    Capsule,
-    Cylinder,
-    Mesh,
-    PointCloud,
-    Scene,
-    Sphere,
-    merge_meshes,
-)
+from adept_traj.scene import Scene, shape_triangles
 from adept_traj.validation import as_path, check_type
 from adept_traj.viz.explorer_page import PAGE_TEMPLATE
 
@@ -68,8 +58,6 @@ __all__ = ["EXPLORER_FILE", "VIEW_DT", "explorer_data", "explorer_html", "write_
 EXPLORER_FILE = "explorer.html"
 #: Time step [s] of the 3-D view's robot poses (the page interpolates between them).
 VIEW_DT = 0.04
-#: Segments of the circles of the drawn spheres, cylinders and capsules.
-_SEGMENTS = 16
 FIXED_COLOR, MOVING_COLOR = "#c0392b", "#8e44ad"
 
 
@@ -82,71 +70,6 @@ def _finite(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else float(value)
 
 
-# ============================================================================ geometry
-def _sphere(radius: float, centre_z: float = 0.0, rings: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (v, 3) and triangles (f, 3) of a UV sphere centred at (0, 0, centre_z)."""
-    theta = np.linspace(0.0, math.pi, rings + 1)
-    phi = np.linspace(0.0, 2 * math.pi, _SEGMENTS, endpoint=False)
-    th, ph = np.meshgrid(theta, phi, indexing="ij")
-    v = radius * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
-    v = v.reshape(-1, 3) + np.array([0.0, 0.0, centre_z])
-    i, j = np.meshgrid(np.arange(rings), np.arange(_SEGMENTS), indexing="ij")
-    a = i * _SEGMENTS + j
-    b = i * _SEGMENTS + (j + 1) % _SEGMENTS
-    c, d = a + _SEGMENTS, b + _SEGMENTS
-    faces = np.concatenate([np.stack([a, b, d], -1), np.stack([a, d, c], -1)]).reshape(-1, 3)
-    return v, faces
-
-
-def _cylinder(radius: float, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """A closed cylinder along z, centred (vertices, triangles)."""
-    phi = np.linspace(0.0, 2 * math.pi, _SEGMENTS, endpoint=False)
-    ring = np.stack([radius * np.cos(phi), radius * np.sin(phi)], -1)
-    z = 0.5 * length
-    v = np.vstack([np.column_stack([ring, np.full(_SEGMENTS, -z)]),
-                   np.column_stack([ring, np.full(_SEGMENTS, z)]),
-                   [[0, 0, -z], [0, 0, z]]])  # fmt: skip
-    j = np.arange(_SEGMENTS)
-    k = (j + 1) % _SEGMENTS
-    n = _SEGMENTS
-    side = np.concatenate([np.stack([j, k, k + n], -1), np.stack([j, k + n, j + n], -1)])
-    caps = np.concatenate([np.stack([np.full(n, 2 * n), k, j], -1),
-                           np.stack([np.full(n, 2 * n + 1), j + n, k + n], -1)])  # fmt: skip
-    return v, np.concatenate([side, caps])
-
-
-def _box(size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7],
-                      [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])  # fmt: skip
-    return corners * (0.5 * np.asarray(size, float)), faces
-
-
-def _mesh(shape: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (v, 3) [m] in the shape's frame and triangles (f, 3) of an obstacle shape."""
-    if isinstance(shape, Box):
-        return _box(shape.size)
-    if isinstance(shape, Sphere):
-        return _sphere(shape.radius)
-    if isinstance(shape, Cylinder):
-        return _cylinder(shape.radius, shape.length)
-    if isinstance(shape, Capsule):
-        parts = [_cylinder(shape.radius, shape.length)]
-        parts += [_sphere(shape.radius, z) for z in (-0.5 * shape.length, 0.5 * shape.length)]
-        return merge_meshes(*parts)
-    if isinstance(shape, Mesh):  # its own triangles
-        return np.asarray(shape.vertices, dtype=float), np.asarray(shape.triangles)
-    if isinstance(shape, PointCloud):  # drawn as the box of its points (the page stays small)
-        points = np.asarray(shape.points, dtype=float)
-        lo, hi = points.min(axis=0), points.max(axis=0)
-        v, f = _box(hi - lo)
-        return v + 0.5 * (lo + hi), f
-    raise InvalidInputError(
-        f"cannot draw obstacle shape {type(shape).__name__} "
-        "(box, sphere, cylinder, capsule, mesh, point cloud)"
-    )
-
-
 def _obstacles(scene: Scene, horizon: float) -> tuple[list[dict[str, Any]], float]:
     """The obstacles (mesh once; the pose, or the poses on the shared grid of step
     :data:`VIEW_DT` over [0, ``horizon``] for a moving one) and that grid's step [s]."""
@@ -155,7 +78,7 @@ def _obstacles(scene: Scene, horizon: float) -> tuple[list[dict[str, Any]], floa
     poses = scene.obstacle_poses(times) if scene.obstacles else np.zeros((0, n, 4, 4))
     out = []
     for ob, pose in zip(scene.obstacles, poses, strict=True):
-        v, f = _mesh(ob.shape)
+        v, f = shape_triangles(ob.shape)
         kept = pose if ob.is_moving else pose[:1]
         out.append(
             {
