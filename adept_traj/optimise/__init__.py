@@ -6,14 +6,43 @@ polishing (``polish``) and :func:`plan`.
 Every public name is imported from the module that holds it on first use
 (:func:`~adept_traj.lazy_names.lazy_names`): ``from adept_traj.optimise import TIME_OPTIMAL``
 imports neither pymoo nor the evolutionary search, which the time-optimal mode does not use.
+The package serves every name of a module's ``__all__`` (read from its source by
+:func:`~adept_traj.lazy_names.public_names`: the module holds the one list), or, for a
+module with names of its own internals (tuning constants, helpers of its subpackage), the
+names listed here.
 """
 
 from __future__ import annotations
 
-from adept_traj.lazy_names import lazy_names
+from adept_traj.lazy_names import lazy_names, public_names
 
-#: Each public name and the module that holds it.
+#: The modules every public name (``__all__``) of which the package serves.
+_WHOLE_MODULES = (
+    "adept_traj.optimise.local.polish_modes",
+    "adept_traj.optimise.local.weighted_move",
+    "adept_traj.optimise.operators.crossover",
+    "adept_traj.optimise.operators.de_variant",
+    "adept_traj.optimise.operators.duplicates",
+    "adept_traj.optimise.operators.mating",
+    "adept_traj.optimise.operators.mutation",
+    "adept_traj.optimise.operators.population",
+    "adept_traj.optimise.operators.survival",
+    "adept_traj.optimise.operators.tournament",
+    "adept_traj.optimise.parallel.early_certificates",
+    "adept_traj.optimise.parallel.front_certificates",
+    "adept_traj.optimise.parallel.polish_worker",
+    "adept_traj.optimise.planner",
+    "adept_traj.optimise.search.algorithm_names",
+    "adept_traj.optimise.search.algorithms",
+    "adept_traj.optimise.search.checkpoint",
+    "adept_traj.optimise.search.fast_end_search",
+    "adept_traj.optimise.search.loop",
+    "adept_traj.optimise.search.run_records",
+    "adept_traj.optimise.search.sampling",
+)
+#: Each public name of the other modules the package serves, and its module.
 _WHERE: dict[str, str] = {
+    "PlanningInterrupted": "adept_traj.errors",
     **dict.fromkeys(
         ["BASIN_THRESHOLD", "basin_labels", "basin_starts"], "adept_traj.optimise.local.basins"
     ),
@@ -37,22 +66,6 @@ _WHERE: dict[str, str] = {
         "adept_traj.optimise.local.multi_start",
     ),
     **dict.fromkeys(
-        [
-            "GRADIENT_COST",
-            "POLISH_MODES",
-            "POLISH_SHARE",
-            "SPREAD_MEMBERS",
-            "TIME_OPTIMAL",
-            "polish_fastest",
-            "polish_members",
-            "polish_mode",
-            "polish_run",
-            "polish_run_with_certificates",
-            "time_optimal_run",
-        ],
-        "adept_traj.optimise.local.polish_modes",
-    ),
-    **dict.fromkeys(
         ["Refinement", "refine_minimum_time", "refine_starts", "screen_starts"],
         "adept_traj.optimise.local.refinement",
     ),
@@ -66,77 +79,10 @@ _WHERE: dict[str, str] = {
         "adept_traj.optimise.local.via_points",
     ),
     **dict.fromkeys(
-        [
-            "MAX_EVALUATIONS_PER_START",
-            "STEP_EVALUATIONS",
-            "STOP_DECREASE",
-            "WEIGHTED_BOX",
-            "weighted_descent",
-            "weighted_run",
-        ],
-        "adept_traj.optimise.local.weighted_move",
-    ),
-    **dict.fromkeys(["sbx_children"], "adept_traj.optimise.operators.crossover"),
-    **dict.fromkeys(["ArrayVariant"], "adept_traj.optimise.operators.de_variant"),
-    **dict.fromkeys(
-        ["BLOCK_PAIRS", "BlockedDuplicateElimination"], "adept_traj.optimise.operators.duplicates"
-    ),
-    **dict.fromkeys(["ArrayMating"], "adept_traj.optimise.operators.mating"),
-    **dict.fromkeys(["mutate"], "adept_traj.optimise.operators.mutation"),
-    **dict.fromkeys(
-        ["ArrayEvaluator", "cache_violations", "optimum", "population_values", "ranked_optimum"],
-        "adept_traj.optimise.operators.population",
-    ),
-    **dict.fromkeys(
         ["KinematicTimeRepair", "kinematic_time"], "adept_traj.optimise.operators.repair"
     ),
-    **dict.fromkeys(
-        ["RankAndCrowdingSurvival", "crowding_distance"], "adept_traj.optimise.operators.survival"
-    ),
-    **dict.fromkeys(
-        ["TournamentArrays", "binary_tournament", "select_parents"],
-        "adept_traj.optimise.operators.tournament",
-    ),
-    **dict.fromkeys(
-        ["EARLY_SHARE", "EarlyCertificates", "feasible_front", "start_early_certificates"],
-        "adept_traj.optimise.parallel.early_certificates",
-    ),
-    **dict.fromkeys(["certify_front_members"], "adept_traj.optimise.parallel.front_certificates"),
-    **dict.fromkeys(
-        ["Polisher", "check_polisher", "polish_with_certificates", "start_polisher"],
-        "adept_traj.optimise.parallel.polish_worker",
-    ),
-    **dict.fromkeys(["plan", "warn_missing_limits"], "adept_traj.optimise.planner"),
-    **dict.fromkeys(
-        ["ALGORITHMS", "OTHER_ALGORITHMS", "PAPER_SETTINGS"],
-        "adept_traj.optimise.search.algorithm_names",
-    ),
-    **dict.fromkeys(
-        ["AlgorithmSettings", "make_algorithm"], "adept_traj.optimise.search.algorithms"
-    ),
-    **dict.fromkeys(
-        [
-            "CHECKPOINT_VERSION",
-            "CapturedCheckpoint",
-            "capture_checkpoint",
-            "checkpoint_arrays",
-            "has_checkpoint",
-            "load_checkpoint",
-            "restore_algorithm",
-            "save_checkpoint",
-            "write_checkpoint",
-        ],
-        "adept_traj.optimise.search.checkpoint",
-    ),
-    **dict.fromkeys(["FastEndSearch"], "adept_traj.optimise.search.fast_end_search"),
-    **dict.fromkeys(["CHECKPOINT_INTERVAL", "optimise"], "adept_traj.optimise.search.loop"),
-    **dict.fromkeys(["GenerationInfo", "RunState"], "adept_traj.optimise.search.run_records"),
-    "PlanningInterrupted": "adept_traj.errors",
-    **dict.fromkeys(
-        ["RampSampling", "SeededInitialization", "check_population_memory", "population_bytes"],
-        "adept_traj.optimise.search.sampling",
-    ),
 }
+_WHERE.update({name: m for m in _WHOLE_MODULES for name in public_names(m)})
 
 __all__ = sorted(_WHERE)
 

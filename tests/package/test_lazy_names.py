@@ -76,3 +76,55 @@ def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_se
     count, missing = resolved.split(" ", 1)
     assert int(count) > 90
     assert missing == "[]"
+
+
+def test_public_names_reads_a_modules_all_without_importing_it() -> None:
+    import importlib
+    import subprocess
+    import sys
+
+    from adept_traj.lazy_names import public_names
+
+    code = (
+        "import sys\n"
+        "from adept_traj.lazy_names import public_names\n"
+        "print(public_names('adept_traj.optimise.search.checkpoint'))\n"
+        "print('adept_traj.optimise.search.checkpoint' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    names, imported = done.stdout.splitlines()
+    checkpoint = importlib.import_module("adept_traj.optimise.search.checkpoint")
+    assert names == repr(list(checkpoint.__all__))
+    assert imported == "False"
+    assert public_names("json.decoder") == list(importlib.import_module("json.decoder").__all__)
+
+
+def test_optimise_serves_every_name_of_its_whole_modules() -> None:
+    import importlib
+
+    import adept_traj.optimise as optimise
+
+    for module in (
+        "adept_traj.optimise.local.polish_modes",
+        "adept_traj.optimise.local.weighted_move",
+        "adept_traj.optimise.search.checkpoint",
+        "adept_traj.optimise.operators.tournament",
+    ):
+        holder = importlib.import_module(module)
+        for name in holder.__all__:
+            assert name in optimise.__all__, (module, name)
+            assert getattr(optimise, name) is getattr(holder, name), (module, name)
+
+
+def test_public_names_refuses_a_module_without_a_literal_all(tmp_path, monkeypatch) -> None:
+    from adept_traj.lazy_names import public_names
+
+    (tmp_path / "computed_all_probe.py").write_text("__all__ = sorted(['a', 'b'])\n")
+    (tmp_path / "no_all_probe.py").write_text("x = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    for name in ("computed_all_probe", "no_all_probe"):
+        with pytest.raises(ImportError, match=f"module '{name}' has no literal __all__"):
+            public_names(name)
+    with pytest.raises(ImportError, match="no Python source file for module 'no_such_probe'"):
+        public_names("no_such_probe")
