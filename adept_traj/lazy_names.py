@@ -77,7 +77,7 @@ def public_names(module: str) -> list[str]:
         No such module, no source file, or no literal ``__all__`` in it.
     """
     parent, _, leaf = module.rpartition(".")
-    folders = importlib.import_module(parent).__path__ if parent else sys.path
+    folders = getattr(importlib.import_module(parent), "__path__", []) if parent else sys.path
     files = [Path(folder, f"{leaf}.py") for folder in folders]
     found = next((file for file in files if file.is_file()), None)
     if found is None:  # e.g. a module without source: its spec says where it is
