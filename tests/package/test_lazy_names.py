@@ -3,6 +3,7 @@ then kept in its namespace; a name not served is an AttributeError."""
 
 from __future__ import annotations
 
+import subprocess
 import sys
 import types
 
@@ -55,10 +56,14 @@ def test_the_moved_names_are_found_where_they_were() -> None:
         adept_traj.results.certify  # noqa: B018  (moved to certification, not from results)
 
 
-def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_search() -> None:
-    import subprocess
-    import sys
+def _fresh_python(code: str) -> list[str]:
+    """The lines ``code`` prints in a new interpreter (nothing imported before it)."""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
 
+
+def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_search() -> None:
     code = (
         "import sys\n"
         "from adept_traj.optimise import ALGORITHMS, POLISH_MODES, TIME_OPTIMAL, RunState\n"
@@ -69,9 +74,7 @@ def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_se
         "missing = [n for n in o.__all__ if getattr(o, n, None) is None]\n"
         "print(len(o.__all__), missing)\n"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    light, resolved = done.stdout.splitlines()
+    light, resolved = _fresh_python(code)
     assert light == "[]"
     count, missing = resolved.split(" ", 1)
     assert int(count) > 90
@@ -80,8 +83,6 @@ def test_every_name_of_optimise_resolves_and_the_time_optimal_names_import_no_se
 
 def test_public_names_reads_a_modules_all_without_importing_it() -> None:
     import importlib
-    import subprocess
-    import sys
 
     from adept_traj.lazy_names import public_names
 
@@ -91,9 +92,7 @@ def test_public_names_reads_a_modules_all_without_importing_it() -> None:
         "print(public_names('adept_traj.optimise.search.checkpoint'))\n"
         "print('adept_traj.optimise.search.checkpoint' in sys.modules)\n"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    names, imported = done.stdout.splitlines()
+    names, imported = _fresh_python(code)
     checkpoint = importlib.import_module("adept_traj.optimise.search.checkpoint")
     assert names == repr(list(checkpoint.__all__))
     assert imported == "False"
