@@ -1,10 +1,12 @@
 """adept_traj.optimise.local.sqp, the trust boxes' SQP: a closed-form optimum (a linear cost on
 a ball), scipy's SLSQP (an independent implementation of the same method) on a random
-smooth problem, bounds honoured, infeasible subproblems and iteration limits reported, and
-determinism."""
+smooth problem, bounds honoured, infeasible subproblems and iteration limits reported,
+determinism, and the subproblems' warm start (each step that of a cold solve; a failing
+warm solve solved again cold)."""
 
 from __future__ import annotations
 
+import daqp
 import numpy as np
 import pytest
 from scipy.optimize import minimize
@@ -107,3 +109,81 @@ def test_bad_input_is_refused_before_any_row_is_evaluated() -> None:
     with pytest.raises(ConfigurationError, match="tol"):
         sqp(np.ones(2), np.zeros(2), -free, free, rows, max_iter=5, tol=0.0)
     assert calls == []
+
+
+def _random_rows(seed: int, n: int = 6, m: int = 40):
+    """Convex quadratic rows ½ yᵀQ_i y + b_iᵀy − 1 ≤ 0 and a linear cost (as above, more
+    rows: several active at the optimum)."""
+    rng = np.random.default_rng(seed)
+    Q = [(lambda M: M @ M.T + np.eye(n))(rng.normal(size=(n, n))) for _ in range(m)]
+    b = rng.normal(size=(m, n))
+
+    def rows(y):
+        g = np.array([0.5 * y @ Qi @ y for Qi in Q]) + b @ y - 1.0
+        return g, np.array([Qi @ y for Qi in Q]) + b
+
+    return rng.normal(size=n), rows
+
+
+def test_each_warm_started_subproblem_has_the_step_of_a_cold_solve(monkeypatch) -> None:
+    """Every DAQP call after the first of a run starts from an active set (sense flags);
+    the step it returns is the one DAQP gives the same QP from no active set (the QP is
+    strictly convex: one answer), and the run ends where scipy's SLSQP does."""
+    c, rows = _random_rows(5)
+    calls: list[tuple] = []
+    solve = daqp.solve
+
+    def recording(H, f, A, bupper, blower, sense, **kw):
+        out = solve(H, f, A, bupper, blower, sense, **kw)
+        calls.append((H.copy(), f.copy(), A.copy(), bupper.copy(), blower.copy(),
+                      sense.copy(), kw, out[0].copy(), out[2]))  # fmt: skip
+        return out
+
+    monkeypatch.setattr(daqp, "solve", recording)
+    lo, hi = np.full(6, -5.0), np.full(6, 5.0)
+    res = sqp(c, np.zeros(6), lo, hi, rows, max_iter=100)
+    monkeypatch.undo()
+    assert res.converged
+    assert len(calls) >= 3
+    assert not calls[0][5].any()  # the first from no active set
+    assert all(call[5].any() for call in calls[1:])  # the others warm
+    for H, f, A, bu, bl, sense, kw, d, flag in calls:
+        assert flag >= 1
+        cold = solve(H, f, A, bu, bl, np.zeros_like(sense), **kw)
+        assert cold[2] >= 1
+        np.testing.assert_allclose(d, cold[0], rtol=1e-7, atol=1e-10)
+    ref = minimize(
+        lambda y: c @ y, np.zeros(6), jac=lambda y: c, method="SLSQP", bounds=list(zip(lo, hi)),
+        constraints=[{"type": "ineq", "fun": lambda y: -rows(y)[0], "jac": lambda y: -rows(y)[1]}],
+        options={"maxiter": 200, "ftol": 1e-12},
+    )  # fmt: skip
+    assert ref.success
+    np.testing.assert_allclose(res.x, ref.x, atol=1e-5)
+
+
+def test_a_failing_warm_solve_is_solved_again_cold(monkeypatch) -> None:
+    """DAQP made to fail every warm-started call: each subproblem is solved again from no
+    active set, and the run ends at the same point as one that never warm-starts."""
+    c, rows = _random_rows(7)
+    solve = daqp.solve
+    lo, hi = np.full(6, -5.0), np.full(6, 5.0)
+    warm_calls = []
+
+    def cold_only(H, f, A, bupper, blower, sense, **kw):
+        return solve(H, f, A, bupper, blower, np.zeros_like(sense), **kw)
+
+    monkeypatch.setattr(daqp, "solve", cold_only)
+    never_warm = sqp(c, np.zeros(6), lo, hi, rows, max_iter=100)
+
+    def failing_warm(H, f, A, bupper, blower, sense, **kw):
+        if sense.any():
+            warm_calls.append(1)
+            return np.zeros(len(f)), 0.0, -1, {"lam": np.zeros(len(bupper))}
+        return solve(H, f, A, bupper, blower, sense, **kw)
+
+    monkeypatch.setattr(daqp, "solve", failing_warm)
+    res = sqp(c, np.zeros(6), lo, hi, rows, max_iter=100)
+    assert warm_calls  # the warm start was tried
+    assert res.converged
+    assert never_warm.converged
+    np.testing.assert_array_equal(res.x, never_warm.x)

@@ -20,7 +20,11 @@ Powell-damped BFGS update of :math:`B` (the Hessian of the Lagrangian: the rows'
 curvature, the cost having none). The subproblem is solved by DAQP (a dual active-set QP
 solver for dense problems, ``daqp`` on PyPI): with the hundreds to thousands of rows of a
 trajectory's samples and a few dozen variables its solve costs a small fraction of
-SLSQP's least-squares subproblem (``docs/engine.md``). The caller's ``rows`` function is
+SLSQP's least-squares subproblem (``docs/engine.md``). Each subproblem after the first
+starts from the active set of the one before (DAQP's warm start: the rows and bounds
+whose multipliers were not zero), which the iterates seldom change; a warm solve that
+fails is solved again cold, so the warm start changes how fast a step is found, never
+whether one is. The caller's ``rows`` function is
 called once per trial point; it may record points (the trust box keeps the fastest point
 met inside every row).
 """
@@ -142,8 +146,9 @@ def _sqp(c: np.ndarray, y0: Any, bounds: tuple, rows: Rows, max_iter: int, tol: 
     n, m = len(y), len(h)
     B = np.eye(n)
     rho = np.zeros(m)
+    active = None  # the last subproblem's active set (DAQP's sense flags)
     for k in range(1, max_iter + 1):
-        d, lam = _subproblem(B, c, J, h, lo - y, hi - y)
+        d, lam, active = _subproblem(B, c, J, h, lo - y, hi - y, active)
         if d is None:
             return SqpResult(y, k, False)
         violation = np.maximum(h, 0.0)
@@ -172,20 +177,38 @@ def _sqp(c: np.ndarray, y0: Any, bounds: tuple, rows: Rows, max_iter: int, tol: 
 
 
 def _subproblem(
-    B: np.ndarray, c: np.ndarray, J: np.ndarray, h: np.ndarray, dl: np.ndarray, du: np.ndarray
-) -> tuple[np.ndarray | None, np.ndarray]:
-    """The QP step d (``None``: infeasible or failed) and the rows' multipliers λ ≥ 0."""
+    B: np.ndarray,
+    c: np.ndarray,
+    J: np.ndarray,
+    h: np.ndarray,
+    dl: np.ndarray,
+    du: np.ndarray,
+    warm: np.ndarray | None = None,
+) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
+    """The QP step d (``None``: infeasible or failed), the rows' multipliers λ ≥ 0 and
+    the active set at the answer as DAQP's sense flags (n + m,) (``None`` on failure).
+
+    ``warm``: the active set to start from (a previous answer's flags, same rows and
+    bounds), else none; a warm solve that fails is solved again from no active set."""
     import daqp  # lazy: only the local solver needs it
 
     upper = np.concatenate([du, -h])
     lower = np.concatenate([dl, np.full(len(h), -_INF)])
-    sense = np.zeros(len(upper), dtype=np.intc)
-    d, _, flag, info = daqp.solve(
-        B, c, np.ascontiguousarray(J), upper, lower, sense, primal_tol=_PRIMAL_TOL
-    )
-    if flag < 1:
-        return None, np.zeros(len(h))
-    return np.asarray(d, dtype=float), np.maximum(np.asarray(info["lam"])[len(c) :], 0.0)
+    A = np.ascontiguousarray(J)
+    for sense in (warm, None) if warm is not None and len(warm) == len(upper) else (None,):
+        flags = np.zeros(len(upper), dtype=np.intc) if sense is None else sense.copy()
+        d, _, flag, info = daqp.solve(B, c, A, upper, lower, flags, primal_tol=_PRIMAL_TOL)
+        if flag >= 1:
+            lam = np.asarray(info["lam"], dtype=float)
+            return np.asarray(d, dtype=float), np.maximum(lam[len(c) :], 0.0), _active(lam)
+    return None, np.zeros(len(h)), None
+
+
+def _active(lam: np.ndarray) -> np.ndarray:
+    """DAQP's sense flags of the constraints active at an answer with multipliers ``lam``
+    (n + m,): ``ACTIVE`` (1) where λ ≠ 0, with ``LOWER`` (2) where λ < 0 (the lower
+    bound)."""
+    return np.where(lam > 0.0, 1, np.where(lam < 0.0, 3, 0)).astype(np.intc)
 
 
 def _bfgs(B: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
