@@ -44,7 +44,7 @@ Every worker, the same way:
   worker first runs it in a thread at nice :data:`LOWEST_PRIORITY` (Linux niceness is
   per thread: it runs while a core idles and never takes one from the caller), then says
   it is ready (:meth:`Worker.ready`) and runs ``target`` at the caller's priority
-  (:meth:`Worker.hurry` raises a preparation the caller waits for).
+  (:meth:`Worker.hurry` raises a preparation the caller waits for, and its processes).
 """
 
 from __future__ import annotations
@@ -62,6 +62,7 @@ from multiprocessing.connection import Connection, Pipe
 from typing import Any
 
 from adept_traj.errors import ConfigurationError, WorkerDiedError, WorkerError, error_from_process
+from adept_traj.process_tree import raise_priority
 
 __all__ = [
     "LOWEST_PRIORITY", "Channel", "Worker", "can_fork", "children", "map_forked",
@@ -314,19 +315,12 @@ class Worker:
         return self._ready and self.pid is not None
 
     def hurry(self) -> bool:
-        """Raise the threads of a worker still preparing to the calling thread's niceness
-        (a caller about to wait for it); whether it was done (not where the system refuses:
-        that needs ``CAP_SYS_NICE`` or ``RLIMIT_NICE``; nor for a stopped worker)."""
+        """Raise a worker still preparing, and the processes it forked, to the calling
+        thread's niceness (:func:`~adept_traj.process_tree.raise_priority`: a caller about
+        to wait for it); whether it was done (not for a stopped worker)."""
         if self.pid is None or os.getpid() != self._creator:
             return False
-        who, mine = os.PRIO_PROCESS, os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
-        try:
-            for tid in map(int, os.listdir(f"/proc/{self.pid}/task")):
-                with contextlib.suppress(ProcessLookupError):  # that thread has ended
-                    os.setpriority(who, tid, min(mine, os.getpriority(who, tid)))
-        except (PermissionError, FileNotFoundError):  # not allowed; no /proc; ended
-            return False
-        return True
+        return raise_priority(self.pid, os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))
 
     def _message(self) -> tuple:
         """The worker's next message; a :class:`WorkerDiedError` at the pipe's end.

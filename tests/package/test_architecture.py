@@ -16,8 +16,10 @@ PACKAGE = Path(__file__).resolve().parents[2] / "adept_traj"
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
     "errors": 0, "data": 0, "urdf": 0, "lazy_names": 0,
+    "process_tree": 0.5,  # a process tree's threads and priority, for process_pool
     "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
     "process_helper": 1.5,
+    "work_ahead": 1.6,  # a Helper computing a value ahead at nice 19
     "transforms": 2, "schema": 2,
     "robot": 3,
     "scene": 4,

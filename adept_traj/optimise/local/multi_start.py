@@ -39,8 +39,9 @@ from adept_traj.optimise.local.via_points import (
 )
 from adept_traj.optimise.operators.repair import KINEMATIC_SLACK, kinematic_time
 from adept_traj.optimise.search.sampling import RampSampling
-from adept_traj.process_pool import Channel, Worker, can_fork
+from adept_traj.process_pool import can_fork
 from adept_traj.validation import as_integer, as_scalar
+from adept_traj.work_ahead import WorkAhead
 
 __all__ = [
     "MAX_BASINS",
@@ -131,10 +132,10 @@ def time_optimal(
     first = 1 if problem.scene.moving else max(1, int(_wanted(problem, processes)))
     try:
         screened = screen_starts(problem, starts[:first], stop=near, **options)
-        known = None if ahead is None or near(screened) else ahead.recv()
+        known = None if ahead is None or near(screened) else ahead.result()
     finally:
         if ahead is not None:
-            ahead.close()  # not needed when the first start is near the bound
+            ahead.cancel()  # not needed when the first start is near the bound
     stage = None
     if not near(screened):  # the relaxed problem's optimum before the other starts
         stage = global_stage(problem, n_starts=n_starts, rate_hz=rate_hz,
@@ -293,19 +294,16 @@ def initial_starts(
     return relaxed
 
 
-def _relaxed_ahead(problem: Any, rate_hz: float, processes: int | None) -> Worker | None:
-    """A worker computing :func:`relaxed_optimum` while the caller screens its first start
-    (``None`` without moving obstacles, with one process, or without ``fork``)."""
+def _relaxed_ahead(problem: Any, rate_hz: float, processes: int | None) -> WorkAhead | None:
+    """:func:`relaxed_optimum` computed ahead, at the lowest priority, while the caller
+    screens its first start (:class:`~adept_traj.work_ahead.WorkAhead`: it takes no core
+    from the screening, and is raised when waited for); ``None`` without moving obstacles,
+    with one process, or without ``fork``."""
     n_proc = _wanted(problem, processes)
     if not problem.scene.moving or n_proc <= 1 or not can_fork():
         return None
-    return Worker(_send_relaxed, problem, rate_hz, processes,
-                  note="raised in the relaxed problem's worker")  # fmt: skip
-
-
-def _send_relaxed(channel: Channel, problem: Any, rate_hz: float, processes: int | None) -> None:
-    """The worker of :func:`_relaxed_ahead`."""
-    channel.send(relaxed_optimum(problem, rate_hz=rate_hz, processes=processes))
+    make = functools.partial(relaxed_optimum, problem, rate_hz=rate_hz, processes=processes)
+    return WorkAhead(make, note="raised in the relaxed problem's worker")
 
 
 def fastest_of_basins(
