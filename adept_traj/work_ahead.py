@@ -68,7 +68,7 @@ class WorkAhead(Helper):
         worker = self._worker
         if worker is None or worker.pid is None:
             return self._make()
-        worker.hurry()  # not allowed to: it runs on at nice 19, as fast while a core idles
+        worker.hurry()  # where the system refuses, it runs on at nice 19 (as fast on an idle core)
         try:
             return worker.recv()
         except WorkerDiedError:
