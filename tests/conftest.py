@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import resource
 import shutil
 import signal
 import socket
@@ -106,6 +107,14 @@ def chromium_driver(profile: Path, *flags: str):
 
 
 # ---------------------------------------------------------------- local servers
+def may_lower_niceness() -> bool:
+    """Whether this process may lower a thread's niceness from 19 back to its own (root,
+    or an ``RLIMIT_NICE`` that allows it): where not, ``Worker.hurry`` is refused."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_NICE)
+    own = os.getpriority(os.PRIO_PROCESS, 0)
+    return os.geteuid() == 0 or soft == resource.RLIM_INFINITY or 20 - soft <= own
+
+
 def fetch(url: str, method: str = "GET") -> tuple[int, bytes, dict[str, str]]:
     """(status, body, headers) of a request to ``url`` (an HTTP error's status too)."""
     request = urllib.request.Request(url, method=method)

@@ -30,6 +30,7 @@ from adept_traj.process_pool import (
     prepare_quietly,
     serve,
 )
+from tests.conftest import may_lower_niceness
 
 
 def _ended(pid: int, within: float = 10.0) -> bool:
@@ -129,15 +130,6 @@ def test_prepare_runs_at_the_callers_priority_when_asked() -> None:
         assert worker.recv() == ([own], own)
 
 
-def _may_lower_niceness() -> bool:
-    """Whether this process may lower a niceness back from 19 (root, or RLIMIT_NICE)."""
-    import resource
-
-    soft, _ = resource.getrlimit(resource.RLIMIT_NICE)
-    own = os.getpriority(os.PRIO_PROCESS, 0)
-    return os.geteuid() == 0 or soft == resource.RLIM_INFINITY or 20 - soft <= own
-
-
 def _until_hurried() -> None:
     """A preparation that lasts until its thread is raised above nice 19 (at most 60 s)."""
     deadline = time.monotonic() + 60.0
@@ -152,7 +144,7 @@ def test_hurry_raises_a_preparing_worker_to_the_callers_priority() -> None:
     with Worker(_niceness, seen, prepare=_until_hurried) as worker:
         time.sleep(0.2)
         assert not worker.ready()  # still preparing at nice 19
-        if not _may_lower_niceness():
+        if not may_lower_niceness():
             assert worker.hurry() is False  # refused by the system, said so
             return
         assert worker.hurry() is True

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import resource
 import subprocess
 import time
 from pathlib import Path
 
 from adept_traj.process_tree import raise_priority, tree_threads
+from tests.conftest import may_lower_niceness
 
 #: A shell that starts two sleeping children, one with a sleeping child of its own.
 _TREE = "sleep 60 & (sleep 60 & wait) & wait"
@@ -91,11 +91,6 @@ def test_an_ended_process_has_no_threads_and_cannot_be_raised() -> None:
     assert raise_priority(ended.pid, 0) is False
 
 
-def _may_lower(own: int) -> bool:
-    soft, _ = resource.getrlimit(resource.RLIMIT_NICE)
-    return os.geteuid() == 0 or soft == resource.RLIM_INFINITY or 20 - soft <= own
-
-
 def _niceness(tid: int) -> int:
     return os.getpriority(os.PRIO_PROCESS, tid)
 
@@ -106,7 +101,7 @@ def test_raise_priority_lowers_the_niceness_of_every_thread_of_the_tree() -> Non
     try:
         members = _descendants(shell.pid)
         assert {_niceness(pid) for pid in members} == {19}  # inherited by every fork
-        if not _may_lower(own):
+        if not may_lower_niceness():
             assert raise_priority(shell.pid, own) is False  # refused, said so
             return
         assert raise_priority(shell.pid, own) is True

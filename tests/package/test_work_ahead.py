@@ -6,7 +6,6 @@ and dropped unused by cancel."""
 from __future__ import annotations
 
 import os
-import resource
 import signal
 import threading
 import time
@@ -17,17 +16,12 @@ import pytest
 import adept_traj.work_ahead as work_ahead
 from adept_traj.process_pool import LOWEST_PRIORITY, map_forked
 from adept_traj.work_ahead import WorkAhead
+from tests.conftest import may_lower_niceness
 
 
 def _where() -> tuple[int, int]:
     """(process id, niceness of this thread)."""
     return os.getpid(), os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
-
-
-def _may_lower() -> bool:
-    soft, _ = resource.getrlimit(resource.RLIMIT_NICE)
-    own = os.getpriority(os.PRIO_PROCESS, 0)
-    return os.geteuid() == 0 or soft == resource.RLIM_INFINITY or 20 - soft <= own
 
 
 def test_the_value_is_computed_in_another_process_at_the_lowest_priority() -> None:
@@ -64,7 +58,7 @@ def test_result_raises_the_worker_and_the_processes_it_forked(tmp_path: Path) ->
     forked = int(marker.read_text())
     assert forked != ahead.pid
     assert os.getpriority(os.PRIO_PROCESS, forked) == LOWEST_PRIORITY  # forked at nice 19
-    if not _may_lower():
+    if not may_lower_niceness():
         ahead.cancel()  # the system refuses the raise: the forked item would wait 60 s
         return
     first, second = ahead.result()
