@@ -196,7 +196,7 @@ def _subproblem(
     lower = np.concatenate([dl, np.full(len(h), -_INF)])
     A = np.ascontiguousarray(J)
     for sense in (warm, None) if warm is not None and len(warm) == len(upper) else (None,):
-        flags = np.zeros(len(upper), dtype=np.intc) if sense is None else sense.copy()
+        flags = np.zeros(len(upper), dtype=np.intc) if sense is None else sense
         d, _, flag, info = daqp.solve(B, c, A, upper, lower, flags, primal_tol=_PRIMAL_TOL)
         if flag >= 1:
             lam = np.asarray(info["lam"], dtype=float)
