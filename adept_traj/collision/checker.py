@@ -26,6 +26,7 @@ from adept_traj.collision.broad_phase import BroadPhase
 from adept_traj.collision.cloud_distance import CloudDistance
 from adept_traj.collision.cloud_search import SearchSamples, cloud_obstacles
 from adept_traj.collision.distance_table import DistanceTable
+from adept_traj.collision.exact_distances import exact_distances
 from adept_traj.collision.mesh_distance import distance_functor
 from adept_traj.collision.primitives import distance_request
 from adept_traj.collision.pruning import ObstaclePruning, restrict_checker
@@ -352,22 +353,17 @@ class CollisionChecker:
         obstacle_poses = self.obstacle_poses(t)
         broad = self.broad_phase
         if exact:
-            n = frames.shape[-1]
-            flat_d = np.empty((n, self.n_solids, self.n_obstacles))
-            known = np.ones(flat_d.shape, dtype=bool)
-            every = np.arange(n)
-            for k in range(self.n_solids):
-                poses = broad.solid_poses(frames, every, k)
-                for o in range(self.n_obstacles):
-                    if broad.static[k, o]:
-                        flat_d[:, k, o] = broad.static_distance[k, o]
-                    elif broad.closed_form[k, o]:
-                        flat_d[:, k, o] = broad.closed_form_distance(poses, obstacle_poses[o], k, o)
-            todo = ~(broad.static | broad.closed_form | self.allowed)[None] & known
-        else:
-            bounds = broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
-            flat_d, known = bounds.lower, bounds.exact | self.allowed
-            todo = (flat_d <= self.influence) & ~known
+            flat_d = exact_distances(self, frames, obstacle_poses)
+            shape = (*q.shape[:-1], self.n_solids, self.n_obstacles)
+            n_coal = int((~(broad.static | broad.closed_form | self.allowed)).sum())
+            return PairDistances(
+                distance=flat_d.reshape(shape),
+                exact=np.ones(shape, dtype=bool),
+                n_narrow=n_coal * frames.shape[-1],
+            )
+        bounds = broad.bounds(frames, obstacle_poses, q.reshape(-1, q.shape[-1]))
+        flat_d, known = bounds.lower, bounds.exact | self.allowed
+        todo = (flat_d <= self.influence) & ~known
         flat_d[:, self.allowed] = np.inf
         samples, solids, obstacles = np.nonzero(todo)
         for c in range(0, len(samples), 8192):  # solid poses in batches (1 MB), not per call
