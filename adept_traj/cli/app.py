@@ -43,6 +43,7 @@ from typing import NoReturn
 
 from adept_traj.cli import status
 from adept_traj.errors import AdeptTrajError
+from adept_traj.frozen_imports import frozen_imports
 
 __all__ = ["main", "run"]
 
@@ -130,7 +131,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     standard error), 130 interrupted, and the command's own statuses.
     """
     argv = negative_values_attached(sys.argv[1:] if argv is None else list(argv))
-    parser, runs = _parser(_selected(argv))
+    return _dispatch(argv, *_parser(_selected(argv)))
+
+
+def _dispatch(
+    argv: list[str],
+    parser: argparse.ArgumentParser,
+    runs: dict[str, Callable[[argparse.Namespace], int]],
+) -> int:
+    """Parse ``argv`` and run its command, its errors turned into exit statuses."""
     args = parser.parse_args(argv)
     try:
         return runs[args.command](args)
@@ -143,8 +152,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def run() -> NoReturn:
-    """The ``adept-traj`` program: :func:`main`, then the end of the process with the
-    command's status (``SystemExit``).
+    """The ``adept-traj`` program: what :func:`main` does, then the end of the process
+    with the command's status (``SystemExit``).
 
     The interpreter's normal exit follows: threads still running are waited for, the exit
     handlers run (:mod:`atexit`: e.g. the worker processes are reaped), the standard
@@ -152,8 +161,16 @@ def run() -> NoReturn:
     first stopped and every object frozen (:func:`gc.freeze`), so that the exit does not
     walk every object of numpy, pinocchio and coal once more: the system frees them at
     once.
+
+    The selected command's module and what it imports are imported with the collector
+    off and then frozen (:func:`~adept_traj.frozen_imports.frozen_imports`): they live as
+    long as the process, and no collection of the run scans them. (:func:`main`, which a
+    caller may call in its own process, leaves the collector alone.)
     """
-    code = main()
+    argv = negative_values_attached(sys.argv[1:])
+    with frozen_imports():
+        parser, runs = _parser(_selected(argv))
+    code = _dispatch(argv, parser, runs)
     if not any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
         gc.disable()
         gc.freeze()

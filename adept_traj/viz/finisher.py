@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from adept_traj.errors import InvalidInputError, WorkerDiedError
+from adept_traj.frozen_imports import frozen_imports
 from adept_traj.process_helper import Helper
 from adept_traj.process_pool import LOWEST_PRIORITY, Channel, Worker, can_fork
 from adept_traj.results import PlanningResult, Replay
@@ -240,18 +241,22 @@ def _page(result: PlanningResult, path: Path, replay: Replay) -> Path:
 
 
 def _preload(figures: bool, html: bool) -> None:
-    """Import what the outputs need (matplotlib and the figure modules; meshcat)."""
-    if figures:
-        import mpl_toolkits.mplot3d  # noqa: F401  (the tool path's 3-D axes)
+    """Import what the outputs need (matplotlib and the figure modules; meshcat), in the
+    helper process, with the collector off and then frozen
+    (:func:`~adept_traj.frozen_imports.frozen_imports`: the figures' collections then
+    scan none of it)."""
+    with frozen_imports():
+        if figures:
+            import mpl_toolkits.mplot3d  # noqa: F401  (the tool path's 3-D axes)
 
-        from adept_traj.viz.plots.common import load_matplotlib
+            from adept_traj.viz.plots.common import load_matplotlib
 
-        load_matplotlib()
-    if html:
-        import plotly.offline  # noqa: F401  (the explorer's library)
+            load_matplotlib()
+        if html:
+            import plotly.offline  # noqa: F401  (the explorer's library)
 
-        import adept_traj.viz.explorer
-        import adept_traj.viz.meshcat_scene  # noqa: F401
+            import adept_traj.viz.explorer
+            import adept_traj.viz.meshcat_scene  # noqa: F401
 
 
 def _helper(channel: Channel, robot: Robot, scene: Scene) -> None:

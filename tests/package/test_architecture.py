@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "adept_traj"
 #: Rank of each subpackage in the data flow; a module may import its own subpackage and any
 #: of lower rank. Equal ranks are siblings that must not import each other.
 RANK = {
-    "errors": 0, "data": 0, "urdf": 0, "lazy_names": 0,
+    "errors": 0, "data": 0, "urdf": 0, "lazy_names": 0, "frozen_imports": 0,
     "process_tree": 0.5,  # a process tree's threads and priority, for process_pool
     "validation": 1, "files": 1, "memory": 1, "process_pool": 1,
     "process_helper": 1.5,
