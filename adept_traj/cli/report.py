@@ -229,15 +229,20 @@ def finishers_for(robot: Any, scene: Any, *, figures: bool, html: bool, time_opt
     """The finish's helpers of ``plan`` (:func:`finisher_for`), stopped when the block is
     left: ``(drawer, pager)``. For an evolutionary run, whose imports take the idle time
     of a long search, one helper for the figures and the page (``pager`` ``None``); for
-    the time-optimal mode, whose search is shorter than the imports, one for the figures
-    and one for the page, importing side by side at the caller's priority."""
+    the time-optimal mode, whose search is shorter than the imports, one for the figures,
+    importing at the caller's priority, and one for the page, importing at the lowest (its
+    imports and page take a fraction of the figures' time: they leave the cores to the
+    run and the figures' imports, and are raised when the page is due)."""
     with contextlib.ExitStack() as stack:
         if not time_optimal:
             yield stack.enter_context(finisher_for(robot, scene, figures=figures, html=html)), None
             return
         parts = (robot, scene)
         drawer = stack.enter_context(finisher_for(*parts, figures=figures, html=False, urgent=True))
-        pager = stack.enter_context(finisher_for(*parts, figures=False, html=html, urgent=True))
+        # the page alone (no figures) is the last output: its imports are urgent then
+        pager = stack.enter_context(
+            finisher_for(*parts, figures=False, html=html, urgent=not figures)
+        )
         yield drawer, pager
 
 

@@ -102,8 +102,10 @@ def _plan(monkeypatch, result, out: Path, *options: str, plan=None, **fakes) -> 
 def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The time-optimal search is shorter than the imports: they share the cores with the
-    run from the start (``urgent``) rather than waiting at nice 19 for an idle one."""
+    """The time-optimal search is shorter than the imports: the figures' share the cores
+    with the run from the start (``urgent``) rather than waiting at nice 19 for an idle
+    one; the page's, a fraction of the figures' time, import at nice 19 (raised when the
+    page is due)."""
     marker = tmp_path / "preload"
     monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
     monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
@@ -115,9 +117,25 @@ def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
     assert len(list((tmp_path / "run" / "figures").iterdir())) == 5
     pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
     assert pager not in {helper, os.getpid()}  # the page's imports in a helper of its own
-    assert page_nice == _nice()
+    assert page_nice == finisher.IMPORT_NICENESS != _nice()
     assert (tmp_path / "run" / "playback.html").is_file()
     assert (tmp_path / "run" / "explorer.html").is_file()
+
+
+def test_a_time_optimal_run_without_figures_imports_the_page_at_the_callers_priority(
+    stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With ``--no-plots`` the page is the last output: its helper imports at once."""
+    marker = tmp_path / "preload"
+    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
+    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
+    options = ("--algorithm", "time-optimal", "--no-plots")
+    assert _plan(monkeypatch, stored, tmp_path / "run", *options) == status.NOT_CERTIFIED
+    assert not marker.exists()  # no figures' helper
+    pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
+    assert pager != os.getpid()
+    assert page_nice == _nice() != finisher.IMPORT_NICENESS
+    assert (tmp_path / "run" / "playback.html").is_file()
 
 
 def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_nice_19(
