@@ -124,8 +124,10 @@ def tabulate(
     tf_o = coal.Transform3s(pose_o[:3, :3], pose_o[:3, 3])
     tf_s = coal.Transform3s()
     values = np.empty(count)
-    for i, ps in enumerate(poses):
-        tf_s.setTransform(ps[:3, :3], ps[:3, 3])
+    rotations = np.ascontiguousarray(poses[:, :3, :3])  # sliced once, not per point
+    translations = np.ascontiguousarray(poses[:, :3, 3])
+    for i, (rotation, translation) in enumerate(zip(rotations, translations)):
+        tf_s.setTransform(rotation, translation)
         result.clear()
         values[i] = functor(tf_s, tf_o, request, result)
     if kin.revolute[p - 1]:
