@@ -12,6 +12,7 @@ figures with :func:`figure` beside what it prints. At the end of a run that did 
       "date": "2026-12-01 01:24 UTC",
       "machine": {"cpu": ..., "cores_available": 2, "cores": 2, "python": ..., "os": ...},
       "load_average": {"start": [1, 5, 15 min], "end": [...]},
+      "speed_probe": {"start": {"alone": s, "side_by_side": s}, "end": {...}},
       "figures": [{"id", "name", "value", "digits", "unit", "target", "met", "runs",
                    "note"}, ...],
       "output": "what the script printed"
@@ -33,7 +34,10 @@ import json
 import os
 import platform
 import shlex
+import statistics
+import struct
 import sys
+import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -135,6 +139,45 @@ def steal_share(start: list[int] | None, end: list[int] | None) -> float | None:
     return round(spent[7] / total, 3) if total > 0 else None
 
 
+#: Iterations of the speed probe's pure-Python loop.
+PROBE_LOOP = 1_000_000
+
+
+def _probe_loop() -> float:
+    """Wall time [s] of a fixed pure-Python loop (no allocation, no I/O)."""
+    tic = time.perf_counter()
+    total = 0
+    for i in range(PROBE_LOOP):
+        total += i & 7
+    return time.perf_counter() - tic
+
+
+def speed_probe(repeat: int = 3) -> dict[str, float] | None:
+    """The machine's speed now, to read a run's wall times by: the median over ``repeat``
+    runs of :data:`PROBE_LOOP` iterations of a fixed pure-Python loop, alone
+    (``"alone"`` [s]) and in two processes at once (``"side_by_side"`` [s], the slower of
+    the two). On a shared virtual machine both vary with the hour; their ratio is about 1
+    where the two vCPUs are two cores and up to 2 where they share one core's time.
+    ``None`` without ``fork``."""
+    if not hasattr(os, "fork"):
+        return None
+    alone = statistics.median(_probe_loop() for _ in range(repeat))
+    pairs = []
+    for _ in range(repeat):
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the second process: its loop's time through the pipe
+            os.write(write, struct.pack("d", _probe_loop()))
+            os._exit(0)
+        mine = _probe_loop()
+        other = struct.unpack("d", os.read(read, 8))[0]
+        os.waitpid(pid, 0)
+        os.close(read)
+        os.close(write)
+        pairs.append(max(mine, other))
+    return {"alone": round(alone, 4), "side_by_side": round(statistics.median(pairs), 4)}
+
+
 class _Tee(io.TextIOBase):
     def __init__(self, *streams: Any) -> None:
         self._streams = streams
@@ -176,6 +219,7 @@ def recorded(
         "date": _now(),
         "machine": machine(),
         "load_average": {"start": _load(), "end": None},
+        "speed_probe": {"start": speed_probe(), "end": None},
         "steal": None,
         "figures": [],
         "output": "",
@@ -200,6 +244,7 @@ def recorded(
 
 def _write(record: dict[str, Any], output: str, name: str, argv: list[str]) -> None:
     record["load_average"]["end"] = _load()
+    record["speed_probe"]["end"] = speed_probe()
     record["output"] = output
     quick = "--quick" in argv or os.environ.get("ADEPT_BENCH_NO_RECORD") == "1"
     folder = Path(os.environ.get("ADEPT_BENCH_RESULTS", RESULTS))

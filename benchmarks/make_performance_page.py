@@ -149,6 +149,16 @@ def _load(record: dict[str, Any]) -> str:
     return "; ".join(parts) if parts else "not recorded"
 
 
+def _probe(record: dict[str, Any]) -> str:
+    probe = record.get("speed_probe") or {}
+    parts = []
+    for when in ("start", "end"):
+        if probe.get(when):
+            p = probe[when]
+            parts.append(f"{when} {p['alone']:.3f} s alone, {p['side_by_side']:.3f} s two at once")
+    return "; ".join(parts) if parts else "not recorded"
+
+
 def _steal(record: dict[str, Any]) -> str:
     steal = record.get("steal")
     return "not recorded" if steal is None else f"{100 * steal:.1f} %"
@@ -225,6 +235,7 @@ def render_page(results: dict[str, dict[str, Any]]) -> str:
             f"- machine: {_machine(r['machine'])}",
             f"- load average (1, 5, 15 min): {_load(r)}",
             f"- CPU time taken by the hypervisor (steal) during the run: {_steal(r)}",
+            f"- machine speed (`_results.speed_probe`: a fixed pure-Python loop): {_probe(r)}",
             f"- source: {r['source']}",
             "",
         ]

@@ -69,6 +69,9 @@ def test_page_shows_figures_machine_date_and_source(tmp_path):
     assert "- machine: Test CPU 9000, 2 of 4 cores, Python 3.11.7, Linux 6.0" in text
     assert "- load average (1, 5, 15 min): start 0.5, 0.4, 0.3; end 1, 0.5, 0.3" in text
     assert "- source: transcribed from notebook, date 2026-11-30 12:00 UTC" in text
+    assert (
+        "- machine speed (`_results.speed_probe`: a fixed pure-Python loop): not recorded" in text
+    )
     assert "| the run | 3.50 s | ≤ 5 s | met | 3.40, 3.50, 3.60 |" in text
     assert "| the rate | 12 345/s | ≥ 20 000/s | **not met** | one core |" in text
     assert "| a range | 1.1–1.3× |  |  |  |" in text
@@ -78,6 +81,27 @@ def test_page_shows_figures_machine_date_and_source(tmp_path):
     # Every benchmark script without a results file is listed as such.
     assert "## Not yet recorded" in text
     assert "- `benchmarks/bench_job.py`:" in text
+
+
+def test_page_shows_the_speed_probe(tmp_path):
+    probe = {"start": {"alone": 0.052, "side_by_side": 0.0731}, "end": None}
+    write(tmp_path, sample(speed_probe=probe))
+    text = page.render_page(page.load_results(tmp_path))
+    assert (
+        "- machine speed (`_results.speed_probe`: a fixed pure-Python loop): "
+        "start 0.052 s alone, 0.073 s two at once\n" in text
+    )
+
+
+def test_the_speed_probe_times_one_loop_alone_and_two_at_once(monkeypatch):
+    """Two loops at once each take at least about as long as one alone (never far less:
+    the second process really runs the loop), with the loop's length."""
+    monkeypatch.setattr(_results, "PROBE_LOOP", 200_000)
+    short = _results.speed_probe(repeat=1)
+    monkeypatch.setattr(_results, "PROBE_LOOP", 2_000_000)
+    long = _results.speed_probe(repeat=1)
+    assert long["alone"] > 3 * short["alone"]
+    assert long["side_by_side"] > 0.7 * long["alone"]
 
 
 def test_quoted_figures_are_rewritten_and_unknown_ones_refused(tmp_path):
@@ -153,6 +177,10 @@ def test_recorded_writes_the_figures_and_the_output(tmp_path, monkeypatch, capsy
     assert record["machine"]["cpu"]
     assert len(record["load_average"]["start"]) == 3
     assert len(record["load_average"]["end"]) == 3
+    for when in ("start", "end"):  # the speed probe, before and after
+        probe = record["speed_probe"][when]
+        assert 0 < probe["alone"] < 60, probe
+        assert 0 < probe["side_by_side"] < 60, probe
     assert [f["id"] for f in record["figures"]] == ["run", "n"]
     assert record["figures"][0]["value"] == 3.14
     assert record["figures"][0]["digits"] == 2
