@@ -99,6 +99,17 @@ def _plan(monkeypatch, result, out: Path, *options: str, plan=None, **fakes) -> 
     return main(argv)
 
 
+def _plan_marked(
+    monkeypatch: pytest.MonkeyPatch, stored: PlanningResult, tmp_path: Path, *options: str
+) -> tuple[int, Path]:
+    """``plan`` into ``tmp_path/run`` with the helpers' imports replaced by
+    :func:`_marking_preload` (waited for up to 30 s): its exit status and the marker."""
+    marker = tmp_path / "preload"
+    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
+    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
+    return _plan(monkeypatch, stored, tmp_path / "run", *options), marker
+
+
 def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -106,10 +117,7 @@ def test_a_time_optimal_run_has_its_helper_import_at_the_callers_priority(
     with the run from the start (``urgent``) rather than waiting at nice 19 for an idle
     one; the page's, a fraction of the figures' time, import at nice 19 (raised when the
     page is due)."""
-    marker = tmp_path / "preload"
-    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
-    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
-    code = _plan(monkeypatch, stored, tmp_path / "run", "--algorithm", "time-optimal")
+    code, marker = _plan_marked(monkeypatch, stored, tmp_path, "--algorithm", "time-optimal")
     assert code == status.NOT_CERTIFIED
     helper, import_nice = map(int, marker.read_text().split())
     assert helper != os.getpid()
@@ -126,11 +134,9 @@ def test_a_time_optimal_run_without_figures_imports_the_page_at_the_callers_prio
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """With ``--no-plots`` the page is the last output: its helper imports at once."""
-    marker = tmp_path / "preload"
-    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
-    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
     options = ("--algorithm", "time-optimal", "--no-plots")
-    assert _plan(monkeypatch, stored, tmp_path / "run", *options) == status.NOT_CERTIFIED
+    code, marker = _plan_marked(monkeypatch, stored, tmp_path, *options)
+    assert code == status.NOT_CERTIFIED
     assert not marker.exists()  # no figures' helper
     pager, page_nice = map(int, marker.with_suffix(".page").read_text().split())
     assert pager != os.getpid()
@@ -141,10 +147,8 @@ def test_a_time_optimal_run_without_figures_imports_the_page_at_the_callers_prio
 def test_the_helper_writes_the_files_at_the_callers_priority_after_importing_at_nice_19(
     stored: PlanningResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    marker = tmp_path / "preload"
-    monkeypatch.setattr(finisher, "_preload", _marking_preload(marker))
-    monkeypatch.setattr(finisher, "READY_TIMEOUT", 30.0)
-    assert _plan(monkeypatch, stored, tmp_path / "run") == status.NOT_CERTIFIED
+    code, marker = _plan_marked(monkeypatch, stored, tmp_path)
+    assert code == status.NOT_CERTIFIED
     helper, import_nice = map(int, marker.read_text().split())
     assert helper != os.getpid()
     assert import_nice == finisher.IMPORT_NICENESS
