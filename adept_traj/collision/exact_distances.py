@@ -19,6 +19,7 @@ import coal
 import numpy as np
 
 from adept_traj.collision.primitives import distance_request
+from adept_traj.scene.shapes import coal_transform
 
 if TYPE_CHECKING:  # the checker imports this module
     from adept_traj.collision.checker import CollisionChecker
@@ -57,7 +58,7 @@ def exact_distances(
     out = np.empty((n, checker.n_solids, checker.n_obstacles))
     by_coal = ~(broad.static | broad.closed_form | checker.allowed)
     request, result = distance_request(), coal.DistanceResult()
-    fixed = [_transforms(p[None])[0] if p.ndim == 2 else None for p in obstacle_poses]
+    fixed = [coal_transform(p) if p.ndim == 2 else None for p in obstacle_poses]
     for start in range(0, n, CHUNK):
         rows = np.arange(start, min(start + CHUNK, n))
         moving: dict[int, list[coal.Transform3s]] = {}  # formed once for every solid
