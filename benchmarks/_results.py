@@ -167,14 +167,17 @@ def speed_probe(repeat: int = 3) -> dict[str, float] | None:
         read, write = os.pipe()
         pid = os.fork()
         if pid == 0:  # the second process: its loop's time through the pipe
+            os.close(read)
             os.write(write, struct.pack("d", _probe_loop()))
             os._exit(0)
+        os.close(write)  # a second process that dies unheard gives an end of file, not a hang
         mine = _probe_loop()
-        other = struct.unpack("d", os.read(read, 8))[0]
+        with os.fdopen(read, "rb") as pipe:
+            sent = pipe.read()
         os.waitpid(pid, 0)
-        os.close(read)
-        os.close(write)
-        pairs.append(max(mine, other))
+        if len(sent) != 8:
+            raise RuntimeError("the speed probe's second process ended without its time")
+        pairs.append(max(mine, struct.unpack("d", sent)[0]))
     return {"alone": round(alone, 4), "side_by_side": round(statistics.median(pairs), 4)}
 
 
