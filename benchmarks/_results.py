@@ -178,7 +178,7 @@ def speed_probe(repeat: int = 3) -> dict[str, float] | None:
         if len(sent) != 8:
             raise RuntimeError("the speed probe's second process ended without its time")
         pairs.append(max(mine, struct.unpack("d", sent)[0]))
-    return {"alone": round(alone, 4), "side_by_side": round(statistics.median(pairs), 4)}
+    return {"alone": round(alone, 6), "side_by_side": round(statistics.median(pairs), 6)}
 
 
 class _Tee(io.TextIOBase):
