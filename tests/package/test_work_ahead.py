@@ -38,8 +38,10 @@ def _forks_and_reports(marker: Path) -> list[int]:
     60 s) and returns its niceness."""
 
     def item(k: int) -> int:
-        if k == 1:
-            marker.write_text(str(os.getpid()))
+        if k == 1:  # written whole, then renamed: never read half-written
+            part = marker.with_suffix(".part")
+            part.write_text(str(os.getpid()))
+            part.replace(marker)
         deadline = time.monotonic() + 60.0
         while _where()[1] == LOWEST_PRIORITY and time.monotonic() < deadline:
             time.sleep(0.01)
@@ -79,7 +81,15 @@ def test_an_error_of_the_computation_is_raised_by_result() -> None:
 
 
 def test_without_fork_or_after_a_kill_the_value_is_computed_here(monkeypatch) -> None:
-    ahead = WorkAhead(_where)
+    here = os.getpid()
+
+    def slow_elsewhere() -> tuple[int, int]:
+        # the worker never finishes before its kill (its value sent first would be read)
+        while os.getpid() != here:
+            time.sleep(0.05)
+        return _where()
+
+    ahead = WorkAhead(slow_elsewhere)
     os.kill(ahead.pid, signal.SIGKILL)
     assert ahead.result() == _where()  # died without a word: computed in the caller
     monkeypatch.setattr(work_ahead, "can_fork", lambda: False)
