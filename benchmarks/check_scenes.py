@@ -30,8 +30,11 @@ VECTORS = Path(__file__).parent / "reference" / "reference_vectors.json"
 SCENES = sorted((Path(__file__).parent / "scenes").glob("*.toml"))
 
 
-def coal_min_distance(problem: at.TrajectoryProblem, x: np.ndarray, rate_hz: float):
-    """(smallest distance [m], time [s], pair) of move x by coal called pair by pair."""
+def coal_min_distance(
+    problem: at.TrajectoryProblem, x: np.ndarray, rate_hz: float, start_time: float = 0.0
+):
+    """(smallest distance [m], time [s] from the move's start, pair) of move x by coal
+    called pair by pair; the obstacles at the scene's clock ``start_time + t`` [s]."""
     T = float(x[0])
     t = np.linspace(0.0, T, int(np.ceil(T * rate_hz)) + 1)
     q = problem.trajectory.sample(x, t / T, orders=(0,)).q
@@ -39,7 +42,7 @@ def coal_min_distance(problem: at.TrajectoryProblem, x: np.ndarray, rate_hz: flo
     model, gm = robot.model, robot.collision_model
     data, gdata = model.createData(), gm.createData()
     shapes = [ob.shape.to_coal() for ob in scene.obstacles]
-    poses = scene.obstacle_poses(t, in_base_frame=True)  # (n_obstacles, n, 4, 4)
+    poses = scene.obstacle_poses(start_time + t, in_base_frame=True)  # (n_obstacles, n, 4, 4)
     request, result = coal.DistanceRequest(), coal.DistanceResult()
     request.gjk_tolerance = 1e-9
     best = (np.inf, 0.0, ("", ""))
