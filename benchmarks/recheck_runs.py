@@ -106,19 +106,20 @@ def limit_excess(problem, x: np.ndarray, t: np.ndarray, limits) -> dict[str, flo
     return out
 
 
-def members(result: PlanningResult, n_random: int, rng: np.random.Generator) -> dict[str, int]:
-    """``{label: front index}`` of the members to re-check (empty: none certified)."""
+def members(result: PlanningResult, n_random: int, rng: np.random.Generator) -> dict:
+    """``{label: decision vector}`` of the members to re-check (empty: none certified)."""
     feasible = np.flatnonzero(result.front.feasible)
-    if feasible.size == 0:
-        return {}
     x = result.front.x
-    picked = {"fastest": int(feasible[np.argmin(x[feasible, 0])])}
-    if result.feasible:
-        best = np.flatnonzero(np.all(x == result.best_x, axis=1))
-        if best.size:
-            picked["best trade-off"] = int(best[0])
-    for k in rng.choice(feasible, size=min(n_random, feasible.size), replace=False):
-        picked.setdefault(f"member {int(k)}", int(k))
+    picked: dict[str, np.ndarray] = {}
+    if feasible.size:
+        picked["fastest"] = x[feasible[np.argmin(x[feasible, 0])]]
+    best = np.asarray(result.best_x)
+    if result.feasible and not ("fastest" in picked and np.array_equal(best, picked["fastest"])):
+        picked["best trade-off"] = best  # whether or not it is a row of the front
+    if feasible.size:
+        others = feasible[np.any(x[feasible] != picked["fastest"], axis=1)]
+        for k in rng.choice(others, size=min(n_random, others.size), replace=False):
+            picked[f"member {int(k)}"] = x[k]
     return picked
 
 
@@ -135,20 +136,20 @@ def recheck(folder: Path, rate_hz: float, n_random: int, rng: np.random.Generato
     problem = result.problem()
     ok = True
     try:
-        for label, k in picked.items():
-            x = result.front.x[k]
+        for label, x in picked.items():
             T = float(x[0])
             t = np.linspace(0.0, T, int(np.ceil(T * rate_hz)) + 1)
             d, t_d, pair = coal_min_distance(problem, x, rate_hz, start_time=start)
-            own = self_min_distance(problem, x, t, pairs) if pairs else (np.inf, 0.0, ())
+            own = self_min_distance(problem, x, t, pairs) if pairs else (np.inf, 0.0, None)
             excess = limit_excess(problem, x, t, result.limits)
             good = d >= margin and own[0] >= margin and max(excess.values()) <= 0.0
             ok &= good
             worst_limit = max(excess, key=excess.get)
             print(
                 f"{folder.name:<28} {label:<15} T {T:.4f} s: obstacles {d - margin:+.5f} m "
-                f"over the margin at {t_d:.3f} s {pair}; self {own[0] - margin:+.5f} m "
-                f"{own[2]}; limits: {worst_limit} {excess[worst_limit]:+.3g} "
+                f"over the margin at {t_d:.3f} s {pair}; "
+                + (f"self {own[0] - margin:+.5f} m {own[2]}" if pairs else "self not checked")
+                + f"; limits: {worst_limit} {excess[worst_limit]:+.3g} "
                 f"{'ok' if good else 'FAILED'}",
                 flush=True,
             )
@@ -163,6 +164,12 @@ def main() -> None:
     parser.add_argument("--rate-hz", type=float, default=4000.0)
     parser.add_argument("--random", type=int, default=0, help="more certified members per run")
     args = parser.parse_args()
+    if not args.rate_hz >= 1000.0:
+        parser.error(
+            f"--rate-hz must be at least 1000 (the certificate's rate); got {args.rate_hz}"
+        )
+    if args.random < 0:
+        parser.error(f"--random must be 0 or more; got {args.random}")
     rng = np.random.default_rng(0)
     folders = run_folders(args.folders)
     results = [recheck(f, args.rate_hz, args.random, rng) for f in folders]
